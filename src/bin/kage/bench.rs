@@ -1,0 +1,188 @@
+//! `kage bench`: milliseconds per frame at 1920x1080 on the peers' procedural
+//! scenes (`../shared/peers/common/gen_scene.py`), split into visibility and
+//! shading, beside Mesa llvmpipe running the same scene in the same go when its
+//! peer program is built. Camera, light and Phong rule follow
+//! `../shared/peers/common/peer_common.h`, so the images can be compared.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use glam::{Affine3A, Vec3};
+use kage::scene::load::{self, FileSystem};
+use kage::scene::{file::add_model, Camera, Falloff, Light, LightKind, Material, Projection, Scene};
+use kage::{render, RenderOptions};
+use miette::{miette, IntoDiagnostic, Result};
+
+/// Options of `kage bench`.
+#[derive(clap::Args)]
+pub struct BenchArgs {
+    /// Folder with sphere10k.obj, sphere100k.obj, sphere1m.obj (written there by
+    /// gen_scene.py when missing).
+    #[arg(long, default_value = "target/peer_meshes")]
+    meshes: PathBuf,
+    /// The peers folder (for gen_scene.py and the llvmpipe program).
+    #[arg(long, default_value = "../shared/peers")]
+    peers: PathBuf,
+    /// Timed frames per row (the median is reported).
+    #[arg(long, default_value_t = 10)]
+    frames: usize,
+    /// Only these scenes (comma-separated names).
+    #[arg(long, default_value = "sphere10k,sphere100k,sphere1m")]
+    scenes: String,
+    /// Image width.
+    #[arg(long, default_value_t = 1920)]
+    width: u32,
+    /// Image height.
+    #[arg(long, default_value_t = 1080)]
+    height: u32,
+}
+
+struct Row {
+    name: String,
+    triangles: usize,
+    visibility_ms: f64,
+    shading_ms: f64,
+    total_ms: f64,
+    peer: Option<(f64, Option<f64>)>,
+}
+
+/// Runs the benchmark and prints the table.
+pub fn run(args: &BenchArgs) -> Result<()> {
+    let lp = args.peers.join("llvmpipe/llvmpipe_bench_egl");
+    let mut rows = Vec::new();
+    for name in args.scenes.split(',').map(str::trim) {
+        let mesh = ensure_mesh(args, name)?;
+        let scene = peer_scene(&mesh, args.width, args.height)?;
+        let (row, image) = time_kage(name, &scene, args.frames)?;
+        let peer = lp.exists().then(|| run_llvmpipe(&lp, &mesh, args, &image)).transpose()?;
+        rows.push(Row { peer, ..row });
+        eprintln!("{name}: done");
+    }
+    print_table(&rows, args);
+    Ok(())
+}
+
+fn ensure_mesh(args: &BenchArgs, name: &str) -> Result<PathBuf> {
+    let path = args.meshes.join(format!("{name}.obj"));
+    if !path.exists() {
+        let script = args.peers.join("common/gen_scene.py");
+        let status = Command::new("python3").arg(&script).arg("--all").arg(&args.meshes).status().into_diagnostic()?;
+        if !status.success() || !path.exists() {
+            return Err(miette!("{} is missing and {} could not write it", path.display(), script.display()));
+        }
+    }
+    Ok(path)
+}
+
+/// The peers' scene convention (peer_common.h) around the loaded mesh.
+fn peer_scene(path: &Path, width: u32, height: u32) -> Result<Scene> {
+    let fs = FileSystem { base: path.parent().unwrap_or(Path::new(".")).to_path_buf() };
+    let model = load::model(Path::new(path.file_name().unwrap_or_default()), &fs).map_err(|e| miette!("{e}"))?;
+    let albedo = Vec3::new(0.75, 0.72, 0.65);
+    let material = Material { name: "peer".into(), ka: albedo, kd: 0.9 * albedo, ks: Vec3::splat(0.3), shininess: 32.0, ..Material::default() };
+    let (lo, hi) = model.bounds();
+    let (c, r) = ((lo + hi) * 0.5, (hi - lo).length() * 0.5);
+    let mut scene = Scene {
+        width,
+        height,
+        background: Vec3::new(0.1, 0.1, 0.15),
+        camera: Camera {
+            eye: c + 1.2 * r * Vec3::new(0.0, 0.5, 1.0).normalize(),
+            target: c,
+            up: Vec3::Y,
+            near: 0.1 * r,
+            far: 2.5 * r,
+            projection: Projection::Perspective { fov_y_deg: 45.0 },
+        },
+        lights: vec![Light {
+            kind: LightKind::Point { position: c + r * Vec3::new(1.0, 1.6, -0.6) },
+            color: Vec3::ONE,
+            intensity: 1.0,
+            ambient: 0.1,
+            size: 0.0,
+            falloff: Falloff::None,
+        }],
+        materials: vec![material],
+        objects: Vec::new(),
+        warnings: Vec::new(),
+    };
+    add_model(&mut scene, &model, "peer", Affine3A::IDENTITY, Some(0));
+    Ok(scene)
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+fn time_kage(name: &str, scene: &Scene, frames: usize) -> Result<(Row, kage::resolve::LinearImage)> {
+    let opts = RenderOptions::default();
+    let mut frame = render(scene, &opts).map_err(|e| miette!("{e}"))?; // warm-up
+    let (mut vis, mut shade, mut total) = (Vec::new(), Vec::new(), Vec::new());
+    for _ in 0..frames.max(1) {
+        let t = std::time::Instant::now();
+        frame = render(scene, &opts).map_err(|e| miette!("{e}"))?;
+        total.push(t.elapsed().as_secs_f64() * 1e3);
+        vis.push(frame.stats.visibility_ms);
+        shade.push(frame.stats.shading_ms);
+    }
+    let row = Row {
+        name: name.to_string(),
+        triangles: scene.triangle_count(),
+        visibility_ms: median(vis),
+        shading_ms: median(shade),
+        total_ms: median(total),
+        peer: None,
+    };
+    Ok((row, frame.image))
+}
+
+/// Runs llvmpipe on the same mesh; returns its median ms and the RMSE (0-255
+/// scale) between its image and kage's.
+fn run_llvmpipe(bin: &Path, mesh: &Path, args: &BenchArgs, ours: &kage::resolve::LinearImage) -> Result<(f64, Option<f64>)> {
+    let prefix = std::env::temp_dir().join("kage_bench_llvmpipe");
+    let out = Command::new(bin)
+        .env("LP_NUM_THREADS", "2")
+        .args(["-w", &args.width.to_string(), "-h", &args.height.to_string(), "-f", &args.frames.to_string(), "-m", "phong", "-o"])
+        .arg(&prefix)
+        .arg(mesh)
+        .output()
+        .into_diagnostic()?;
+    let text = String::from_utf8_lossy(&out.stdout);
+    let ms = text
+        .split_whitespace()
+        .find_map(|w| w.strip_prefix("median_ms="))
+        .and_then(|v| v.parse().ok())
+        .ok_or_else(|| miette!("llvmpipe printed no median_ms: {text}{}", String::from_utf8_lossy(&out.stderr)))?;
+    let png = PathBuf::from(format!("{}_phong.png", prefix.display()));
+    Ok((ms, rmse_against(&png, ours)))
+}
+
+fn rmse_against(png: &Path, ours: &kage::resolve::LinearImage) -> Option<f64> {
+    let theirs = image::open(png).ok()?.into_rgb8();
+    if theirs.dimensions() != (ours.width(), ours.height()) {
+        return None;
+    }
+    let sum: f64 = theirs
+        .pixels()
+        .zip(ours.pixels())
+        .flat_map(|(t, o)| (0..3).map(move |k| (t[k] as f64 - (o[k].clamp(0.0, 1.0) as f64 * 255.0).round()).powi(2)))
+        .sum();
+    Some((sum / (3.0 * ours.pixels().len() as f64)).sqrt())
+}
+
+fn print_table(rows: &[Row], args: &BenchArgs) {
+    println!("| scene | triangles | visibility ms | shading ms | kage ms/frame | llvmpipe ms/frame | kage / llvmpipe | RMSE vs llvmpipe (0-255) |");
+    println!("|---|---:|---:|---:|---:|---:|---:|---:|");
+    for r in rows {
+        let (peer, ratio, rmse) = match r.peer {
+            Some((ms, rmse)) => (format!("{ms:.1}"), format!("{:.2}", r.total_ms / ms), rmse.map_or("n/a".into(), |e| format!("{e:.2}"))),
+            None => ("not built".into(), "n/a".into(), "n/a".into()),
+        };
+        println!(
+            "| {} | {} | {:.1} | {:.1} | {:.1} | {peer} | {ratio} | {rmse} |",
+            r.name, r.triangles, r.visibility_ms, r.shading_ms, r.total_ms
+        );
+    }
+    println!("\n{}x{}, median of {} frames, {} threads.", args.width, args.height, args.frames, rayon::current_num_threads());
+}

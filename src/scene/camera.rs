@@ -1,0 +1,225 @@
+//! The eye: a look-at camera with a perspective or orthographic lens.
+//!
+//! Conventions (see `ARCHITECTURE.md`): world space is right-handed with +y up; the
+//! camera looks down its own −z. Clip space follows the reversed-z convention: after
+//! the divide by w, depth is 1 at the near plane and falls towards 0 (perspective: at
+//! infinity; orthographic: at the far plane). Larger depth is nearer.
+
+use glam::{Mat4, Vec2, Vec3, Vec4};
+
+/// How the camera projects.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Projection {
+    /// Pinhole camera with a vertical field of view in degrees.
+    Perspective {
+        /// Vertical field of view, degrees, in (0, 180).
+        fov_y_deg: f32,
+    },
+    /// Parallel projection showing `height` world units from bottom to top.
+    Orthographic {
+        /// World-space height of the view.
+        height: f32,
+    },
+}
+
+/// A look-at camera.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Camera {
+    /// Eye position.
+    pub eye: Vec3,
+    /// Point looked at.
+    pub target: Vec3,
+    /// Approximate up direction.
+    pub up: Vec3,
+    /// Near clipping distance (> 0).
+    pub near: f32,
+    /// Far clipping distance (> near).
+    pub far: f32,
+    /// Lens.
+    pub projection: Projection,
+}
+
+/// A ray with origin and (not necessarily unit) direction.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Ray {
+    /// Origin.
+    pub origin: Vec3,
+    /// Direction.
+    pub dir: Vec3,
+}
+
+impl Camera {
+    /// World → view matrix.
+    #[must_use]
+    pub fn view(&self) -> Mat4 {
+        let f = (self.target - self.eye).normalize();
+        let s = f.cross(self.up).normalize();
+        let u = s.cross(f);
+        Mat4::from_cols(
+            Vec4::new(s.x, u.x, -f.x, 0.0),
+            Vec4::new(s.y, u.y, -f.y, 0.0),
+            Vec4::new(s.z, u.z, -f.z, 0.0),
+            Vec4::new(-s.dot(self.eye), -u.dot(self.eye), f.dot(self.eye), 1.0),
+        )
+    }
+
+    /// View → clip matrix for an image of the given aspect (width / height), reversed z.
+    #[must_use]
+    pub fn projection(&self, aspect: f32) -> Mat4 {
+        match self.projection {
+            Projection::Perspective { fov_y_deg } => {
+                // z_clip = near, w = −z_view: depth = near / distance, 1 at near, → 0 far.
+                let t = (fov_y_deg.to_radians() * 0.5).tan();
+                Mat4::from_cols(
+                    Vec4::new(1.0 / (t * aspect), 0.0, 0.0, 0.0),
+                    Vec4::new(0.0, 1.0 / t, 0.0, 0.0),
+                    Vec4::new(0.0, 0.0, 0.0, -1.0),
+                    Vec4::new(0.0, 0.0, self.near, 0.0),
+                )
+            }
+            Projection::Orthographic { height } => {
+                let (hh, hw) = (height * 0.5, height * 0.5 * aspect);
+                // x, y as usual; z_ndc = (far + z_view) / (far - near): 1 at near, 0 at far.
+                let k = 1.0 / (self.far - self.near);
+                Mat4::from_cols(
+                    Vec4::new(1.0 / hw, 0.0, 0.0, 0.0),
+                    Vec4::new(0.0, 1.0 / hh, 0.0, 0.0),
+                    Vec4::new(0.0, 0.0, k, 0.0),
+                    Vec4::new(0.0, 0.0, self.far * k, 1.0),
+                )
+            }
+        }
+    }
+
+    /// The far plane as a clip-space half-space `z − f·w ≥ 0`: returns f.
+    #[must_use]
+    pub fn far_plane_factor(&self) -> f32 {
+        match self.projection {
+            Projection::Perspective { .. } => self.near / self.far,
+            Projection::Orthographic { .. } => 0.0,
+        }
+    }
+
+    /// World → clip matrix.
+    #[must_use]
+    pub fn view_projection(&self, aspect: f32) -> Mat4 {
+        self.projection(aspect) * self.view()
+    }
+
+    /// The ray through image point `pixel` (pixel units, row 0 at the top, pixel
+    /// centres at +0.5) of a `size` image. Its direction has unit length.
+    #[must_use]
+    pub fn ray(&self, pixel: Vec2, size: Vec2) -> Ray {
+        self.pixel_rays(size).ray(pixel)
+    }
+
+    /// A generator of pixel rays for a `size` image, with the per-image work done once.
+    #[must_use]
+    pub fn pixel_rays(&self, size: Vec2) -> PixelRays {
+        let inv_view = self.view().inverse();
+        let aspect = size.x / size.y;
+        let (scale, ortho) = match self.projection {
+            Projection::Perspective { fov_y_deg } => {
+                let t = (fov_y_deg.to_radians() * 0.5).tan();
+                (Vec2::new(t * aspect, t), false)
+            }
+            Projection::Orthographic { height } => (Vec2::new(height * 0.5 * aspect, height * 0.5), true),
+        };
+        PixelRays {
+            origin: self.eye,
+            right: inv_view.transform_vector3(Vec3::X) * scale.x,
+            up: inv_view.transform_vector3(Vec3::Y) * scale.y,
+            forward: inv_view.transform_vector3(Vec3::NEG_Z),
+            size,
+            ortho,
+        }
+    }
+
+    /// Checks the camera can form an image; returns what is wrong otherwise.
+    pub fn validate(&self) -> Result<(), String> {
+        let finite = self.eye.is_finite() && self.target.is_finite() && self.up.is_finite();
+        if !finite {
+            return Err("camera eye, target and up must be finite".into());
+        }
+        let fwd = self.target - self.eye;
+        if fwd.length_squared() <= f32::EPSILON {
+            return Err("camera eye and target coincide".into());
+        }
+        if fwd.normalize().cross(self.up).length_squared() <= 1e-10 {
+            return Err("camera up is parallel to the view direction".into());
+        }
+        if !(self.near > 0.0 && self.far > self.near && self.far.is_finite()) {
+            return Err(format!("need 0 < near < far, got near {} far {}", self.near, self.far));
+        }
+        match self.projection {
+            Projection::Perspective { fov_y_deg } if !(fov_y_deg > 0.0 && fov_y_deg < 180.0) => {
+                Err(format!("fov must be in (0, 180) degrees, got {fov_y_deg}"))
+            }
+            Projection::Orthographic { height } if !(height > 0.0 && height.is_finite()) => {
+                Err(format!("orthographic height must be > 0, got {height}"))
+            }
+            _ => Ok(()),
+        }
+    }
+}
+
+/// Rays through the pixels of one image (see [`Camera::pixel_rays`]).
+#[derive(Debug, Clone, Copy)]
+pub struct PixelRays {
+    origin: Vec3,
+    right: Vec3,
+    up: Vec3,
+    forward: Vec3,
+    size: Vec2,
+    ortho: bool,
+}
+
+impl PixelRays {
+    /// The ray through image point `pixel`; unit direction.
+    #[must_use]
+    pub fn ray(&self, pixel: Vec2) -> Ray {
+        let ndc = Vec2::new(2.0 * pixel.x / self.size.x - 1.0, 1.0 - 2.0 * pixel.y / self.size.y);
+        let offset = self.right * ndc.x + self.up * ndc.y;
+        if self.ortho {
+            Ray { origin: self.origin + offset, dir: self.forward.normalize() }
+        } else {
+            Ray { origin: self.origin, dir: (self.forward + offset).normalize() }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn cam(projection: Projection) -> Camera {
+        Camera {
+            eye: Vec3::new(1.0, 2.0, 5.0),
+            target: Vec3::new(0.0, 0.5, 0.0),
+            up: Vec3::Y,
+            near: 0.1,
+            far: 50.0,
+            projection,
+        }
+    }
+
+    /// A point on the ray through a pixel projects back onto that pixel, and its
+    /// reversed-z depth lies in (0, 1].
+    #[test]
+    fn ray_and_projection_agree() {
+        let size = Vec2::new(64.0, 48.0);
+        for p in [Projection::Perspective { fov_y_deg: 50.0 }, Projection::Orthographic { height: 4.0 }] {
+            let c = cam(p);
+            let m = c.view_projection(size.x / size.y);
+            for pix in [Vec2::new(0.5, 0.5), Vec2::new(31.0, 20.25), Vec2::new(63.5, 47.5)] {
+                let r = c.ray(pix, size);
+                let w = r.origin + r.dir * 3.0;
+                let clip = m * w.extend(1.0);
+                let ndc = clip.truncate() / clip.w;
+                let back = Vec2::new((ndc.x + 1.0) * 0.5 * size.x, (1.0 - ndc.y) * 0.5 * size.y);
+                assert!((back - pix).length() < 1e-3, "{p:?} {pix} -> {back}");
+                assert!(ndc.z > 0.0 && ndc.z <= 1.0, "depth {}", ndc.z);
+            }
+        }
+    }
+}

@@ -1,0 +1,469 @@
+//! The TOML scene format (documented key by key in `docs/scene-format.md`).
+//!
+//! Parsing happens in two steps, as in pbrt-v4: the text becomes plain records that
+//! remember where each value came from ([`SceneFile`]), then [`SceneFile::build`]
+//! loads meshes and textures and produces a [`Scene`]. Both steps report errors at
+//! the file, line and column of the value at fault.
+
+use std::collections::HashMap;
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use glam::{Affine3A, EulerRot, Quat, Vec3};
+use serde::Deserialize;
+use toml::Spanned;
+
+use super::load::{self, AssetSource, LoadedModel};
+use super::mesh::shapes;
+use super::{framing, Camera, Falloff, Light, LightKind, Material, Object, Projection, Scene, Texture};
+use crate::error::{Error, Result, SourceLocation};
+
+type V3 = [f32; 3];
+
+/// A parsed scene file: plain records with source spans.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneFile {
+    #[serde(default)]
+    image: ImageRec,
+    camera: Option<Spanned<CameraRec>>,
+    #[serde(default, rename = "light")]
+    lights: Vec<Spanned<LightRec>>,
+    #[serde(default, rename = "material")]
+    materials: Vec<Spanned<MaterialRec>>,
+    #[serde(default, rename = "object")]
+    objects: Vec<Spanned<ObjectRec>>,
+    #[serde(skip)]
+    origin: Option<Origin>,
+}
+
+#[derive(Debug, Clone)]
+struct Origin {
+    path: PathBuf,
+    text: Arc<str>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ImageRec {
+    #[serde(default = "default_width")]
+    width: Spanned<i64>,
+    #[serde(default = "default_height")]
+    height: Spanned<i64>,
+    #[serde(default = "default_background")]
+    background: V3,
+}
+
+fn default_width() -> Spanned<i64> {
+    Spanned::new(0..0, 960)
+}
+fn default_height() -> Spanned<i64> {
+    Spanned::new(0..0, 540)
+}
+fn default_background() -> V3 {
+    [0.1, 0.1, 0.15]
+}
+
+impl Default for ImageRec {
+    fn default() -> Self {
+        ImageRec { width: default_width(), height: default_height(), background: default_background() }
+    }
+}
+
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default)]
+#[serde(rename_all = "kebab-case")]
+enum ProjectionRec {
+    #[default]
+    Perspective,
+    Orthographic,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CameraRec {
+    eye: V3,
+    target: V3,
+    #[serde(default = "up")]
+    up: V3,
+    #[serde(default = "fov")]
+    fov: f32,
+    #[serde(default = "near")]
+    near: f32,
+    #[serde(default = "far")]
+    far: f32,
+    #[serde(default)]
+    projection: ProjectionRec,
+    height: Option<f32>,
+}
+
+fn up() -> V3 {
+    [0.0, 1.0, 0.0]
+}
+fn fov() -> f32 {
+    45.0
+}
+fn near() -> f32 {
+    0.1
+}
+fn far() -> f32 {
+    1000.0
+}
+fn one() -> f32 {
+    1.0
+}
+fn white() -> V3 {
+    [1.0; 3]
+}
+
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+enum LightType {
+    Point,
+    Spot,
+    Directional,
+}
+
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default)]
+#[serde(rename_all = "kebab-case")]
+enum FalloffRec {
+    #[default]
+    None,
+    InverseSquare,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct LightRec {
+    #[serde(rename = "type")]
+    kind: LightType,
+    position: Option<V3>,
+    direction: Option<V3>,
+    target: Option<V3>,
+    #[serde(default = "white")]
+    color: V3,
+    #[serde(default = "one")]
+    intensity: f32,
+    #[serde(default)]
+    ambient: f32,
+    #[serde(default)]
+    size: f32,
+    #[serde(default = "inner")]
+    inner_angle: f32,
+    #[serde(default = "outer")]
+    outer_angle: f32,
+    #[serde(default)]
+    falloff: FalloffRec,
+}
+
+fn inner() -> f32 {
+    25.0
+}
+fn outer() -> f32 {
+    30.0
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MaterialRec {
+    name: Spanned<String>,
+    ka: Option<V3>,
+    #[serde(default = "grey")]
+    kd: V3,
+    #[serde(default = "ks")]
+    ks: V3,
+    #[serde(default = "shininess")]
+    shininess: f32,
+    #[serde(default)]
+    ke: V3,
+    ka_map: Option<Spanned<String>>,
+    kd_map: Option<Spanned<String>>,
+    ks_map: Option<Spanned<String>>,
+    ke_map: Option<Spanned<String>>,
+    #[serde(default)]
+    two_sided: bool,
+}
+
+fn grey() -> V3 {
+    [0.8; 3]
+}
+fn ks() -> V3 {
+    [0.2; 3]
+}
+fn shininess() -> f32 {
+    32.0
+}
+
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+enum ShapeRec {
+    Plane,
+    Cube,
+    Sphere,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(untagged)]
+enum ScaleRec {
+    Uniform(f32),
+    Axes(V3),
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ObjectRec {
+    name: Option<String>,
+    mesh: Option<Spanned<String>>,
+    shape: Option<ShapeRec>,
+    material: Option<Spanned<String>>,
+    #[serde(default)]
+    translate: V3,
+    #[serde(default)]
+    rotate: V3,
+    scale: Option<ScaleRec>,
+    fit: Option<Spanned<f32>>,
+}
+
+impl SceneFile {
+    /// Parses scene text. `path` is used for messages and to resolve relative files.
+    pub fn parse(text: &str, path: &Path) -> Result<SceneFile> {
+        let shared: Arc<str> = Arc::from(text);
+        let mut file: SceneFile = toml::from_str(text).map_err(|e| Error::SceneSyntax {
+            location: Box::new(SourceLocation::new(path, shared.clone(), e.span().unwrap_or(0..0))),
+            message: e.message().trim().to_string(),
+        })?;
+        file.origin = Some(Origin { path: path.to_path_buf(), text: shared });
+        Ok(file)
+    }
+
+    fn invalid(&self, span: Range<usize>, message: impl Into<String>) -> Error {
+        let origin = self.origin.clone().unwrap_or(Origin { path: "<scene>".into(), text: Arc::from("") });
+        Error::SceneInvalid {
+            location: Box::new(SourceLocation::new(origin.path, origin.text, span)),
+            message: message.into(),
+        }
+    }
+
+    /// Loads every mesh and texture and builds the scene.
+    pub fn build(&self, assets: &dyn AssetSource) -> Result<Scene> {
+        let (w, h) = (&self.image.width, &self.image.height);
+        for side in [w, h] {
+            if *side.get_ref() < 1 || *side.get_ref() > super::MAX_IMAGE_SIDE as i64 {
+                return Err(self.invalid(side.span(), "image sides must be between 1 and 16384 pixels"));
+            }
+        }
+        let mut materials = Vec::new();
+        let mut by_name = HashMap::new();
+        for m in &self.materials {
+            let mat = self.material(m.get_ref(), assets)?;
+            if by_name.insert(mat.name.clone(), materials.len()).is_some() {
+                return Err(self.invalid(m.get_ref().name.span(), format!("material '{}' is defined twice", mat.name)));
+            }
+            materials.push(mat);
+        }
+        let mut scene = Scene {
+            width: *w.get_ref() as u32,
+            height: *h.get_ref() as u32,
+            background: Vec3::from(self.image.background),
+            camera: framing((Vec3::ZERO, Vec3::ONE), 1.0).0,
+            lights: self.lights.iter().map(|l| self.light(l)).collect::<Result<_>>()?,
+            materials,
+            objects: Vec::new(),
+            warnings: Vec::new(),
+        };
+        let mut models = Vec::new();
+        for o in &self.objects {
+            models.push(self.object(o, &by_name, assets, &mut scene)?);
+        }
+        if scene.objects.is_empty() {
+            return Err(self.invalid(0..0, "the scene has no [[object]]: there is nothing to draw"));
+        }
+        self.place_camera_and_lights(&mut scene, &models)?;
+        scene.validate()?;
+        Ok(scene)
+    }
+
+    fn place_camera_and_lights(&self, scene: &mut Scene, models: &[LoadedModel]) -> Result<()> {
+        let aspect = scene.width as f32 / scene.height as f32;
+        let bounds = scene.bounds().expect("objects exist");
+        let (auto_cam, auto_lights) = framing(bounds, aspect);
+        let model_cam = models.iter().find_map(|m| m.camera);
+        scene.camera = match &self.camera {
+            Some(c) => self.camera(c)?,
+            None => model_cam.unwrap_or(auto_cam),
+        };
+        if self.lights.is_empty() {
+            let model_lights: Vec<Light> = models.iter().flat_map(|m| m.lights.iter().cloned()).collect();
+            scene.lights = if model_lights.is_empty() { auto_lights } else { model_lights };
+        }
+        Ok(())
+    }
+
+    fn camera(&self, c: &Spanned<CameraRec>) -> Result<Camera> {
+        let r = c.get_ref();
+        let projection = match r.projection {
+            ProjectionRec::Perspective => Projection::Perspective { fov_y_deg: r.fov },
+            ProjectionRec::Orthographic => {
+                let height = r.height.ok_or_else(|| self.invalid(c.span(), "an orthographic camera needs `height` (world units shown top to bottom)"))?;
+                Projection::Orthographic { height }
+            }
+        };
+        let cam = Camera {
+            eye: r.eye.into(),
+            target: r.target.into(),
+            up: r.up.into(),
+            near: r.near,
+            far: r.far,
+            projection,
+        };
+        cam.validate().map_err(|m| self.invalid(c.span(), m))?;
+        Ok(cam)
+    }
+
+    fn light(&self, l: &Spanned<LightRec>) -> Result<Light> {
+        let r = l.get_ref();
+        let need = |v: Option<V3>, key: &str| v.map(Vec3::from).ok_or_else(|| self.invalid(l.span(), format!("a {:?} light needs `{key}`", r.kind).to_lowercase()));
+        let aim = |from: Option<V3>| -> Result<Vec3> {
+            let d = match (r.direction, r.target, from) {
+                (Some(d), _, _) => Vec3::from(d),
+                (None, Some(t), Some(p)) => Vec3::from(t) - Vec3::from(p),
+                _ => return Err(self.invalid(l.span(), "this light needs `direction` (or `position` and `target`)")),
+            };
+            d.try_normalize().ok_or_else(|| self.invalid(l.span(), "the light direction has zero length"))
+        };
+        let kind = match r.kind {
+            LightType::Point => LightKind::Point { position: need(r.position, "position")? },
+            LightType::Directional => LightKind::Directional { direction: aim(r.position)? },
+            LightType::Spot => LightKind::Spot {
+                position: need(r.position, "position")?,
+                direction: aim(r.position)?,
+                inner: r.inner_angle.to_radians(),
+                outer: r.outer_angle.to_radians(),
+            },
+        };
+        let values = [r.intensity, r.ambient, r.size, r.color[0], r.color[1], r.color[2]];
+        if values.iter().any(|v| !v.is_finite() || *v < 0.0) {
+            return Err(self.invalid(l.span(), "light colour, intensity, ambient and size must be finite and ≥ 0"));
+        }
+        let falloff = match r.falloff {
+            FalloffRec::None => Falloff::None,
+            FalloffRec::InverseSquare => Falloff::InverseSquare,
+        };
+        Ok(Light { kind, color: r.color.into(), intensity: r.intensity, ambient: r.ambient, size: r.size, falloff })
+    }
+
+    fn material(&self, r: &MaterialRec, assets: &dyn AssetSource) -> Result<Material> {
+        let texture = |p: &Option<Spanned<String>>, srgb: bool| -> Result<Option<Arc<Texture>>> {
+            p.as_ref().map(|p| load::texture(Path::new(p.get_ref()), srgb, assets)).transpose()
+        };
+        Ok(Material {
+            name: r.name.get_ref().clone(),
+            ka: r.ka.unwrap_or(r.kd).into(),
+            kd: r.kd.into(),
+            ks: r.ks.into(),
+            shininess: r.shininess,
+            ke: r.ke.into(),
+            maps: super::ComponentMaps {
+                ambient: texture(&r.ka_map, true)?,
+                diffuse: texture(&r.kd_map, true)?,
+                specular: texture(&r.ks_map, true)?,
+                emission: texture(&r.ke_map, true)?,
+            },
+            two_sided: r.two_sided,
+        })
+    }
+
+    fn object(
+        &self,
+        o: &Spanned<ObjectRec>,
+        by_name: &HashMap<String, usize>,
+        assets: &dyn AssetSource,
+        scene: &mut Scene,
+    ) -> Result<LoadedModel> {
+        let r = o.get_ref();
+        let model = match (&r.mesh, r.shape) {
+            (Some(path), None) => load::model(Path::new(path.get_ref()), assets)?,
+            (None, Some(shape)) => LoadedModel::single(match shape {
+                ShapeRec::Plane => shapes::plane(),
+                ShapeRec::Cube => shapes::cube(),
+                ShapeRec::Sphere => shapes::sphere(48),
+            }),
+            _ => return Err(self.invalid(o.span(), "an object needs exactly one of `mesh` (a file) or `shape`")),
+        };
+        let material = match &r.material {
+            Some(name) => Some(*by_name.get(name.get_ref()).ok_or_else(|| {
+                let known: Vec<&str> = self.materials.iter().map(|m| m.get_ref().name.get_ref().as_str()).collect();
+                self.invalid(name.span(), format!("no material named '{}' (defined: {})", name.get_ref(), known.join(", ")))
+            })?),
+            None => None,
+        };
+        let transform = self.transform(r, &model)?;
+        let label = r.name.clone().or_else(|| r.mesh.as_ref().map(|m| m.get_ref().clone())).unwrap_or_else(|| format!("{:?}", r.shape).to_lowercase());
+        add_model(scene, &model, &label, transform, material);
+        Ok(model)
+    }
+
+    fn transform(&self, r: &ObjectRec, model: &LoadedModel) -> Result<Affine3A> {
+        let scale = match r.scale {
+            None => Vec3::ONE,
+            Some(ScaleRec::Uniform(s)) => Vec3::splat(s),
+            Some(ScaleRec::Axes(a)) => a.into(),
+        };
+        let [rx, ry, rz] = r.rotate.map(f32::to_radians);
+        let placed = Affine3A::from_scale_rotation_translation(scale, Quat::from_euler(EulerRot::ZYX, rz, ry, rx), r.translate.into());
+        let Some(fit) = &r.fit else { return Ok(placed) };
+        let (lo, hi) = model.bounds();
+        let extent = (hi - lo).max_element();
+        if !(*fit.get_ref() > 0.0) || extent <= 0.0 {
+            return Err(self.invalid(fit.span(), "`fit` must be > 0 and the mesh must have a non-zero extent"));
+        }
+        let s = fit.get_ref() / extent;
+        let base = Vec3::new((lo.x + hi.x) * 0.5, lo.y, (lo.z + hi.z) * 0.5);
+        Ok(placed * Affine3A::from_scale(Vec3::splat(s)) * Affine3A::from_translation(-base))
+    }
+}
+
+/// Adds every part of a loaded model to the scene as objects, with `material`
+/// overriding the model's own materials when given.
+pub fn add_model(scene: &mut Scene, model: &LoadedModel, label: &str, transform: Affine3A, material: Option<usize>) {
+    scene.warnings.extend(model.warnings.iter().cloned());
+    for part in &model.parts {
+        let material = material.unwrap_or_else(|| {
+            scene.materials.push(part.material.clone().unwrap_or_default());
+            scene.materials.len() - 1
+        });
+        let name = if model.parts.len() > 1 { format!("{label}/{}", part.name) } else { label.to_string() };
+        scene.objects.push(Object { name, mesh: part.mesh.clone(), transform: transform * part.transform, material });
+    }
+}
+
+/// Reads and builds a scene file from disk.
+pub fn load_scene(path: &Path) -> Result<Scene> {
+    let text = std::fs::read_to_string(path).map_err(|source| Error::Read { path: path.to_path_buf(), source })?;
+    let base = path.parent().unwrap_or(Path::new(".")).to_path_buf();
+    SceneFile::parse(&text, path)?.build(&load::FileSystem { base })
+}
+
+/// A scene showing one model file, framed automatically.
+pub fn scene_for_model(path: &Path, width: u32, height: u32) -> Result<Scene> {
+    let base = path.parent().unwrap_or(Path::new(".")).to_path_buf();
+    let fs = load::FileSystem { base };
+    let name = Path::new(path.file_name().unwrap_or(path.as_os_str()));
+    let model = load::model(name, &fs)?;
+    let mut scene = Scene {
+        width,
+        height,
+        background: default_background().into(),
+        camera: framing((Vec3::ZERO, Vec3::ONE), 1.0).0,
+        lights: Vec::new(),
+        materials: Vec::new(),
+        objects: Vec::new(),
+        warnings: Vec::new(),
+    };
+    add_model(&mut scene, &model, &path.display().to_string(), Affine3A::IDENTITY, None);
+    let (camera, lights) = framing(scene.bounds().expect("a model has parts"), width as f32 / height as f32);
+    scene.camera = model.camera.unwrap_or(camera);
+    scene.lights = if model.lights.is_empty() { lights } else { model.lights.clone() };
+    scene.validate()?;
+    Ok(scene)
+}

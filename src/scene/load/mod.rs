@@ -1,0 +1,158 @@
+//! Mesh and texture files: Wavefront OBJ + MTL, STL (binary and ASCII), glTF 2.0.
+//!
+//! Each loader turns a file into a [`LoadedModel`]: parts (a mesh with an optional
+//! material of its own and a placement), and for glTF the file's camera and lights.
+//! Files are read through an [`AssetSource`], so the built-in demo scene can be
+//! served from bytes compiled into the binary.
+
+mod gltf;
+mod obj;
+mod stl;
+
+use std::io;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use glam::{Affine3A, Vec3};
+
+use super::mesh::{Mesh, MeshRepairs};
+use super::{Camera, Light, Material, Texture};
+use crate::error::{Error, Result};
+
+/// Where scene files find the files they name.
+pub trait AssetSource: Sync {
+    /// Reads a file named relative to the scene.
+    fn read(&self, path: &Path) -> io::Result<Vec<u8>>;
+    /// The path a user should see for `path` in messages.
+    fn display_path(&self, path: &Path) -> PathBuf;
+    /// The folder on disk relative paths start from, if files live on disk.
+    fn base_dir(&self) -> Option<&Path> {
+        None
+    }
+}
+
+/// Files on disk, relative to a base folder (the scene file's).
+#[derive(Debug, Clone)]
+pub struct FileSystem {
+    /// Folder relative paths start from.
+    pub base: PathBuf,
+}
+
+impl AssetSource for FileSystem {
+    fn read(&self, path: &Path) -> io::Result<Vec<u8>> {
+        std::fs::read(self.base.join(path))
+    }
+    fn display_path(&self, path: &Path) -> PathBuf {
+        self.base.join(path)
+    }
+    fn base_dir(&self) -> Option<&Path> {
+        Some(&self.base)
+    }
+}
+
+/// Files compiled into the binary, looked up by file name.
+#[derive(Debug, Clone, Copy)]
+pub struct Embedded(pub &'static [(&'static str, &'static [u8])]);
+
+impl AssetSource for Embedded {
+    fn read(&self, path: &Path) -> io::Result<Vec<u8>> {
+        let name = path.file_name().and_then(|n| n.to_str()).unwrap_or_default();
+        self.0.iter().find(|(n, _)| *n == name).map(|(_, b)| b.to_vec()).ok_or_else(|| {
+            io::Error::new(io::ErrorKind::NotFound, format!("'{name}' is not one of the built-in files"))
+        })
+    }
+    fn display_path(&self, path: &Path) -> PathBuf {
+        Path::new("<builtin>").join(path)
+    }
+}
+
+/// One mesh of a model, with its own material if the file gave one.
+#[derive(Debug, Clone)]
+pub struct Part {
+    /// Name from the file (object, group or glTF mesh name).
+    pub name: String,
+    /// Geometry.
+    pub mesh: Arc<Mesh>,
+    /// Material from the file, if any.
+    pub material: Option<Material>,
+    /// Placement inside the model (glTF node transforms).
+    pub transform: Affine3A,
+}
+
+/// Everything a model file contributes to a scene.
+#[derive(Debug, Clone, Default)]
+pub struct LoadedModel {
+    /// Meshes.
+    pub parts: Vec<Part>,
+    /// The file's first camera (glTF), already placed in the model's space.
+    pub camera: Option<Camera>,
+    /// The file's lights (glTF `KHR_lights_punctual`).
+    pub lights: Vec<Light>,
+    /// What the loader repaired or ignored.
+    pub warnings: Vec<String>,
+}
+
+impl LoadedModel {
+    /// A model of one mesh without a material.
+    #[must_use]
+    pub fn single(mesh: Mesh) -> LoadedModel {
+        let part = Part { name: "mesh".into(), mesh: Arc::new(mesh), material: None, transform: Affine3A::IDENTITY };
+        LoadedModel { parts: vec![part], ..Default::default() }
+    }
+
+    /// Bounds of all parts in model space.
+    #[must_use]
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        self.parts.iter().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), p| {
+            let (a, b) = p.mesh.bounds();
+            let (a, b) = (p.transform.transform_point3(a), p.transform.transform_point3(b));
+            (lo.min(a.min(b)), hi.max(a.max(b)))
+        })
+    }
+
+    fn note_repairs(&mut self, path: &Path, repairs: MeshRepairs) {
+        if repairs.degenerate_triangles > 0 {
+            self.warnings.push(format!(
+                "{}: dropped {} zero-area triangle(s)",
+                path.display(),
+                repairs.degenerate_triangles
+            ));
+        }
+    }
+}
+
+/// Loads a model file, choosing the loader by extension.
+pub fn model(path: &Path, assets: &dyn AssetSource) -> Result<LoadedModel> {
+    let shown = assets.display_path(path);
+    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or_default().to_ascii_lowercase();
+    let bytes = read(path, assets)?;
+    let fail = |message: String| Error::MeshLoad { path: shown.clone(), message };
+    let model = match ext.as_str() {
+        "obj" => obj::load(&bytes, path, assets).map_err(fail)?,
+        "stl" => stl::load(&bytes).map_err(fail)?,
+        "gltf" | "glb" => gltf::load(&bytes, path, assets).map_err(fail)?,
+        _ => return Err(fail(format!("unknown mesh format '.{ext}' (kage reads .obj, .stl, .gltf and .glb)"))),
+    };
+    Ok(model)
+}
+
+/// Reads a file through `assets`, naming it in the error.
+pub fn read(path: &Path, assets: &dyn AssetSource) -> Result<Vec<u8>> {
+    assets.read(path).map_err(|source| Error::Read { path: assets.display_path(path), source })
+}
+
+/// Loads a colour (`srgb`) or data texture.
+pub fn texture(path: &Path, srgb: bool, assets: &dyn AssetSource) -> Result<Arc<Texture>> {
+    let bytes = read(path, assets)?;
+    Texture::decode(&bytes, srgb)
+        .map(Arc::new)
+        .map_err(|message| Error::TextureLoad { path: assets.display_path(path), message })
+}
+
+/// Builds a checked mesh, turning problems into a message for the loader's error and
+/// recording repairs in `model`.
+fn checked(model: &mut LoadedModel, path: &Path, built: Result<(Mesh, MeshRepairs), String>, what: &str) -> Result<Mesh, String> {
+    let (mesh, repairs) = built.map_err(|e| format!("{what}: {e}"))?;
+    model.note_repairs(path, repairs);
+    Ok(mesh)
+}

@@ -1,0 +1,92 @@
+//! STL, binary and ASCII: the format CAD and 3D-printing tools export.
+//!
+//! STL stores independent facets with no shared vertices, so every part is
+//! flat-shaded from its facet geometry (stored facet normals are often wrong and are
+//! ignored).
+
+use glam::Vec3;
+
+use super::{checked, LoadedModel};
+use crate::scene::mesh::{Mesh, NormalMode};
+
+/// Parses STL bytes (binary when the size matches the triangle count, else ASCII).
+pub fn load(bytes: &[u8]) -> Result<LoadedModel, String> {
+    let positions = if is_binary(bytes) { binary(bytes)? } else { ascii(bytes)? };
+    let triangles = (0..positions.len() as u32 / 3).map(|t| [3 * t, 3 * t + 1, 3 * t + 2]).collect();
+    let mut model = LoadedModel::default();
+    let built = Mesh::new(positions, Vec::new(), Vec::new(), triangles, NormalMode::Flat);
+    let mesh = checked(&mut model, std::path::Path::new("stl"), built, "STL")?;
+    Ok(LoadedModel { warnings: model.warnings, ..LoadedModel::single(mesh) })
+}
+
+fn is_binary(bytes: &[u8]) -> bool {
+    if bytes.len() < 84 {
+        return false;
+    }
+    let n = u32::from_le_bytes([bytes[80], bytes[81], bytes[82], bytes[83]]) as u64;
+    84 + 50 * n == bytes.len() as u64 || !bytes.starts_with(b"solid")
+}
+
+fn binary(bytes: &[u8]) -> Result<Vec<Vec3>, String> {
+    if bytes.len() < 84 {
+        return Err("file too short for a binary STL header".into());
+    }
+    let n = u32::from_le_bytes([bytes[80], bytes[81], bytes[82], bytes[83]]) as usize;
+    let body = &bytes[84..];
+    if body.len() < n.saturating_mul(50) {
+        return Err(format!("header promises {n} triangles but the file holds {}", body.len() / 50));
+    }
+    let f = |o: usize| f32::from_le_bytes([body[o], body[o + 1], body[o + 2], body[o + 3]]);
+    Ok((0..n)
+        .flat_map(|t| (0..3).map(move |v| 50 * t + 12 + 12 * v))
+        .map(|o| Vec3::new(f(o), f(o + 4), f(o + 8)))
+        .collect())
+}
+
+fn ascii(bytes: &[u8]) -> Result<Vec<Vec3>, String> {
+    let text = std::str::from_utf8(bytes).map_err(|_| "not a binary STL and not UTF-8 text".to_string())?;
+    let mut out = Vec::new();
+    for (n, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        if words.next() != Some("vertex") {
+            continue;
+        }
+        let xyz: Vec<f32> = words.map(str::parse).collect::<Result<_, _>>().map_err(|e| format!("line {}: {e}", n + 1))?;
+        let [x, y, z] = xyz[..] else { return Err(format!("line {}: a vertex needs 3 numbers", n + 1)) };
+        out.push(Vec3::new(x, y, z));
+    }
+    if out.len() % 3 != 0 {
+        return Err(format!("{} vertices is not a whole number of facets", out.len()));
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const ASCII: &str = "solid t\n facet normal 0 0 1\n  outer loop\n   vertex 0 0 0\n   vertex 1 0 0\n   vertex 0 1 0\n  endloop\n endfacet\nendsolid t\n";
+
+    #[test]
+    fn ascii_and_binary_agree() {
+        let a = load(ASCII.as_bytes()).unwrap();
+        let mut bin = vec![0u8; 80];
+        bin.extend(1u32.to_le_bytes());
+        bin.extend([0u8; 12]);
+        for v in [[0f32, 0., 0.], [1., 0., 0.], [0., 1., 0.]] {
+            v.iter().for_each(|c| bin.extend(c.to_le_bytes()));
+        }
+        bin.extend([0u8; 2]);
+        let b = load(&bin).unwrap();
+        assert_eq!(a.parts[0].mesh.positions, b.parts[0].mesh.positions);
+        assert_eq!(a.parts[0].mesh.normals[0], Vec3::Z);
+    }
+
+    #[test]
+    fn truncated_binary_is_an_error() {
+        let mut bin = vec![0u8; 80];
+        bin.extend(5u32.to_le_bytes());
+        bin.extend([0u8; 60]);
+        assert!(load(&bin).unwrap_err().contains("promises 5 triangles"));
+    }
+}

@@ -1,0 +1,60 @@
+//! Surface materials: the coefficients of seed 002 eq. 1 and their attribute maps.
+//!
+//! Each component (ambient Ka, diffuse Kd, specular Ks, emission Ke) may carry its
+//! own texture, which multiplies that component only (seed 002 §3.2, "attribute
+//! mapping"): a diffuse map never tints the highlight.
+
+use std::sync::Arc;
+
+use glam::Vec3;
+
+use super::texture::Texture;
+
+/// A Phong material of seed 002 eq. 1.
+#[derive(Debug, Clone)]
+pub struct Material {
+    /// Name, for messages.
+    pub name: String,
+    /// Ambient reflectance Ka.
+    pub ka: Vec3,
+    /// Diffuse reflectance Kd.
+    pub kd: Vec3,
+    /// Specular reflectance Ks.
+    pub ks: Vec3,
+    /// Phong exponent n.
+    pub shininess: f32,
+    /// Emitted radiance Ke (added once, not per light).
+    pub ke: Vec3,
+    /// Per-component texture maps.
+    pub maps: ComponentMaps,
+    /// Draw back faces too (no culling); shading uses the side facing the eye.
+    pub two_sided: bool,
+}
+
+/// Optional texture per shading component.
+#[derive(Debug, Clone, Default)]
+pub struct ComponentMaps {
+    /// Multiplies Ka.
+    pub ambient: Option<Arc<Texture>>,
+    /// Multiplies Kd.
+    pub diffuse: Option<Arc<Texture>>,
+    /// Multiplies Ks.
+    pub specular: Option<Arc<Texture>>,
+    /// Multiplies Ke.
+    pub emission: Option<Arc<Texture>>,
+}
+
+impl Default for Material {
+    fn default() -> Self {
+        Material {
+            name: "default".into(),
+            ka: Vec3::splat(0.8),
+            kd: Vec3::splat(0.8),
+            ks: Vec3::splat(0.2),
+            shininess: 32.0,
+            ke: Vec3::ZERO,
+            maps: ComponentMaps::default(),
+            two_sided: false,
+        }
+    }
+}

@@ -1,0 +1,233 @@
+//! Indexed triangle meshes: the geometry every loader produces and the rasterizer eats.
+//!
+//! Loaders hand their raw arrays to [`Mesh::new`], which is the one place input is
+//! checked: non-finite positions are an error, triangles with out-of-range indices are
+//! an error, zero-area triangles are dropped (and counted, so the caller can warn), and
+//! a mesh left with no triangles is an error.
+
+use glam::{Vec2, Vec3};
+
+/// An indexed triangle mesh in its own (object) space.
+#[derive(Debug, Clone, Default)]
+pub struct Mesh {
+    /// Vertex positions.
+    pub positions: Vec<Vec3>,
+    /// Unit vertex normals, one per position.
+    pub normals: Vec<Vec3>,
+    /// Texture coordinates, one per position, or empty. Origin at the image's
+    /// top-left corner (glTF convention; OBJ's v is flipped on load).
+    pub uvs: Vec<Vec2>,
+    /// Triangles as vertex indices, counter-clockwise seen from the front.
+    pub triangles: Vec<[u32; 3]>,
+}
+
+/// What [`Mesh::new`] had to drop.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct MeshRepairs {
+    /// Triangles of zero area (repeated or collinear vertices) that were removed.
+    pub degenerate_triangles: usize,
+}
+
+/// How to make normals for a mesh that has none.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum NormalMode {
+    /// Area-weighted average of the faces around each shared vertex.
+    Smooth,
+    /// Each triangle keeps its own face normal (vertices are split).
+    Flat,
+}
+
+impl Mesh {
+    /// Checks and builds a mesh. `normals` and `uvs` may be empty; missing normals
+    /// are computed with `mode`.
+    pub fn new(
+        positions: Vec<Vec3>,
+        normals: Vec<Vec3>,
+        uvs: Vec<Vec2>,
+        triangles: Vec<[u32; 3]>,
+        mode: NormalMode,
+    ) -> Result<(Mesh, MeshRepairs), String> {
+        if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
+            return Err(format!("vertex {i} has a non-finite coordinate {:?}", positions[i]));
+        }
+        let n = positions.len() as u64;
+        if let Some(t) = triangles.iter().position(|t| t.iter().any(|&i| i as u64 >= n)) {
+            return Err(format!("triangle {t} refers to a vertex past the {n} given"));
+        }
+        let before = triangles.len();
+        let triangles: Vec<[u32; 3]> = triangles
+            .into_iter()
+            .filter(|t| face_normal(&positions, *t).length_squared() > 0.0)
+            .collect();
+        let repairs = MeshRepairs { degenerate_triangles: before - triangles.len() };
+        if triangles.is_empty() {
+            return Err(if before == 0 {
+                "the mesh has no triangles".to_string()
+            } else {
+                format!("all {before} triangles have zero area")
+            });
+        }
+        let uvs = if uvs.len() == positions.len() { uvs } else { Vec::new() };
+        let normals_ok = normals.len() == positions.len() && normals.iter().all(|v| v.is_finite());
+        let mut mesh = Mesh { positions, normals: if normals_ok { normals } else { Vec::new() }, uvs, triangles };
+        if mesh.normals.is_empty() {
+            match mode {
+                NormalMode::Smooth => mesh.compute_smooth_normals(),
+                NormalMode::Flat => mesh.split_flat(),
+            }
+        }
+        mesh.normals.iter_mut().for_each(|v| *v = v.normalize_or(Vec3::Y));
+        Ok((mesh, repairs))
+    }
+
+    fn compute_smooth_normals(&mut self) {
+        let mut acc = vec![Vec3::ZERO; self.positions.len()];
+        for &t in &self.triangles {
+            let n = face_normal(&self.positions, t); // length = 2·area: area weighting
+            for i in t {
+                acc[i as usize] += n;
+            }
+        }
+        self.normals = acc;
+    }
+
+    fn split_flat(&mut self) {
+        let mut m = Mesh::default();
+        for &t in &self.triangles {
+            let n = face_normal(&self.positions, t);
+            let base = m.positions.len() as u32;
+            for i in t {
+                m.positions.push(self.positions[i as usize]);
+                m.normals.push(n);
+                if !self.uvs.is_empty() {
+                    m.uvs.push(self.uvs[i as usize]);
+                }
+            }
+            m.triangles.push([base, base + 1, base + 2]);
+        }
+        *self = m;
+    }
+
+    /// Axis-aligned bounds `(min, max)` of the vertices used by triangles.
+    #[must_use]
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        self.triangles.iter().flatten().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &i| {
+            let p = self.positions[i as usize];
+            (lo.min(p), hi.max(p))
+        })
+    }
+}
+
+/// Unnormalised face normal (cross product; length is twice the area).
+#[must_use]
+pub fn face_normal(p: &[Vec3], t: [u32; 3]) -> Vec3 {
+    let [a, b, c] = t.map(|i| p[i as usize]);
+    (b - a).cross(c - a)
+}
+
+/// Built-in shapes, so scenes and tests can draw without files.
+pub mod shapes {
+    use super::*;
+
+    /// A square of side 1 in the XZ plane at y = 0, facing +y, uv over [0,1]².
+    #[must_use]
+    pub fn plane() -> Mesh {
+        let positions = vec![
+            Vec3::new(-0.5, 0.0, 0.5),
+            Vec3::new(0.5, 0.0, 0.5),
+            Vec3::new(0.5, 0.0, -0.5),
+            Vec3::new(-0.5, 0.0, -0.5),
+        ];
+        let uvs = vec![Vec2::new(0.0, 1.0), Vec2::new(1.0, 1.0), Vec2::new(1.0, 0.0), Vec2::ZERO];
+        Mesh { positions, normals: vec![Vec3::Y; 4], uvs, triangles: vec![[0, 1, 2], [0, 2, 3]] }
+    }
+
+    /// A cube of side 1 centred at the origin, flat-shaded.
+    #[must_use]
+    pub fn cube() -> Mesh {
+        let mut m = Mesh::default();
+        for axis in 0..3 {
+            for sign in [-1.0f32, 1.0] {
+                let n = Vec3::from_array(std::array::from_fn(|k| if k == axis { sign } else { 0.0 }));
+                let u = Vec3::from_array(std::array::from_fn(|k| if k == (axis + 1) % 3 { 1.0 } else { 0.0 }));
+                let v = n.cross(u);
+                let base = m.positions.len() as u32;
+                for (a, b) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
+                    m.positions.push(0.5 * (n + a * u + b * v));
+                    m.normals.push(n);
+                    m.uvs.push(Vec2::new(0.5 + 0.5 * a, 0.5 - 0.5 * b));
+                }
+                m.triangles.push([base, base + 1, base + 2]);
+                m.triangles.push([base, base + 2, base + 3]);
+            }
+        }
+        m
+    }
+
+    /// A UV sphere of radius 1 at the origin with `stacks` × 2·`stacks` quads,
+    /// smooth normals, counter-clockwise outward (as the peers' `gen_scene.py`).
+    #[must_use]
+    pub fn sphere(stacks: u32) -> Mesh {
+        let stacks = stacks.max(2);
+        let slices = 2 * stacks;
+        let mut m = Mesh::default();
+        for i in 0..=stacks {
+            let theta = std::f32::consts::PI * i as f32 / stacks as f32;
+            for j in 0..=slices {
+                let phi = std::f32::consts::TAU * j as f32 / slices as f32;
+                let p = Vec3::new(theta.sin() * phi.cos(), theta.cos(), -theta.sin() * phi.sin());
+                m.positions.push(p);
+                m.normals.push(p);
+                m.uvs.push(Vec2::new(j as f32 / slices as f32, i as f32 / stacks as f32));
+            }
+        }
+        let row = slices + 1;
+        for i in 0..stacks {
+            for j in 0..slices {
+                let (a, b) = (i * row + j, (i + 1) * row + j);
+                if i != 0 {
+                    m.triangles.push([a, b, a + 1]);
+                }
+                if i != stacks - 1 {
+                    m.triangles.push([a + 1, b, b + 1]);
+                }
+            }
+        }
+        m
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rejects_nan_and_empty_and_drops_degenerates() {
+        let p = vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::new(2.0, 0.0, 0.0)];
+        let e = Mesh::new(p.clone(), vec![], vec![], vec![], NormalMode::Smooth).unwrap_err();
+        assert!(e.contains("no triangles"), "{e}");
+        let (m, r) = Mesh::new(p.clone(), vec![], vec![], vec![[0, 1, 2], [0, 1, 3]], NormalMode::Smooth).unwrap();
+        assert_eq!((m.triangles.len(), r.degenerate_triangles), (1, 1));
+        let e = Mesh::new(p.clone(), vec![], vec![], vec![[0, 1, 3]], NormalMode::Flat).unwrap_err();
+        assert!(e.contains("zero area"), "{e}");
+        let mut bad = p;
+        bad[2].y = f32::NAN;
+        let e = Mesh::new(bad, vec![], vec![], vec![[0, 1, 2]], NormalMode::Smooth).unwrap_err();
+        assert!(e.contains("vertex 2") && e.contains("non-finite"), "{e}");
+    }
+
+    /// Shapes are closed and outward-facing: the divergence theorem gives a positive
+    /// volume equal to the analytic one.
+    #[test]
+    fn shapes_enclose_their_volume() {
+        let volume = |m: &Mesh| -> f32 {
+            m.triangles.iter().map(|t| {
+                let [a, b, c] = t.map(|i| m.positions[i as usize]);
+                a.dot(b.cross(c)) / 6.0
+            }).sum()
+        };
+        assert!((volume(&shapes::cube()) - 1.0).abs() < 1e-5);
+        let v = volume(&shapes::sphere(64));
+        assert!((v - 4.0 / 3.0 * std::f32::consts::PI).abs() < 0.01, "{v}");
+    }
+}

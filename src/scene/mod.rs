@@ -1,0 +1,157 @@
+//! The scene: what is drawn (objects with meshes and materials), how it is lit and
+//! from where it is seen. Scene files are parsed to plain records first
+//! ([`file`]), then meshes and textures are loaded ([`load`]) into this form.
+
+pub mod camera;
+pub mod demo;
+pub mod file;
+pub mod light;
+pub mod load;
+pub mod material;
+pub mod mesh;
+pub mod texture;
+
+use std::sync::Arc;
+
+use glam::{Affine3A, Vec3};
+
+pub use camera::{Camera, Projection, Ray};
+pub use light::{Falloff, Light, LightKind};
+pub use material::{ComponentMaps, Material};
+pub use mesh::Mesh;
+pub use texture::Texture;
+
+use crate::error::{Error, Result};
+
+/// Largest image side kage accepts, in pixels.
+pub const MAX_IMAGE_SIDE: u32 = 16_384;
+/// Largest image kage accepts, in pixels (a 16k × 8k frame).
+pub const MAX_IMAGE_PIXELS: u64 = 16_384 * 8_192;
+
+/// A mesh placed in the world with a material.
+#[derive(Debug, Clone)]
+pub struct Object {
+    /// Name, for messages and statistics.
+    pub name: String,
+    /// Shared geometry in object space.
+    pub mesh: Arc<Mesh>,
+    /// Object → world transform.
+    pub transform: Affine3A,
+    /// Index into [`Scene::materials`].
+    pub material: usize,
+}
+
+/// A complete scene.
+#[derive(Debug, Clone)]
+pub struct Scene {
+    /// Output width in pixels.
+    pub width: u32,
+    /// Output height in pixels.
+    pub height: u32,
+    /// Linear RGB colour of pixels that see no object.
+    pub background: Vec3,
+    /// The eye.
+    pub camera: Camera,
+    /// Lights.
+    pub lights: Vec<Light>,
+    /// Materials, referenced by index from objects.
+    pub materials: Vec<Material>,
+    /// Objects.
+    pub objects: Vec<Object>,
+    /// Things the loaders repaired or ignored, for the user to see.
+    pub warnings: Vec<String>,
+}
+
+/// Checks an image size before anything is allocated for it.
+pub fn check_image_size(width: u64, height: u64) -> Result<()> {
+    let err = |reason| Err(Error::ImageSize { width, height, reason });
+    if width == 0 || height == 0 {
+        return err("width and height must be at least 1");
+    }
+    if width > MAX_IMAGE_SIDE as u64 || height > MAX_IMAGE_SIDE as u64 {
+        return err("each side must be at most 16384 pixels");
+    }
+    if width * height > MAX_IMAGE_PIXELS {
+        return err("the image must have at most 134,217,728 pixels (16384 x 8192)");
+    }
+    Ok(())
+}
+
+impl Scene {
+    /// Checks everything a render relies on: image size, camera, materials referenced.
+    pub fn validate(&self) -> Result<()> {
+        check_image_size(self.width as u64, self.height as u64)?;
+        self.camera.validate().map_err(Error::Scene)?;
+        if let Some(o) = self.objects.iter().find(|o| o.material >= self.materials.len()) {
+            return Err(Error::Scene(format!("object '{}' has no material", o.name)));
+        }
+        if let Some(o) = self.objects.iter().find(|o| !o.transform.is_finite()) {
+            return Err(Error::Scene(format!("object '{}' has a non-finite transform", o.name)));
+        }
+        Ok(())
+    }
+
+    /// World-space bounds `(min, max)` of all objects (`None` if there are none).
+    #[must_use]
+    pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
+        self.objects.iter().fold(None, |acc, o| {
+            let (lo, hi) = o.mesh.bounds();
+            let corners = (0..8).map(|k| {
+                let pick = |bit: usize, a: f32, b: f32| if k >> bit & 1 == 0 { a } else { b };
+                o.transform.transform_point3(Vec3::new(pick(0, lo.x, hi.x), pick(1, lo.y, hi.y), pick(2, lo.z, hi.z)))
+            });
+            let (mut lo, mut hi) = acc.unwrap_or((Vec3::INFINITY, Vec3::NEG_INFINITY));
+            for c in corners {
+                lo = lo.min(c);
+                hi = hi.max(c);
+            }
+            Some((lo, hi))
+        })
+    }
+
+    /// Number of triangles over all objects.
+    #[must_use]
+    pub fn triangle_count(&self) -> usize {
+        self.objects.iter().map(|o| o.mesh.triangles.len()).sum()
+    }
+}
+
+/// A camera and lights that show everything inside `bounds`: the camera looks at
+/// the centre from above and in front, far enough that the bounding sphere fits the
+/// vertical field of view; a key light and a dim fill light.
+#[must_use]
+pub fn framing(bounds: (Vec3, Vec3), aspect: f32) -> (Camera, Vec<Light>) {
+    let (lo, hi) = bounds;
+    let c = (lo + hi) * 0.5;
+    let r = ((hi - lo).length() * 0.5).max(1e-3);
+    let fov_y_deg: f32 = 40.0;
+    let half_v = fov_y_deg.to_radians() * 0.5;
+    let half = half_v.min((half_v.tan() * aspect).atan());
+    let dist = 1.05 * r / half.sin();
+    let eye = c + dist * Vec3::new(0.45, 0.5, 1.0).normalize();
+    let camera = Camera {
+        eye,
+        target: c,
+        up: Vec3::Y,
+        near: (dist - r).max(dist * 1e-3) * 0.5,
+        far: (dist + r) * 2.0,
+        projection: Projection::Perspective { fov_y_deg },
+    };
+    let key = Light {
+        kind: LightKind::Point { position: c + r * Vec3::new(1.5, 3.0, 1.2) },
+        color: Vec3::ONE,
+        intensity: 0.85,
+        ambient: 0.12,
+        size: 0.05 * r,
+        falloff: Falloff::None,
+    };
+    let fill = Light {
+        kind: LightKind::Directional { direction: Vec3::new(1.0, -0.3, 0.6).normalize() },
+        color: Vec3::new(0.75, 0.8, 1.0),
+        intensity: 0.3,
+        ambient: 0.0,
+        size: 0.0,
+        falloff: Falloff::None,
+    };
+    (camera, vec![key, fill])
+}

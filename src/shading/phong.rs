@@ -1,0 +1,83 @@
+//! Seed 002 eq. 1: per light i, ambient Ia_i·Ka, diffuse Id_i·Kd·cosθ and specular
+//! Is_i·Ks·(cosα)^n, each component multiplied by its own attribute map (§3.2),
+//! plus emission Ke once.
+//!
+//! cosθ = N·L; cosα = R·V with R the mirror of L about N (Phong, as the paper and the
+//! peers use); the specular term is zero where N·L ≤ 0.
+
+use glam::Vec3;
+
+use super::surface::SurfacePoint;
+use crate::scene::{Light, Material};
+
+/// The components of seed 002 eq. 4, summed over lights.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Components {
+    /// Σ Ia_i · Ka · Mapa.
+    pub ambient: Vec3,
+    /// Σ shadow_i · Id_i · Kd · cosθ · Mapd.
+    pub diffuse: Vec3,
+    /// Σ shadow_i · Is_i · Ks · (cosα)^n · Maps.
+    pub specular: Vec3,
+    /// Ke · Mape.
+    pub emission: Vec3,
+}
+
+impl Components {
+    /// The pixel's colour: the sum of the components.
+    #[must_use]
+    pub fn total(&self) -> Vec3 {
+        self.ambient + self.diffuse + self.specular + self.emission
+    }
+}
+
+/// The material's coefficients at a point, with their maps applied.
+#[derive(Debug, Clone, Copy)]
+pub struct Coefficients {
+    ka: Vec3,
+    kd: Vec3,
+    ks: Vec3,
+    ke: Vec3,
+    n: f32,
+}
+
+impl Coefficients {
+    /// Samples every map of `m` at the point's uv.
+    #[must_use]
+    pub fn at(m: &Material, s: &SurfacePoint) -> Self {
+        let map = |t: &Option<std::sync::Arc<crate::scene::Texture>>| t.as_ref().map_or(Vec3::ONE, |t| t.sample(s.uv));
+        Coefficients {
+            ka: m.ka * map(&m.maps.ambient),
+            kd: m.kd * map(&m.maps.diffuse),
+            ks: m.ks * map(&m.maps.specular),
+            ke: m.ke * map(&m.maps.emission),
+            n: m.shininess,
+        }
+    }
+}
+
+/// Adds light `light`'s ambient, diffuse and specular terms at `s` to `acc`, with
+/// `shadow` ∈ [0, 1] (1 = lit) multiplying diffuse and specular only.
+pub fn add_light(acc: &mut Components, light: &Light, k: &Coefficients, s: &SurfacePoint, shadow: f32) {
+    acc.ambient += light.color * light.ambient * k.ka;
+    let inc = light.incident(s.position);
+    let cos_theta = s.normal.dot(inc.to_light);
+    if cos_theta <= 0.0 || shadow <= 0.0 {
+        return;
+    }
+    let r = 2.0 * cos_theta * s.normal - inc.to_light;
+    let cos_alpha = r.dot(s.to_eye).max(0.0);
+    acc.diffuse += shadow * inc.radiance * k.kd * cos_theta;
+    acc.specular += shadow * inc.radiance * k.ks * cos_alpha.powf(k.n);
+}
+
+/// Seed 002 eq. 1 for all lights, unshadowed.
+#[must_use]
+pub fn shade(lights: &[Light], m: &Material, s: &SurfacePoint) -> Components {
+    let k = Coefficients::at(m, s);
+    let mut acc = Components { emission: k.ke, ..Default::default() };
+    for light in lights {
+        add_light(&mut acc, light, &k, s, 1.0);
+    }
+    acc
+}

@@ -1,0 +1,109 @@
+//! The visibility pass: every polygon is scan-converted into ONE visibility buffer
+//! (seed 002 §4's item buffer; seed 004 §3(1)'s aliased polygon pass), holding per
+//! pixel the depth and the id of the nearest item. Shading happens afterwards, once
+//! per visible pixel, by passes that read this buffer.
+//!
+//! Stages, one file each: [`clip`] (homogeneous clipping), [`scan`] (exact
+//! fixed-point DDA scan conversion, top-left rule) and [`raster`] (projection,
+//! binning into bands and the band-parallel z-buffer).
+
+pub mod clip;
+pub mod raster;
+pub mod scan;
+
+pub use raster::{rasterize, RasterStats};
+
+/// What a pixel sees: an object and one of its triangles.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct ItemId {
+    /// Index into `Scene::objects`.
+    pub object: u32,
+    /// Triangle index within the object's mesh.
+    pub triangle: u32,
+}
+
+impl ItemId {
+    /// The id of pixels that see nothing.
+    pub const NONE: ItemId = ItemId { object: u32::MAX, triangle: u32::MAX };
+
+    /// Whether this pixel sees nothing.
+    #[must_use]
+    pub fn is_none(self) -> bool {
+        self == Self::NONE
+    }
+}
+
+/// Per-pixel depth and item id, rows top to bottom.
+///
+/// Depth is reversed: `1` at the near plane, falling towards `0` (perspective: at
+/// infinity, depth = near / distance along the view axis; orthographic: at the far
+/// plane). Larger is nearer; empty pixels hold `0` and [`ItemId::NONE`].
+#[derive(Debug, Clone)]
+pub struct VisibilityBuffer {
+    width: u32,
+    height: u32,
+    depth: Vec<f32>,
+    items: Vec<ItemId>,
+}
+
+impl VisibilityBuffer {
+    /// An empty buffer. The size must have been checked
+    /// ([`crate::scene::check_image_size`]).
+    #[must_use]
+    pub fn new(width: u32, height: u32) -> Self {
+        let n = width as usize * height as usize;
+        VisibilityBuffer { width, height, depth: vec![0.0; n], items: vec![ItemId::NONE; n] }
+    }
+
+    /// Width in pixels.
+    #[must_use]
+    pub fn width(&self) -> u32 {
+        self.width
+    }
+
+    /// Height in pixels.
+    #[must_use]
+    pub fn height(&self) -> u32 {
+        self.height
+    }
+
+    /// Depth of every pixel, row-major.
+    #[must_use]
+    pub fn depths(&self) -> &[f32] {
+        &self.depth
+    }
+
+    /// Item of every pixel, row-major.
+    #[must_use]
+    pub fn items(&self) -> &[ItemId] {
+        &self.items
+    }
+
+    /// Item at pixel (x, y).
+    #[must_use]
+    pub fn item(&self, x: u32, y: u32) -> ItemId {
+        self.items[y as usize * self.width as usize + x as usize]
+    }
+
+    /// Depth at pixel (x, y).
+    #[must_use]
+    pub fn depth(&self, x: u32, y: u32) -> f32 {
+        self.depth[y as usize * self.width as usize + x as usize]
+    }
+
+    /// Forgets everything drawn.
+    pub fn clear(&mut self) {
+        self.depth.fill(0.0);
+        self.items.fill(ItemId::NONE);
+    }
+
+    fn parts_mut(&mut self) -> (&mut [f32], &mut [ItemId]) {
+        (&mut self.depth, &mut self.items)
+    }
+
+    /// Bytes held by the buffer.
+    #[must_use]
+    pub fn memory_bytes(&self) -> usize {
+        self.depth.len() * std::mem::size_of::<f32>() + self.items.len() * std::mem::size_of::<ItemId>()
+    }
+}

@@ -1,0 +1,282 @@
+//! The polygon pass driver: project vertices, bin triangles into horizontal bands,
+//! then scan-convert every band in parallel into its own rows of the z-buffer.
+//!
+//! Triangles are cut into chunks of consecutive triangles; binning runs per chunk in
+//! parallel and rasterization per band in parallel. A band draws its triangles in
+//! scene order (chunk by chunk), so the image does not depend on the number of
+//! threads: single- and multi-threaded renders are bit-identical.
+
+use std::ops::Range;
+
+use glam::{Mat4, Vec4};
+use rayon::prelude::*;
+
+use super::clip::{ClipPlanes, MAX_CLIPPED};
+use super::scan::{column_range, row_range, scan_triangle, signed_area2, FixedPoint, SpanSink, ONE};
+use super::{ItemId, VisibilityBuffer};
+use crate::scene::Scene;
+
+/// Rows per band: the unit of parallel work and of binning.
+pub const BAND_ROWS: usize = 16;
+/// Triangles per binning chunk.
+const CHUNK_TRIANGLES: u32 = 16 * 1024;
+/// Half-width of the guard band beyond the image, in pixels: vertices inside it
+/// are not clipped in x and y; fixed-point coordinates stay below 2^27.
+const GUARD_PX: f32 = (1 << 18) as f32;
+/// Bin entries with this bit set index a chunk's clipped triangles.
+const CLIPPED: u32 = 1 << 31;
+
+/// Counts from one polygon pass.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct RasterStats {
+    /// Triangles submitted.
+    pub triangles: usize,
+    /// Triangles that reached at least one band.
+    pub binned: usize,
+    /// Triangles that needed clipping.
+    pub clipped: usize,
+}
+
+/// A projected vertex: fixed-point screen position and reversed depth.
+#[derive(Debug, Clone, Copy, Default)]
+struct ScreenVertex {
+    x: i32,
+    y: i32,
+    z: f32,
+}
+
+impl ScreenVertex {
+    fn point(self) -> FixedPoint {
+        FixedPoint { x: self.x as i64, y: self.y as i64 }
+    }
+}
+
+/// One object's vertices in clip space and, where inside all planes, on screen.
+struct Projected {
+    clip: Vec<Vec4>,
+    outcode: Vec<u8>,
+    screen: Vec<ScreenVertex>,
+    cull_back: bool,
+}
+
+/// Maps clip space to the fixed-point screen.
+#[derive(Clone, Copy)]
+struct Viewport {
+    width: f32,
+    height: f32,
+}
+
+impl Viewport {
+    fn to_screen(self, c: Vec4) -> ScreenVertex {
+        let inv_w = 1.0 / c.w;
+        let sx = (c.x * inv_w * 0.5 + 0.5) * self.width;
+        let sy = (0.5 - c.y * inv_w * 0.5) * self.height;
+        let one = ONE as f32;
+        ScreenVertex { x: (sx * one).round() as i32, y: (sy * one).round() as i32, z: c.z * inv_w }
+    }
+}
+
+struct Chunk {
+    object: usize,
+    triangles: Range<u32>,
+}
+
+#[derive(Default)]
+struct ChunkBins {
+    /// Per band: triangle indices (or `CLIPPED | i`).
+    bands: Vec<Vec<u32>>,
+    clipped: Vec<([ScreenVertex; 3], u32)>,
+    binned: usize,
+    clipped_count: usize,
+}
+
+/// Everything bands need to draw.
+struct Frame<'a> {
+    scene: &'a Scene,
+    projected: Vec<Projected>,
+    planes: ClipPlanes,
+    viewport: Viewport,
+    width: i64,
+    height: i64,
+    bands: usize,
+}
+
+/// Draws every object of `scene` into `vb` (which must be cleared by the caller if
+/// it was used before).
+pub fn rasterize(scene: &Scene, vb: &mut VisibilityBuffer) -> RasterStats {
+    let (w, h) = (vb.width() as usize, vb.height() as usize);
+    let view_proj = scene.camera.view_projection(w as f32 / h as f32);
+    let planes = ClipPlanes::new(
+        scene.camera.far_plane_factor(),
+        1.0 + 2.0 * GUARD_PX / w as f32,
+        1.0 + 2.0 * GUARD_PX / h as f32,
+    );
+    let viewport = Viewport { width: w as f32, height: h as f32 };
+    let projected = scene.objects.iter().map(|o| project(scene, o, view_proj, &planes, viewport)).collect();
+    let frame = Frame { scene, projected, planes, viewport, width: w as i64, height: h as i64, bands: h.div_ceil(BAND_ROWS) };
+    let chunks = chunks(scene);
+    let bins: Vec<ChunkBins> = chunks.par_iter().map(|c| frame.bin(c)).collect();
+    let (depth, items) = vb.parts_mut();
+    depth
+        .par_chunks_mut(w * BAND_ROWS)
+        .zip(items.par_chunks_mut(w * BAND_ROWS))
+        .enumerate()
+        .for_each(|(band, (d, i))| frame.draw_band(band, d, i, &chunks, &bins));
+    RasterStats {
+        triangles: scene.triangle_count(),
+        binned: bins.iter().map(|b| b.binned).sum(),
+        clipped: bins.iter().map(|b| b.clipped_count).sum(),
+    }
+}
+
+fn project(scene: &Scene, object: &crate::scene::Object, view_proj: Mat4, planes: &ClipPlanes, viewport: Viewport) -> Projected {
+    let m = view_proj * Mat4::from(object.transform);
+    let clip: Vec<Vec4> = object.mesh.positions.par_iter().map(|p| m * p.extend(1.0)).collect();
+    let outcode: Vec<u8> = clip.par_iter().map(|c| planes.outcode(*c)).collect();
+    let screen = clip
+        .par_iter()
+        .zip(&outcode)
+        .map(|(c, &o)| if o == 0 { viewport.to_screen(*c) } else { ScreenVertex::default() })
+        .collect();
+    Projected { clip, outcode, screen, cull_back: !scene.materials[object.material].two_sided }
+}
+
+fn chunks(scene: &Scene) -> Vec<Chunk> {
+    let mut out = Vec::new();
+    for (object, o) in scene.objects.iter().enumerate() {
+        let n = o.mesh.triangles.len() as u32;
+        out.extend((0..n).step_by(CHUNK_TRIANGLES as usize).map(|s| Chunk { object, triangles: s..(s + CHUNK_TRIANGLES).min(n) }));
+    }
+    out
+}
+
+impl Frame<'_> {
+    fn bin(&self, chunk: &Chunk) -> ChunkBins {
+        let mut bins = ChunkBins { bands: vec![Vec::new(); self.bands], ..Default::default() };
+        let p = &self.projected[chunk.object];
+        let tris = &self.scene.objects[chunk.object].mesh.triangles;
+        for t in chunk.triangles.clone() {
+            let [a, b, c] = tris[t as usize].map(|i| i as usize);
+            let codes = [p.outcode[a], p.outcode[b], p.outcode[c]];
+            if codes[0] | codes[1] | codes[2] == 0 {
+                self.bin_triangle(&mut bins, [p.screen[a], p.screen[b], p.screen[c]], p.cull_back, t);
+            } else if codes[0] & codes[1] & codes[2] == 0 {
+                bins.clipped_count += 1;
+                self.bin_clipped(&mut bins, [p.clip[a], p.clip[b], p.clip[c]], codes[0] | codes[1] | codes[2], p.cull_back, t);
+            }
+        }
+        bins
+    }
+
+    fn bin_clipped(&self, bins: &mut ChunkBins, tri: [Vec4; 3], mask: u8, cull_back: bool, t: u32) {
+        let mut poly = [Vec4::ZERO; MAX_CLIPPED];
+        let n = self.planes.clip(tri, mask, &mut poly);
+        let screen: Vec<ScreenVertex> = poly[..n].iter().map(|c| self.viewport.to_screen(*c)).collect();
+        for k in 1..n.saturating_sub(1) {
+            let v = [screen[0], screen[k], screen[k + 1]];
+            if let Some(bands) = self.bands_of(v, cull_back) {
+                let entry = CLIPPED | bins.clipped.len() as u32;
+                bins.clipped.push((v, t));
+                bands.for_each(|b| bins.bands[b].push(entry));
+            }
+        }
+    }
+
+    fn bin_triangle(&self, bins: &mut ChunkBins, v: [ScreenVertex; 3], cull_back: bool, t: u32) {
+        if let Some(bands) = self.bands_of(v, cull_back) {
+            bins.binned += 1;
+            bands.for_each(|b| bins.bands[b].push(t));
+        }
+    }
+
+    /// The bands a triangle touches, or `None` if it is culled, degenerate or
+    /// covers no pixel centre of the image.
+    fn bands_of(&self, v: [ScreenVertex; 3], cull_back: bool) -> Option<Range<usize>> {
+        let p = v.map(ScreenVertex::point);
+        let area = signed_area2(&p);
+        if area == 0 || (cull_back && area > 0) {
+            return None;
+        }
+        let rows = clamp(row_range(&p), self.height);
+        let cols = clamp(column_range(&p), self.width);
+        if rows.is_empty() || cols.is_empty() {
+            return None;
+        }
+        Some(rows.start as usize / BAND_ROWS..(rows.end as usize - 1) / BAND_ROWS + 1)
+    }
+
+    fn draw_band(&self, band: usize, depth: &mut [f32], items: &mut [ItemId], chunks: &[Chunk], bins: &[ChunkBins]) {
+        let row0 = (band * BAND_ROWS) as i64;
+        let rows = row0..(row0 + BAND_ROWS as i64).min(self.height);
+        let mut sink = DepthSink { depth, items, width: self.width, row0, plane: DepthPlane::default(), item: ItemId::NONE };
+        for (chunk, bin) in chunks.iter().zip(bins) {
+            let p = &self.projected[chunk.object];
+            let tris = &self.scene.objects[chunk.object].mesh.triangles;
+            for &entry in &bin.bands[band] {
+                let (v, t) = if entry & CLIPPED != 0 {
+                    bin.clipped[(entry & !CLIPPED) as usize]
+                } else {
+                    (tris[entry as usize].map(|i| p.screen[i as usize]), entry)
+                };
+                sink.item = ItemId { object: chunk.object as u32, triangle: t };
+                sink.plane = DepthPlane::new(&v);
+                scan_triangle(&v.map(ScreenVertex::point), rows.clone(), &mut sink);
+            }
+        }
+    }
+}
+
+fn clamp(r: Range<i64>, n: i64) -> Range<i64> {
+    r.start.max(0)..r.end.min(n)
+}
+
+/// Depth as a plane over the screen: `z(x, y) = c + dx·x + dy·y` at the centre of
+/// pixel (x, y). Reversed depth divided by w is linear in screen space.
+#[derive(Debug, Clone, Copy, Default)]
+struct DepthPlane {
+    c: f64,
+    dx: f64,
+    dy: f64,
+}
+
+impl DepthPlane {
+    fn new(v: &[ScreenVertex; 3]) -> Self {
+        let s = 1.0 / ONE as f64;
+        let [(x0, y0, z0), (x1, y1, z1), (x2, y2, z2)] = v.map(|p| (p.x as f64 * s, p.y as f64 * s, p.z as f64));
+        let area = (x1 - x0) * (y2 - y0) - (x2 - x0) * (y1 - y0);
+        let dx = ((z1 - z0) * (y2 - y0) - (z2 - z0) * (y1 - y0)) / area;
+        let dy = ((z2 - z0) * (x1 - x0) - (z1 - z0) * (x2 - x0)) / area;
+        DepthPlane { c: z0 + dx * (0.5 - x0) + dy * (0.5 - y0), dx, dy }
+    }
+}
+
+/// Writes spans into a band's rows with a z-test (larger depth wins, ties keep the
+/// earlier triangle).
+struct DepthSink<'a> {
+    depth: &'a mut [f32],
+    items: &'a mut [ItemId],
+    width: i64,
+    row0: i64,
+    plane: DepthPlane,
+    item: ItemId,
+}
+
+impl SpanSink for DepthSink<'_> {
+    fn span(&mut self, y: i64, x0: i64, x1: i64) {
+        let (x0, x1) = (x0.max(0), x1.min(self.width));
+        if x0 >= x1 {
+            return;
+        }
+        let base = ((y - self.row0) * self.width) as usize;
+        let row_z = self.plane.c + self.plane.dy * y as f64;
+        let depth = &mut self.depth[base + x0 as usize..base + x1 as usize];
+        let items = &mut self.items[base + x0 as usize..base + x1 as usize];
+        for (k, (d, it)) in depth.iter_mut().zip(items.iter_mut()).enumerate() {
+            let z = (row_z + self.plane.dx * (x0 + k as i64) as f64) as f32;
+            if z > *d {
+                *d = z;
+                *it = self.item;
+            }
+        }
+    }
+}
