@@ -20,9 +20,10 @@ use crate::scene::Scene;
 pub const BAND_ROWS: usize = 16;
 /// Triangles per binning chunk.
 const CHUNK_TRIANGLES: u32 = 16 * 1024;
-/// Half-width of the guard band beyond the image, in pixels: vertices inside it
-/// are not clipped in x and y; fixed-point coordinates stay below 2^27.
-const GUARD_PX: f32 = (1 << 18) as f32;
+/// Width of the guard band around the image, in pixels: vertices inside it are not
+/// clipped in x and y. With images of at most 16384 pixels a side and 12 fractional
+/// bits, fixed-point coordinates stay below 2^27, so the DDA's products fit in i64.
+const GUARD_PX: f32 = (1 << 14) as f32;
 /// Bin entries with this bit set index a chunk's clipped triangles.
 const CLIPPED: u32 = 1 << 31;
 
@@ -68,11 +69,11 @@ struct Viewport {
 
 impl Viewport {
     fn to_screen(self, c: Vec4) -> ScreenVertex {
-        let inv_w = 1.0 / c.w;
-        let sx = (c.x * inv_w * 0.5 + 0.5) * self.width;
-        let sy = (0.5 - c.y * inv_w * 0.5) * self.height;
-        let one = ONE as f32;
-        ScreenVertex { x: (sx * one).round() as i32, y: (sy * one).round() as i32, z: c.z * inv_w }
+        let inv_w = 1.0 / c.w as f64;
+        let sx = (c.x as f64 * inv_w * 0.5 + 0.5) * self.width as f64;
+        let sy = (0.5 - c.y as f64 * inv_w * 0.5) * self.height as f64;
+        let one = ONE as f64;
+        ScreenVertex { x: (sx * one).round() as i32, y: (sy * one).round() as i32, z: (c.z as f64 * inv_w) as f32 }
     }
 }
 

@@ -17,7 +17,7 @@
 use std::ops::Range;
 
 /// Fractional bits of screen coordinates.
-pub const SUBPIXEL_BITS: u32 = 8;
+pub const SUBPIXEL_BITS: u32 = 12;
 /// One pixel in fixed-point units.
 pub const ONE: i64 = 1 << SUBPIXEL_BITS;
 const HALF: i64 = ONE / 2;
@@ -183,6 +183,7 @@ mod tests {
                     }
                 }
             }
+            want.sort_unstable();
             assert_eq!(got, want, "{v:?}");
         }
     }
