@@ -49,6 +49,8 @@ struct RenderArgs {
 
 fn main() -> miette::Result<()> {
     let cli = Cli::parse();
+    // Paths and locations stay on one line, so they can be copied and grepped.
+    miette::set_hook(Box::new(|_| Box::new(miette::MietteHandlerOpts::new().wrap_lines(false).build())))?;
     match cli.command {
         Command::Render(args) => render_command(&args).map_err(report::to_report),
         Command::Bench(args) => bench::run(&args),

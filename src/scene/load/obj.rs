@@ -29,17 +29,22 @@ pub fn load(bytes: &[u8], path: &Path, assets: &dyn AssetSource) -> Result<Loade
         Vec::new()
     });
     let materials: Vec<Material> = materials.iter().map(|m| material(m, dir, assets)).collect::<Result<_, _>>()?;
+    let mut first_error = None;
     for m in models {
         let built = mesh(&m.mesh);
-        let Ok(mesh) = checked(&mut out, path, built, &format!("object '{}'", m.name)) else {
-            out.warnings.push(format!("{}: object '{}' has no drawable triangles; skipped", path.display(), m.name));
-            continue;
+        let mesh = match checked(&mut out, path, built, &format!("object '{}'", m.name)) {
+            Ok(mesh) => mesh,
+            Err(e) => {
+                out.warnings.push(format!("{}: {e}; skipped", path.display()));
+                first_error.get_or_insert(e);
+                continue;
+            }
         };
         let material = m.mesh.material_id.and_then(|i| materials.get(i).cloned());
         out.parts.push(Part { name: m.name, mesh: Arc::new(mesh), material, transform: Affine3A::IDENTITY });
     }
     if out.parts.is_empty() {
-        return Err("the file has no triangles".into());
+        return Err(first_error.unwrap_or_else(|| "the file has no triangles".into()));
     }
     Ok(out)
 }
