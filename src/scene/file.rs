@@ -393,7 +393,8 @@ impl SceneFile {
         let material = match &r.material {
             Some(name) => Some(*by_name.get(name.get_ref()).ok_or_else(|| {
                 let known: Vec<&str> = self.materials.iter().map(|m| m.get_ref().name.get_ref().as_str()).collect();
-                self.invalid(name.span(), format!("no material named '{}' (defined: {})", name.get_ref(), known.join(", ")))
+                let known = if known.is_empty() { "no [[material]] is defined".to_string() } else { format!("defined: {}", known.join(", ")) };
+                self.invalid(name.span(), format!("no material named '{}' ({known})", name.get_ref()))
             })?),
             None => None,
         };

@@ -15,7 +15,7 @@ pub fn to_report(e: Error) -> Report {
             let len = loc.span.len().max(1);
             let diag = MietteDiagnostic::new(format!("{}: {}", loc, message))
                 .with_code(if matches!(e, Error::SceneSyntax { .. }) { "kage::scene::syntax" } else { "kage::scene::invalid" })
-                .with_label(LabeledSpan::at(loc.span.start..loc.span.start + len, message));
+                .with_label(LabeledSpan::at(loc.span.start..loc.span.start + len, "here"));
             let source = NamedSource::new(loc.path.display().to_string(), loc.text.to_string());
             Report::new(diag).with_source_code(source)
         }

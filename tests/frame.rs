@@ -1,0 +1,139 @@
+//! Whole frames: known shading answers, thread-count independence, memory, and the
+//! model loaders on the shared real-world assets (skipped when absent).
+
+mod common;
+
+use std::path::Path;
+
+use glam::Vec3;
+use kage::scene::file::scene_for_model;
+use kage::scene::mesh::shapes;
+use kage::scene::{Camera, Falloff, Light, LightKind, Projection};
+use kage::{render, RenderOptions};
+
+fn plane_scene(light: Light) -> kage::Scene {
+    let camera = Camera { eye: Vec3::new(0.0, 3.0, 0.001), target: Vec3::ZERO, up: Vec3::NEG_Z, near: 0.1, far: 10.0, projection: Projection::Orthographic { height: 0.5 } };
+    let mut s = common::scene_with(shapes::plane(), camera, 16, 16, false);
+    s.lights = vec![light];
+    s
+}
+
+/// An unoccluded plane under a directional light at angle θ: every pixel is
+/// Ka·Ia + Kd·I·cosθ + Ks·I·(cosα)^n, computed here by hand.
+#[test]
+fn unoccluded_plane_matches_equation_one() {
+    let theta: f32 = 0.6;
+    let dir = Vec3::new(theta.sin(), -theta.cos(), 0.0);
+    let light = Light { kind: LightKind::Directional { direction: dir }, color: Vec3::new(1.0, 0.5, 0.25), intensity: 2.0, ambient: 0.1, size: 0.0, falloff: Falloff::None };
+    let scene = plane_scene(light);
+    let m = &scene.materials[0];
+    let frame = render(&scene, &RenderOptions::default()).unwrap();
+    let c = Vec3::new(1.0, 0.5, 0.25);
+    // Orthographic view straight down: V = +y; R = mirror of L about +y.
+    let l = -dir;
+    let r = Vec3::new(-l.x, l.y, -l.z);
+    let want = c * 0.1 * m.ka + c * 2.0 * m.kd * theta.cos() + c * 2.0 * m.ks * r.dot(Vec3::Y).max(0.0).powf(m.shininess);
+    for p in frame.image.pixels() {
+        assert!((*p - want).abs().max_element() < 1e-4, "{p} vs {want}");
+    }
+}
+
+/// Two coincident lights of intensity 1 give the image of one light of intensity 2
+/// (ambient aside, which both carry).
+#[test]
+fn lights_add_up() {
+    let light = |intensity, ambient| Light { kind: LightKind::Point { position: Vec3::new(0.3, 1.0, 0.2) }, color: Vec3::ONE, intensity, ambient, size: 0.0, falloff: Falloff::InverseSquare };
+    let one = plane_scene(light(2.0, 0.2));
+    let mut two = plane_scene(light(1.0, 0.1));
+    two.lights.push(light(1.0, 0.1));
+    let (a, b) = (render(&one, &RenderOptions::default()).unwrap(), render(&two, &RenderOptions::default()).unwrap());
+    for (p, q) in a.image.pixels().iter().zip(b.image.pixels()) {
+        assert!((*p - *q).abs().max_element() < 1e-5, "{p} vs {q}");
+    }
+}
+
+/// What is computed does not depend on how it is parallelised.
+#[test]
+fn one_and_two_threads_give_identical_frames() {
+    let scene = kage::scene::demo::demo_scene().unwrap();
+    let a = render(&scene, &RenderOptions { threads: Some(1) }).unwrap();
+    let b = render(&scene, &RenderOptions { threads: Some(2) }).unwrap();
+    let c = render(&scene, &RenderOptions { threads: Some(5) }).unwrap();
+    assert_eq!(a.visibility.items(), b.visibility.items());
+    assert_eq!(a.visibility.depths(), c.visibility.depths());
+    assert_eq!(a.image, b.image);
+    assert_eq!(a.image, c.image);
+}
+
+/// The demo is not a silent black image: every object shows and is lit.
+#[test]
+fn demo_scene_shows_every_object() {
+    let scene = kage::scene::demo::demo_scene().unwrap();
+    let frame = render(&scene, &RenderOptions::default()).unwrap();
+    for (i, o) in scene.objects.iter().enumerate() {
+        let n = frame.visibility.items().iter().filter(|it| it.object == i as u32).count();
+        assert!(n > 1000, "object {} covers only {n} pixels", o.name);
+    }
+    let mean = frame.image.pixels().iter().copied().sum::<Vec3>() / frame.image.pixels().len() as f32;
+    assert!(mean.min_element() > 0.1, "mean colour {mean}");
+}
+
+/// A 1920x1080 frame's buffers stay well under 100 MB.
+#[test]
+fn full_hd_buffers_fit_in_100_mb() {
+    let mut scene = kage::scene::demo::demo_scene().unwrap();
+    scene.width = 1920;
+    scene.height = 1080;
+    let frame = render(&scene, &RenderOptions::default()).unwrap();
+    assert!(frame.stats.buffer_bytes < 60 << 20, "{} bytes", frame.stats.buffer_bytes);
+}
+
+fn shared(rel: &str) -> Option<std::path::PathBuf> {
+    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets").join(rel);
+    if p.exists() {
+        Some(p)
+    } else {
+        eprintln!("skipped: {} not present", p.display());
+        None
+    }
+}
+
+fn coverage(path: &Path) -> f32 {
+    let scene = scene_for_model(path, 96, 72).unwrap();
+    let frame = render(&scene, &RenderOptions::default()).unwrap();
+    frame.visibility.items().iter().filter(|i| !i.is_none()).count() as f32 / (96.0 * 72.0)
+}
+
+/// Every kind of model file loads and, framed automatically, fills a fair part of
+/// the image without overflowing it.
+#[test]
+fn real_models_load_and_frame() {
+    for rel in [
+        "meshes/utah-teapot/teapot.obj",
+        "meshes/suzanne/suzanne.obj",
+        "meshes/dragon/dragon.obj",
+        "gltf/Box/Box.glb",
+        "gltf/Duck/Duck.glb",
+        "gltf/CesiumMilkTruck/CesiumMilkTruck.glb",
+        "gltf/Avocado/Avocado.gltf",
+        "csg/ex004_cube_minus_sphere.stl",
+        "scenes/cornell-box/CornellBox-Original.obj",
+    ] {
+        let Some(p) = shared(rel) else { continue };
+        let c = coverage(&p);
+        assert!(c > 0.05 && c < 0.95, "{rel}: covers {:.0}% of the image", 100.0 * c);
+    }
+}
+
+/// glTF cameras and KHR_lights_punctual lights are honoured.
+#[test]
+fn gltf_cameras_and_lights() {
+    if let Some(p) = shared("gltf/Cameras/Cameras.gltf") {
+        let scene = scene_for_model(&p, 64, 48).unwrap();
+        assert!(scene.camera.eye.z > 1.0, "the file's camera, not a fitted one: {:?}", scene.camera);
+    }
+    if let Some(p) = shared("gltf/LightsPunctualLamp/LightsPunctualLamp.gltf") {
+        let scene = scene_for_model(&p, 64, 48).unwrap();
+        assert!(!scene.lights.is_empty() && scene.lights.iter().all(|l| l.falloff == Falloff::InverseSquare || matches!(l.kind, LightKind::Directional { .. })));
+    }
+}
