@@ -45,7 +45,10 @@ pub fn render(scene: &Scene, options: &RenderOptions) -> Result<Frame> {
     match options.threads {
         None => Ok(render_here(scene)),
         Some(n) => {
-            let pool = rayon::ThreadPoolBuilder::new().num_threads(n.max(1)).build().map_err(|e| crate::Error::Scene(e.to_string()))?;
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(n.max(1))
+                .build()
+                .map_err(|e| crate::Error::Scene(e.to_string()))?;
             Ok(pool.install(|| render_here(scene)))
         }
     }
@@ -65,5 +68,9 @@ fn render_here(scene: &Scene) -> Frame {
         raster,
         buffer_bytes,
     };
-    Frame { image, visibility, stats }
+    Frame {
+        image,
+        visibility,
+        stats,
+    }
 }

@@ -12,7 +12,14 @@ use kage::scene::{Camera, Falloff, Light, LightKind, Projection};
 use kage::{render, RenderOptions};
 
 fn plane_scene(light: Light) -> kage::Scene {
-    let camera = Camera { eye: Vec3::new(0.0, 3.0, 0.001), target: Vec3::ZERO, up: Vec3::NEG_Z, near: 0.1, far: 10.0, projection: Projection::Orthographic { height: 0.5 } };
+    let camera = Camera {
+        eye: Vec3::new(0.0, 3.0, 0.001),
+        target: Vec3::ZERO,
+        up: Vec3::NEG_Z,
+        near: 0.1,
+        far: 10.0,
+        projection: Projection::Orthographic { height: 0.5 },
+    };
     let mut s = common::scene_with(shapes::plane(), camera, 16, 16, false);
     s.lights = vec![light];
     s
@@ -24,7 +31,14 @@ fn plane_scene(light: Light) -> kage::Scene {
 fn unoccluded_plane_matches_equation_one() {
     let theta: f32 = 0.6;
     let dir = Vec3::new(theta.sin(), -theta.cos(), 0.0);
-    let light = Light { kind: LightKind::Directional { direction: dir }, color: Vec3::new(1.0, 0.5, 0.25), intensity: 2.0, ambient: 0.1, size: 0.0, falloff: Falloff::None };
+    let light = Light {
+        kind: LightKind::Directional { direction: dir },
+        color: Vec3::new(1.0, 0.5, 0.25),
+        intensity: 2.0,
+        ambient: 0.1,
+        size: 0.0,
+        falloff: Falloff::None,
+    };
     let scene = plane_scene(light);
     let m = &scene.materials[0];
     let frame = render(&scene, &RenderOptions::default()).unwrap();
@@ -32,7 +46,9 @@ fn unoccluded_plane_matches_equation_one() {
     // Orthographic view straight down: V = +y; R = mirror of L about +y.
     let l = -dir;
     let r = Vec3::new(-l.x, l.y, -l.z);
-    let want = c * 0.1 * m.ka + c * 2.0 * m.kd * theta.cos() + c * 2.0 * m.ks * r.dot(Vec3::Y).max(0.0).powf(m.shininess);
+    let want = c * 0.1 * m.ka
+        + c * 2.0 * m.kd * theta.cos()
+        + c * 2.0 * m.ks * r.dot(Vec3::Y).max(0.0).powf(m.shininess);
     for p in frame.image.pixels() {
         assert!((*p - want).abs().max_element() < 1e-4, "{p} vs {want}");
     }
@@ -42,11 +58,23 @@ fn unoccluded_plane_matches_equation_one() {
 /// (ambient aside, which both carry).
 #[test]
 fn lights_add_up() {
-    let light = |intensity, ambient| Light { kind: LightKind::Point { position: Vec3::new(0.3, 1.0, 0.2) }, color: Vec3::ONE, intensity, ambient, size: 0.0, falloff: Falloff::InverseSquare };
+    let light = |intensity, ambient| Light {
+        kind: LightKind::Point {
+            position: Vec3::new(0.3, 1.0, 0.2),
+        },
+        color: Vec3::ONE,
+        intensity,
+        ambient,
+        size: 0.0,
+        falloff: Falloff::InverseSquare,
+    };
     let one = plane_scene(light(2.0, 0.2));
     let mut two = plane_scene(light(1.0, 0.1));
     two.lights.push(light(1.0, 0.1));
-    let (a, b) = (render(&one, &RenderOptions::default()).unwrap(), render(&two, &RenderOptions::default()).unwrap());
+    let (a, b) = (
+        render(&one, &RenderOptions::default()).unwrap(),
+        render(&two, &RenderOptions::default()).unwrap(),
+    );
     for (p, q) in a.image.pixels().iter().zip(b.image.pixels()) {
         assert!((*p - *q).abs().max_element() < 1e-5, "{p} vs {q}");
     }
@@ -71,10 +99,16 @@ fn demo_scene_shows_every_object() {
     let scene = kage::scene::demo::demo_scene().unwrap();
     let frame = render(&scene, &RenderOptions::default()).unwrap();
     for (i, o) in scene.objects.iter().enumerate() {
-        let n = frame.visibility.items().iter().filter(|it| it.object == i as u32).count();
+        let n = frame
+            .visibility
+            .items()
+            .iter()
+            .filter(|it| it.object == i as u32)
+            .count();
         assert!(n > 1000, "object {} covers only {n} pixels", o.name);
     }
-    let mean = frame.image.pixels().iter().copied().sum::<Vec3>() / frame.image.pixels().len() as f32;
+    let mean =
+        frame.image.pixels().iter().copied().sum::<Vec3>() / frame.image.pixels().len() as f32;
     assert!(mean.min_element() > 0.1, "mean colour {mean}");
 }
 
@@ -85,11 +119,17 @@ fn full_hd_buffers_fit_in_100_mb() {
     scene.width = 1920;
     scene.height = 1080;
     let frame = render(&scene, &RenderOptions::default()).unwrap();
-    assert!(frame.stats.buffer_bytes < 60 << 20, "{} bytes", frame.stats.buffer_bytes);
+    assert!(
+        frame.stats.buffer_bytes < 60 << 20,
+        "{} bytes",
+        frame.stats.buffer_bytes
+    );
 }
 
 fn shared(rel: &str) -> Option<std::path::PathBuf> {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets").join(rel);
+    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/assets")
+        .join(rel);
     if p.exists() {
         Some(p)
     } else {
@@ -101,7 +141,13 @@ fn shared(rel: &str) -> Option<std::path::PathBuf> {
 fn coverage(path: &Path) -> f32 {
     let scene = scene_for_model(path, 96, 72).unwrap();
     let frame = render(&scene, &RenderOptions::default()).unwrap();
-    frame.visibility.items().iter().filter(|i| !i.is_none()).count() as f32 / (96.0 * 72.0)
+    frame
+        .visibility
+        .items()
+        .iter()
+        .filter(|i| !i.is_none())
+        .count() as f32
+        / (96.0 * 72.0)
 }
 
 /// Every kind of model file loads and, framed automatically, fills a fair part of
@@ -121,7 +167,11 @@ fn real_models_load_and_frame() {
     ] {
         let Some(p) = shared(rel) else { continue };
         let c = coverage(&p);
-        assert!(c > 0.05 && c < 0.95, "{rel}: covers {:.0}% of the image", 100.0 * c);
+        assert!(
+            c > 0.05 && c < 0.95,
+            "{rel}: covers {:.0}% of the image",
+            100.0 * c
+        );
     }
 }
 
@@ -130,10 +180,21 @@ fn real_models_load_and_frame() {
 fn gltf_cameras_and_lights() {
     if let Some(p) = shared("gltf/Cameras/Cameras.gltf") {
         let scene = scene_for_model(&p, 64, 48).unwrap();
-        assert!(scene.camera.eye.z > 1.0, "the file's camera, not a fitted one: {:?}", scene.camera);
+        assert!(
+            scene.camera.eye.z > 1.0,
+            "the file's camera, not a fitted one: {:?}",
+            scene.camera
+        );
     }
     if let Some(p) = shared("gltf/LightsPunctualLamp/LightsPunctualLamp.gltf") {
         let scene = scene_for_model(&p, 64, 48).unwrap();
-        assert!(!scene.lights.is_empty() && scene.lights.iter().all(|l| l.falloff == Falloff::InverseSquare || matches!(l.kind, LightKind::Directional { .. })));
+        assert!(
+            !scene.lights.is_empty()
+                && scene
+                    .lights
+                    .iter()
+                    .all(|l| l.falloff == Falloff::InverseSquare
+                        || matches!(l.kind, LightKind::Directional { .. }))
+        );
     }
 }

@@ -17,7 +17,11 @@ impl LinearImage {
     /// A black image. The size must have been checked.
     #[must_use]
     pub fn new(width: u32, height: u32) -> Self {
-        LinearImage { width, height, pixels: vec![Vec3::ZERO; width as usize * height as usize] }
+        LinearImage {
+            width,
+            height,
+            pixels: vec![Vec3::ZERO; width as usize * height as usize],
+        }
     }
 
     /// Width in pixels.

@@ -22,17 +22,21 @@ pub fn shade_frame(scene: &Scene, vb: &VisibilityBuffer) -> LinearImage {
     let frames = ObjectFrames::new(scene);
     let rays = scene.camera.pixel_rays(Vec2::new(w as f32, h as f32));
     let mut image = LinearImage::new(w, h);
-    image.pixels_mut().par_chunks_mut(w as usize).enumerate().for_each(|(y, row)| {
-        for (x, px) in row.iter_mut().enumerate() {
-            let item = vb.item(x as u32, y as u32);
-            *px = if item.is_none() {
-                scene.background
-            } else {
-                let ray = rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
-                let s = frames.surface(scene, item, &ray);
-                phong::shade(&scene.lights, &scene.materials[s.material], &s).total()
-            };
-        }
-    });
+    image
+        .pixels_mut()
+        .par_chunks_mut(w as usize)
+        .enumerate()
+        .for_each(|(y, row)| {
+            for (x, px) in row.iter_mut().enumerate() {
+                let item = vb.item(x as u32, y as u32);
+                *px = if item.is_none() {
+                    scene.background
+                } else {
+                    let ray = rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
+                    let s = frames.surface(scene, item, &ray);
+                    phong::shade(&scene.lights, &scene.materials[s.material], &s).total()
+                };
+            }
+        });
     image
 }

@@ -45,7 +45,9 @@ impl Coefficients {
     /// Samples every map of `m` at the point's uv.
     #[must_use]
     pub fn at(m: &Material, s: &SurfacePoint) -> Self {
-        let map = |t: &Option<std::sync::Arc<crate::scene::Texture>>| t.as_ref().map_or(Vec3::ONE, |t| t.sample(s.uv));
+        let map = |t: &Option<std::sync::Arc<crate::scene::Texture>>| {
+            t.as_ref().map_or(Vec3::ONE, |t| t.sample(s.uv))
+        };
         Coefficients {
             ka: m.ka * map(&m.maps.ambient),
             kd: m.kd * map(&m.maps.diffuse),
@@ -58,7 +60,13 @@ impl Coefficients {
 
 /// Adds light `light`'s ambient, diffuse and specular terms at `s` to `acc`, with
 /// `shadow` ∈ [0, 1] (1 = lit) multiplying diffuse and specular only.
-pub fn add_light(acc: &mut Components, light: &Light, k: &Coefficients, s: &SurfacePoint, shadow: f32) {
+pub fn add_light(
+    acc: &mut Components,
+    light: &Light,
+    k: &Coefficients,
+    s: &SurfacePoint,
+    shadow: f32,
+) {
     acc.ambient += light.color * light.ambient * k.ka;
     let inc = light.incident(s.position);
     let cos_theta = s.normal.dot(inc.to_light);
@@ -75,7 +83,10 @@ pub fn add_light(acc: &mut Components, light: &Light, k: &Coefficients, s: &Surf
 #[must_use]
 pub fn shade(lights: &[Light], m: &Material, s: &SurfacePoint) -> Components {
     let k = Coefficients::at(m, s);
-    let mut acc = Components { emission: k.ke, ..Default::default() };
+    let mut acc = Components {
+        emission: k.ke,
+        ..Default::default()
+    };
     for light in lights {
         add_light(&mut acc, light, &k, s, 1.0);
     }

@@ -33,7 +33,11 @@ impl ObjectFrames {
     /// Precomputes every object's transforms.
     #[must_use]
     pub fn new(scene: &Scene) -> Self {
-        let frames = scene.objects.iter().map(|o| (o.transform, o.transform.matrix3.inverse().transpose())).collect();
+        let frames = scene
+            .objects
+            .iter()
+            .map(|o| (o.transform, o.transform.matrix3.inverse().transpose()))
+            .collect();
         ObjectFrames { frames }
     }
 
@@ -42,7 +46,8 @@ impl ObjectFrames {
     pub fn triangle(&self, scene: &Scene, item: ItemId) -> [Vec3; 3] {
         let (m, _) = self.frames[item.object as usize];
         let mesh = &scene.objects[item.object as usize].mesh;
-        mesh.triangles[item.triangle as usize].map(|i| m.transform_point3(mesh.positions[i as usize]))
+        mesh.triangles[item.triangle as usize]
+            .map(|i| m.transform_point3(mesh.positions[i as usize]))
     }
 
     /// The surface seen along `ray` on `item`'s triangle.
@@ -58,16 +63,27 @@ impl ObjectFrames {
         let blend3 = |a: [Vec3; 3]| a[0] * weights[0] + a[1] * weights[1] + a[2] * weights[2];
         let (_, nm) = self.frames[item.object as usize];
         let geometric = (p[1] - p[0]).cross(p[2] - p[0]).normalize_or(Vec3::Y);
-        let normal = Vec3::from(nm * glam::Vec3A::from(blend3(idx.map(|i| mesh.normals[i])))).normalize_or(geometric);
+        let normal = Vec3::from(nm * glam::Vec3A::from(blend3(idx.map(|i| mesh.normals[i]))))
+            .normalize_or(geometric);
         let to_eye = -ray.dir.normalize();
-        let normal = if normal.dot(to_eye) < 0.0 { -normal } else { normal };
+        let normal = if normal.dot(to_eye) < 0.0 {
+            -normal
+        } else {
+            normal
+        };
         let uv = if mesh.uvs.is_empty() {
             Vec2::ZERO
         } else {
             let u = idx.map(|i| mesh.uvs[i]);
             u[0] * weights[0] + u[1] * weights[1] + u[2] * weights[2]
         };
-        SurfacePoint { position, normal, to_eye, uv, material: object.material }
+        SurfacePoint {
+            position,
+            normal,
+            to_eye,
+            uv,
+            material: object.material,
+        }
     }
 }
 
@@ -82,10 +98,16 @@ pub fn intersect_plane(ray: &Ray, p: [Vec3; 3]) -> (f32, Vec2) {
     if det.abs() < f32::MIN_POSITIVE {
         // Seen edge-on: the point nearest the centroid is as good as any.
         let c = (p[0] + p[1] + p[2]) / 3.0;
-        return ((c - ray.origin).dot(ray.dir) / ray.dir.length_squared(), Vec2::splat(1.0 / 3.0));
+        return (
+            (c - ray.origin).dot(ray.dir) / ray.dir.length_squared(),
+            Vec2::splat(1.0 / 3.0),
+        );
     }
     let inv = 1.0 / det;
     let tvec = ray.origin - p[0];
     let qvec = tvec.cross(e1);
-    (e2.dot(qvec) * inv, Vec2::new(tvec.dot(pvec) * inv, ray.dir.dot(qvec) * inv))
+    (
+        e2.dot(qvec) * inv,
+        Vec2::new(tvec.dot(pvec) * inv, ray.dir.dot(qvec) * inv),
+    )
 }

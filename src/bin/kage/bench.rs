@@ -9,7 +9,9 @@ use std::process::Command;
 
 use glam::{Affine3A, Vec3};
 use kage::scene::load::{self, FileSystem};
-use kage::scene::{file::add_model, Camera, Falloff, Light, LightKind, Material, Projection, Scene};
+use kage::scene::{
+    file::add_model, Camera, Falloff, Light, LightKind, Material, Projection, Scene,
+};
 use kage::{render, RenderOptions};
 use miette::{miette, IntoDiagnostic, Result};
 
@@ -54,7 +56,10 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         let mesh = ensure_mesh(args, name)?;
         let scene = peer_scene(&mesh, args.width, args.height)?;
         let (row, image) = time_kage(name, &scene, args.frames)?;
-        let peer = lp.exists().then(|| run_llvmpipe(&lp, &mesh, args, &image)).transpose()?;
+        let peer = lp
+            .exists()
+            .then(|| run_llvmpipe(&lp, &mesh, args, &image))
+            .transpose()?;
         rows.push(Row { peer, ..row });
         eprintln!("{name}: done");
     }
@@ -66,9 +71,18 @@ fn ensure_mesh(args: &BenchArgs, name: &str) -> Result<PathBuf> {
     let path = args.meshes.join(format!("{name}.obj"));
     if !path.exists() {
         let script = args.peers.join("common/gen_scene.py");
-        let status = Command::new("python3").arg(&script).arg("--all").arg(&args.meshes).status().into_diagnostic()?;
+        let status = Command::new("python3")
+            .arg(&script)
+            .arg("--all")
+            .arg(&args.meshes)
+            .status()
+            .into_diagnostic()?;
         if !status.success() || !path.exists() {
-            return Err(miette!("{} is missing and {} could not write it", path.display(), script.display()));
+            return Err(miette!(
+                "{} is missing and {} could not write it",
+                path.display(),
+                script.display()
+            ));
         }
     }
     Ok(path)
@@ -76,10 +90,20 @@ fn ensure_mesh(args: &BenchArgs, name: &str) -> Result<PathBuf> {
 
 /// The peers' scene convention (peer_common.h) around the loaded mesh.
 fn peer_scene(path: &Path, width: u32, height: u32) -> Result<Scene> {
-    let fs = FileSystem { base: path.parent().unwrap_or(Path::new(".")).to_path_buf() };
-    let model = load::model(Path::new(path.file_name().unwrap_or_default()), &fs).map_err(|e| miette!("{e}"))?;
+    let fs = FileSystem {
+        base: path.parent().unwrap_or(Path::new(".")).to_path_buf(),
+    };
+    let model = load::model(Path::new(path.file_name().unwrap_or_default()), &fs)
+        .map_err(|e| miette!("{e}"))?;
     let albedo = Vec3::new(0.75, 0.72, 0.65);
-    let material = Material { name: "peer".into(), ka: albedo, kd: 0.9 * albedo, ks: Vec3::splat(0.3), shininess: 32.0, ..Material::default() };
+    let material = Material {
+        name: "peer".into(),
+        ka: albedo,
+        kd: 0.9 * albedo,
+        ks: Vec3::splat(0.3),
+        shininess: 32.0,
+        ..Material::default()
+    };
     let (lo, hi) = model.bounds();
     let (c, r) = ((lo + hi) * 0.5, (hi - lo).length() * 0.5);
     let mut scene = Scene {
@@ -95,7 +119,9 @@ fn peer_scene(path: &Path, width: u32, height: u32) -> Result<Scene> {
             projection: Projection::Perspective { fov_y_deg: 45.0 },
         },
         lights: vec![Light {
-            kind: LightKind::Point { position: c + r * Vec3::new(1.0, 1.6, -0.6) },
+            kind: LightKind::Point {
+                position: c + r * Vec3::new(1.0, 1.6, -0.6),
+            },
             color: Vec3::ONE,
             intensity: 1.0,
             ambient: 0.1,
@@ -115,7 +141,11 @@ fn median(mut v: Vec<f64>) -> f64 {
     v[v.len() / 2]
 }
 
-fn time_kage(name: &str, scene: &Scene, frames: usize) -> Result<(Row, kage::resolve::LinearImage)> {
+fn time_kage(
+    name: &str,
+    scene: &Scene,
+    frames: usize,
+) -> Result<(Row, kage::resolve::LinearImage)> {
     let opts = RenderOptions::default();
     let mut frame = render(scene, &opts).map_err(|e| miette!("{e}"))?; // warm-up
     let (mut vis, mut shade, mut total) = (Vec::new(), Vec::new(), Vec::new());
@@ -139,11 +169,26 @@ fn time_kage(name: &str, scene: &Scene, frames: usize) -> Result<(Row, kage::res
 
 /// Runs llvmpipe on the same mesh; returns its median ms and the RMSE (0-255
 /// scale) between its image and kage's.
-fn run_llvmpipe(bin: &Path, mesh: &Path, args: &BenchArgs, ours: &kage::resolve::LinearImage) -> Result<(f64, Option<f64>)> {
+fn run_llvmpipe(
+    bin: &Path,
+    mesh: &Path,
+    args: &BenchArgs,
+    ours: &kage::resolve::LinearImage,
+) -> Result<(f64, Option<f64>)> {
     let prefix = std::env::temp_dir().join("kage_bench_llvmpipe");
     let out = Command::new(bin)
         .env("LP_NUM_THREADS", "2")
-        .args(["-w", &args.width.to_string(), "-h", &args.height.to_string(), "-f", &args.frames.to_string(), "-m", "phong", "-o"])
+        .args([
+            "-w",
+            &args.width.to_string(),
+            "-h",
+            &args.height.to_string(),
+            "-f",
+            &args.frames.to_string(),
+            "-m",
+            "phong",
+            "-o",
+        ])
         .arg(&prefix)
         .arg(mesh)
         .output()
@@ -153,7 +198,12 @@ fn run_llvmpipe(bin: &Path, mesh: &Path, args: &BenchArgs, ours: &kage::resolve:
         .split_whitespace()
         .find_map(|w| w.strip_prefix("median_ms="))
         .and_then(|v| v.parse().ok())
-        .ok_or_else(|| miette!("llvmpipe printed no median_ms: {text}{}", String::from_utf8_lossy(&out.stderr)))?;
+        .ok_or_else(|| {
+            miette!(
+                "llvmpipe printed no median_ms: {text}{}",
+                String::from_utf8_lossy(&out.stderr)
+            )
+        })?;
     let png = PathBuf::from(format!("{}_phong.png", prefix.display()));
     Ok((ms, rmse_against(&png, ours)))
 }
@@ -166,7 +216,10 @@ fn rmse_against(png: &Path, ours: &kage::resolve::LinearImage) -> Option<f64> {
     let sum: f64 = theirs
         .pixels()
         .zip(ours.pixels())
-        .flat_map(|(t, o)| (0..3).map(move |k| (t[k] as f64 - (o[k].clamp(0.0, 1.0) as f64 * 255.0).round()).powi(2)))
+        .flat_map(|(t, o)| {
+            (0..3)
+                .map(move |k| (t[k] as f64 - (o[k].clamp(0.0, 1.0) as f64 * 255.0).round()).powi(2))
+        })
         .sum();
     Some((sum / (3.0 * ours.pixels().len() as f64)).sqrt())
 }
@@ -176,7 +229,11 @@ fn print_table(rows: &[Row], args: &BenchArgs) {
     println!("|---|---:|---:|---:|---:|---:|---:|---:|");
     for r in rows {
         let (peer, ratio, rmse) = match r.peer {
-            Some((ms, rmse)) => (format!("{ms:.1}"), format!("{:.2}", r.total_ms / ms), rmse.map_or("n/a".into(), |e| format!("{e:.2}"))),
+            Some((ms, rmse)) => (
+                format!("{ms:.1}"),
+                format!("{:.2}", r.total_ms / ms),
+                rmse.map_or("n/a".into(), |e| format!("{e:.2}")),
+            ),
             None => ("not built".into(), "n/a".into(), "n/a".into()),
         };
         println!(
@@ -184,5 +241,11 @@ fn print_table(rows: &[Row], args: &BenchArgs) {
             r.name, r.triangles, r.visibility_ms, r.shading_ms, r.total_ms
         );
     }
-    println!("\n{}x{}, median of {} frames, {} threads.", args.width, args.height, args.frames, rayon::current_num_threads());
+    println!(
+        "\n{}x{}, median of {} frames, {} threads.",
+        args.width,
+        args.height,
+        args.frames,
+        rayon::current_num_threads()
+    );
 }

@@ -7,15 +7,24 @@ use miette::{LabeledSpan, MietteDiagnostic, NamedSource, Report};
 /// Turns a library error into a report for the terminal.
 pub fn to_report(e: Error) -> Report {
     let located = match &e {
-        Error::SceneSyntax { location, message } | Error::SceneInvalid { location, message } => Some((location.clone(), message.clone())),
+        Error::SceneSyntax { location, message } | Error::SceneInvalid { location, message } => {
+            Some((location.clone(), message.clone()))
+        }
         _ => None,
     };
     match located {
         Some((loc, message)) => {
             let len = loc.span.len().max(1);
             let diag = MietteDiagnostic::new(format!("{}: {}", loc, message))
-                .with_code(if matches!(e, Error::SceneSyntax { .. }) { "kage::scene::syntax" } else { "kage::scene::invalid" })
-                .with_label(LabeledSpan::at(loc.span.start..loc.span.start + len, "here"));
+                .with_code(if matches!(e, Error::SceneSyntax { .. }) {
+                    "kage::scene::syntax"
+                } else {
+                    "kage::scene::invalid"
+                })
+                .with_label(LabeledSpan::at(
+                    loc.span.start..loc.span.start + len,
+                    "here",
+                ));
             let source = NamedSource::new(loc.path.display().to_string(), loc.text.to_string());
             Report::new(diag).with_source_code(source)
         }
