@@ -1,8 +1,11 @@
 //! One frame, start to finish: visibility pass → shading passes → resolve.
+//!
+//! A [`Renderer`] keeps its buffers between frames, as an interactive preview
+//! re-renders the same size again and again; [`render`] is the one-shot form.
 
 use std::time::Instant;
 
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::resolve::LinearImage;
 use crate::scene::Scene;
 use crate::shading;
@@ -39,38 +42,63 @@ pub struct Frame {
     pub stats: FrameStats,
 }
 
-/// Renders `scene` (validated first).
-pub fn render(scene: &Scene, options: &RenderOptions) -> Result<Frame> {
-    scene.validate()?;
-    match options.threads {
-        None => Ok(render_here(scene)),
-        Some(n) => {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(n.max(1))
-                .build()
-                .map_err(|e| crate::Error::Scene(e.to_string()))?;
-            Ok(pool.install(|| render_here(scene)))
+/// Renders frames, reusing its buffers from one frame to the next.
+#[derive(Debug)]
+pub struct Renderer {
+    pool: Option<rayon::ThreadPool>,
+    frame: Frame,
+}
+
+impl Renderer {
+    /// A renderer with empty buffers.
+    pub fn new(options: &RenderOptions) -> Result<Renderer> {
+        let pool = match options.threads {
+            None => None,
+            Some(n) => Some(
+                rayon::ThreadPoolBuilder::new()
+                    .num_threads(n.max(1))
+                    .build()
+                    .map_err(|e| Error::Scene(format!("cannot start {n} threads: {e}")))?,
+            ),
+        };
+        let frame = Frame { image: LinearImage::new(0, 0), visibility: VisibilityBuffer::new(0, 0), stats: FrameStats::default() };
+        Ok(Renderer { pool, frame })
+    }
+
+    /// Renders `scene` (validated first) and returns the frame.
+    pub fn render(&mut self, scene: &Scene) -> Result<&Frame> {
+        scene.validate()?;
+        let frame = &mut self.frame;
+        match &self.pool {
+            None => render_into(scene, frame),
+            Some(pool) => pool.install(|| render_into(scene, frame)),
         }
+        Ok(&self.frame)
+    }
+
+    /// Gives up the last frame.
+    #[must_use]
+    pub fn into_frame(self) -> Frame {
+        self.frame
     }
 }
 
-fn render_here(scene: &Scene) -> Frame {
+/// Renders `scene` once.
+pub fn render(scene: &Scene, options: &RenderOptions) -> Result<Frame> {
+    let mut r = Renderer::new(options)?;
+    r.render(scene)?;
+    Ok(r.into_frame())
+}
+
+fn render_into(scene: &Scene, frame: &mut Frame) {
     let t0 = Instant::now();
-    let mut visibility = VisibilityBuffer::new(scene.width, scene.height);
-    let raster = visibility::rasterize(scene, &mut visibility);
+    frame.visibility.resize(scene.width, scene.height);
+    frame.stats.raster = visibility::rasterize(scene, &mut frame.visibility);
     let t1 = Instant::now();
-    let image = shading::shade_frame(scene, &visibility);
+    frame.image.resize(scene.width, scene.height);
+    shading::shade_into(scene, &frame.visibility, &mut frame.image);
     let t2 = Instant::now();
-    let buffer_bytes = visibility.memory_bytes() + std::mem::size_of_val(image.pixels());
-    let stats = FrameStats {
-        visibility_ms: (t1 - t0).as_secs_f64() * 1e3,
-        shading_ms: (t2 - t1).as_secs_f64() * 1e3,
-        raster,
-        buffer_bytes,
-    };
-    Frame {
-        image,
-        visibility,
-        stats,
-    }
+    frame.stats.visibility_ms = (t1 - t0).as_secs_f64() * 1e3;
+    frame.stats.shading_ms = (t2 - t1).as_secs_f64() * 1e3;
+    frame.stats.buffer_bytes = frame.visibility.memory_bytes() + std::mem::size_of_val(frame.image.pixels());
 }

@@ -25,5 +25,5 @@ pub mod shading;
 pub mod visibility;
 
 pub use error::{Error, SourceLocation};
-pub use frame::{render, Frame, FrameStats, RenderOptions};
+pub use frame::{render, Frame, FrameStats, RenderOptions, Renderer};
 pub use scene::Scene;

@@ -24,6 +24,14 @@ impl LinearImage {
         }
     }
 
+    /// Makes the image `width` × `height`, reusing its memory when it can; the
+    /// contents are undefined until written.
+    pub fn resize(&mut self, width: u32, height: u32) {
+        self.width = width;
+        self.height = height;
+        self.pixels.resize(width as usize * height as usize, Vec3::ZERO);
+    }
+
     /// Width in pixels.
     #[must_use]
     pub fn width(&self) -> u32 {

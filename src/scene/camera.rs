@@ -171,12 +171,18 @@ impl Camera {
 /// Rays through the pixels of one image (see [`Camera::pixel_rays`]).
 #[derive(Debug, Clone, Copy)]
 pub struct PixelRays {
-    origin: Vec3,
-    right: Vec3,
-    up: Vec3,
-    forward: Vec3,
-    size: Vec2,
-    ortho: bool,
+    /// Eye (perspective) or the image centre on the eye plane (orthographic).
+    pub origin: Vec3,
+    /// World offset from the image centre to its right edge.
+    pub right: Vec3,
+    /// World offset from the image centre to its top edge.
+    pub up: Vec3,
+    /// Unit viewing direction (perspective: at unit distance).
+    pub forward: Vec3,
+    /// Image size in pixels.
+    pub size: Vec2,
+    /// Parallel rays (orthographic) rather than rays from one point.
+    pub ortho: bool,
 }
 
 impl PixelRays {

@@ -53,61 +53,100 @@ impl ObjectFrames {
     /// The surface seen along `ray` on `item`'s triangle.
     #[must_use]
     pub fn surface(&self, scene: &Scene, item: ItemId, ray: &Ray) -> SurfacePoint {
+        self.prepare(scene, item).surface(ray)
+    }
+
+    /// Gathers everything about `item`'s triangle that does not depend on the ray,
+    /// so neighbouring pixels showing the same triangle share the work.
+    #[must_use]
+    pub fn prepare(&self, scene: &Scene, item: ItemId) -> PreparedTriangle {
         let object = &scene.objects[item.object as usize];
         let mesh = &object.mesh;
         let idx = mesh.triangles[item.triangle as usize].map(|i| i as usize);
-        let p = self.triangle(scene, item);
-        let (t, b) = intersect_plane(ray, p);
-        let position = ray.origin + ray.dir * t;
-        let weights = [1.0 - b.x - b.y, b.x, b.y];
-        let blend3 = |a: [Vec3; 3]| a[0] * weights[0] + a[1] * weights[1] + a[2] * weights[2];
+        let [a, b, c] = self.triangle(scene, item);
         let (_, nm) = self.frames[item.object as usize];
-        let geometric = (p[1] - p[0]).cross(p[2] - p[0]).normalize_or(Vec3::Y);
-        let normal = Vec3::from(nm * glam::Vec3A::from(blend3(idx.map(|i| mesh.normals[i]))))
-            .normalize_or(geometric);
-        let to_eye = -ray.dir.normalize();
-        let normal = if normal.dot(to_eye) < 0.0 {
-            -normal
-        } else {
-            normal
-        };
-        let uv = if mesh.uvs.is_empty() {
-            Vec2::ZERO
-        } else {
-            let u = idx.map(|i| mesh.uvs[i]);
-            u[0] * weights[0] + u[1] * weights[1] + u[2] * weights[2]
-        };
-        SurfacePoint {
-            position,
-            normal,
-            to_eye,
-            uv,
+        let (e1, e2) = (b - a, c - a);
+        PreparedTriangle {
+            item,
+            a,
+            e1,
+            e2,
+            geometric: e1.cross(e2).normalize_or(Vec3::Y),
+            normals: idx.map(|i| Vec3::from(nm * glam::Vec3A::from(mesh.normals[i]))),
+            uvs: (!mesh.uvs.is_empty()).then(|| idx.map(|i| mesh.uvs[i])),
             material: object.material,
         }
     }
 }
 
-/// Intersects the ray with the triangle's PLANE (Möller–Trumbore without the
-/// inside test: a pixel centre that the fill rule gave to this triangle may lie a
-/// hair outside it). Returns the distance and barycentrics (b1, b2).
+/// One item's triangle in world space, ready to be hit by pixel rays.
+#[derive(Debug, Clone, Copy)]
+pub struct PreparedTriangle {
+    /// The item it belongs to.
+    pub item: ItemId,
+    a: Vec3,
+    e1: Vec3,
+    e2: Vec3,
+    geometric: Vec3,
+    normals: [Vec3; 3],
+    uvs: Option<[Vec2; 3]>,
+    /// Index into `Scene::materials`.
+    pub material: usize,
+}
+
+/// The ray-independent data of a [`PreparedTriangle`], for batched shading.
+#[derive(Debug, Clone, Copy)]
+pub struct TriangleGeometry {
+    /// First vertex, world space.
+    pub a: Vec3,
+    /// Second vertex minus the first.
+    pub e1: Vec3,
+    /// Third vertex minus the first.
+    pub e2: Vec3,
+    /// Unit geometric normal (used where the vertex normals cancel).
+    pub geometric: Vec3,
+    /// World-space vertex normals (not normalised).
+    pub normals: [Vec3; 3],
+    /// Vertex texture coordinates, if the mesh has them.
+    pub uvs: Option<[Vec2; 3]>,
+}
+
+impl PreparedTriangle {
+    /// The triangle's world-space data.
+    #[must_use]
+    pub fn geometry(&self) -> TriangleGeometry {
+        TriangleGeometry { a: self.a, e1: self.e1, e2: self.e2, geometric: self.geometric, normals: self.normals, uvs: self.uvs }
+    }
+
+    /// The surface point where `ray` meets the triangle's plane.
+    #[must_use]
+    pub fn surface(&self, ray: &Ray) -> SurfacePoint {
+        let (t, b) = intersect_plane(ray, self.a, self.e1, self.e2);
+        let w = [1.0 - b.x - b.y, b.x, b.y];
+        let n = self.normals[0] * w[0] + self.normals[1] * w[1] + self.normals[2] * w[2];
+        let n = n.normalize_or(self.geometric);
+        let to_eye = -ray.dir;
+        let normal = if n.dot(to_eye) < 0.0 { -n } else { n };
+        let uv = self.uvs.map_or(Vec2::ZERO, |u| u[0] * w[0] + u[1] * w[1] + u[2] * w[2]);
+        SurfacePoint { position: ray.origin + ray.dir * t, normal, to_eye, uv, material: self.material }
+    }
+}
+
+/// Intersects the ray with the PLANE of triangle (a, a + e1, a + e2) —
+/// Möller–Trumbore without the inside test: a pixel centre that the fill rule gave
+/// to this triangle may lie a hair outside it. Returns the distance along the
+/// (unit) direction and the barycentrics (b1, b2).
 #[must_use]
-pub fn intersect_plane(ray: &Ray, p: [Vec3; 3]) -> (f32, Vec2) {
-    let (e1, e2) = (p[1] - p[0], p[2] - p[0]);
+pub fn intersect_plane(ray: &Ray, a: Vec3, e1: Vec3, e2: Vec3) -> (f32, Vec2) {
     let pvec = ray.dir.cross(e2);
     let det = e1.dot(pvec);
     if det.abs() < f32::MIN_POSITIVE {
         // Seen edge-on: the point nearest the centroid is as good as any.
-        let c = (p[0] + p[1] + p[2]) / 3.0;
-        return (
-            (c - ray.origin).dot(ray.dir) / ray.dir.length_squared(),
-            Vec2::splat(1.0 / 3.0),
-        );
+        let c = a + (e1 + e2) / 3.0;
+        return ((c - ray.origin).dot(ray.dir), Vec2::splat(1.0 / 3.0));
     }
     let inv = 1.0 / det;
-    let tvec = ray.origin - p[0];
+    let tvec = ray.origin - a;
     let qvec = tvec.cross(e1);
-    (
-        e2.dot(qvec) * inv,
-        Vec2::new(tvec.dot(pvec) * inv, ray.dir.dot(qvec) * inv),
-    )
+    (e2.dot(qvec) * inv, Vec2::new(tvec.dot(pvec) * inv, ray.dir.dot(qvec) * inv))
 }

@@ -99,6 +99,16 @@ impl VisibilityBuffer {
         self.depth[y as usize * self.width as usize + x as usize]
     }
 
+    /// Makes the buffer `width` × `height`, reusing its memory when it can. The
+    /// contents are undefined until the next [`super::rasterize`].
+    pub fn resize(&mut self, width: u32, height: u32) {
+        let n = width as usize * height as usize;
+        self.width = width;
+        self.height = height;
+        self.depth.resize(n, 0.0);
+        self.items.resize(n, ItemId::NONE);
+    }
+
     /// Forgets everything drawn.
     pub fn clear(&mut self) {
         self.depth.fill(0.0);

@@ -111,8 +111,8 @@ struct Frame<'a> {
     bands: usize,
 }
 
-/// Draws every object of `scene` into `vb` (which must be cleared by the caller if
-/// it was used before).
+/// Draws every object of `scene` into `vb`, which is cleared first (each band
+/// clears its own rows, in parallel, just before drawing them).
 pub fn rasterize(scene: &Scene, vb: &mut VisibilityBuffer) -> RasterStats {
     let (w, h) = (vb.width() as usize, vb.height() as usize);
     let view_proj = scene.camera.view_projection(w as f32 / h as f32);
@@ -282,6 +282,8 @@ impl Frame<'_> {
     ) {
         let row0 = (band * BAND_ROWS) as i64;
         let rows = row0..(row0 + BAND_ROWS as i64).min(self.height);
+        depth.fill(0.0);
+        items.fill(ItemId::NONE);
         let mut sink = DepthSink {
             depth,
             items,

@@ -12,7 +12,7 @@ use kage::scene::load::{self, FileSystem};
 use kage::scene::{
     file::add_model, Camera, Falloff, Light, LightKind, Material, Projection, Scene,
 };
-use kage::{render, RenderOptions};
+use kage::{RenderOptions, Renderer};
 use miette::{miette, IntoDiagnostic, Result};
 
 /// Options of `kage bench`.
@@ -22,9 +22,12 @@ pub struct BenchArgs {
     /// gen_scene.py when missing).
     #[arg(long, default_value = "target/peer_meshes")]
     meshes: PathBuf,
-    /// The peers folder (for gen_scene.py and the llvmpipe program).
+    /// The peers folder (for gen_scene.py).
     #[arg(long, default_value = "../shared/peers")]
     peers: PathBuf,
+    /// The llvmpipe peer program (`scripts/build-peers.sh` builds it); skipped if absent.
+    #[arg(long, default_value = "target/peers/llvmpipe_bench_egl")]
+    llvmpipe: PathBuf,
     /// Timed frames per row (the median is reported).
     #[arg(long, default_value_t = 10)]
     frames: usize,
@@ -50,7 +53,7 @@ struct Row {
 
 /// Runs the benchmark and prints the table.
 pub fn run(args: &BenchArgs) -> Result<()> {
-    let lp = args.peers.join("llvmpipe/llvmpipe_bench_egl");
+    let lp = &args.llvmpipe;
     let mut rows = Vec::new();
     for name in args.scenes.split(',').map(str::trim) {
         let mesh = ensure_mesh(args, name)?;
@@ -58,7 +61,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         let (row, image) = time_kage(name, &scene, args.frames)?;
         let peer = lp
             .exists()
-            .then(|| run_llvmpipe(&lp, &mesh, args, &image))
+            .then(|| run_llvmpipe(lp, &mesh, args, &image))
             .transpose()?;
         rows.push(Row { peer, ..row });
         eprintln!("{name}: done");
@@ -146,16 +149,17 @@ fn time_kage(
     scene: &Scene,
     frames: usize,
 ) -> Result<(Row, kage::resolve::LinearImage)> {
-    let opts = RenderOptions::default();
-    let mut frame = render(scene, &opts).map_err(|e| miette!("{e}"))?; // warm-up
+    let mut renderer = Renderer::new(&RenderOptions::default()).map_err(|e| miette!("{e}"))?;
+    renderer.render(scene).map_err(|e| miette!("{e}"))?; // warm-up
     let (mut vis, mut shade, mut total) = (Vec::new(), Vec::new(), Vec::new());
     for _ in 0..frames.max(1) {
         let t = std::time::Instant::now();
-        frame = render(scene, &opts).map_err(|e| miette!("{e}"))?;
+        let stats = renderer.render(scene).map_err(|e| miette!("{e}"))?.stats;
         total.push(t.elapsed().as_secs_f64() * 1e3);
-        vis.push(frame.stats.visibility_ms);
-        shade.push(frame.stats.shading_ms);
+        vis.push(stats.visibility_ms);
+        shade.push(stats.shading_ms);
     }
+    let frame = renderer.into_frame();
     let row = Row {
         name: name.to_string(),
         triangles: scene.triangle_count(),
