@@ -78,6 +78,9 @@ impl Gather {
         self.v[1][i] = v.y;
         self.v[2][i] = v.z;
     }
+    fn fill(&mut self, v: Vec3) {
+        self.v = [[v.x; LANES], [v.y; LANES], [v.z; LANES]];
+    }
     fn load(&self) -> V3 {
         V3 { x: F::new(self.v[0]), y: F::new(self.v[1]), z: F::new(self.v[2]) }
     }
@@ -132,6 +135,33 @@ impl Block {
         self.textured[i] = k.is_none();
         if let Some(k) = k {
             self.set_coefficients(i, k);
+        }
+    }
+
+    /// Puts every pixel of the block on `tri` (the common case inside a large
+    /// triangle): the same as [`Block::set`] on each lane, with vector stores.
+    pub fn set_all(&mut self, tri: &PreparedTriangle, k: Option<&Coefficients>) {
+        let g = tri.geometry();
+        self.a.fill(g.a);
+        self.e1.fill(g.e1);
+        self.e2.fill(g.e2);
+        for (slot, n) in self.n.iter_mut().zip(g.normals) {
+            slot.fill(n);
+        }
+        self.geometric.fill(g.geometric);
+        let uv = g.uvs.unwrap_or_default();
+        self.u.fill(Vec3::new(uv[0].x, uv[1].x, uv[2].x));
+        self.v.fill(Vec3::new(uv[0].y, uv[1].y, uv[2].y));
+        self.material = [tri.material; LANES];
+        self.live = [true; LANES];
+        self.textured = [k.is_none(); LANES];
+        if let Some(k) = k {
+            let (ka, kd, ks, ke, n) = k.parts();
+            self.ka.fill(ka);
+            self.kd.fill(kd);
+            self.ks.fill(ks);
+            self.ke.fill(ke);
+            self.shininess = [n; LANES];
         }
     }
 
@@ -206,6 +236,8 @@ impl Block {
     fn lights(&self, lights: &[Light], p: &V3, n: &V3, v: &V3) -> V3 {
         let (ka, kd, ks) = (self.ka.load(), self.kd.load(), self.ks.load());
         let shininess = F::new(self.shininess);
+        let n0 = self.shininess[0];
+        let whole = (self.shininess.iter().all(|&n| n == n0) && n0.fract() == 0.0 && (1.0..=4096.0).contains(&n0)).then_some(n0 as u32);
         let ambient: Vec3 = lights.iter().map(|l| l.color * l.ambient).sum();
         let mut diffuse = V3::splat(Vec3::ZERO);
         let mut specular = V3::splat(Vec3::ZERO);
@@ -215,13 +247,33 @@ impl Block {
             let lit = cos_theta.simd_gt(F::ZERO);
             let r = n.scale(cos_theta + cos_theta).sub(l);
             let cos_alpha = r.dot(*v).max(F::ZERO);
-            let spec = cos_alpha.simd_gt(F::ZERO).select(cos_alpha.powf_simd(shininess), F::ZERO);
+            let spec = power(cos_alpha, shininess, whole);
             let d = lit.select(cos_theta, F::ZERO);
             let s = lit.select(spec, F::ZERO);
             diffuse = diffuse.add(radiance.scale(d));
             specular = specular.add(radiance.scale(s));
         }
         ka.mul(V3::splat(ambient)).add(kd.mul(diffuse)).add(ks.mul(specular)).add(self.ke.load())
+    }
+}
+
+/// `x^n` per lane for x ≥ 0: by repeated squaring when every lane has the same
+/// whole exponent `whole` (exact, and several times faster), else through
+/// exp/log.
+fn power(x: F, n: F, whole: Option<u32>) -> F {
+    match whole {
+        Some(mut e) => {
+            let (mut base, mut acc) = (x, F::ONE);
+            while e > 0 {
+                if e & 1 == 1 {
+                    acc *= base;
+                }
+                base *= base;
+                e >>= 1;
+            }
+            acc
+        }
+        None => x.simd_gt(F::ZERO).select(x.powf_simd(n), F::ZERO),
     }
 }
 
@@ -261,7 +313,8 @@ fn incident(light: &Light, p: &V3) -> (V3, V3) {
 
 /// Origins and unit directions of the rays through pixels `x0 .. x0 + 8` of row `y`.
 fn lane_rays(rays: &PixelRays, x0: usize, y: usize) -> (V3, V3) {
-    let xs = F::new(std::array::from_fn(|i| (x0 + i) as f32 + 0.5));
+    const STEPS: F = F::new([0.5, 1.5, 2.5, 3.5, 4.5, 5.5, 6.5, 7.5]);
+    let xs = F::splat(x0 as f32) + STEPS;
     let ndc_x = xs * F::splat(2.0 / rays.size.x) - F::ONE;
     let ndc_y = F::splat(1.0 - 2.0 * (y as f32 + 0.5) / rays.size.y);
     let offset = V3::splat(rays.right).scale(ndc_x).add(V3::splat(rays.up).scale(ndc_y));

@@ -40,6 +40,16 @@ pub fn shade_into(scene: &Scene, vb: &VisibilityBuffer, image: &mut LinearImage)
         let mut prepared: Option<PreparedTriangle> = None;
         let mut block = lanes::Block::default();
         for (c, (out, items)) in out.chunks_mut(lanes::LANES).zip(items.chunks(lanes::LANES)).enumerate() {
+            let first = items[0];
+            if items.len() == lanes::LANES && !first.is_none() && items.iter().all(|&i| i == first) {
+                let tri = match prepared {
+                    Some(t) if t.item == first => t,
+                    _ => *prepared.insert(frames.prepare(scene, first)),
+                };
+                block.set_all(&tri, constants[tri.material].as_ref());
+                block.shade(&rays, (c * lanes::LANES, y), &scene.lights, sample, out);
+                continue;
+            }
             block.clear();
             for (i, (&item, px)) in items.iter().zip(out.iter_mut()).enumerate() {
                 if item.is_none() {
