@@ -68,6 +68,7 @@ impl V3 {
 
 /// `1/√x` to about 23 bits: the hardware estimate refined by one Newton step,
 /// several times cheaper than a square root and a division.
+#[inline(always)]
 fn rsqrt(x: F) -> F {
     let y = x.recip_sqrt();
     y * (F::splat(1.5) - F::splat(0.5) * x * y * y)
@@ -84,9 +85,6 @@ impl Gather {
         self.v[0][i] = v.x;
         self.v[1][i] = v.y;
         self.v[2][i] = v.z;
-    }
-    fn fill(&mut self, v: Vec3) {
-        self.v = [[v.x; LANES], [v.y; LANES], [v.z; LANES]];
     }
     fn load(&self) -> V3 {
         V3 { x: F::new(self.v[0]), y: F::new(self.v[1]), z: F::new(self.v[2]) }
@@ -145,33 +143,6 @@ impl Block {
         }
     }
 
-    /// Puts every pixel of the block on `tri` (the common case inside a large
-    /// triangle): the same as [`Block::set`] on each lane, with vector stores.
-    pub fn set_all(&mut self, tri: &PreparedTriangle, k: Option<&Coefficients>) {
-        let g = tri.geometry();
-        self.a.fill(g.a);
-        self.e1.fill(g.e1);
-        self.e2.fill(g.e2);
-        for (slot, n) in self.n.iter_mut().zip(g.normals) {
-            slot.fill(n);
-        }
-        self.geometric.fill(g.geometric);
-        let uv = g.uvs.unwrap_or_default();
-        self.u.fill(Vec3::new(uv[0].x, uv[1].x, uv[2].x));
-        self.v.fill(Vec3::new(uv[0].y, uv[1].y, uv[2].y));
-        self.material = [tri.material; LANES];
-        self.live = [true; LANES];
-        self.textured = [k.is_none(); LANES];
-        if let Some(k) = k {
-            let (ka, kd, ks, ke, n) = k.parts();
-            self.ka.fill(ka);
-            self.kd.fill(kd);
-            self.ks.fill(ks);
-            self.ke.fill(ke);
-            self.shininess = [n; LANES];
-        }
-    }
-
     fn set_coefficients(&mut self, i: usize, k: &Coefficients) {
         let (ka, kd, ks, ke, n) = k.parts();
         self.ka.set(i, ka);
@@ -181,6 +152,25 @@ impl Block {
         self.shininess[i] = n;
     }
 
+    /// The lanes' inputs, loaded into vectors.
+    fn inputs(&self) -> LaneInputs {
+        let n0 = self.shininess[0];
+        let same = self.shininess.iter().all(|&n| n == n0);
+        LaneInputs {
+            a: self.a.load(),
+            e1: self.e1.load(),
+            e2: self.e2.load(),
+            n: [self.n[0].load(), self.n[1].load(), self.n[2].load()],
+            geometric: self.geometric.load(),
+            ka: self.ka.load(),
+            kd: self.kd.load(),
+            ks: self.ks.load(),
+            ke: self.ke.load(),
+            shininess: F::new(self.shininess),
+            whole: if same { whole_exponent(n0) } else { None },
+        }
+    }
+
     /// Shades the block: `x0` is the first pixel's column on row `y`; lanes with a
     /// textured material get their coefficients from `coefficients_at`. Writes the
     /// colours of live lanes to `out`.
@@ -188,29 +178,18 @@ impl Block {
         &mut self,
         rays: &PixelRays,
         (x0, y): (usize, usize),
-        lights: &[Light],
+        lighting: &Lighting,
         coefficients_at: impl Fn(&SurfacePoint) -> Coefficients,
         out: &mut [Vec3],
     ) {
-        let (origin, dir) = lane_rays(rays, x0, y);
-        let (a, e1, e2) = (self.a.load(), self.e1.load(), self.e2.load());
-        // Möller–Trumbore against the plane (see surface::intersect_plane).
-        let pvec = dir.cross(e2);
-        let det = e1.dot(pvec);
-        let det = det.abs().simd_lt(F::splat(f32::MIN_POSITIVE)).select(F::splat(f32::MIN_POSITIVE), det);
-        let inv = F::ONE / det;
-        let tvec = origin.sub(a);
-        let qvec = tvec.cross(e1);
-        let (b1, b2, t) = (tvec.dot(pvec) * inv, dir.dot(qvec) * inv, e2.dot(qvec) * inv);
-        let b0 = F::ONE - b1 - b2;
-        let interp = |g: &[Gather; 3]| g[0].load().scale(b0).add(g[1].load().scale(b1)).add(g[2].load().scale(b2));
-        let n = interp(&self.n).normalize_or(self.geometric.load());
-        let to_eye = V3 { x: -dir.x, y: -dir.y, z: -dir.z };
-        let facing = n.dot(to_eye).simd_lt(F::ZERO);
-        let n = V3::select(facing, V3 { x: -n.x, y: -n.y, z: -n.z }, n);
-        let p = origin.add(dir.scale(t));
-        self.sample_textures(b0, b1, b2, (&p, &n, &to_eye), &coefficients_at);
-        let rgb = self.lights(lights, &p, &n, &to_eye);
+        let mut inputs = self.inputs();
+        let s = surface(&inputs, rays, x0, y);
+        if self.sample_textures(&s, &coefficients_at) {
+            let textured = self.inputs();
+            (inputs.ka, inputs.kd, inputs.ks, inputs.ke) = (textured.ka, textured.kd, textured.ks, textured.ke);
+            (inputs.shininess, inputs.whole) = (textured.shininess, textured.whole);
+        }
+        let rgb = lighting.shade(&inputs, &s);
         for (i, px) in out.iter_mut().enumerate() {
             if self.live[i] {
                 *px = rgb.lane(i);
@@ -218,55 +197,153 @@ impl Block {
         }
     }
 
-    fn sample_textures(&mut self, b0: F, b1: F, b2: F, (p, n, v): (&V3, &V3, &V3), at: &impl Fn(&SurfacePoint) -> Coefficients) {
+    /// Samples the maps of textured lanes; false if there were none.
+    fn sample_textures(&mut self, s: &LaneSurface, at: &impl Fn(&SurfacePoint) -> Coefficients) -> bool {
         if !self.textured.iter().zip(&self.live).any(|(t, l)| *t && *l) {
-            return;
+            return false;
         }
+        let [b0, b1, b2] = s.weights;
         let (u, w) = (self.u.load(), self.v.load());
         let uu = u.x * b0 + u.y * b1 + u.z * b2;
         let vv = w.x * b0 + w.y * b1 + w.z * b2;
         for i in 0..LANES {
             if self.textured[i] && self.live[i] {
-                let s = SurfacePoint {
-                    position: p.lane(i),
-                    normal: n.lane(i),
-                    to_eye: v.lane(i),
+                let point = SurfacePoint {
+                    position: s.p.lane(i),
+                    normal: s.n.lane(i),
+                    to_eye: s.v.lane(i),
                     uv: Vec2::new(uu.as_array()[i], vv.as_array()[i]),
                     material: self.material[i],
                 };
-                let k = at(&s);
+                let k = at(&point);
                 self.set_coefficients(i, &k);
             }
         }
+        true
+    }
+}
+
+/// Shades eight pixels that all show `tri` with the map-free coefficients `k`:
+/// the inputs are broadcast straight into vector registers, skipping the gather.
+pub fn shade_uniform(
+    tri: &PreparedTriangle,
+    k: &Coefficients,
+    rays: &PixelRays,
+    (x0, y): (usize, usize),
+    lighting: &Lighting,
+    out: &mut [Vec3],
+) {
+    let g = tri.geometry();
+    let (ka, kd, ks, ke, n) = k.parts();
+    let inputs = LaneInputs {
+        a: V3::splat(g.a),
+        e1: V3::splat(g.e1),
+        e2: V3::splat(g.e2),
+        n: g.normals.map(V3::splat),
+        geometric: V3::splat(g.geometric),
+        ka: V3::splat(ka),
+        kd: V3::splat(kd),
+        ks: V3::splat(ks),
+        ke: V3::splat(ke),
+        shininess: F::splat(n),
+        whole: whole_exponent(n),
+    };
+    let rgb = lighting.shade(&inputs, &surface(&inputs, rays, x0, y));
+    let (r, g, b) = (rgb.x.to_array(), rgb.y.to_array(), rgb.z.to_array());
+    for (i, px) in out.iter_mut().enumerate() {
+        *px = Vec3::new(r[i], g[i], b[i]);
+    }
+}
+
+/// One triangle and material per lane, in vector registers.
+#[derive(Debug, Clone, Copy)]
+struct LaneInputs {
+    a: V3,
+    e1: V3,
+    e2: V3,
+    n: [V3; 3],
+    geometric: V3,
+    ka: V3,
+    kd: V3,
+    ks: V3,
+    ke: V3,
+    shininess: F,
+    /// The exponent shared by all lanes when it is a whole number.
+    whole: Option<u32>,
+}
+
+fn whole_exponent(n: f32) -> Option<u32> {
+    (n.fract() == 0.0 && (1.0..=4096.0).contains(&n)).then_some(n as u32)
+}
+
+/// The surface each lane sees.
+struct LaneSurface {
+    p: V3,
+    /// Unit normal facing the eye.
+    n: V3,
+    /// Unit vector to the eye.
+    v: V3,
+    /// Barycentric weights of the three vertices.
+    weights: [F; 3],
+}
+
+/// Ray/plane intersection (Möller–Trumbore, as `surface::intersect_plane`) and
+/// normal interpolation for eight pixels.
+#[inline(always)]
+fn surface(inp: &LaneInputs, rays: &PixelRays, x0: usize, y: usize) -> LaneSurface {
+    let (origin, dir) = lane_rays(rays, x0, y);
+    let pvec = dir.cross(inp.e2);
+    let det = inp.e1.dot(pvec);
+    let det = det.abs().simd_lt(F::splat(f32::MIN_POSITIVE)).select(F::splat(f32::MIN_POSITIVE), det);
+    let inv = F::ONE / det;
+    let tvec = origin.sub(inp.a);
+    let qvec = tvec.cross(inp.e1);
+    let (b1, b2, t) = (tvec.dot(pvec) * inv, dir.dot(qvec) * inv, inp.e2.dot(qvec) * inv);
+    let b0 = F::ONE - b1 - b2;
+    let n = inp.n[0].scale(b0).add(inp.n[1].scale(b1)).add(inp.n[2].scale(b2)).normalize_or(inp.geometric);
+    let v = V3 { x: -dir.x, y: -dir.y, z: -dir.z };
+    let facing = n.dot(v).simd_lt(F::ZERO);
+    let n = V3::select(facing, V3 { x: -n.x, y: -n.y, z: -n.z }, n);
+    LaneSurface { p: origin.add(dir.scale(t)), n, v, weights: [b0, b1, b2] }
+}
+
+/// The lights of a frame, with their summed ambient colour.
+#[derive(Debug, Clone)]
+pub struct Lighting<'a> {
+    lights: &'a [Light],
+    ambient: Vec3,
+}
+
+impl<'a> Lighting<'a> {
+    /// Prepares `lights` for lane shading.
+    #[must_use]
+    pub fn new(lights: &'a [Light]) -> Self {
+        Lighting { lights, ambient: lights.iter().map(|l| l.color * l.ambient).sum() }
     }
 
-    fn lights(&self, lights: &[Light], p: &V3, n: &V3, v: &V3) -> V3 {
-        let (ka, kd, ks) = (self.ka.load(), self.kd.load(), self.ks.load());
-        let shininess = F::new(self.shininess);
-        let n0 = self.shininess[0];
-        let whole = (self.shininess.iter().all(|&n| n == n0) && n0.fract() == 0.0 && (1.0..=4096.0).contains(&n0)).then_some(n0 as u32);
-        let ambient: Vec3 = lights.iter().map(|l| l.color * l.ambient).sum();
+    /// Seed 002 eq. 1 summed over the lights, per lane.
+    #[inline(always)]
+    fn shade(&self, inp: &LaneInputs, s: &LaneSurface) -> V3 {
         let mut diffuse = V3::splat(Vec3::ZERO);
         let mut specular = V3::splat(Vec3::ZERO);
-        for light in lights {
-            let (l, radiance) = incident(light, p);
-            let cos_theta = n.dot(l);
+        for light in self.lights {
+            let (l, radiance) = incident(light, &s.p);
+            let cos_theta = s.n.dot(l);
             let lit = cos_theta.simd_gt(F::ZERO);
-            let r = n.scale(cos_theta + cos_theta).sub(l);
-            let cos_alpha = r.dot(*v).max(F::ZERO);
-            let spec = power(cos_alpha, shininess, whole);
-            let d = lit.select(cos_theta, F::ZERO);
-            let s = lit.select(spec, F::ZERO);
-            diffuse = diffuse.add(radiance.scale(d));
-            specular = specular.add(radiance.scale(s));
+            let r = s.n.scale(cos_theta + cos_theta).sub(l);
+            let cos_alpha = r.dot(s.v).max(F::ZERO);
+            let spec = power(cos_alpha, inp.shininess, inp.whole);
+            diffuse = diffuse.add(radiance.scale(lit.select(cos_theta, F::ZERO)));
+            specular = specular.add(radiance.scale(lit.select(spec, F::ZERO)));
         }
-        ka.mul(V3::splat(ambient)).add(kd.mul(diffuse)).add(ks.mul(specular)).add(self.ke.load())
+        inp.ka.mul(V3::splat(self.ambient)).add(inp.kd.mul(diffuse)).add(inp.ks.mul(specular)).add(inp.ke)
     }
 }
 
 /// `x^n` per lane for x ≥ 0: by repeated squaring when every lane has the same
 /// whole exponent `whole` (exact, and several times faster), else through
 /// exp/log.
+#[inline(always)]
 fn power(x: F, n: F, whole: Option<u32>) -> F {
     match whole {
         Some(mut e) => {
@@ -285,6 +362,7 @@ fn power(x: F, n: F, whole: Option<u32>) -> F {
 }
 
 /// Unit direction towards the light and radiance, per lane (as `Light::incident`).
+#[inline(always)]
 fn incident(light: &Light, p: &V3) -> (V3, V3) {
     let scale = V3::splat(light.color * light.intensity);
     let positional = |pos: Vec3| {
@@ -319,6 +397,7 @@ fn incident(light: &Light, p: &V3) -> (V3, V3) {
 }
 
 /// Origins and unit directions of the rays through pixels `x0 .. x0 + 8` of row `y`.
+#[inline(always)]
 fn lane_rays(rays: &PixelRays, x0: usize, y: usize) -> (V3, V3) {
     const STEPS: F = F::new([0.5, 1.5, 2.5, 3.5, 4.5, 5.5, 6.5, 7.5]);
     let xs = F::splat(x0 as f32) + STEPS;

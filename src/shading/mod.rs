@@ -35,6 +35,7 @@ pub fn shade_into(scene: &Scene, vb: &VisibilityBuffer, image: &mut LinearImage)
     let rays = scene.camera.pixel_rays(Vec2::new(w as f32, vb.height() as f32));
     let constants: Vec<Option<Coefficients>> = scene.materials.iter().map(Coefficients::constant).collect();
     let sample = |s: &SurfacePoint| Coefficients::at(&scene.materials[s.material], s);
+    let lighting = lanes::Lighting::new(&scene.lights);
     let rows = image.pixels_mut().par_chunks_mut(w).zip(vb.items().par_chunks(w));
     rows.enumerate().for_each(|(y, (out, items))| {
         let mut prepared: Option<PreparedTriangle> = None;
@@ -46,9 +47,10 @@ pub fn shade_into(scene: &Scene, vb: &VisibilityBuffer, image: &mut LinearImage)
                     Some(t) if t.item == first => t,
                     _ => *prepared.insert(frames.prepare(scene, first)),
                 };
-                block.set_all(&tri, constants[tri.material].as_ref());
-                block.shade(&rays, (c * lanes::LANES, y), &scene.lights, sample, out);
-                continue;
+                if let Some(k) = &constants[tri.material] {
+                    lanes::shade_uniform(&tri, k, &rays, (c * lanes::LANES, y), &lighting, out);
+                    continue;
+                }
             }
             block.clear();
             for (i, (&item, px)) in items.iter().zip(out.iter_mut()).enumerate() {
@@ -63,7 +65,7 @@ pub fn shade_into(scene: &Scene, vb: &VisibilityBuffer, image: &mut LinearImage)
                 block.set(i, &tri, constants[tri.material].as_ref());
             }
             if block.live.iter().any(|&l| l) {
-                block.shade(&rays, (c * lanes::LANES, y), &scene.lights, sample, out);
+                block.shade(&rays, (c * lanes::LANES, y), &lighting, sample, out);
             }
         }
     });
