@@ -61,7 +61,11 @@ impl Renderer {
                     .map_err(|e| Error::Scene(format!("cannot start {n} threads: {e}")))?,
             ),
         };
-        let frame = Frame { image: LinearImage::new(0, 0), visibility: VisibilityBuffer::new(0, 0), stats: FrameStats::default() };
+        let frame = Frame {
+            image: LinearImage::new(0, 0),
+            visibility: VisibilityBuffer::new(0, 0),
+            stats: FrameStats::default(),
+        };
         Ok(Renderer { pool, frame })
     }
 
@@ -100,5 +104,6 @@ fn render_into(scene: &Scene, frame: &mut Frame) {
     let t2 = Instant::now();
     frame.stats.visibility_ms = (t1 - t0).as_secs_f64() * 1e3;
     frame.stats.shading_ms = (t2 - t1).as_secs_f64() * 1e3;
-    frame.stats.buffer_bytes = frame.visibility.memory_bytes() + std::mem::size_of_val(frame.image.pixels());
+    frame.stats.buffer_bytes =
+        frame.visibility.memory_bytes() + std::mem::size_of_val(frame.image.pixels());
 }

@@ -205,7 +205,12 @@ fn gltf_cameras_and_lights() {
 fn simd_shading_matches_the_scalar_reference() {
     let mut scene = kage::scene::demo::demo_scene().unwrap();
     scene.lights.push(Light {
-        kind: LightKind::Spot { position: Vec3::new(1.0, 3.0, 2.0), direction: Vec3::new(-0.2, -1.0, -0.4).normalize(), inner: 0.3, outer: 0.5 },
+        kind: LightKind::Spot {
+            position: Vec3::new(1.0, 3.0, 2.0),
+            direction: Vec3::new(-0.2, -1.0, -0.4).normalize(),
+            inner: 0.3,
+            outer: 0.5,
+        },
         color: Vec3::new(0.9, 0.7, 0.5),
         intensity: 3.0,
         ambient: 0.05,
@@ -216,6 +221,12 @@ fn simd_shading_matches_the_scalar_reference() {
     let frame = render(&scene, &RenderOptions::default()).unwrap();
     let mut scalar = kage::resolve::LinearImage::new(scene.width, scene.height);
     kage::shading::shade_into_scalar(&scene, &frame.visibility, &mut scalar);
-    let worst = frame.image.pixels().iter().zip(scalar.pixels()).map(|(a, b)| (*a - *b).abs().max_element()).fold(0.0f32, f32::max);
+    let worst = frame
+        .image
+        .pixels()
+        .iter()
+        .zip(scalar.pixels())
+        .map(|(a, b)| (*a - *b).abs().max_element())
+        .fold(0.0f32, f32::max);
     assert!(worst < 2e-3, "largest difference {worst}");
 }

@@ -29,7 +29,8 @@ impl LinearImage {
     pub fn resize(&mut self, width: u32, height: u32) {
         self.width = width;
         self.height = height;
-        self.pixels.resize(width as usize * height as usize, Vec3::ZERO);
+        self.pixels
+            .resize(width as usize * height as usize, Vec3::ZERO);
     }
 
     /// Width in pixels.

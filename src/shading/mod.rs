@@ -29,20 +29,35 @@ pub fn shade_frame(scene: &Scene, vb: &VisibilityBuffer) -> LinearImage {
 /// Shades every pixel of `vb` into `image` (same size), rows in parallel, eight
 /// pixels at a time ([`lanes`]).
 pub fn shade_into(scene: &Scene, vb: &VisibilityBuffer, image: &mut LinearImage) {
-    assert_eq!((image.width(), image.height()), (vb.width(), vb.height()), "image and buffer sizes");
+    assert_eq!(
+        (image.width(), image.height()),
+        (vb.width(), vb.height()),
+        "image and buffer sizes"
+    );
     let w = vb.width() as usize;
     let frames = ObjectFrames::new(scene);
-    let rays = scene.camera.pixel_rays(Vec2::new(w as f32, vb.height() as f32));
-    let constants: Vec<Option<Coefficients>> = scene.materials.iter().map(Coefficients::constant).collect();
+    let rays = scene
+        .camera
+        .pixel_rays(Vec2::new(w as f32, vb.height() as f32));
+    let constants: Vec<Option<Coefficients>> =
+        scene.materials.iter().map(Coefficients::constant).collect();
     let sample = |s: &SurfacePoint| Coefficients::at(&scene.materials[s.material], s);
     let lighting = lanes::Lighting::new(&scene.lights);
-    let rows = image.pixels_mut().par_chunks_mut(w).zip(vb.items().par_chunks(w));
+    let rows = image
+        .pixels_mut()
+        .par_chunks_mut(w)
+        .zip(vb.items().par_chunks(w));
     rows.enumerate().for_each(|(y, (out, items))| {
         let mut prepared: Option<PreparedTriangle> = None;
         let mut block = lanes::Block::default();
-        for (c, (out, items)) in out.chunks_mut(lanes::LANES).zip(items.chunks(lanes::LANES)).enumerate() {
+        for (c, (out, items)) in out
+            .chunks_mut(lanes::LANES)
+            .zip(items.chunks(lanes::LANES))
+            .enumerate()
+        {
             let first = items[0];
-            if items.len() == lanes::LANES && !first.is_none() && items.iter().all(|&i| i == first) {
+            if items.len() == lanes::LANES && !first.is_none() && items.iter().all(|&i| i == first)
+            {
                 let tri = match prepared {
                     Some(t) if t.item == first => t,
                     _ => *prepared.insert(frames.prepare(scene, first)),
@@ -76,14 +91,23 @@ pub fn shade_into(scene: &Scene, vb: &VisibilityBuffer, image: &mut LinearImage)
 pub fn shade_into_scalar(scene: &Scene, vb: &VisibilityBuffer, image: &mut LinearImage) {
     let w = vb.width() as usize;
     let frames = ObjectFrames::new(scene);
-    let rays = scene.camera.pixel_rays(Vec2::new(w as f32, vb.height() as f32));
-    let rows = image.pixels_mut().par_chunks_mut(w).zip(vb.items().par_chunks(w));
+    let rays = scene
+        .camera
+        .pixel_rays(Vec2::new(w as f32, vb.height() as f32));
+    let rows = image
+        .pixels_mut()
+        .par_chunks_mut(w)
+        .zip(vb.items().par_chunks(w));
     rows.enumerate().for_each(|(y, (out, items))| {
         for (x, (px, &item)) in out.iter_mut().zip(items).enumerate() {
             *px = if item.is_none() {
                 scene.background
             } else {
-                let s = frames.surface(scene, item, &rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5)));
+                let s = frames.surface(
+                    scene,
+                    item,
+                    &rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5)),
+                );
                 phong::shade(&scene.lights, &scene.materials[s.material], &s).total()
             };
         }

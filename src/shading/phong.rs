@@ -53,8 +53,17 @@ impl Coefficients {
     #[must_use]
     pub fn constant(m: &Material) -> Option<Self> {
         let maps = &m.maps;
-        let none = maps.ambient.is_none() && maps.diffuse.is_none() && maps.specular.is_none() && maps.emission.is_none();
-        none.then_some(Coefficients { ka: m.ka, kd: m.kd, ks: m.ks, ke: m.ke, n: m.shininess })
+        let none = maps.ambient.is_none()
+            && maps.diffuse.is_none()
+            && maps.specular.is_none()
+            && maps.emission.is_none();
+        none.then_some(Coefficients {
+            ka: m.ka,
+            kd: m.kd,
+            ks: m.ks,
+            ke: m.ke,
+            n: m.shininess,
+        })
     }
 
     /// Samples every map of `m` at the point's uv.

@@ -115,7 +115,14 @@ impl PreparedTriangle {
     /// The triangle's world-space data.
     #[must_use]
     pub fn geometry(&self) -> TriangleGeometry {
-        TriangleGeometry { a: self.a, e1: self.e1, e2: self.e2, geometric: self.geometric, normals: self.normals, uvs: self.uvs }
+        TriangleGeometry {
+            a: self.a,
+            e1: self.e1,
+            e2: self.e2,
+            geometric: self.geometric,
+            normals: self.normals,
+            uvs: self.uvs,
+        }
     }
 
     /// The surface point where `ray` meets the triangle's plane.
@@ -127,8 +134,16 @@ impl PreparedTriangle {
         let n = n.normalize_or(self.geometric);
         let to_eye = -ray.dir;
         let normal = if n.dot(to_eye) < 0.0 { -n } else { n };
-        let uv = self.uvs.map_or(Vec2::ZERO, |u| u[0] * w[0] + u[1] * w[1] + u[2] * w[2]);
-        SurfacePoint { position: ray.origin + ray.dir * t, normal, to_eye, uv, material: self.material }
+        let uv = self
+            .uvs
+            .map_or(Vec2::ZERO, |u| u[0] * w[0] + u[1] * w[1] + u[2] * w[2]);
+        SurfacePoint {
+            position: ray.origin + ray.dir * t,
+            normal,
+            to_eye,
+            uv,
+            material: self.material,
+        }
     }
 }
 
@@ -148,5 +163,8 @@ pub fn intersect_plane(ray: &Ray, a: Vec3, e1: Vec3, e2: Vec3) -> (f32, Vec2) {
     let inv = 1.0 / det;
     let tvec = ray.origin - a;
     let qvec = tvec.cross(e1);
-    (e2.dot(qvec) * inv, Vec2::new(tvec.dot(pvec) * inv, ray.dir.dot(qvec) * inv))
+    (
+        e2.dot(qvec) * inv,
+        Vec2::new(tvec.dot(pvec) * inv, ray.dir.dot(qvec) * inv),
+    )
 }
