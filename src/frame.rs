@@ -11,6 +11,9 @@ use crate::scene::Scene;
 use crate::shading;
 use crate::visibility::{self, RasterStats, VisibilityBuffer};
 
+/// Most worker threads a renderer accepts.
+pub const MAX_THREADS: usize = 1024;
+
 /// How to render.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct RenderOptions {
@@ -54,6 +57,11 @@ impl Renderer {
     pub fn new(options: &RenderOptions) -> Result<Renderer> {
         let pool = match options.threads {
             None => None,
+            Some(n) if n > MAX_THREADS => {
+                return Err(Error::Scene(format!(
+                    "{n} threads requested; at most {MAX_THREADS}"
+                )))
+            }
             Some(n) => Some(
                 rayon::ThreadPoolBuilder::new()
                     .num_threads(n.max(1))

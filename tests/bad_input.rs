@@ -204,3 +204,27 @@ fn the_cli_exits_non_zero_with_a_located_report() {
     let (ok, err) = kage(&["render", "-o", dir.join("z.bmp").to_str().unwrap()]);
     assert!(!ok && err.contains("unknown image format '.bmp'"), "{err}");
 }
+
+#[test]
+fn an_empty_view_is_warned_about_not_silent() {
+    let dir = scratch("empty-view");
+    let scene = write(
+        &dir,
+        "away.toml",
+        "[camera]\neye = [0, 0, 5]\ntarget = [0, 0, 10]\n[[object]]\nshape = \"cube\"\n",
+    );
+    let (ok, err) = kage(&[
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        dir.join("a.png").to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    assert!(err.contains("no object is in view"), "{err}");
+}
+
+#[test]
+fn too_many_threads_is_an_error_not_a_hang() {
+    let (ok, err) = kage(&["render", "--threads", "1000000", "-o", "/dev/null.png"]);
+    assert!(!ok && err.contains("threads requested"), "{err}");
+}

@@ -18,6 +18,9 @@ impl Texture {
             .map_err(|e| e.to_string())?
             .into_rgb32f();
         let (width, height) = img.dimensions();
+        if width == 0 || height == 0 {
+            return Err("the image has no pixels".into());
+        }
         let decode = |c: f32| if srgb { srgb_to_linear(c) } else { c };
         let texels = img
             .pixels()

@@ -96,6 +96,11 @@ fn render_command(args: &RenderArgs) -> kage::error::Result<()> {
         },
     )?;
     kage::output::write_image(&frame.image, &args.output)?;
+    if frame.visibility.items().iter().all(|i| i.is_none()) {
+        eprintln!(
+            "warning: no object is in view: the image shows only the background (check the camera)"
+        );
+    }
     let s = frame.stats;
     eprintln!(
         "wrote {} ({}x{}, {} triangles): visibility {:.1} ms, shading {:.1} ms",
