@@ -11,7 +11,7 @@ use rayon::prelude::*;
 
 use crate::resolve::LinearImage;
 use crate::scene::Scene;
-use crate::visibility::VisibilityBuffer;
+use crate::visibility::{ItemId, VisibilityBuffer};
 
 pub use phong::Components;
 pub use surface::{ObjectFrames, PreparedTriangle, SurfacePoint};
@@ -47,43 +47,66 @@ pub fn shade_into(scene: &Scene, vb: &VisibilityBuffer, image: &mut LinearImage)
         .pixels_mut()
         .par_chunks_mut(w)
         .zip(vb.items().par_chunks(w));
-    rows.enumerate().for_each(|(y, (out, items))| {
-        let mut prepared: Option<PreparedTriangle> = None;
-        let mut block = lanes::Block::default();
-        for (c, (out, items)) in out
-            .chunks_mut(lanes::LANES)
-            .zip(items.chunks(lanes::LANES))
-            .enumerate()
-        {
-            let first = items[0];
-            if items.len() == lanes::LANES && !first.is_none() && items.iter().all(|&i| i == first)
+    let caches = || (TriangleCache::new(), lanes::Block::default());
+    rows.enumerate()
+        .for_each_init(caches, |(cache, block), (y, (out, items))| {
+            for (c, (out, items)) in out
+                .chunks_mut(lanes::LANES)
+                .zip(items.chunks(lanes::LANES))
+                .enumerate()
             {
-                let tri = match prepared {
-                    Some(t) if t.item == first => t,
-                    _ => *prepared.insert(frames.prepare(scene, first)),
-                };
-                if let Some(k) = &constants[tri.material] {
-                    lanes::shade_uniform(&tri, k, &rays, (c * lanes::LANES, y), &lighting, out);
-                    continue;
+                let first = items[0];
+                if items.len() == lanes::LANES
+                    && !first.is_none()
+                    && items.iter().all(|&i| i == first)
+                {
+                    let tri = cache.get(scene, &frames, first);
+                    if let Some(k) = &constants[tri.material] {
+                        lanes::shade_uniform(tri, k, &rays, (c * lanes::LANES, y), &lighting, out);
+                        continue;
+                    }
+                }
+                block.clear();
+                for (i, (&item, px)) in items.iter().zip(out.iter_mut()).enumerate() {
+                    if item.is_none() {
+                        *px = scene.background;
+                        continue;
+                    }
+                    let tri = cache.get(scene, &frames, item);
+                    block.set(i, tri, constants[tri.material].as_ref());
+                }
+                if block.live.iter().any(|&l| l) {
+                    block.shade(&rays, (c * lanes::LANES, y), &lighting, sample, out);
                 }
             }
-            block.clear();
-            for (i, (&item, px)) in items.iter().zip(out.iter_mut()).enumerate() {
-                if item.is_none() {
-                    *px = scene.background;
-                    continue;
-                }
-                let tri = match prepared {
-                    Some(t) if t.item == item => t,
-                    _ => *prepared.insert(frames.prepare(scene, item)),
-                };
-                block.set(i, &tri, constants[tri.material].as_ref());
-            }
-            if block.live.iter().any(|&l| l) {
-                block.shade(&rays, (c * lanes::LANES, y), &lighting, sample, out);
-            }
+        });
+}
+
+/// A small direct-mapped cache of prepared triangles, one per worker: the rows a
+/// worker shades in turn keep meeting the same triangles.
+struct TriangleCache {
+    slots: Vec<Option<PreparedTriangle>>,
+}
+
+impl TriangleCache {
+    const SLOTS: usize = 512;
+
+    fn new() -> Self {
+        TriangleCache {
+            slots: vec![None; Self::SLOTS],
         }
-    });
+    }
+
+    fn get(&mut self, scene: &Scene, frames: &ObjectFrames, item: ItemId) -> &PreparedTriangle {
+        let key =
+            (item.triangle as usize ^ (item.object as usize).wrapping_mul(0x9E37)) % Self::SLOTS;
+        let slot = &mut self.slots[key];
+        match slot {
+            Some(t) if t.item == item => {}
+            _ => *slot = Some(frames.prepare(scene, item)),
+        }
+        slot.as_ref().expect("filled above")
+    }
 }
 
 /// The scalar reference of [`shade_into`]: one pixel at a time through
