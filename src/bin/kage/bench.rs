@@ -31,6 +31,9 @@ pub struct BenchArgs {
     /// Timed frames per row (the median is reported).
     #[arg(long, default_value_t = 10)]
     frames: usize,
+    /// Alternating rounds of kage and llvmpipe; the best round of each is reported.
+    #[arg(long, default_value_t = 3)]
+    rounds: usize,
     /// Only these scenes (comma-separated names).
     #[arg(long, default_value = "sphere10k,sphere100k,sphere1m")]
     scenes: String,
@@ -58,12 +61,27 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     for name in args.scenes.split(',').map(str::trim) {
         let mesh = ensure_mesh(args, name)?;
         let scene = peer_scene(&mesh, args.width, args.height)?;
-        let (row, image) = time_kage(name, &scene, args.frames)?;
-        let peer = lp
-            .exists()
-            .then(|| run_llvmpipe(lp, &mesh, args, &image))
-            .transpose()?;
-        rows.push(Row { peer, ..row });
+        // Rounds alternate kage and the peer; each keeps its best round, so a burst
+        // of load from a neighbour on a shared machine hurts neither side's number.
+        let mut best: Option<Row> = None;
+        for _ in 0..args.rounds.max(1) {
+            let (row, image) = time_kage(name, &scene, args.frames)?;
+            let peer = lp
+                .exists()
+                .then(|| run_llvmpipe(lp, &mesh, args, &image))
+                .transpose()?;
+            best = Some(match best {
+                None => Row { peer, ..row },
+                Some(b) => Row {
+                    peer: match (b.peer, peer) {
+                        (Some(p), Some(q)) => Some(if q.0 < p.0 { q } else { p }),
+                        (p, q) => p.or(q),
+                    },
+                    ..if row.total_ms < b.total_ms { row } else { b }
+                },
+            });
+        }
+        rows.push(best.expect("at least one round"));
         eprintln!("{name}: done");
     }
     print_table(&rows, args);
@@ -246,10 +264,11 @@ fn print_table(rows: &[Row], args: &BenchArgs) {
         );
     }
     println!(
-        "\n{}x{}, median of {} frames, {} threads.",
+        "\n{}x{}, median of {} frames, best of {} alternating rounds, {} threads.",
         args.width,
         args.height,
         args.frames,
+        args.rounds.max(1),
         rayon::current_num_threads()
     );
 }
