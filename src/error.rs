@@ -33,13 +33,7 @@ impl SourceLocation {
         let line = before.matches('\n').count() + 1;
         let line_start = before.rfind('\n').map_or(0, |i| i + 1);
         let column = text[line_start..start].chars().count() + 1;
-        Self {
-            path: path.into(),
-            line,
-            column,
-            span: start..end,
-            text,
-        }
+        Self { path: path.into(), line, column, span: start..end, text }
     }
 }
 

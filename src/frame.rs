@@ -58,9 +58,7 @@ impl Renderer {
         let pool = match options.threads {
             None => None,
             Some(n) if n > MAX_THREADS => {
-                return Err(Error::Scene(format!(
-                    "{n} threads requested; at most {MAX_THREADS}"
-                )))
+                return Err(Error::Scene(format!("{n} threads requested; at most {MAX_THREADS}")))
             }
             Some(n) => Some(
                 rayon::ThreadPoolBuilder::new()
@@ -112,6 +110,5 @@ fn render_into(scene: &Scene, frame: &mut Frame) {
     let t2 = Instant::now();
     frame.stats.visibility_ms = (t1 - t0).as_secs_f64() * 1e3;
     frame.stats.shading_ms = (t2 - t1).as_secs_f64() * 1e3;
-    frame.stats.buffer_bytes =
-        frame.visibility.memory_bytes() + std::mem::size_of_val(frame.image.pixels());
+    frame.stats.buffer_bytes = frame.visibility.memory_bytes() + std::mem::size_of_val(frame.image.pixels());
 }

@@ -15,9 +15,7 @@ fn scratch(name: &str) -> PathBuf {
 }
 
 fn parse_err(text: &str) -> String {
-    let fs = FileSystem {
-        base: scratch("parse"),
-    };
+    let fs = FileSystem { base: scratch("parse") };
     match SceneFile::parse(text, Path::new("bad.toml")).and_then(|f| f.build(&fs)) {
         Ok(_) => panic!("expected an error for:\n{text}"),
         Err(e) => e.to_string(),
@@ -35,43 +33,23 @@ fn malformed_toml_names_file_line_and_column() {
 #[test]
 fn wrong_types_and_unknown_keys_point_at_the_value() {
     let e = parse_err(&format!("[image]\nwidth = \"wide\"\n{OK_OBJECT}"));
-    assert!(
-        e.starts_with("bad.toml:2:9") && e.contains("expected i64"),
-        "{e}"
-    );
+    assert!(e.starts_with("bad.toml:2:9") && e.contains("expected i64"), "{e}");
     let e = parse_err(&format!("{OK_OBJECT}colour = [1, 0, 0]\n"));
-    assert!(
-        e.starts_with("bad.toml:3:1") && e.contains("unknown field `colour`"),
-        "{e}"
-    );
+    assert!(e.starts_with("bad.toml:3:1") && e.contains("unknown field `colour`"), "{e}");
     let e = parse_err(&format!("[[light]]\ntype = \"laser\"\n{OK_OBJECT}"));
-    assert!(
-        e.starts_with("bad.toml:2:8") && e.contains("unknown variant `laser`"),
-        "{e}"
-    );
+    assert!(e.starts_with("bad.toml:2:8") && e.contains("unknown variant `laser`"), "{e}");
 }
 
 #[test]
 fn semantic_errors_point_at_the_value() {
     let e = parse_err("[[object]]\nshape = \"cube\"\nmaterial = \"gold\"\n");
-    assert!(
-        e.starts_with("bad.toml:3:12") && e.contains("no material named 'gold'"),
-        "{e}"
-    );
+    assert!(e.starts_with("bad.toml:3:12") && e.contains("no material named 'gold'"), "{e}");
     let e = parse_err(&format!("[image]\nwidth = 0\n{OK_OBJECT}"));
-    assert!(
-        e.starts_with("bad.toml:2:9") && e.contains("between 1 and 16384"),
-        "{e}"
-    );
+    assert!(e.starts_with("bad.toml:2:9") && e.contains("between 1 and 16384"), "{e}");
     let e = parse_err(&format!("[image]\nheight = 100000\n{OK_OBJECT}"));
     assert!(e.starts_with("bad.toml:2:10"), "{e}");
-    let e = parse_err(&format!(
-        "[camera]\neye = [0, 0, 0]\ntarget = [0, 0, 0]\n{OK_OBJECT}"
-    ));
-    assert!(
-        e.starts_with("bad.toml:1:1") && e.contains("eye and target coincide"),
-        "{e}"
-    );
+    let e = parse_err(&format!("[camera]\neye = [0, 0, 0]\ntarget = [0, 0, 0]\n{OK_OBJECT}"));
+    assert!(e.starts_with("bad.toml:1:1") && e.contains("eye and target coincide"), "{e}");
     let e = parse_err(&format!("[[light]]\ntype = \"point\"\n{OK_OBJECT}"));
     assert!(e.contains("needs `position`"), "{e}");
     let e = parse_err("[image]\nwidth = 8\n");
@@ -81,17 +59,10 @@ fn semantic_errors_point_at_the_value() {
 #[test]
 fn missing_mesh_and_texture_name_the_path() {
     let e = parse_err("[[object]]\nmesh = \"nowhere/teapot.obj\"\n");
-    assert!(
-        e.contains("nowhere/teapot.obj") && e.contains("cannot read"),
-        "{e}"
-    );
-    let e = parse_err(
-        "[[material]]\nname = \"m\"\nkd_map = \"missing.png\"\n[[object]]\nshape = \"cube\"\n",
-    );
+    assert!(e.contains("nowhere/teapot.obj") && e.contains("cannot read"), "{e}");
+    let e = parse_err("[[material]]\nname = \"m\"\nkd_map = \"missing.png\"\n[[object]]\nshape = \"cube\"\n");
     assert!(e.contains("missing.png"), "{e}");
-    let e = load_scene(Path::new("no/such/scene.toml"))
-        .unwrap_err()
-        .to_string();
+    let e = load_scene(Path::new("no/such/scene.toml")).unwrap_err().to_string();
     assert!(e.contains("no/such/scene.toml"), "{e}");
 }
 
@@ -116,20 +87,9 @@ fn bad_meshes_are_errors_or_warned_repairs() {
     let flat = write(&dir, "flat.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n");
     let e = scene_for_model(&flat, 64, 64).unwrap_err().to_string();
     assert!(e.contains("zero area"), "{e}");
-    let some = write(
-        &dir,
-        "some.obj",
-        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 2 0 0\nf 1 2 3\nf 1 2 4\n",
-    );
+    let some = write(&dir, "some.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 2 0 0\nf 1 2 3\nf 1 2 4\n");
     let scene = scene_for_model(&some, 64, 64).unwrap();
-    assert!(
-        scene
-            .warnings
-            .iter()
-            .any(|w| w.contains("dropped 1 zero-area")),
-        "{:?}",
-        scene.warnings
-    );
+    assert!(scene.warnings.iter().any(|w| w.contains("dropped 1 zero-area")), "{:?}", scene.warnings);
     let garbage = write(&dir, "garbage.glb", "not a gltf");
     let e = scene_for_model(&garbage, 64, 64).unwrap_err().to_string();
     assert!(e.contains("garbage.glb"), "{e}");
@@ -141,66 +101,33 @@ fn bad_meshes_are_errors_or_warned_repairs() {
 #[test]
 fn absurd_image_sizes_are_refused_before_allocating() {
     let mut scene = kage::scene::demo::demo_scene().unwrap();
-    for (w, h, want) in [
-        (0, 10, "at least 1"),
-        (100_000, 100_000, "at most 16384"),
-        (16_384, 16_384, "at most 134,217,728"),
-    ] {
+    for (w, h, want) in
+        [(0, 10, "at least 1"), (100_000, 100_000, "at most 16384"), (16_384, 16_384, "at most 134,217,728")]
+    {
         scene.width = w;
         scene.height = h;
         match render(&scene, &RenderOptions::default()) {
             Err(Error::ImageSize { reason, .. }) => assert!(reason.contains(want), "{reason}"),
-            other => panic!(
-                "{w}x{h}: expected a size error, got {:?}",
-                other.map(|_| ())
-            ),
+            other => panic!("{w}x{h}: expected a size error, got {:?}", other.map(|_| ())),
         }
     }
 }
 
 fn kage(args: &[&str]) -> (bool, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_kage"))
-        .args(args)
-        .output()
-        .unwrap();
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
+    let out = Command::new(env!("CARGO_BIN_EXE_kage")).args(args).output().unwrap();
+    (out.status.success(), String::from_utf8_lossy(&out.stderr).into_owned())
 }
 
 #[test]
 fn the_cli_exits_non_zero_with_a_located_report() {
     let dir = scratch("cli");
-    let scene = write(
-        &dir,
-        "broken.toml",
-        "[[object]]\nshape = \"cube\"\nmaterial = \"gold\"\n",
-    );
-    let (ok, err) = kage(&[
-        "render",
-        scene.to_str().unwrap(),
-        "-o",
-        dir.join("x.png").to_str().unwrap(),
-    ]);
+    let scene = write(&dir, "broken.toml", "[[object]]\nshape = \"cube\"\nmaterial = \"gold\"\n");
+    let (ok, err) = kage(&["render", scene.to_str().unwrap(), "-o", dir.join("x.png").to_str().unwrap()]);
     assert!(!ok);
-    assert!(
-        err.contains("broken.toml:3:12") && err.contains("no material named 'gold'"),
-        "{err}"
-    );
-    let (ok, err) = kage(&[
-        "render",
-        "--width",
-        "100000",
-        "--height",
-        "100000",
-        "-o",
-        dir.join("y.png").to_str().unwrap(),
-    ]);
-    assert!(
-        !ok && err.contains("invalid image size 100000x100000"),
-        "{err}"
-    );
+    assert!(err.contains("broken.toml:3:12") && err.contains("no material named 'gold'"), "{err}");
+    let (ok, err) =
+        kage(&["render", "--width", "100000", "--height", "100000", "-o", dir.join("y.png").to_str().unwrap()]);
+    assert!(!ok && err.contains("invalid image size 100000x100000"), "{err}");
     let (ok, err) = kage(&["render", "-o", dir.join("z.bmp").to_str().unwrap()]);
     assert!(!ok && err.contains("unknown image format '.bmp'"), "{err}");
 }
@@ -208,17 +135,9 @@ fn the_cli_exits_non_zero_with_a_located_report() {
 #[test]
 fn an_empty_view_is_warned_about_not_silent() {
     let dir = scratch("empty-view");
-    let scene = write(
-        &dir,
-        "away.toml",
-        "[camera]\neye = [0, 0, 5]\ntarget = [0, 0, 10]\n[[object]]\nshape = \"cube\"\n",
-    );
-    let (ok, err) = kage(&[
-        "render",
-        scene.to_str().unwrap(),
-        "-o",
-        dir.join("a.png").to_str().unwrap(),
-    ]);
+    let scene =
+        write(&dir, "away.toml", "[camera]\neye = [0, 0, 5]\ntarget = [0, 0, 10]\n[[object]]\nshape = \"cube\"\n");
+    let (ok, err) = kage(&["render", scene.to_str().unwrap(), "-o", dir.join("a.png").to_str().unwrap()]);
     assert!(ok, "{err}");
     assert!(err.contains("no object is in view"), "{err}");
 }

@@ -46,9 +46,8 @@ fn unoccluded_plane_matches_equation_one() {
     // Orthographic view straight down: V = +y; R = mirror of L about +y.
     let l = -dir;
     let r = Vec3::new(-l.x, l.y, -l.z);
-    let want = c * 0.1 * m.ka
-        + c * 2.0 * m.kd * theta.cos()
-        + c * 2.0 * m.ks * r.dot(Vec3::Y).max(0.0).powf(m.shininess);
+    let want =
+        c * 0.1 * m.ka + c * 2.0 * m.kd * theta.cos() + c * 2.0 * m.ks * r.dot(Vec3::Y).max(0.0).powf(m.shininess);
     for p in frame.image.pixels() {
         assert!((*p - want).abs().max_element() < 1e-4, "{p} vs {want}");
     }
@@ -59,9 +58,7 @@ fn unoccluded_plane_matches_equation_one() {
 #[test]
 fn lights_add_up() {
     let light = |intensity, ambient| Light {
-        kind: LightKind::Point {
-            position: Vec3::new(0.3, 1.0, 0.2),
-        },
+        kind: LightKind::Point { position: Vec3::new(0.3, 1.0, 0.2) },
         color: Vec3::ONE,
         intensity,
         ambient,
@@ -71,10 +68,7 @@ fn lights_add_up() {
     let one = plane_scene(light(2.0, 0.2));
     let mut two = plane_scene(light(1.0, 0.1));
     two.lights.push(light(1.0, 0.1));
-    let (a, b) = (
-        render(&one, &RenderOptions::default()).unwrap(),
-        render(&two, &RenderOptions::default()).unwrap(),
-    );
+    let (a, b) = (render(&one, &RenderOptions::default()).unwrap(), render(&two, &RenderOptions::default()).unwrap());
     for (p, q) in a.image.pixels().iter().zip(b.image.pixels()) {
         assert!((*p - *q).abs().max_element() < 1e-5, "{p} vs {q}");
     }
@@ -99,16 +93,10 @@ fn demo_scene_shows_every_object() {
     let scene = kage::scene::demo::demo_scene().unwrap();
     let frame = render(&scene, &RenderOptions::default()).unwrap();
     for (i, o) in scene.objects.iter().enumerate() {
-        let n = frame
-            .visibility
-            .items()
-            .iter()
-            .filter(|it| it.object == i as u32)
-            .count();
+        let n = frame.visibility.items().iter().filter(|it| it.object == i as u32).count();
         assert!(n > 1000, "object {} covers only {n} pixels", o.name);
     }
-    let mean =
-        frame.image.pixels().iter().copied().sum::<Vec3>() / frame.image.pixels().len() as f32;
+    let mean = frame.image.pixels().iter().copied().sum::<Vec3>() / frame.image.pixels().len() as f32;
     assert!(mean.min_element() > 0.1, "mean colour {mean}");
 }
 
@@ -119,17 +107,11 @@ fn full_hd_buffers_fit_in_100_mb() {
     scene.width = 1920;
     scene.height = 1080;
     let frame = render(&scene, &RenderOptions::default()).unwrap();
-    assert!(
-        frame.stats.buffer_bytes < 60 << 20,
-        "{} bytes",
-        frame.stats.buffer_bytes
-    );
+    assert!(frame.stats.buffer_bytes < 60 << 20, "{} bytes", frame.stats.buffer_bytes);
 }
 
 fn shared(rel: &str) -> Option<std::path::PathBuf> {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/assets")
-        .join(rel);
+    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets").join(rel);
     if p.exists() {
         Some(p)
     } else {
@@ -141,13 +123,7 @@ fn shared(rel: &str) -> Option<std::path::PathBuf> {
 fn coverage(path: &Path) -> f32 {
     let scene = scene_for_model(path, 96, 72).unwrap();
     let frame = render(&scene, &RenderOptions::default()).unwrap();
-    frame
-        .visibility
-        .items()
-        .iter()
-        .filter(|i| !i.is_none())
-        .count() as f32
-        / (96.0 * 72.0)
+    frame.visibility.items().iter().filter(|i| !i.is_none()).count() as f32 / (96.0 * 72.0)
 }
 
 /// Every kind of model file loads and, framed automatically, fills a fair part of
@@ -167,11 +143,7 @@ fn real_models_load_and_frame() {
     ] {
         let Some(p) = shared(rel) else { continue };
         let c = coverage(&p);
-        assert!(
-            c > 0.05 && c < 0.95,
-            "{rel}: covers {:.0}% of the image",
-            100.0 * c
-        );
+        assert!(c > 0.05 && c < 0.95, "{rel}: covers {:.0}% of the image", 100.0 * c);
     }
 }
 
@@ -180,11 +152,7 @@ fn real_models_load_and_frame() {
 fn gltf_cameras_and_lights() {
     if let Some(p) = shared("gltf/Cameras/Cameras.gltf") {
         let scene = scene_for_model(&p, 64, 48).unwrap();
-        assert!(
-            scene.camera.eye.z > 1.0,
-            "the file's camera, not a fitted one: {:?}",
-            scene.camera
-        );
+        assert!(scene.camera.eye.z > 1.0, "the file's camera, not a fitted one: {:?}", scene.camera);
     }
     if let Some(p) = shared("gltf/LightsPunctualLamp/LightsPunctualLamp.gltf") {
         let scene = scene_for_model(&p, 64, 48).unwrap();
@@ -193,8 +161,7 @@ fn gltf_cameras_and_lights() {
                 && scene
                     .lights
                     .iter()
-                    .all(|l| l.falloff == Falloff::InverseSquare
-                        || matches!(l.kind, LightKind::Directional { .. }))
+                    .all(|l| l.falloff == Falloff::InverseSquare || matches!(l.kind, LightKind::Directional { .. }))
         );
     }
 }

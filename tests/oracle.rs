@@ -20,13 +20,7 @@ fn compare(seed: u64, ortho: bool, tally: &mut Tally) {
     let mut rng = StdRng::seed_from_u64(seed);
     let n = rng.gen_range(5..60);
     let two_sided = rng.gen_bool(0.5);
-    let scene = scene_with(
-        triangle_soup(&mut rng, n),
-        random_camera(&mut rng, ortho),
-        160,
-        120,
-        two_sided,
-    );
+    let scene = scene_with(triangle_soup(&mut rng, n), random_camera(&mut rng, ortho), 160, 120, two_sided);
     let mut vb = VisibilityBuffer::new(scene.width, scene.height);
     rasterize(&scene, &mut vb);
     for y in 0..scene.height {
@@ -39,8 +33,7 @@ fn compare(seed: u64, ortho: bool, tally: &mut Tally) {
             tally.covered += 1;
             match want {
                 Some(h) if !got.is_none() && got.triangle == h.triangle => {
-                    let e =
-                        (view_distance(&scene.camera, vb.depth(x, y)) - h.view_z).abs() / h.view_z;
+                    let e = (view_distance(&scene.camera, vb.depth(x, y)) - h.view_z).abs() / h.view_z;
                     tally.worst_depth_error = tally.worst_depth_error.max(e);
                 }
                 Some(h) if (h.second_z - h.view_z) / h.view_z < 1e-4 => tally.excused += 1,
@@ -52,12 +45,7 @@ fn compare(seed: u64, ortho: bool, tally: &mut Tally) {
 
 #[test]
 fn item_ids_and_depths_match_a_brute_force_ray_cast() {
-    let mut tally = Tally {
-        covered: 0,
-        mismatched: 0,
-        excused: 0,
-        worst_depth_error: 0.0,
-    };
+    let mut tally = Tally { covered: 0, mismatched: 0, excused: 0, worst_depth_error: 0.0 };
     for seed in 0..24 {
         compare(seed, seed % 3 == 2, &mut tally);
     }
@@ -70,19 +58,7 @@ fn item_ids_and_depths_match_a_brute_force_ray_cast() {
         tally.excused,
         tally.worst_depth_error
     );
-    assert!(
-        tally.covered > 50_000,
-        "the soups must cover enough pixels to mean something"
-    );
-    assert!(
-        share < 0.001,
-        "{} of {} covered pixels disagree with the ray cast",
-        tally.mismatched,
-        tally.covered
-    );
-    assert!(
-        tally.worst_depth_error < 1e-4,
-        "depth off by {:.2e} relative",
-        tally.worst_depth_error
-    );
+    assert!(tally.covered > 50_000, "the soups must cover enough pixels to mean something");
+    assert!(share < 0.001, "{} of {} covered pixels disagree with the ray cast", tally.mismatched, tally.covered);
+    assert!(tally.worst_depth_error < 1e-4, "depth off by {:.2e} relative", tally.worst_depth_error);
 }

@@ -20,9 +20,7 @@ fn triangulate(lo: DVec2, hi: DVec2, points: &[DVec2]) -> (Vec<DVec2>, Vec<[usiz
     let mut tris = vec![[0, 1, 2], [0, 2, 3]];
     let cross = |a: DVec2, b: DVec2, p: DVec2| (b - a).perp_dot(p - a);
     for &p in points {
-        let found = tris
-            .iter()
-            .position(|t| (0..3).all(|k| cross(v[t[k]], v[t[(k + 1) % 3]], p) > 1e-3));
+        let found = tris.iter().position(|t| (0..3).all(|k| cross(v[t[k]], v[t[(k + 1) % 3]], p) > 1e-3));
         let Some(i) = found else { continue };
         let [a, b, c] = tris[i];
         v.push(p);
@@ -65,24 +63,15 @@ proptest! {
 fn ground(seed: u64) -> Mesh {
     let mut s = seed;
     let mut rnd = || {
-        s = s
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
+        s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
         (s >> 11) as f64 / (1u64 << 53) as f64
     };
-    let pts: Vec<DVec2> = (0..300)
-        .map(|_| DVec2::new(rnd() * 40.0 - 20.0, rnd() * 40.0 - 20.0))
-        .collect();
+    let pts: Vec<DVec2> = (0..300).map(|_| DVec2::new(rnd() * 40.0 - 20.0, rnd() * 40.0 - 20.0)).collect();
     let (v, tris) = triangulate(DVec2::splat(-20.0), DVec2::splat(20.0), &pts);
     // (x, y) of the 2-D triangulation → (x, 0, −y): counter-clockwise seen from +y.
-    let positions = v
-        .iter()
-        .map(|p| Vec3::new(p.x as f32, 0.0, -p.y as f32))
-        .collect();
+    let positions = v.iter().map(|p| Vec3::new(p.x as f32, 0.0, -p.y as f32)).collect();
     let triangles = tris.iter().map(|t| t.map(|i| i as u32)).collect();
-    Mesh::new(positions, vec![], vec![], triangles, NormalMode::Flat)
-        .unwrap()
-        .0
+    Mesh::new(positions, vec![], vec![], triangles, NormalMode::Flat).unwrap().0
 }
 
 /// The camera stands on a huge triangulated ground, so many triangles cross the
@@ -107,10 +96,7 @@ fn ground_through_the_near_plane_has_no_holes_and_matches_rays() {
         let scene = scene_with(ground(seed), camera, 120, 90, false);
         let mut vb = VisibilityBuffer::new(scene.width, scene.height);
         let stats = rasterize(&scene, &mut vb);
-        assert!(
-            stats.clipped > 0,
-            "the test must exercise near-plane clipping"
-        );
+        assert!(stats.clipped > 0, "the test must exercise near-plane clipping");
         let (mut holes, mut extra, mut other, mut seen) = (0, 0, 0, 0);
         for y in 0..scene.height {
             for x in 0..scene.width {
@@ -123,18 +109,8 @@ fn ground_through_the_near_plane_has_no_holes_and_matches_rays() {
                 seen += usize::from(!vb.item(x, y).is_none());
             }
         }
-        assert!(
-            seen > 2000,
-            "seed {seed}: the ground must fill much of the image"
-        );
-        assert_eq!(
-            (holes, extra),
-            (0, 0),
-            "seed {seed}: pixels missed / drawn outside the ground"
-        );
-        assert!(
-            other * 200 < seen,
-            "seed {seed}: {other} pixels show a different triangle than the ray"
-        );
+        assert!(seen > 2000, "seed {seed}: the ground must fill much of the image");
+        assert_eq!((holes, extra), (0, 0), "seed {seed}: pixels missed / drawn outside the ground");
+        assert!(other * 200 < seen, "seed {seed}: {other} pixels show a different triangle than the ray");
     }
 }

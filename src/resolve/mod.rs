@@ -17,11 +17,7 @@ impl LinearImage {
     /// A black image. The size must have been checked.
     #[must_use]
     pub fn new(width: u32, height: u32) -> Self {
-        LinearImage {
-            width,
-            height,
-            pixels: vec![Vec3::ZERO; width as usize * height as usize],
-        }
+        LinearImage { width, height, pixels: vec![Vec3::ZERO; width as usize * height as usize] }
     }
 
     /// Makes the image `width` × `height`, reusing its memory when it can; the
@@ -29,8 +25,7 @@ impl LinearImage {
     pub fn resize(&mut self, width: u32, height: u32) {
         self.width = width;
         self.height = height;
-        self.pixels
-            .resize(width as usize * height as usize, Vec3::ZERO);
+        self.pixels.resize(width as usize * height as usize, Vec3::ZERO);
     }
 
     /// Width in pixels.

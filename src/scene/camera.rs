@@ -123,9 +123,7 @@ impl Camera {
                 let t = (fov_y_deg.to_radians() * 0.5).tan();
                 (Vec2::new(t * aspect, t), false)
             }
-            Projection::Orthographic { height } => {
-                (Vec2::new(height * 0.5 * aspect, height * 0.5), true)
-            }
+            Projection::Orthographic { height } => (Vec2::new(height * 0.5 * aspect, height * 0.5), true),
         };
         PixelRays {
             origin: self.eye,
@@ -151,10 +149,7 @@ impl Camera {
             return Err("camera up is parallel to the view direction".into());
         }
         if !(self.near > 0.0 && self.far > self.near && self.far.is_finite()) {
-            return Err(format!(
-                "need 0 < near < far, got near {} far {}",
-                self.near, self.far
-            ));
+            return Err(format!("need 0 < near < far, got near {} far {}", self.near, self.far));
         }
         match self.projection {
             Projection::Perspective { fov_y_deg } if !(fov_y_deg > 0.0 && fov_y_deg < 180.0) => {
@@ -189,21 +184,12 @@ impl PixelRays {
     /// The ray through image point `pixel`; unit direction.
     #[must_use]
     pub fn ray(&self, pixel: Vec2) -> Ray {
-        let ndc = Vec2::new(
-            2.0 * pixel.x / self.size.x - 1.0,
-            1.0 - 2.0 * pixel.y / self.size.y,
-        );
+        let ndc = Vec2::new(2.0 * pixel.x / self.size.x - 1.0, 1.0 - 2.0 * pixel.y / self.size.y);
         let offset = self.right * ndc.x + self.up * ndc.y;
         if self.ortho {
-            Ray {
-                origin: self.origin + offset,
-                dir: self.forward.normalize(),
-            }
+            Ray { origin: self.origin + offset, dir: self.forward.normalize() }
         } else {
-            Ray {
-                origin: self.origin,
-                dir: (self.forward + offset).normalize(),
-            }
+            Ray { origin: self.origin, dir: (self.forward + offset).normalize() }
         }
     }
 }
@@ -228,17 +214,10 @@ mod tests {
     #[test]
     fn ray_and_projection_agree() {
         let size = Vec2::new(64.0, 48.0);
-        for p in [
-            Projection::Perspective { fov_y_deg: 50.0 },
-            Projection::Orthographic { height: 4.0 },
-        ] {
+        for p in [Projection::Perspective { fov_y_deg: 50.0 }, Projection::Orthographic { height: 4.0 }] {
             let c = cam(p);
             let m = c.view_projection(size.x / size.y);
-            for pix in [
-                Vec2::new(0.5, 0.5),
-                Vec2::new(31.0, 20.25),
-                Vec2::new(63.5, 47.5),
-            ] {
+            for pix in [Vec2::new(0.5, 0.5), Vec2::new(31.0, 20.25), Vec2::new(63.5, 47.5)] {
                 let r = c.ray(pix, size);
                 let w = r.origin + r.dir * 3.0;
                 let clip = m * w.extend(1.0);

@@ -15,14 +15,8 @@ static FILES: [(&str, &[u8]); 5] = [
     ("teapot.obj", include_bytes!("../../assets/teapot.obj")),
     ("default.mtl", include_bytes!("../../assets/default.mtl")),
     ("default.png", include_bytes!("../../assets/default.png")),
-    (
-        "spot_triangulated.obj",
-        include_bytes!("../../assets/spot_triangulated.obj"),
-    ),
-    (
-        "spot_texture.png",
-        include_bytes!("../../assets/spot_texture.png"),
-    ),
+    ("spot_triangulated.obj", include_bytes!("../../assets/spot_triangulated.obj")),
+    ("spot_texture.png", include_bytes!("../../assets/spot_texture.png")),
 ];
 
 /// Builds the demo scene from the embedded files.

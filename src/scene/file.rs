@@ -16,9 +16,7 @@ use toml::Spanned;
 
 use super::load::{self, AssetSource, LoadedModel};
 use super::mesh::shapes;
-use super::{
-    framing, Camera, Falloff, Light, LightKind, Material, Object, Projection, Scene, Texture,
-};
+use super::{framing, Camera, Falloff, Light, LightKind, Material, Object, Projection, Scene, Texture};
 use crate::error::{Error, Result, SourceLocation};
 
 type V3 = [f32; 3];
@@ -69,11 +67,7 @@ fn default_background() -> V3 {
 
 impl Default for ImageRec {
     fn default() -> Self {
-        ImageRec {
-            width: default_width(),
-            height: default_height(),
-            background: default_background(),
-        }
+        ImageRec { width: default_width(), height: default_height(), background: default_background() }
     }
 }
 
@@ -235,25 +229,15 @@ impl SceneFile {
     pub fn parse(text: &str, path: &Path) -> Result<SceneFile> {
         let shared: Arc<str> = Arc::from(text);
         let mut file: SceneFile = toml::from_str(text).map_err(|e| Error::SceneSyntax {
-            location: Box::new(SourceLocation::new(
-                path,
-                shared.clone(),
-                e.span().unwrap_or(0..0),
-            )),
+            location: Box::new(SourceLocation::new(path, shared.clone(), e.span().unwrap_or(0..0))),
             message: e.message().trim().to_string(),
         })?;
-        file.origin = Some(Origin {
-            path: path.to_path_buf(),
-            text: shared,
-        });
+        file.origin = Some(Origin { path: path.to_path_buf(), text: shared });
         Ok(file)
     }
 
     fn invalid(&self, span: Range<usize>, message: impl Into<String>) -> Error {
-        let origin = self.origin.clone().unwrap_or(Origin {
-            path: "<scene>".into(),
-            text: Arc::from(""),
-        });
+        let origin = self.origin.clone().unwrap_or(Origin { path: "<scene>".into(), text: Arc::from("") });
         Error::SceneInvalid {
             location: Box::new(SourceLocation::new(origin.path, origin.text, span)),
             message: message.into(),
@@ -265,10 +249,7 @@ impl SceneFile {
         let (w, h) = (&self.image.width, &self.image.height);
         for side in [w, h] {
             if *side.get_ref() < 1 || *side.get_ref() > super::MAX_IMAGE_SIDE as i64 {
-                return Err(self.invalid(
-                    side.span(),
-                    "image sides must be between 1 and 16384 pixels",
-                ));
+                return Err(self.invalid(side.span(), "image sides must be between 1 and 16384 pixels"));
             }
         }
         let mut materials = Vec::new();
@@ -276,10 +257,7 @@ impl SceneFile {
         for m in &self.materials {
             let mat = self.material(m.get_ref(), assets)?;
             if by_name.insert(mat.name.clone(), materials.len()).is_some() {
-                return Err(self.invalid(
-                    m.get_ref().name.span(),
-                    format!("material '{}' is defined twice", mat.name),
-                ));
+                return Err(self.invalid(m.get_ref().name.span(), format!("material '{}' is defined twice", mat.name)));
             }
             materials.push(mat);
         }
@@ -288,11 +266,7 @@ impl SceneFile {
             height: *h.get_ref() as u32,
             background: Vec3::from(self.image.background),
             camera: framing((Vec3::ZERO, Vec3::ONE), 1.0).0,
-            lights: self
-                .lights
-                .iter()
-                .map(|l| self.light(l))
-                .collect::<Result<_>>()?,
+            lights: self.lights.iter().map(|l| self.light(l)).collect::<Result<_>>()?,
             materials,
             objects: Vec::new(),
             warnings: Vec::new(),
@@ -302,10 +276,7 @@ impl SceneFile {
             models.push(self.object(o, &by_name, assets, &mut scene)?);
         }
         if scene.objects.is_empty() {
-            return Err(self.invalid(
-                0..0,
-                "the scene has no [[object]]: there is nothing to draw",
-            ));
+            return Err(self.invalid(0..0, "the scene has no [[object]]: there is nothing to draw"));
         }
         self.place_camera_and_lights(&mut scene, &models)?;
         scene.validate()?;
@@ -322,15 +293,8 @@ impl SceneFile {
             None => model_cam.unwrap_or(auto_cam),
         };
         if self.lights.is_empty() {
-            let model_lights: Vec<Light> = models
-                .iter()
-                .flat_map(|m| m.lights.iter().cloned())
-                .collect();
-            scene.lights = if model_lights.is_empty() {
-                auto_lights
-            } else {
-                model_lights
-            };
+            let model_lights: Vec<Light> = models.iter().flat_map(|m| m.lights.iter().cloned()).collect();
+            scene.lights = if model_lights.is_empty() { auto_lights } else { model_lights };
         }
         Ok(())
     }
@@ -341,10 +305,7 @@ impl SceneFile {
             ProjectionRec::Perspective => Projection::Perspective { fov_y_deg: r.fov },
             ProjectionRec::Orthographic => {
                 let height = r.height.ok_or_else(|| {
-                    self.invalid(
-                        c.span(),
-                        "an orthographic camera needs `height` (world units shown top to bottom)",
-                    )
+                    self.invalid(c.span(), "an orthographic camera needs `height` (world units shown top to bottom)")
                 })?;
                 Projection::Orthographic { height }
             }
@@ -364,34 +325,20 @@ impl SceneFile {
     fn light(&self, l: &Spanned<LightRec>) -> Result<Light> {
         let r = l.get_ref();
         let need = |v: Option<V3>, key: &str| {
-            v.map(Vec3::from).ok_or_else(|| {
-                self.invalid(
-                    l.span(),
-                    format!("a {:?} light needs `{key}`", r.kind).to_lowercase(),
-                )
-            })
+            v.map(Vec3::from)
+                .ok_or_else(|| self.invalid(l.span(), format!("a {:?} light needs `{key}`", r.kind).to_lowercase()))
         };
         let aim = |from: Option<V3>| -> Result<Vec3> {
             let d = match (r.direction, r.target, from) {
                 (Some(d), _, _) => Vec3::from(d),
                 (None, Some(t), Some(p)) => Vec3::from(t) - Vec3::from(p),
-                _ => {
-                    return Err(self.invalid(
-                        l.span(),
-                        "this light needs `direction` (or `position` and `target`)",
-                    ))
-                }
+                _ => return Err(self.invalid(l.span(), "this light needs `direction` (or `position` and `target`)")),
             };
-            d.try_normalize()
-                .ok_or_else(|| self.invalid(l.span(), "the light direction has zero length"))
+            d.try_normalize().ok_or_else(|| self.invalid(l.span(), "the light direction has zero length"))
         };
         let kind = match r.kind {
-            LightType::Point => LightKind::Point {
-                position: need(r.position, "position")?,
-            },
-            LightType::Directional => LightKind::Directional {
-                direction: aim(r.position)?,
-            },
+            LightType::Point => LightKind::Point { position: need(r.position, "position")? },
+            LightType::Directional => LightKind::Directional { direction: aim(r.position)? },
             LightType::Spot => LightKind::Spot {
                 position: need(r.position, "position")?,
                 direction: aim(r.position)?,
@@ -399,39 +346,20 @@ impl SceneFile {
                 outer: r.outer_angle.to_radians(),
             },
         };
-        let values = [
-            r.intensity,
-            r.ambient,
-            r.size,
-            r.color[0],
-            r.color[1],
-            r.color[2],
-        ];
+        let values = [r.intensity, r.ambient, r.size, r.color[0], r.color[1], r.color[2]];
         if values.iter().any(|v| !v.is_finite() || *v < 0.0) {
-            return Err(self.invalid(
-                l.span(),
-                "light colour, intensity, ambient and size must be finite and ≥ 0",
-            ));
+            return Err(self.invalid(l.span(), "light colour, intensity, ambient and size must be finite and ≥ 0"));
         }
         let falloff = match r.falloff {
             FalloffRec::None => Falloff::None,
             FalloffRec::InverseSquare => Falloff::InverseSquare,
         };
-        Ok(Light {
-            kind,
-            color: r.color.into(),
-            intensity: r.intensity,
-            ambient: r.ambient,
-            size: r.size,
-            falloff,
-        })
+        Ok(Light { kind, color: r.color.into(), intensity: r.intensity, ambient: r.ambient, size: r.size, falloff })
     }
 
     fn material(&self, r: &MaterialRec, assets: &dyn AssetSource) -> Result<Material> {
         let texture = |p: &Option<Spanned<String>>, srgb: bool| -> Result<Option<Arc<Texture>>> {
-            p.as_ref()
-                .map(|p| load::texture(Path::new(p.get_ref()), srgb, assets))
-                .transpose()
+            p.as_ref().map(|p| load::texture(Path::new(p.get_ref()), srgb, assets)).transpose()
         };
         Ok(Material {
             name: r.name.get_ref().clone(),
@@ -465,29 +393,17 @@ impl SceneFile {
                 ShapeRec::Cube => shapes::cube(),
                 ShapeRec::Sphere => shapes::sphere(48),
             }),
-            _ => {
-                return Err(self.invalid(
-                    o.span(),
-                    "an object needs exactly one of `mesh` (a file) or `shape`",
-                ))
-            }
+            _ => return Err(self.invalid(o.span(), "an object needs exactly one of `mesh` (a file) or `shape`")),
         };
         let material = match &r.material {
             Some(name) => Some(*by_name.get(name.get_ref()).ok_or_else(|| {
-                let known: Vec<&str> = self
-                    .materials
-                    .iter()
-                    .map(|m| m.get_ref().name.get_ref().as_str())
-                    .collect();
+                let known: Vec<&str> = self.materials.iter().map(|m| m.get_ref().name.get_ref().as_str()).collect();
                 let known = if known.is_empty() {
                     "no [[material]] is defined".to_string()
                 } else {
                     format!("defined: {}", known.join(", "))
                 };
-                self.invalid(
-                    name.span(),
-                    format!("no material named '{}' ({known})", name.get_ref()),
-                )
+                self.invalid(name.span(), format!("no material named '{}' ({known})", name.get_ref()))
             })?),
             None => None,
         };
@@ -517,10 +433,7 @@ impl SceneFile {
         let (lo, hi) = model.bounds();
         let extent = (hi - lo).max_element();
         if fit.get_ref().is_nan() || *fit.get_ref() <= 0.0 || extent <= 0.0 {
-            return Err(self.invalid(
-                fit.span(),
-                "`fit` must be > 0 and the mesh must have a non-zero extent",
-            ));
+            return Err(self.invalid(fit.span(), "`fit` must be > 0 and the mesh must have a non-zero extent"));
         }
         let s = fit.get_ref() / extent;
         let base = Vec3::new((lo.x + hi.x) * 0.5, lo.y, (lo.z + hi.z) * 0.5);
@@ -530,41 +443,21 @@ impl SceneFile {
 
 /// Adds every part of a loaded model to the scene as objects, with `material`
 /// overriding the model's own materials when given.
-pub fn add_model(
-    scene: &mut Scene,
-    model: &LoadedModel,
-    label: &str,
-    transform: Affine3A,
-    material: Option<usize>,
-) {
+pub fn add_model(scene: &mut Scene, model: &LoadedModel, label: &str, transform: Affine3A, material: Option<usize>) {
     scene.warnings.extend(model.warnings.iter().cloned());
     for part in &model.parts {
         let material = material.unwrap_or_else(|| {
-            scene
-                .materials
-                .push(part.material.clone().unwrap_or_default());
+            scene.materials.push(part.material.clone().unwrap_or_default());
             scene.materials.len() - 1
         });
-        let name = if model.parts.len() > 1 {
-            format!("{label}/{}", part.name)
-        } else {
-            label.to_string()
-        };
-        scene.objects.push(Object {
-            name,
-            mesh: part.mesh.clone(),
-            transform: transform * part.transform,
-            material,
-        });
+        let name = if model.parts.len() > 1 { format!("{label}/{}", part.name) } else { label.to_string() };
+        scene.objects.push(Object { name, mesh: part.mesh.clone(), transform: transform * part.transform, material });
     }
 }
 
 /// Reads and builds a scene file from disk.
 pub fn load_scene(path: &Path) -> Result<Scene> {
-    let text = std::fs::read_to_string(path).map_err(|source| Error::Read {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let text = std::fs::read_to_string(path).map_err(|source| Error::Read { path: path.to_path_buf(), source })?;
     let base = path.parent().unwrap_or(Path::new(".")).to_path_buf();
     SceneFile::parse(&text, path)?.build(&load::FileSystem { base })
 }
@@ -585,23 +478,10 @@ pub fn scene_for_model(path: &Path, width: u32, height: u32) -> Result<Scene> {
         objects: Vec::new(),
         warnings: Vec::new(),
     };
-    add_model(
-        &mut scene,
-        &model,
-        &path.display().to_string(),
-        Affine3A::IDENTITY,
-        None,
-    );
-    let (camera, lights) = framing(
-        scene.bounds().expect("a model has parts"),
-        width as f32 / height as f32,
-    );
+    add_model(&mut scene, &model, &path.display().to_string(), Affine3A::IDENTITY, None);
+    let (camera, lights) = framing(scene.bounds().expect("a model has parts"), width as f32 / height as f32);
     scene.camera = model.camera.unwrap_or(camera);
-    scene.lights = if model.lights.is_empty() {
-        lights
-    } else {
-        model.lights.clone()
-    };
+    scene.lights = if model.lights.is_empty() { lights } else { model.lights.clone() };
     scene.validate()?;
     Ok(scene)
 }

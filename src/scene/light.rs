@@ -72,25 +72,13 @@ impl Light {
     pub fn incident(&self, p: Vec3) -> Incident {
         let scale = self.color * self.intensity;
         match self.kind {
-            LightKind::Directional { direction } => Incident {
-                to_light: -direction,
-                radiance: scale,
-            },
+            LightKind::Directional { direction } => Incident { to_light: -direction, radiance: scale },
             LightKind::Point { position } => self.positional(position, p, scale),
-            LightKind::Spot {
-                position,
-                direction,
-                inner,
-                outer,
-            } => {
+            LightKind::Spot { position, direction, inner, outer } => {
                 let mut inc = self.positional(position, p, scale);
                 let cos = (-inc.to_light).dot(direction);
                 let (ci, co) = (inner.cos(), outer.cos());
-                let t = if ci > co {
-                    ((cos - co) / (ci - co)).clamp(0.0, 1.0)
-                } else {
-                    f32::from(cos >= co)
-                };
+                let t = if ci > co { ((cos - co) / (ci - co)).clamp(0.0, 1.0) } else { f32::from(cos >= co) };
                 inc.radiance *= t * t * (3.0 - 2.0 * t);
                 inc
             }
@@ -104,9 +92,6 @@ impl Light {
             Falloff::None => 1.0,
             Falloff::InverseSquare => 1.0 / dist2,
         };
-        Incident {
-            to_light: d / dist2.sqrt(),
-            radiance: scale * att,
-        }
+        Incident { to_light: d / dist2.sqrt(), radiance: scale * att }
     }
 }

@@ -48,28 +48,16 @@ impl Mesh {
         mode: NormalMode,
     ) -> Result<(Mesh, MeshRepairs), String> {
         if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
-            return Err(format!(
-                "vertex {i} has a non-finite coordinate {:?}",
-                positions[i]
-            ));
+            return Err(format!("vertex {i} has a non-finite coordinate {:?}", positions[i]));
         }
         let n = positions.len() as u64;
-        if let Some(t) = triangles
-            .iter()
-            .position(|t| t.iter().any(|&i| i as u64 >= n))
-        {
-            return Err(format!(
-                "triangle {t} refers to a vertex past the {n} given"
-            ));
+        if let Some(t) = triangles.iter().position(|t| t.iter().any(|&i| i as u64 >= n)) {
+            return Err(format!("triangle {t} refers to a vertex past the {n} given"));
         }
         let before = triangles.len();
-        let triangles: Vec<[u32; 3]> = triangles
-            .into_iter()
-            .filter(|t| face_normal(&positions, *t).length_squared() > 0.0)
-            .collect();
-        let repairs = MeshRepairs {
-            degenerate_triangles: before - triangles.len(),
-        };
+        let triangles: Vec<[u32; 3]> =
+            triangles.into_iter().filter(|t| face_normal(&positions, *t).length_squared() > 0.0).collect();
+        let repairs = MeshRepairs { degenerate_triangles: before - triangles.len() };
         if triangles.is_empty() {
             return Err(if before == 0 {
                 "the mesh has no triangles".to_string()
@@ -77,27 +65,16 @@ impl Mesh {
                 format!("all {before} triangles have zero area")
             });
         }
-        let uvs = if uvs.len() == positions.len() {
-            uvs
-        } else {
-            Vec::new()
-        };
+        let uvs = if uvs.len() == positions.len() { uvs } else { Vec::new() };
         let normals_ok = normals.len() == positions.len() && normals.iter().all(|v| v.is_finite());
-        let mut mesh = Mesh {
-            positions,
-            normals: if normals_ok { normals } else { Vec::new() },
-            uvs,
-            triangles,
-        };
+        let mut mesh = Mesh { positions, normals: if normals_ok { normals } else { Vec::new() }, uvs, triangles };
         if mesh.normals.is_empty() {
             match mode {
                 NormalMode::Smooth => mesh.compute_smooth_normals(),
                 NormalMode::Flat => mesh.split_flat(),
             }
         }
-        mesh.normals
-            .iter_mut()
-            .for_each(|v| *v = v.normalize_or(Vec3::Y));
+        mesh.normals.iter_mut().for_each(|v| *v = v.normalize_or(Vec3::Y));
         Ok((mesh, repairs))
     }
 
@@ -132,13 +109,10 @@ impl Mesh {
     /// Axis-aligned bounds `(min, max)` of the vertices used by triangles.
     #[must_use]
     pub fn bounds(&self) -> (Vec3, Vec3) {
-        self.triangles.iter().flatten().fold(
-            (Vec3::INFINITY, Vec3::NEG_INFINITY),
-            |(lo, hi), &i| {
-                let p = self.positions[i as usize];
-                (lo.min(p), hi.max(p))
-            },
-        )
+        self.triangles.iter().flatten().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &i| {
+            let p = self.positions[i as usize];
+            (lo.min(p), hi.max(p))
+        })
     }
 }
 
@@ -162,18 +136,8 @@ pub mod shapes {
             Vec3::new(0.5, 0.0, -0.5),
             Vec3::new(-0.5, 0.0, -0.5),
         ];
-        let uvs = vec![
-            Vec2::new(0.0, 1.0),
-            Vec2::new(1.0, 1.0),
-            Vec2::new(1.0, 0.0),
-            Vec2::ZERO,
-        ];
-        Mesh {
-            positions,
-            normals: vec![Vec3::Y; 4],
-            uvs,
-            triangles: vec![[0, 1, 2], [0, 2, 3]],
-        }
+        let uvs = vec![Vec2::new(0.0, 1.0), Vec2::new(1.0, 1.0), Vec2::new(1.0, 0.0), Vec2::ZERO];
+        Mesh { positions, normals: vec![Vec3::Y; 4], uvs, triangles: vec![[0, 1, 2], [0, 2, 3]] }
     }
 
     /// A cube of side 1 centred at the origin, flat-shaded.
@@ -182,15 +146,8 @@ pub mod shapes {
         let mut m = Mesh::default();
         for axis in 0..3 {
             for sign in [-1.0f32, 1.0] {
-                let n =
-                    Vec3::from_array(std::array::from_fn(|k| if k == axis { sign } else { 0.0 }));
-                let u = Vec3::from_array(std::array::from_fn(|k| {
-                    if k == (axis + 1) % 3 {
-                        1.0
-                    } else {
-                        0.0
-                    }
-                }));
+                let n = Vec3::from_array(std::array::from_fn(|k| if k == axis { sign } else { 0.0 }));
+                let u = Vec3::from_array(std::array::from_fn(|k| if k == (axis + 1) % 3 { 1.0 } else { 0.0 }));
                 let v = n.cross(u);
                 let base = m.positions.len() as u32;
                 for (a, b) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
@@ -216,17 +173,10 @@ pub mod shapes {
             let theta = std::f32::consts::PI * i as f32 / stacks as f32;
             for j in 0..=slices {
                 let phi = std::f32::consts::TAU * j as f32 / slices as f32;
-                let p = Vec3::new(
-                    theta.sin() * phi.cos(),
-                    theta.cos(),
-                    -theta.sin() * phi.sin(),
-                );
+                let p = Vec3::new(theta.sin() * phi.cos(), theta.cos(), -theta.sin() * phi.sin());
                 m.positions.push(p);
                 m.normals.push(p);
-                m.uvs.push(Vec2::new(
-                    j as f32 / slices as f32,
-                    i as f32 / stacks as f32,
-                ));
+                m.uvs.push(Vec2::new(j as f32 / slices as f32, i as f32 / stacks as f32));
             }
         }
         let row = slices + 1;
@@ -254,17 +204,9 @@ mod tests {
         let p = vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::new(2.0, 0.0, 0.0)];
         let e = Mesh::new(p.clone(), vec![], vec![], vec![], NormalMode::Smooth).unwrap_err();
         assert!(e.contains("no triangles"), "{e}");
-        let (m, r) = Mesh::new(
-            p.clone(),
-            vec![],
-            vec![],
-            vec![[0, 1, 2], [0, 1, 3]],
-            NormalMode::Smooth,
-        )
-        .unwrap();
+        let (m, r) = Mesh::new(p.clone(), vec![], vec![], vec![[0, 1, 2], [0, 1, 3]], NormalMode::Smooth).unwrap();
         assert_eq!((m.triangles.len(), r.degenerate_triangles), (1, 1));
-        let e =
-            Mesh::new(p.clone(), vec![], vec![], vec![[0, 1, 3]], NormalMode::Flat).unwrap_err();
+        let e = Mesh::new(p.clone(), vec![], vec![], vec![[0, 1, 3]], NormalMode::Flat).unwrap_err();
         assert!(e.contains("zero area"), "{e}");
         let mut bad = p;
         bad[2].y = f32::NAN;

@@ -64,13 +64,7 @@ pub struct Scene {
 
 /// Checks an image size before anything is allocated for it.
 pub fn check_image_size(width: u64, height: u64) -> Result<()> {
-    let err = |reason| {
-        Err(Error::ImageSize {
-            width,
-            height,
-            reason,
-        })
-    };
+    let err = |reason| Err(Error::ImageSize { width, height, reason });
     if width == 0 || height == 0 {
         return err("width and height must be at least 1");
     }
@@ -88,18 +82,11 @@ impl Scene {
     pub fn validate(&self) -> Result<()> {
         check_image_size(self.width as u64, self.height as u64)?;
         self.camera.validate().map_err(Error::Scene)?;
-        if let Some(o) = self
-            .objects
-            .iter()
-            .find(|o| o.material >= self.materials.len())
-        {
+        if let Some(o) = self.objects.iter().find(|o| o.material >= self.materials.len()) {
             return Err(Error::Scene(format!("object '{}' has no material", o.name)));
         }
         if let Some(o) = self.objects.iter().find(|o| !o.transform.is_finite()) {
-            return Err(Error::Scene(format!(
-                "object '{}' has a non-finite transform",
-                o.name
-            )));
+            return Err(Error::Scene(format!("object '{}' has a non-finite transform", o.name)));
         }
         Ok(())
     }
@@ -111,11 +98,7 @@ impl Scene {
             let (lo, hi) = o.mesh.bounds();
             let corners = (0..8).map(|k| {
                 let pick = |bit: usize, a: f32, b: f32| if k >> bit & 1 == 0 { a } else { b };
-                o.transform.transform_point3(Vec3::new(
-                    pick(0, lo.x, hi.x),
-                    pick(1, lo.y, hi.y),
-                    pick(2, lo.z, hi.z),
-                ))
+                o.transform.transform_point3(Vec3::new(pick(0, lo.x, hi.x), pick(1, lo.y, hi.y), pick(2, lo.z, hi.z)))
             });
             let (mut lo, mut hi) = acc.unwrap_or((Vec3::INFINITY, Vec3::NEG_INFINITY));
             for c in corners {
@@ -155,9 +138,7 @@ pub fn framing(bounds: (Vec3, Vec3), aspect: f32) -> (Camera, Vec<Light>) {
         projection: Projection::Perspective { fov_y_deg },
     };
     let key = Light {
-        kind: LightKind::Point {
-            position: c + r * Vec3::new(1.5, 3.0, 1.2),
-        },
+        kind: LightKind::Point { position: c + r * Vec3::new(1.5, 3.0, 1.2) },
         color: Vec3::ONE,
         intensity: 0.85,
         ambient: 0.12,
@@ -165,9 +146,7 @@ pub fn framing(bounds: (Vec3, Vec3), aspect: f32) -> (Camera, Vec<Light>) {
         falloff: Falloff::None,
     };
     let fill = Light {
-        kind: LightKind::Directional {
-            direction: Vec3::new(1.0, -0.3, 0.6).normalize(),
-        },
+        kind: LightKind::Directional { direction: Vec3::new(1.0, -0.3, 0.6).normalize() },
         color: Vec3::new(0.75, 0.8, 1.0),
         intensity: 0.3,
         ambient: 0.0,

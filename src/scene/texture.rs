@@ -14,34 +14,21 @@ impl Texture {
     /// Decodes an encoded image (PNG or JPEG). `srgb` says whether its values are
     /// sRGB-encoded colours (true for colour maps) or already linear.
     pub fn decode(bytes: &[u8], srgb: bool) -> Result<Texture, String> {
-        let img = image::load_from_memory(bytes)
-            .map_err(|e| e.to_string())?
-            .into_rgb32f();
+        let img = image::load_from_memory(bytes).map_err(|e| e.to_string())?.into_rgb32f();
         let (width, height) = img.dimensions();
         if width == 0 || height == 0 {
             return Err("the image has no pixels".into());
         }
         let decode = |c: f32| if srgb { srgb_to_linear(c) } else { c };
-        let texels = img
-            .pixels()
-            .map(|p| Vec3::new(decode(p[0]), decode(p[1]), decode(p[2])))
-            .collect();
-        Ok(Texture {
-            width,
-            height,
-            texels,
-        })
+        let texels = img.pixels().map(|p| Vec3::new(decode(p[0]), decode(p[1]), decode(p[2]))).collect();
+        Ok(Texture { width, height, texels })
     }
 
     /// A texture from linear texels, row 0 at the top. Panics if the sizes disagree.
     #[must_use]
     pub fn from_texels(width: u32, height: u32, texels: Vec<Vec3>) -> Texture {
         assert_eq!(texels.len(), (width * height) as usize, "texel count");
-        Texture {
-            width,
-            height,
-            texels,
-        }
+        Texture { width, height, texels }
     }
 
     /// Bilinear sample at `uv` (origin top-left, texel centres at +0.5), repeating.

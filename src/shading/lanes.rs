@@ -31,56 +31,28 @@ struct V3 {
 
 impl V3 {
     fn splat(v: Vec3) -> V3 {
-        V3 {
-            x: F::splat(v.x),
-            y: F::splat(v.y),
-            z: F::splat(v.z),
-        }
+        V3 { x: F::splat(v.x), y: F::splat(v.y), z: F::splat(v.z) }
     }
     fn dot(self, o: V3) -> F {
         self.x.mul_add(o.x, self.y.mul_add(o.y, self.z * o.z))
     }
     fn cross(self, o: V3) -> V3 {
-        V3 {
-            x: self.y * o.z - self.z * o.y,
-            y: self.z * o.x - self.x * o.z,
-            z: self.x * o.y - self.y * o.x,
-        }
+        V3 { x: self.y * o.z - self.z * o.y, y: self.z * o.x - self.x * o.z, z: self.x * o.y - self.y * o.x }
     }
     fn add(self, o: V3) -> V3 {
-        V3 {
-            x: self.x + o.x,
-            y: self.y + o.y,
-            z: self.z + o.z,
-        }
+        V3 { x: self.x + o.x, y: self.y + o.y, z: self.z + o.z }
     }
     fn sub(self, o: V3) -> V3 {
-        V3 {
-            x: self.x - o.x,
-            y: self.y - o.y,
-            z: self.z - o.z,
-        }
+        V3 { x: self.x - o.x, y: self.y - o.y, z: self.z - o.z }
     }
     fn mul(self, o: V3) -> V3 {
-        V3 {
-            x: self.x * o.x,
-            y: self.y * o.y,
-            z: self.z * o.z,
-        }
+        V3 { x: self.x * o.x, y: self.y * o.y, z: self.z * o.z }
     }
     fn scale(self, s: F) -> V3 {
-        V3 {
-            x: self.x * s,
-            y: self.y * s,
-            z: self.z * s,
-        }
+        V3 { x: self.x * s, y: self.y * s, z: self.z * s }
     }
     fn select(mask: F, a: V3, b: V3) -> V3 {
-        V3 {
-            x: mask.select(a.x, b.x),
-            y: mask.select(a.y, b.y),
-            z: mask.select(a.z, b.z),
-        }
+        V3 { x: mask.select(a.x, b.x), y: mask.select(a.y, b.y), z: mask.select(a.z, b.z) }
     }
     /// Unit vector, or `fallback` where the length is zero.
     fn normalize_or(self, fallback: V3) -> V3 {
@@ -90,11 +62,7 @@ impl V3 {
         V3::select(ok, n, fallback)
     }
     fn lane(&self, i: usize) -> Vec3 {
-        Vec3::new(
-            self.x.as_array()[i],
-            self.y.as_array()[i],
-            self.z.as_array()[i],
-        )
+        Vec3::new(self.x.as_array()[i], self.y.as_array()[i], self.z.as_array()[i])
     }
 }
 
@@ -119,11 +87,7 @@ impl Gather {
         self.v[2][i] = v.z;
     }
     fn load(&self) -> V3 {
-        V3 {
-            x: F::new(self.v[0]),
-            y: F::new(self.v[1]),
-            z: F::new(self.v[2]),
-        }
+        V3 { x: F::new(self.v[0]), y: F::new(self.v[1]), z: F::new(self.v[2]) }
     }
 }
 
@@ -222,8 +186,7 @@ impl Block {
         let s = surface(&inputs, rays, x0, y);
         if self.sample_textures(&s, &coefficients_at) {
             let textured = self.inputs();
-            (inputs.ka, inputs.kd, inputs.ks, inputs.ke) =
-                (textured.ka, textured.kd, textured.ks, textured.ke);
+            (inputs.ka, inputs.kd, inputs.ks, inputs.ke) = (textured.ka, textured.kd, textured.ks, textured.ke);
             (inputs.shininess, inputs.whole) = (textured.shininess, textured.whole);
         }
         let rgb = lighting.shade(&inputs, &s);
@@ -235,11 +198,7 @@ impl Block {
     }
 
     /// Samples the maps of textured lanes; false if there were none.
-    fn sample_textures(
-        &mut self,
-        s: &LaneSurface,
-        at: &impl Fn(&SurfacePoint) -> Coefficients,
-    ) -> bool {
+    fn sample_textures(&mut self, s: &LaneSurface, at: &impl Fn(&SurfacePoint) -> Coefficients) -> bool {
         if !self.textured.iter().zip(&self.live).any(|(t, l)| *t && *l) {
             return false;
         }
@@ -335,45 +294,17 @@ fn surface(inp: &LaneInputs, rays: &PixelRays, x0: usize, y: usize) -> LaneSurfa
     let (origin, dir) = lane_rays(rays, x0, y);
     let pvec = dir.cross(inp.e2);
     let det = inp.e1.dot(pvec);
-    let det = det
-        .abs()
-        .simd_lt(F::splat(f32::MIN_POSITIVE))
-        .select(F::splat(f32::MIN_POSITIVE), det);
+    let det = det.abs().simd_lt(F::splat(f32::MIN_POSITIVE)).select(F::splat(f32::MIN_POSITIVE), det);
     let inv = F::ONE / det;
     let tvec = origin.sub(inp.a);
     let qvec = tvec.cross(inp.e1);
-    let (b1, b2, t) = (
-        tvec.dot(pvec) * inv,
-        dir.dot(qvec) * inv,
-        inp.e2.dot(qvec) * inv,
-    );
+    let (b1, b2, t) = (tvec.dot(pvec) * inv, dir.dot(qvec) * inv, inp.e2.dot(qvec) * inv);
     let b0 = F::ONE - b1 - b2;
-    let n = inp.n[0]
-        .scale(b0)
-        .add(inp.n[1].scale(b1))
-        .add(inp.n[2].scale(b2))
-        .normalize_or(inp.geometric);
-    let v = V3 {
-        x: -dir.x,
-        y: -dir.y,
-        z: -dir.z,
-    };
+    let n = inp.n[0].scale(b0).add(inp.n[1].scale(b1)).add(inp.n[2].scale(b2)).normalize_or(inp.geometric);
+    let v = V3 { x: -dir.x, y: -dir.y, z: -dir.z };
     let facing = n.dot(v).simd_lt(F::ZERO);
-    let n = V3::select(
-        facing,
-        V3 {
-            x: -n.x,
-            y: -n.y,
-            z: -n.z,
-        },
-        n,
-    );
-    LaneSurface {
-        p: origin.add(dir.scale(t)),
-        n,
-        v,
-        weights: [b0, b1, b2],
-    }
+    let n = V3::select(facing, V3 { x: -n.x, y: -n.y, z: -n.z }, n);
+    LaneSurface { p: origin.add(dir.scale(t)), n, v, weights: [b0, b1, b2] }
 }
 
 /// The lights of a frame, with their summed ambient colour.
@@ -387,10 +318,7 @@ impl<'a> Lighting<'a> {
     /// Prepares `lights` for lane shading.
     #[must_use]
     pub fn new(lights: &'a [Light]) -> Self {
-        Lighting {
-            lights,
-            ambient: lights.iter().map(|l| l.color * l.ambient).sum(),
-        }
+        Lighting { lights, ambient: lights.iter().map(|l| l.color * l.ambient).sum() }
     }
 
     /// Seed 002 eq. 1 summed over the lights, per lane.
@@ -408,11 +336,7 @@ impl<'a> Lighting<'a> {
             diffuse = diffuse.add(radiance.scale(lit.select(cos_theta, F::ZERO)));
             specular = specular.add(radiance.scale(lit.select(spec, F::ZERO)));
         }
-        inp.ka
-            .mul(V3::splat(self.ambient))
-            .add(inp.kd.mul(diffuse))
-            .add(inp.ks.mul(specular))
-            .add(inp.ke)
+        inp.ka.mul(V3::splat(self.ambient)).add(inp.kd.mul(diffuse)).add(inp.ks.mul(specular)).add(inp.ke)
     }
 }
 
@@ -457,19 +381,12 @@ fn incident(light: &Light, p: &V3) -> (V3, V3) {
             let (l, att) = positional(position);
             (l, scale.scale(att))
         }
-        LightKind::Spot {
-            position,
-            direction,
-            inner,
-            outer,
-        } => {
+        LightKind::Spot { position, direction, inner, outer } => {
             let (l, att) = positional(position);
             let cos = -l.dot(V3::splat(direction));
             let (ci, co) = (inner.cos(), outer.cos());
             let t = if ci > co {
-                ((cos - F::splat(co)) / F::splat(ci - co))
-                    .max(F::ZERO)
-                    .min(F::ONE)
+                ((cos - F::splat(co)) / F::splat(ci - co)).max(F::ZERO).min(F::ONE)
             } else {
                 cos.simd_lt(F::splat(co)).select(F::ZERO, F::ONE)
             };
@@ -486,19 +403,11 @@ fn lane_rays(rays: &PixelRays, x0: usize, y: usize) -> (V3, V3) {
     let xs = F::splat(x0 as f32) + STEPS;
     let ndc_x = xs * F::splat(2.0 / rays.size.x) - F::ONE;
     let ndc_y = F::splat(1.0 - 2.0 * (y as f32 + 0.5) / rays.size.y);
-    let offset = V3::splat(rays.right)
-        .scale(ndc_x)
-        .add(V3::splat(rays.up).scale(ndc_y));
+    let offset = V3::splat(rays.right).scale(ndc_x).add(V3::splat(rays.up).scale(ndc_y));
     if rays.ortho {
-        (
-            V3::splat(rays.origin).add(offset),
-            V3::splat(rays.forward.normalize()),
-        )
+        (V3::splat(rays.origin).add(offset), V3::splat(rays.forward.normalize()))
     } else {
         let d = V3::splat(rays.forward).add(offset);
-        (
-            V3::splat(rays.origin),
-            d.normalize_or(V3::splat(rays.forward)),
-        )
+        (V3::splat(rays.origin), d.normalize_or(V3::splat(rays.forward)))
     }
 }

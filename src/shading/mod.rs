@@ -29,57 +29,39 @@ pub fn shade_frame(scene: &Scene, vb: &VisibilityBuffer) -> LinearImage {
 /// Shades every pixel of `vb` into `image` (same size), rows in parallel, eight
 /// pixels at a time ([`lanes`]).
 pub fn shade_into(scene: &Scene, vb: &VisibilityBuffer, image: &mut LinearImage) {
-    assert_eq!(
-        (image.width(), image.height()),
-        (vb.width(), vb.height()),
-        "image and buffer sizes"
-    );
+    assert_eq!((image.width(), image.height()), (vb.width(), vb.height()), "image and buffer sizes");
     let w = vb.width() as usize;
     let frames = ObjectFrames::new(scene);
-    let rays = scene
-        .camera
-        .pixel_rays(Vec2::new(w as f32, vb.height() as f32));
-    let constants: Vec<Option<Coefficients>> =
-        scene.materials.iter().map(Coefficients::constant).collect();
+    let rays = scene.camera.pixel_rays(Vec2::new(w as f32, vb.height() as f32));
+    let constants: Vec<Option<Coefficients>> = scene.materials.iter().map(Coefficients::constant).collect();
     let sample = |s: &SurfacePoint| Coefficients::at(&scene.materials[s.material], s);
     let lighting = lanes::Lighting::new(&scene.lights);
-    let rows = image
-        .pixels_mut()
-        .par_chunks_mut(w)
-        .zip(vb.items().par_chunks(w));
+    let rows = image.pixels_mut().par_chunks_mut(w).zip(vb.items().par_chunks(w));
     let caches = || (TriangleCache::new(), lanes::Block::default());
-    rows.enumerate()
-        .for_each_init(caches, |(cache, block), (y, (out, items))| {
-            for (c, (out, items)) in out
-                .chunks_mut(lanes::LANES)
-                .zip(items.chunks(lanes::LANES))
-                .enumerate()
-            {
-                let first = items[0];
-                if items.len() == lanes::LANES
-                    && !first.is_none()
-                    && items.iter().all(|&i| i == first)
-                {
-                    let tri = cache.get(scene, &frames, first);
-                    if let Some(k) = &constants[tri.material] {
-                        lanes::shade_uniform(tri, k, &rays, (c * lanes::LANES, y), &lighting, out);
-                        continue;
-                    }
-                }
-                block.clear();
-                for (i, (&item, px)) in items.iter().zip(out.iter_mut()).enumerate() {
-                    if item.is_none() {
-                        *px = scene.background;
-                        continue;
-                    }
-                    let tri = cache.get(scene, &frames, item);
-                    block.set(i, tri, constants[tri.material].as_ref());
-                }
-                if block.live.iter().any(|&l| l) {
-                    block.shade(&rays, (c * lanes::LANES, y), &lighting, sample, out);
+    rows.enumerate().for_each_init(caches, |(cache, block), (y, (out, items))| {
+        for (c, (out, items)) in out.chunks_mut(lanes::LANES).zip(items.chunks(lanes::LANES)).enumerate() {
+            let first = items[0];
+            if items.len() == lanes::LANES && !first.is_none() && items.iter().all(|&i| i == first) {
+                let tri = cache.get(scene, &frames, first);
+                if let Some(k) = &constants[tri.material] {
+                    lanes::shade_uniform(tri, k, &rays, (c * lanes::LANES, y), &lighting, out);
+                    continue;
                 }
             }
-        });
+            block.clear();
+            for (i, (&item, px)) in items.iter().zip(out.iter_mut()).enumerate() {
+                if item.is_none() {
+                    *px = scene.background;
+                    continue;
+                }
+                let tri = cache.get(scene, &frames, item);
+                block.set(i, tri, constants[tri.material].as_ref());
+            }
+            if block.live.iter().any(|&l| l) {
+                block.shade(&rays, (c * lanes::LANES, y), &lighting, sample, out);
+            }
+        }
+    });
 }
 
 /// A small direct-mapped cache of prepared triangles, one per worker: the rows a
@@ -92,14 +74,11 @@ impl TriangleCache {
     const SLOTS: usize = 512;
 
     fn new() -> Self {
-        TriangleCache {
-            slots: vec![None; Self::SLOTS],
-        }
+        TriangleCache { slots: vec![None; Self::SLOTS] }
     }
 
     fn get(&mut self, scene: &Scene, frames: &ObjectFrames, item: ItemId) -> &PreparedTriangle {
-        let key =
-            (item.triangle as usize ^ (item.object as usize).wrapping_mul(0x9E37)) % Self::SLOTS;
+        let key = (item.triangle as usize ^ (item.object as usize).wrapping_mul(0x9E37)) % Self::SLOTS;
         let slot = &mut self.slots[key];
         match slot {
             Some(t) if t.item == item => {}
@@ -114,23 +93,14 @@ impl TriangleCache {
 pub fn shade_into_scalar(scene: &Scene, vb: &VisibilityBuffer, image: &mut LinearImage) {
     let w = vb.width() as usize;
     let frames = ObjectFrames::new(scene);
-    let rays = scene
-        .camera
-        .pixel_rays(Vec2::new(w as f32, vb.height() as f32));
-    let rows = image
-        .pixels_mut()
-        .par_chunks_mut(w)
-        .zip(vb.items().par_chunks(w));
+    let rays = scene.camera.pixel_rays(Vec2::new(w as f32, vb.height() as f32));
+    let rows = image.pixels_mut().par_chunks_mut(w).zip(vb.items().par_chunks(w));
     rows.enumerate().for_each(|(y, (out, items))| {
         for (x, (px, &item)) in out.iter_mut().zip(items).enumerate() {
             *px = if item.is_none() {
                 scene.background
             } else {
-                let s = frames.surface(
-                    scene,
-                    item,
-                    &rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5)),
-                );
+                let s = frames.surface(scene, item, &rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5)));
                 phong::shade(&scene.lights, &scene.materials[s.material], &s).total()
             };
         }

@@ -53,25 +53,15 @@ impl Coefficients {
     #[must_use]
     pub fn constant(m: &Material) -> Option<Self> {
         let maps = &m.maps;
-        let none = maps.ambient.is_none()
-            && maps.diffuse.is_none()
-            && maps.specular.is_none()
-            && maps.emission.is_none();
-        none.then_some(Coefficients {
-            ka: m.ka,
-            kd: m.kd,
-            ks: m.ks,
-            ke: m.ke,
-            n: m.shininess,
-        })
+        let none =
+            maps.ambient.is_none() && maps.diffuse.is_none() && maps.specular.is_none() && maps.emission.is_none();
+        none.then_some(Coefficients { ka: m.ka, kd: m.kd, ks: m.ks, ke: m.ke, n: m.shininess })
     }
 
     /// Samples every map of `m` at the point's uv.
     #[must_use]
     pub fn at(m: &Material, s: &SurfacePoint) -> Self {
-        let map = |t: &Option<std::sync::Arc<crate::scene::Texture>>| {
-            t.as_ref().map_or(Vec3::ONE, |t| t.sample(s.uv))
-        };
+        let map = |t: &Option<std::sync::Arc<crate::scene::Texture>>| t.as_ref().map_or(Vec3::ONE, |t| t.sample(s.uv));
         Coefficients {
             ka: m.ka * map(&m.maps.ambient),
             kd: m.kd * map(&m.maps.diffuse),
@@ -84,13 +74,7 @@ impl Coefficients {
 
 /// Adds light `light`'s ambient, diffuse and specular terms at `s` to `acc`, with
 /// `shadow` ∈ [0, 1] (1 = lit) multiplying diffuse and specular only.
-pub fn add_light(
-    acc: &mut Components,
-    light: &Light,
-    k: &Coefficients,
-    s: &SurfacePoint,
-    shadow: f32,
-) {
+pub fn add_light(acc: &mut Components, light: &Light, k: &Coefficients, s: &SurfacePoint, shadow: f32) {
     acc.ambient += light.color * light.ambient * k.ka;
     let inc = light.incident(s.position);
     let cos_theta = s.normal.dot(inc.to_light);
@@ -123,10 +107,7 @@ pub fn shade(lights: &[Light], m: &Material, s: &SurfacePoint) -> Components {
 /// Seed 002 eq. 1 for all lights, unshadowed, with the coefficients already known.
 #[must_use]
 pub fn shade_with(lights: &[Light], k: &Coefficients, s: &SurfacePoint) -> Components {
-    let mut acc = Components {
-        emission: k.ke,
-        ..Default::default()
-    };
+    let mut acc = Components { emission: k.ke, ..Default::default() };
     for light in lights {
         add_light(&mut acc, light, k, s, 1.0);
     }

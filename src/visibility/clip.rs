@@ -77,11 +77,7 @@ fn clip_polygon(input: &[Vec4], plane: Vec4, out: &mut [Vec4; MAX_CLIPPED]) -> u
             n += 1;
         }
         if (dc >= 0.0) != (dn >= 0.0) {
-            let (inside, outside, di, dout) = if dc >= 0.0 {
-                (cur, next, dc, dn)
-            } else {
-                (next, cur, dn, dc)
-            };
+            let (inside, outside, di, dout) = if dc >= 0.0 { (cur, next, dc, dn) } else { (next, cur, dn, dc) };
             out[n] = inside + (outside - inside) * (di / (di - dout));
             n += 1;
         }
@@ -97,11 +93,7 @@ mod tests {
     fn crossing_the_near_plane_keeps_the_front_part() {
         let planes = ClipPlanes::new(0.001, 100.0, 100.0);
         // z ≤ w is inside; the third vertex is behind the near plane.
-        let tri = [
-            Vec4::new(0.0, 0.0, 0.5, 1.0),
-            Vec4::new(1.0, 0.0, 0.5, 1.0),
-            Vec4::new(0.0, 1.0, 2.0, 1.0),
-        ];
+        let tri = [Vec4::new(0.0, 0.0, 0.5, 1.0), Vec4::new(1.0, 0.0, 0.5, 1.0), Vec4::new(0.0, 1.0, 2.0, 1.0)];
         let mask = tri.iter().fold(0, |m, v| m | planes.outcode(*v));
         assert_eq!(mask, 1);
         let mut out = [Vec4::ZERO; MAX_CLIPPED];
@@ -113,22 +105,15 @@ mod tests {
     #[test]
     fn shared_edge_clips_to_identical_points() {
         let planes = ClipPlanes::new(0.001, 100.0, 100.0);
-        let (a, b) = (
-            Vec4::new(0.3, -0.2, 0.2, 1.0),
-            Vec4::new(-0.7, 0.9, 3.0, 1.0),
-        );
+        let (a, b) = (Vec4::new(0.3, -0.2, 0.2, 1.0), Vec4::new(-0.7, 0.9, 3.0, 1.0));
         let t1 = [a, b, Vec4::new(1.0, 1.0, 0.1, 1.0)];
         let t2 = [b, a, Vec4::new(-1.0, -1.0, 0.1, 1.0)];
         let mut o1 = [Vec4::ZERO; MAX_CLIPPED];
         let mut o2 = [Vec4::ZERO; MAX_CLIPPED];
         let n1 = planes.clip(t1, 1, &mut o1);
         let n2 = planes.clip(t2, 1, &mut o2);
-        let on_plane = |o: &[Vec4]| {
-            o.iter()
-                .copied()
-                .filter(|v| v.z == v.w || (v.z - v.w).abs() < 1e-6)
-                .collect::<Vec<_>>()
-        };
+        let on_plane =
+            |o: &[Vec4]| o.iter().copied().filter(|v| v.z == v.w || (v.z - v.w).abs() < 1e-6).collect::<Vec<_>>();
         let (p1, p2) = (on_plane(&o1[..n1]), on_plane(&o2[..n2]));
         assert!(p1.iter().any(|p| p2.contains(p)), "{p1:?} vs {p2:?}");
     }

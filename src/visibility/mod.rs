@@ -24,10 +24,7 @@ pub struct ItemId {
 
 impl ItemId {
     /// The id of pixels that see nothing.
-    pub const NONE: ItemId = ItemId {
-        object: u32::MAX,
-        triangle: u32::MAX,
-    };
+    pub const NONE: ItemId = ItemId { object: u32::MAX, triangle: u32::MAX };
 
     /// Whether this pixel sees nothing.
     #[must_use]
@@ -55,12 +52,7 @@ impl VisibilityBuffer {
     #[must_use]
     pub fn new(width: u32, height: u32) -> Self {
         let n = width as usize * height as usize;
-        VisibilityBuffer {
-            width,
-            height,
-            depth: vec![0.0; n],
-            items: vec![ItemId::NONE; n],
-        }
+        VisibilityBuffer { width, height, depth: vec![0.0; n], items: vec![ItemId::NONE; n] }
     }
 
     /// Width in pixels.
@@ -122,7 +114,6 @@ impl VisibilityBuffer {
     /// Bytes held by the buffer.
     #[must_use]
     pub fn memory_bytes(&self) -> usize {
-        self.depth.len() * std::mem::size_of::<f32>()
-            + self.items.len() * std::mem::size_of::<ItemId>()
+        self.depth.len() * std::mem::size_of::<f32>() + self.items.len() * std::mem::size_of::<ItemId>()
     }
 }

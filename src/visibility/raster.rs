@@ -12,9 +12,7 @@ use glam::{Mat4, Vec4};
 use rayon::prelude::*;
 
 use super::clip::{ClipPlanes, MAX_CLIPPED};
-use super::scan::{
-    column_range, row_range, scan_triangle, signed_area2, FixedPoint, SpanSink, ONE,
-};
+use super::scan::{column_range, row_range, scan_triangle, signed_area2, FixedPoint, SpanSink, ONE};
 use super::{ItemId, VisibilityBuffer};
 use crate::scene::Scene;
 
@@ -50,10 +48,7 @@ struct ScreenVertex {
 
 impl ScreenVertex {
     fn point(self) -> FixedPoint {
-        FixedPoint {
-            x: self.x as i64,
-            y: self.y as i64,
-        }
+        FixedPoint { x: self.x as i64, y: self.y as i64 }
     }
 }
 
@@ -78,11 +73,7 @@ impl Viewport {
         let sx = (c.x as f64 * inv_w * 0.5 + 0.5) * self.width as f64;
         let sy = (0.5 - c.y as f64 * inv_w * 0.5) * self.height as f64;
         let one = ONE as f64;
-        ScreenVertex {
-            x: (sx * one).round() as i32,
-            y: (sy * one).round() as i32,
-            z: (c.z as f64 * inv_w) as f32,
-        }
+        ScreenVertex { x: (sx * one).round() as i32, y: (sy * one).round() as i32, z: (c.z as f64 * inv_w) as f32 }
     }
 }
 
@@ -121,24 +112,10 @@ pub fn rasterize(scene: &Scene, vb: &mut VisibilityBuffer) -> RasterStats {
         1.0 + 2.0 * GUARD_PX / w as f32,
         1.0 + 2.0 * GUARD_PX / h as f32,
     );
-    let viewport = Viewport {
-        width: w as f32,
-        height: h as f32,
-    };
-    let projected = scene
-        .objects
-        .iter()
-        .map(|o| project(scene, o, view_proj, &planes, viewport))
-        .collect();
-    let frame = Frame {
-        scene,
-        projected,
-        planes,
-        viewport,
-        width: w as i64,
-        height: h as i64,
-        bands: h.div_ceil(BAND_ROWS),
-    };
+    let viewport = Viewport { width: w as f32, height: h as f32 };
+    let projected = scene.objects.iter().map(|o| project(scene, o, view_proj, &planes, viewport)).collect();
+    let frame =
+        Frame { scene, projected, planes, viewport, width: w as i64, height: h as i64, bands: h.div_ceil(BAND_ROWS) };
     let chunks = chunks(scene);
     let bins: Vec<ChunkBins> = chunks.par_iter().map(|c| frame.bin(c)).collect();
     let (depth, items) = vb.parts_mut();
@@ -162,62 +139,39 @@ fn project(
     viewport: Viewport,
 ) -> Projected {
     let m = view_proj * Mat4::from(object.transform);
-    let clip: Vec<Vec4> = object
-        .mesh
-        .positions
-        .par_iter()
-        .map(|p| m * p.extend(1.0))
-        .collect();
+    let clip: Vec<Vec4> = object.mesh.positions.par_iter().map(|p| m * p.extend(1.0)).collect();
     let outcode: Vec<u8> = clip.par_iter().map(|c| planes.outcode(*c)).collect();
     let screen = clip
         .par_iter()
         .zip(&outcode)
-        .map(|(c, &o)| {
-            if o == 0 {
-                viewport.to_screen(*c)
-            } else {
-                ScreenVertex::default()
-            }
-        })
+        .map(|(c, &o)| if o == 0 { viewport.to_screen(*c) } else { ScreenVertex::default() })
         .collect();
-    Projected {
-        clip,
-        outcode,
-        screen,
-        cull_back: !scene.materials[object.material].two_sided,
-    }
+    Projected { clip, outcode, screen, cull_back: !scene.materials[object.material].two_sided }
 }
 
 fn chunks(scene: &Scene) -> Vec<Chunk> {
     let mut out = Vec::new();
     for (object, o) in scene.objects.iter().enumerate() {
         let n = o.mesh.triangles.len() as u32;
-        out.extend((0..n).step_by(CHUNK_TRIANGLES as usize).map(|s| Chunk {
-            object,
-            triangles: s..(s + CHUNK_TRIANGLES).min(n),
-        }));
+        out.extend(
+            (0..n)
+                .step_by(CHUNK_TRIANGLES as usize)
+                .map(|s| Chunk { object, triangles: s..(s + CHUNK_TRIANGLES).min(n) }),
+        );
     }
     out
 }
 
 impl Frame<'_> {
     fn bin(&self, chunk: &Chunk) -> ChunkBins {
-        let mut bins = ChunkBins {
-            bands: vec![Vec::new(); self.bands],
-            ..Default::default()
-        };
+        let mut bins = ChunkBins { bands: vec![Vec::new(); self.bands], ..Default::default() };
         let p = &self.projected[chunk.object];
         let tris = &self.scene.objects[chunk.object].mesh.triangles;
         for t in chunk.triangles.clone() {
             let [a, b, c] = tris[t as usize].map(|i| i as usize);
             let codes = [p.outcode[a], p.outcode[b], p.outcode[c]];
             if codes[0] | codes[1] | codes[2] == 0 {
-                self.bin_triangle(
-                    &mut bins,
-                    [p.screen[a], p.screen[b], p.screen[c]],
-                    p.cull_back,
-                    t,
-                );
+                self.bin_triangle(&mut bins, [p.screen[a], p.screen[b], p.screen[c]], p.cull_back, t);
             } else if codes[0] & codes[1] & codes[2] == 0 {
                 bins.clipped_count += 1;
                 self.bin_clipped(
@@ -235,10 +189,7 @@ impl Frame<'_> {
     fn bin_clipped(&self, bins: &mut ChunkBins, tri: [Vec4; 3], mask: u8, cull_back: bool, t: u32) {
         let mut poly = [Vec4::ZERO; MAX_CLIPPED];
         let n = self.planes.clip(tri, mask, &mut poly);
-        let screen: Vec<ScreenVertex> = poly[..n]
-            .iter()
-            .map(|c| self.viewport.to_screen(*c))
-            .collect();
+        let screen: Vec<ScreenVertex> = poly[..n].iter().map(|c| self.viewport.to_screen(*c)).collect();
         for k in 1..n.saturating_sub(1) {
             let v = [screen[0], screen[k], screen[k + 1]];
             if let Some(bands) = self.bands_of(v, cull_back) {
@@ -272,26 +223,13 @@ impl Frame<'_> {
         Some(rows.start as usize / BAND_ROWS..(rows.end as usize - 1) / BAND_ROWS + 1)
     }
 
-    fn draw_band(
-        &self,
-        band: usize,
-        depth: &mut [f32],
-        items: &mut [ItemId],
-        chunks: &[Chunk],
-        bins: &[ChunkBins],
-    ) {
+    fn draw_band(&self, band: usize, depth: &mut [f32], items: &mut [ItemId], chunks: &[Chunk], bins: &[ChunkBins]) {
         let row0 = (band * BAND_ROWS) as i64;
         let rows = row0..(row0 + BAND_ROWS as i64).min(self.height);
         depth.fill(0.0);
         items.fill(ItemId::NONE);
-        let mut sink = DepthSink {
-            depth,
-            items,
-            width: self.width,
-            row0,
-            plane: DepthPlane::default(),
-            item: ItemId::NONE,
-        };
+        let mut sink =
+            DepthSink { depth, items, width: self.width, row0, plane: DepthPlane::default(), item: ItemId::NONE };
         for (chunk, bin) in chunks.iter().zip(bins) {
             let p = &self.projected[chunk.object];
             let tris = &self.scene.objects[chunk.object].mesh.triangles;
@@ -301,10 +239,7 @@ impl Frame<'_> {
                 } else {
                     (tris[entry as usize].map(|i| p.screen[i as usize]), entry)
                 };
-                sink.item = ItemId {
-                    object: chunk.object as u32,
-                    triangle: t,
-                };
+                sink.item = ItemId { object: chunk.object as u32, triangle: t };
                 sink.plane = DepthPlane::new(&v);
                 scan_triangle(&v.map(ScreenVertex::point), rows.clone(), &mut sink);
             }
@@ -328,16 +263,11 @@ struct DepthPlane {
 impl DepthPlane {
     fn new(v: &[ScreenVertex; 3]) -> Self {
         let s = 1.0 / ONE as f64;
-        let [(x0, y0, z0), (x1, y1, z1), (x2, y2, z2)] =
-            v.map(|p| (p.x as f64 * s, p.y as f64 * s, p.z as f64));
+        let [(x0, y0, z0), (x1, y1, z1), (x2, y2, z2)] = v.map(|p| (p.x as f64 * s, p.y as f64 * s, p.z as f64));
         let area = (x1 - x0) * (y2 - y0) - (x2 - x0) * (y1 - y0);
         let dx = ((z1 - z0) * (y2 - y0) - (z2 - z0) * (y1 - y0)) / area;
         let dy = ((z2 - z0) * (x1 - x0) - (z1 - z0) * (x2 - x0)) / area;
-        DepthPlane {
-            c: z0 + dx * (0.5 - x0) + dy * (0.5 - y0),
-            dx,
-            dy,
-        }
+        DepthPlane { c: z0 + dx * (0.5 - x0) + dy * (0.5 - y0), dx, dy }
     }
 }
 

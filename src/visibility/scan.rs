@@ -74,13 +74,7 @@ impl EdgeDda {
         let n = (a.x - HALF) * dy + (row * ONE + HALF - a.y) * dx;
         let x = ceil_div(n, d);
         let s = ONE * dx;
-        EdgeDda {
-            x,
-            rem: x * d - n,
-            step_x: s.div_euclid(d),
-            step_rem: s.rem_euclid(d),
-            d,
-        }
+        EdgeDda { x, rem: x * d - n, step_x: s.div_euclid(d), step_rem: s.rem_euclid(d), d }
     }
 
     /// Moves to the next row.
@@ -128,36 +122,27 @@ pub fn scan_triangle(v: &[FixedPoint; 3], rows: Range<i64>, sink: &mut impl Span
     if cross == 0 {
         return;
     }
-    let (top, mid, bottom) = (
-        first_centre_from(a.y),
-        first_centre_from(b.y),
-        first_centre_from(c.y),
-    );
+    let (top, mid, bottom) = (first_centre_from(a.y), first_centre_from(b.y), first_centre_from(c.y));
     let (start, end) = (top.max(rows.start), bottom.min(rows.end));
     if start >= end {
         return;
     }
     let mut long = EdgeDda::new(a, c, start);
     let short_is_left = cross > 0;
-    let mut walk =
-        |short_from: FixedPoint, short_to: FixedPoint, r0: i64, r1: i64, long: &mut EdgeDda| {
-            if r0 >= r1 {
-                return;
+    let mut walk = |short_from: FixedPoint, short_to: FixedPoint, r0: i64, r1: i64, long: &mut EdgeDda| {
+        if r0 >= r1 {
+            return;
+        }
+        let mut short = EdgeDda::new(short_from, short_to, r0);
+        for row in r0..r1 {
+            let (l, r) = if short_is_left { (short.x, long.x) } else { (long.x, short.x) };
+            if l < r {
+                sink.span(row, l, r);
             }
-            let mut short = EdgeDda::new(short_from, short_to, r0);
-            for row in r0..r1 {
-                let (l, r) = if short_is_left {
-                    (short.x, long.x)
-                } else {
-                    (long.x, short.x)
-                };
-                if l < r {
-                    sink.span(row, l, r);
-                }
-                short.step();
-                long.step();
-            }
-        };
+            short.step();
+            long.step();
+        }
+    };
     walk(a, b, start, mid.min(end), &mut long);
     walk(b, c, mid.max(start), end, &mut long);
 }
@@ -167,17 +152,12 @@ mod tests {
     use super::*;
 
     fn fp(x: f64, y: f64) -> FixedPoint {
-        FixedPoint {
-            x: (x * ONE as f64).round() as i64,
-            y: (y * ONE as f64).round() as i64,
-        }
+        FixedPoint { x: (x * ONE as f64).round() as i64, y: (y * ONE as f64).round() as i64 }
     }
 
     fn covered(v: &[FixedPoint; 3]) -> Vec<(i64, i64)> {
         let mut out = Vec::new();
-        scan_triangle(v, -100..100, &mut |y, x0, x1| {
-            out.extend((x0..x1).map(|x| (x, y)))
-        });
+        scan_triangle(v, -100..100, &mut |y, x0, x1| out.extend((x0..x1).map(|x| (x, y))));
         out.sort_unstable();
         out
     }
@@ -186,9 +166,7 @@ mod tests {
     fn matches_edge_function_oracle_on_small_triangles() {
         let mut seed = 12345u64;
         let mut rnd = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
             ((seed >> 33) % 2000) as f64 / 100.0 - 10.0
         };
         for _ in 0..300 {
@@ -213,17 +191,10 @@ mod tests {
     /// Independent oracle: the edge-function test with the top-left tie rule, in
     /// exact integer arithmetic, for a triangle in either winding.
     fn inside_tl(v: &[FixedPoint; 3], x: i64, y: i64) -> bool {
-        let p = FixedPoint {
-            x: x * ONE + HALF,
-            y: y * ONE + HALF,
-        };
+        let p = FixedPoint { x: x * ONE + HALF, y: y * ONE + HALF };
         // Orient clockwise as seen on screen (positive area): the interior has e > 0,
         // left edges run upwards and top edges run towards +x.
-        let v = if signed_area2(v) < 0 {
-            [v[0], v[2], v[1]]
-        } else {
-            *v
-        };
+        let v = if signed_area2(v) < 0 { [v[0], v[2], v[1]] } else { *v };
         (0..3).all(|i| {
             let (a, b) = (v[i], v[(i + 1) % 3]);
             let e = (b.x - a.x) * (p.y - a.y) - (b.y - a.y) * (p.x - a.x);
@@ -240,9 +211,7 @@ mod tests {
         let mut all = covered(&[p0, p1, p2]);
         all.extend(covered(&[p0, p2, p3]));
         all.sort_unstable();
-        let want: Vec<_> = (0..4)
-            .flat_map(|y| (0..4).map(move |x| (x, y)))
-            .collect::<Vec<_>>();
+        let want: Vec<_> = (0..4).flat_map(|y| (0..4).map(move |x| (x, y))).collect::<Vec<_>>();
         let mut want = want;
         want.sort_unstable();
         assert_eq!(all, want);

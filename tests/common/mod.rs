@@ -20,25 +20,15 @@ pub fn scene_with(mesh: Mesh, camera: Camera, width: u32, height: u32, two_sided
         background: Vec3::new(0.1, 0.1, 0.15),
         camera,
         lights: vec![Light {
-            kind: LightKind::Point {
-                position: Vec3::new(2.0, 5.0, 3.0),
-            },
+            kind: LightKind::Point { position: Vec3::new(2.0, 5.0, 3.0) },
             color: Vec3::ONE,
             intensity: 1.0,
             ambient: 0.1,
             size: 0.0,
             falloff: Falloff::None,
         }],
-        materials: vec![Material {
-            two_sided,
-            ..Material::default()
-        }],
-        objects: vec![Object {
-            name: "soup".into(),
-            mesh: Arc::new(mesh),
-            transform: Affine3A::IDENTITY,
-            material: 0,
-        }],
+        materials: vec![Material { two_sided, ..Material::default() }],
+        objects: vec![Object { name: "soup".into(), mesh: Arc::new(mesh), transform: Affine3A::IDENTITY, material: 0 }],
         warnings: Vec::new(),
     }
 }
@@ -48,60 +38,29 @@ pub fn triangle_soup(rng: &mut StdRng, n: usize) -> Mesh {
     let mut positions = Vec::new();
     let mut triangles = Vec::new();
     for t in 0..n as u32 {
-        let c = Vec3::new(
-            rng.gen_range(-1.0..1.0),
-            rng.gen_range(-1.0..1.0),
-            rng.gen_range(-1.0..1.0),
-        );
+        let c = Vec3::new(rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0));
         let s = rng.gen_range(0.1..0.9);
         for _ in 0..3 {
-            positions.push(
-                c + s * Vec3::new(
-                    rng.gen_range(-1.0..1.0),
-                    rng.gen_range(-1.0..1.0),
-                    rng.gen_range(-1.0..1.0),
-                ),
-            );
+            positions
+                .push(c + s * Vec3::new(rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0)));
         }
         triangles.push([3 * t, 3 * t + 1, 3 * t + 2]);
     }
-    Mesh::new(positions, vec![], vec![], triangles, NormalMode::Flat)
-        .expect("soup")
-        .0
+    Mesh::new(positions, vec![], vec![], triangles, NormalMode::Flat).expect("soup").0
 }
 
 /// A random camera looking at the origin from 2.5–5 units away.
 pub fn random_camera(rng: &mut StdRng, ortho: bool) -> Camera {
-    let dir = Vec3::new(
-        rng.gen_range(-1.0..1.0),
-        rng.gen_range(-0.8..0.8),
-        rng.gen_range(-1.0..1.0),
-    )
-    .normalize();
+    let dir = Vec3::new(rng.gen_range(-1.0..1.0), rng.gen_range(-0.8..0.8), rng.gen_range(-1.0..1.0)).normalize();
     let dist = rng.gen_range(2.5..5.0);
     let projection = if ortho {
-        Projection::Orthographic {
-            height: rng.gen_range(1.5..3.5),
-        }
+        Projection::Orthographic { height: rng.gen_range(1.5..3.5) }
     } else {
-        Projection::Perspective {
-            fov_y_deg: rng.gen_range(30.0..75.0),
-        }
+        Projection::Perspective { fov_y_deg: rng.gen_range(30.0..75.0) }
     };
     // Sometimes the near plane cuts through the soup.
-    let near = if rng.gen_bool(0.3) {
-        dist - rng.gen_range(0.0..1.0)
-    } else {
-        0.05
-    };
-    Camera {
-        eye: dir * dist,
-        target: Vec3::ZERO,
-        up: Vec3::Y,
-        near,
-        far: dist + rng.gen_range(0.5..3.0),
-        projection,
-    }
+    let near = if rng.gen_bool(0.3) { dist - rng.gen_range(0.0..1.0) } else { 0.05 };
+    Camera { eye: dir * dist, target: Vec3::ZERO, up: Vec3::Y, near, far: dist + rng.gen_range(0.5..3.0), projection }
 }
 
 /// What the brute-force caster sees at one pixel.
@@ -130,15 +89,11 @@ pub fn cast(scene: &Scene, x: u32, y: u32) -> Option<Hit> {
     let (origin, dir) = match cam.projection {
         Projection::Perspective { fov_y_deg } => {
             let t = (fov_y_deg.to_radians() / 2.0).tan();
-            (
-                cam.eye,
-                (fwd + right * sx * t * w / h + up * sy * t).normalize(),
-            )
+            (cam.eye, (fwd + right * sx * t * w / h + up * sy * t).normalize())
         }
-        Projection::Orthographic { height } => (
-            cam.eye + right * sx * height / 2.0 * w / h + up * sy * height / 2.0,
-            fwd,
-        ),
+        Projection::Orthographic { height } => {
+            (cam.eye + right * sx * height / 2.0 * w / h + up * sy * height / 2.0, fwd)
+        }
     };
     let along = dir.dot(fwd);
     let mut best: Option<Hit> = None;
@@ -158,29 +113,16 @@ pub fn cast(scene: &Scene, x: u32, y: u32) -> Option<Hit> {
                 if let Some(hb) = best {
                     second = second.min(hb.view_z);
                 }
-                best = Some(Hit {
-                    triangle: i as u32,
-                    view_z: z,
-                    second_z: f32::INFINITY,
-                });
+                best = Some(Hit { triangle: i as u32, view_z: z, second_z: f32::INFINITY });
             }
         }
     }
-    best.map(|h| Hit {
-        second_z: second,
-        ..h
-    })
+    best.map(|h| Hit { second_z: second, ..h })
 }
 
 fn ray_triangle(o: Vec3, d: Vec3, a: Vec3, b: Vec3, c: Vec3, cull: bool) -> Option<f32> {
     // Barycentric solve by Cramer's rule in f64.
-    let (o, d, a, b, c) = (
-        o.as_dvec3(),
-        d.as_dvec3(),
-        a.as_dvec3(),
-        b.as_dvec3(),
-        c.as_dvec3(),
-    );
+    let (o, d, a, b, c) = (o.as_dvec3(), d.as_dvec3(), a.as_dvec3(), b.as_dvec3(), c.as_dvec3());
     let (e1, e2) = (b - a, c - a);
     let n = e1.cross(e2);
     let denom = -d.dot(n);

@@ -9,9 +9,7 @@ use std::process::Command;
 
 use glam::{Affine3A, Vec3};
 use kage::scene::load::{self, FileSystem};
-use kage::scene::{
-    file::add_model, Camera, Falloff, Light, LightKind, Material, Projection, Scene,
-};
+use kage::scene::{file::add_model, Camera, Falloff, Light, LightKind, Material, Projection, Scene};
 use kage::{RenderOptions, Renderer};
 use miette::{miette, IntoDiagnostic, Result};
 
@@ -66,10 +64,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         let mut best: Option<Row> = None;
         for _ in 0..args.rounds.max(1) {
             let (row, image) = time_kage(name, &scene, args.frames)?;
-            let peer = lp
-                .exists()
-                .then(|| run_llvmpipe(lp, &mesh, args, &image))
-                .transpose()?;
+            let peer = lp.exists().then(|| run_llvmpipe(lp, &mesh, args, &image)).transpose()?;
             best = Some(match best {
                 None => Row { peer, ..row },
                 Some(b) => Row {
@@ -92,18 +87,9 @@ fn ensure_mesh(args: &BenchArgs, name: &str) -> Result<PathBuf> {
     let path = args.meshes.join(format!("{name}.obj"));
     if !path.exists() {
         let script = args.peers.join("common/gen_scene.py");
-        let status = Command::new("python3")
-            .arg(&script)
-            .arg("--all")
-            .arg(&args.meshes)
-            .status()
-            .into_diagnostic()?;
+        let status = Command::new("python3").arg(&script).arg("--all").arg(&args.meshes).status().into_diagnostic()?;
         if !status.success() || !path.exists() {
-            return Err(miette!(
-                "{} is missing and {} could not write it",
-                path.display(),
-                script.display()
-            ));
+            return Err(miette!("{} is missing and {} could not write it", path.display(), script.display()));
         }
     }
     Ok(path)
@@ -111,11 +97,8 @@ fn ensure_mesh(args: &BenchArgs, name: &str) -> Result<PathBuf> {
 
 /// The peers' scene convention (peer_common.h) around the loaded mesh.
 fn peer_scene(path: &Path, width: u32, height: u32) -> Result<Scene> {
-    let fs = FileSystem {
-        base: path.parent().unwrap_or(Path::new(".")).to_path_buf(),
-    };
-    let model = load::model(Path::new(path.file_name().unwrap_or_default()), &fs)
-        .map_err(|e| miette!("{e}"))?;
+    let fs = FileSystem { base: path.parent().unwrap_or(Path::new(".")).to_path_buf() };
+    let model = load::model(Path::new(path.file_name().unwrap_or_default()), &fs).map_err(|e| miette!("{e}"))?;
     let albedo = Vec3::new(0.75, 0.72, 0.65);
     let material = Material {
         name: "peer".into(),
@@ -140,9 +123,7 @@ fn peer_scene(path: &Path, width: u32, height: u32) -> Result<Scene> {
             projection: Projection::Perspective { fov_y_deg: 45.0 },
         },
         lights: vec![Light {
-            kind: LightKind::Point {
-                position: c + r * Vec3::new(1.0, 1.6, -0.6),
-            },
+            kind: LightKind::Point { position: c + r * Vec3::new(1.0, 1.6, -0.6) },
             color: Vec3::ONE,
             intensity: 1.0,
             ambient: 0.1,
@@ -162,11 +143,7 @@ fn median(mut v: Vec<f64>) -> f64 {
     v[v.len() / 2]
 }
 
-fn time_kage(
-    name: &str,
-    scene: &Scene,
-    frames: usize,
-) -> Result<(Row, kage::resolve::LinearImage)> {
+fn time_kage(name: &str, scene: &Scene, frames: usize) -> Result<(Row, kage::resolve::LinearImage)> {
     let mut renderer = Renderer::new(&RenderOptions::default()).map_err(|e| miette!("{e}"))?;
     renderer.render(scene).map_err(|e| miette!("{e}"))?; // warm-up
     let (mut vis, mut shade, mut total) = (Vec::new(), Vec::new(), Vec::new());
@@ -220,12 +197,7 @@ fn run_llvmpipe(
         .split_whitespace()
         .find_map(|w| w.strip_prefix("median_ms="))
         .and_then(|v| v.parse().ok())
-        .ok_or_else(|| {
-            miette!(
-                "llvmpipe printed no median_ms: {text}{}",
-                String::from_utf8_lossy(&out.stderr)
-            )
-        })?;
+        .ok_or_else(|| miette!("llvmpipe printed no median_ms: {text}{}", String::from_utf8_lossy(&out.stderr)))?;
     let png = PathBuf::from(format!("{}_phong.png", prefix.display()));
     Ok((ms, rmse_against(&png, ours)))
 }
@@ -238,10 +210,7 @@ fn rmse_against(png: &Path, ours: &kage::resolve::LinearImage) -> Option<f64> {
     let sum: f64 = theirs
         .pixels()
         .zip(ours.pixels())
-        .flat_map(|(t, o)| {
-            (0..3)
-                .map(move |k| (t[k] as f64 - (o[k].clamp(0.0, 1.0) as f64 * 255.0).round()).powi(2))
-        })
+        .flat_map(|(t, o)| (0..3).map(move |k| (t[k] as f64 - (o[k].clamp(0.0, 1.0) as f64 * 255.0).round()).powi(2)))
         .sum();
     Some((sum / (3.0 * ours.pixels().len() as f64)).sqrt())
 }

@@ -50,33 +50,21 @@ struct RenderArgs {
 fn main() -> miette::Result<()> {
     let cli = Cli::parse();
     // Paths and locations stay on one line, so they can be copied and grepped.
-    miette::set_hook(Box::new(|_| {
-        Box::new(miette::MietteHandlerOpts::new().wrap_lines(false).build())
-    }))?;
+    miette::set_hook(Box::new(|_| Box::new(miette::MietteHandlerOpts::new().wrap_lines(false).build())))?;
     match cli.command {
         Command::Render(args) => render_command(&args).map_err(report::to_report),
         Command::Bench(args) => bench::run(&args),
     }
 }
 
-fn load(
-    input: Option<&Path>,
-    width: Option<u32>,
-    height: Option<u32>,
-) -> kage::error::Result<Scene> {
+fn load(input: Option<&Path>, width: Option<u32>, height: Option<u32>) -> kage::error::Result<Scene> {
     let is_model = |p: &Path| {
-        let ext = p
-            .extension()
-            .and_then(|e| e.to_str())
-            .unwrap_or_default()
-            .to_ascii_lowercase();
+        let ext = p.extension().and_then(|e| e.to_str()).unwrap_or_default().to_ascii_lowercase();
         matches!(ext.as_str(), "obj" | "stl" | "gltf" | "glb")
     };
     let mut scene = match input {
         None => demo_scene()?,
-        Some(p) if is_model(p) => {
-            file::scene_for_model(p, width.unwrap_or(960), height.unwrap_or(540))?
-        }
+        Some(p) if is_model(p) => file::scene_for_model(p, width.unwrap_or(960), height.unwrap_or(540))?,
         Some(p) => file::load_scene(p)?,
     };
     scene.width = width.unwrap_or(scene.width);
@@ -89,17 +77,10 @@ fn render_command(args: &RenderArgs) -> kage::error::Result<()> {
     for w in &scene.warnings {
         eprintln!("warning: {w}");
     }
-    let frame = render(
-        &scene,
-        &RenderOptions {
-            threads: args.threads,
-        },
-    )?;
+    let frame = render(&scene, &RenderOptions { threads: args.threads })?;
     kage::output::write_image(&frame.image, &args.output)?;
     if frame.visibility.items().iter().all(|i| i.is_none()) {
-        eprintln!(
-            "warning: no object is in view: the image shows only the background (check the camera)"
-        );
+        eprintln!("warning: no object is in view: the image shows only the background (check the camera)");
     }
     let s = frame.stats;
     eprintln!(

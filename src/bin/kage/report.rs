@@ -21,10 +21,7 @@ pub fn to_report(e: Error) -> Report {
                 } else {
                     "kage::scene::invalid"
                 })
-                .with_label(LabeledSpan::at(
-                    loc.span.start..loc.span.start + len,
-                    "here",
-                ));
+                .with_label(LabeledSpan::at(loc.span.start..loc.span.start + len, "here"));
             let source = NamedSource::new(loc.path.display().to_string(), loc.text.to_string());
             Report::new(diag).with_source_code(source)
         }

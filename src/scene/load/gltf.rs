@@ -13,9 +13,7 @@ use glam::{Affine3A, Mat4, Vec2, Vec3};
 
 use super::{checked, AssetSource, LoadedModel, Part};
 use crate::scene::mesh::{Mesh, NormalMode};
-use crate::scene::{
-    Camera, ComponentMaps, Falloff, Light, LightKind, Material, Projection, Texture,
-};
+use crate::scene::{Camera, ComponentMaps, Falloff, Light, LightKind, Material, Projection, Texture};
 
 struct Context<'a> {
     doc: gltf::Document,
@@ -32,24 +30,10 @@ pub fn load(bytes: &[u8], path: &Path, assets: &dyn AssetSource) -> Result<Loade
     let base = assets.base_dir().map(|b| b.join(dir));
     let buffers = gltf::import_buffers(&gltf.document, base.as_deref(), gltf.blob.clone())
         .map_err(|e| format!("buffers: {e}"))?;
-    let cx = Context {
-        doc: gltf.document,
-        buffers,
-        dir,
-        assets,
-        path,
-    };
-    let materials: Vec<Material> = cx
-        .doc
-        .materials()
-        .map(|m| cx.material(&m))
-        .collect::<Result<_, _>>()?;
+    let cx = Context { doc: gltf.document, buffers, dir, assets, path };
+    let materials: Vec<Material> = cx.doc.materials().map(|m| cx.material(&m)).collect::<Result<_, _>>()?;
     let mut model = LoadedModel::default();
-    let scene = cx
-        .doc
-        .default_scene()
-        .or_else(|| cx.doc.scenes().next())
-        .ok_or("the file has no scene")?;
+    let scene = cx.doc.default_scene().or_else(|| cx.doc.scenes().next()).ok_or("the file has no scene")?;
     for node in scene.nodes() {
         cx.visit(&node, Mat4::IDENTITY, &materials, &mut model)?;
     }
@@ -103,39 +87,19 @@ impl Context<'_> {
             return Ok(());
         }
         let reader = prim.reader(|b| self.buffers.get(b.index()).map(|d| &d.0[..]));
-        let positions: Vec<Vec3> = reader
-            .read_positions()
-            .ok_or_else(|| format!("mesh '{name}' has no positions"))?
-            .map(Vec3::from)
-            .collect();
-        let normals = reader
-            .read_normals()
-            .map(|n| n.map(Vec3::from).collect())
-            .unwrap_or_default();
-        let uvs = reader
-            .read_tex_coords(0)
-            .map(|t| t.into_f32().map(Vec2::from).collect())
-            .unwrap_or_default();
+        let positions: Vec<Vec3> =
+            reader.read_positions().ok_or_else(|| format!("mesh '{name}' has no positions"))?.map(Vec3::from).collect();
+        let normals = reader.read_normals().map(|n| n.map(Vec3::from).collect()).unwrap_or_default();
+        let uvs = reader.read_tex_coords(0).map(|t| t.into_f32().map(Vec2::from).collect()).unwrap_or_default();
         let indices: Vec<u32> = match reader.read_indices() {
             Some(i) => i.into_u32().collect(),
             None => (0..positions.len() as u32).collect(),
         };
-        let triangles = indices
-            .chunks_exact(3)
-            .map(|c| [c[0], c[1], c[2]])
-            .collect();
+        let triangles = indices.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
         let built = Mesh::new(positions, normals, uvs, triangles, NormalMode::Smooth);
         let mesh = checked(out, self.path, built, &format!("mesh '{name}'"))?;
-        let material = prim
-            .material()
-            .index()
-            .and_then(|i| materials.get(i).cloned());
-        out.parts.push(Part {
-            name: name.to_string(),
-            mesh: Arc::new(mesh),
-            material,
-            transform,
-        });
+        let material = prim.material().index().and_then(|i| materials.get(i).cloned());
+        out.parts.push(Part { name: name.to_string(), mesh: Arc::new(mesh), material, transform });
         Ok(())
     }
 
@@ -146,10 +110,7 @@ impl Context<'_> {
         let metal = pbr.metallic_factor().clamp(0.0, 1.0);
         let alpha = pbr.roughness_factor().clamp(0.05, 1.0).powi(2);
         let kd = base * (1.0 - metal);
-        let base_map = pbr
-            .base_color_texture()
-            .map(|t| self.texture(&t.texture()))
-            .transpose()?;
+        let base_map = pbr.base_color_texture().map(|t| self.texture(&t.texture())).transpose()?;
         Ok(Material {
             name: m.name().unwrap_or("gltf").to_string(),
             ka: kd,
@@ -161,10 +122,7 @@ impl Context<'_> {
                 ambient: base_map.clone(),
                 diffuse: base_map,
                 specular: None,
-                emission: m
-                    .emissive_texture()
-                    .map(|t| self.texture(&t.texture()))
-                    .transpose()?,
+                emission: m.emissive_texture().map(|t| self.texture(&t.texture())).transpose()?,
             },
             two_sided: m.double_sided(),
         })
@@ -174,21 +132,16 @@ impl Context<'_> {
         let bytes = match t.source().source() {
             gltf::image::Source::View { view, .. } => {
                 let data = &self.buffers[view.buffer().index()].0;
-                data.get(view.offset()..view.offset() + view.length())
-                    .ok_or("image view outside its buffer")?
-                    .to_vec()
+                data.get(view.offset()..view.offset() + view.length()).ok_or("image view outside its buffer")?.to_vec()
             }
             gltf::image::Source::Uri { uri, .. } if uri.starts_with("data:") => {
                 return Err("data-URI images are not supported; use a .glb or an image file".into())
             }
             gltf::image::Source::Uri { uri, .. } => {
-                return crate::scene::load::texture(&self.dir.join(uri), true, self.assets)
-                    .map_err(|e| e.to_string())
+                return crate::scene::load::texture(&self.dir.join(uri), true, self.assets).map_err(|e| e.to_string())
             }
         };
-        Texture::decode(&bytes, true)
-            .map(Arc::new)
-            .map_err(|e| format!("embedded image {}: {e}", t.index()))
+        Texture::decode(&bytes, true).map(Arc::new).map_err(|e| format!("embedded image {}: {e}", t.index()))
     }
 }
 
@@ -198,28 +151,15 @@ fn camera(cam: &gltf::Camera, at: Affine3A) -> Option<Camera> {
     let up = at.transform_vector3(Vec3::Y).normalize_or_zero();
     let (projection, near, far) = match cam.projection() {
         gltf::camera::Projection::Perspective(p) => (
-            Projection::Perspective {
-                fov_y_deg: p.yfov().to_degrees(),
-            },
+            Projection::Perspective { fov_y_deg: p.yfov().to_degrees() },
             p.znear(),
             p.zfar().unwrap_or(p.znear() * 1e5),
         ),
-        gltf::camera::Projection::Orthographic(o) => (
-            Projection::Orthographic {
-                height: 2.0 * o.ymag(),
-            },
-            o.znear().max(1e-4),
-            o.zfar(),
-        ),
+        gltf::camera::Projection::Orthographic(o) => {
+            (Projection::Orthographic { height: 2.0 * o.ymag() }, o.znear().max(1e-4), o.zfar())
+        }
     };
-    let c = Camera {
-        eye,
-        target: eye + fwd,
-        up,
-        near,
-        far,
-        projection,
-    };
+    let c = Camera { eye, target: eye + fwd, up, near, far, projection };
     c.validate().ok().map(|_| c)
 }
 
@@ -230,25 +170,10 @@ fn light(l: &gltf::khr_lights_punctual::Light, at: Affine3A) -> Light {
     let (kind, falloff) = match l.kind() {
         Kind::Directional => (LightKind::Directional { direction }, Falloff::None),
         Kind::Point => (LightKind::Point { position }, Falloff::InverseSquare),
-        Kind::Spot {
-            inner_cone_angle,
-            outer_cone_angle,
-        } => (
-            LightKind::Spot {
-                position,
-                direction,
-                inner: inner_cone_angle,
-                outer: outer_cone_angle,
-            },
+        Kind::Spot { inner_cone_angle, outer_cone_angle } => (
+            LightKind::Spot { position, direction, inner: inner_cone_angle, outer: outer_cone_angle },
             Falloff::InverseSquare,
         ),
     };
-    Light {
-        kind,
-        color: l.color().into(),
-        intensity: l.intensity(),
-        ambient: 0.0,
-        size: 0.0,
-        falloff,
-    }
+    Light { kind, color: l.color().into(), intensity: l.intensity(), ambient: 0.0, size: 0.0, falloff }
 }

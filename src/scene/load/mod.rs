@@ -56,20 +56,10 @@ pub struct Embedded(pub &'static [(&'static str, &'static [u8])]);
 
 impl AssetSource for Embedded {
     fn read(&self, path: &Path) -> io::Result<Vec<u8>> {
-        let name = path
-            .file_name()
-            .and_then(|n| n.to_str())
-            .unwrap_or_default();
-        self.0
-            .iter()
-            .find(|(n, _)| *n == name)
-            .map(|(_, b)| b.to_vec())
-            .ok_or_else(|| {
-                io::Error::new(
-                    io::ErrorKind::NotFound,
-                    format!("'{name}' is not one of the built-in files"),
-                )
-            })
+        let name = path.file_name().and_then(|n| n.to_str()).unwrap_or_default();
+        self.0.iter().find(|(n, _)| *n == name).map(|(_, b)| b.to_vec()).ok_or_else(|| {
+            io::Error::new(io::ErrorKind::NotFound, format!("'{name}' is not one of the built-in files"))
+        })
     }
     fn display_path(&self, path: &Path) -> PathBuf {
         Path::new("<builtin>").join(path)
@@ -106,31 +96,18 @@ impl LoadedModel {
     /// A model of one mesh without a material.
     #[must_use]
     pub fn single(mesh: Mesh) -> LoadedModel {
-        let part = Part {
-            name: "mesh".into(),
-            mesh: Arc::new(mesh),
-            material: None,
-            transform: Affine3A::IDENTITY,
-        };
-        LoadedModel {
-            parts: vec![part],
-            ..Default::default()
-        }
+        let part = Part { name: "mesh".into(), mesh: Arc::new(mesh), material: None, transform: Affine3A::IDENTITY };
+        LoadedModel { parts: vec![part], ..Default::default() }
     }
 
     /// Bounds of all parts in model space.
     #[must_use]
     pub fn bounds(&self) -> (Vec3, Vec3) {
-        self.parts
-            .iter()
-            .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), p| {
-                let (a, b) = p.mesh.bounds();
-                let (a, b) = (
-                    p.transform.transform_point3(a),
-                    p.transform.transform_point3(b),
-                );
-                (lo.min(a.min(b)), hi.max(a.max(b)))
-            })
+        self.parts.iter().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), p| {
+            let (a, b) = p.mesh.bounds();
+            let (a, b) = (p.transform.transform_point3(a), p.transform.transform_point3(b));
+            (lo.min(a.min(b)), hi.max(a.max(b)))
+        })
     }
 
     fn note_repairs(&mut self, path: &Path, repairs: MeshRepairs) {
@@ -147,35 +124,21 @@ impl LoadedModel {
 /// Loads a model file, choosing the loader by extension.
 pub fn model(path: &Path, assets: &dyn AssetSource) -> Result<LoadedModel> {
     let shown = assets.display_path(path);
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .unwrap_or_default()
-        .to_ascii_lowercase();
+    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or_default().to_ascii_lowercase();
     let bytes = read(path, assets)?;
-    let fail = |message: String| Error::MeshLoad {
-        path: shown.clone(),
-        message,
-    };
+    let fail = |message: String| Error::MeshLoad { path: shown.clone(), message };
     let model = match ext.as_str() {
         "obj" => obj::load(&bytes, path, assets).map_err(fail)?,
         "stl" => stl::load(&bytes).map_err(fail)?,
         "gltf" | "glb" => gltf::load(&bytes, path, assets).map_err(fail)?,
-        _ => {
-            return Err(fail(format!(
-                "unknown mesh format '.{ext}' (kage reads .obj, .stl, .gltf and .glb)"
-            )))
-        }
+        _ => return Err(fail(format!("unknown mesh format '.{ext}' (kage reads .obj, .stl, .gltf and .glb)"))),
     };
     Ok(model)
 }
 
 /// Reads a file through `assets`, naming it in the error.
 pub fn read(path: &Path, assets: &dyn AssetSource) -> Result<Vec<u8>> {
-    assets.read(path).map_err(|source| Error::Read {
-        path: assets.display_path(path),
-        source,
-    })
+    assets.read(path).map_err(|source| Error::Read { path: assets.display_path(path), source })
 }
 
 /// Loads a colour (`srgb`) or data texture.
@@ -183,10 +146,7 @@ pub fn texture(path: &Path, srgb: bool, assets: &dyn AssetSource) -> Result<Arc<
     let bytes = read(path, assets)?;
     Texture::decode(&bytes, srgb)
         .map(Arc::new)
-        .map_err(|message| Error::TextureLoad {
-            path: assets.display_path(path),
-            message,
-        })
+        .map_err(|message| Error::TextureLoad { path: assets.display_path(path), message })
 }
 
 /// Builds a checked mesh, turning problems into a message for the loader's error and

@@ -11,27 +11,12 @@ use crate::scene::mesh::{Mesh, NormalMode};
 
 /// Parses STL bytes (binary when the size matches the triangle count, else ASCII).
 pub fn load(bytes: &[u8]) -> Result<LoadedModel, String> {
-    let positions = if is_binary(bytes) {
-        binary(bytes)?
-    } else {
-        ascii(bytes)?
-    };
-    let triangles = (0..positions.len() as u32 / 3)
-        .map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
-        .collect();
+    let positions = if is_binary(bytes) { binary(bytes)? } else { ascii(bytes)? };
+    let triangles = (0..positions.len() as u32 / 3).map(|t| [3 * t, 3 * t + 1, 3 * t + 2]).collect();
     let mut model = LoadedModel::default();
-    let built = Mesh::new(
-        positions,
-        Vec::new(),
-        Vec::new(),
-        triangles,
-        NormalMode::Flat,
-    );
+    let built = Mesh::new(positions, Vec::new(), Vec::new(), triangles, NormalMode::Flat);
     let mesh = checked(&mut model, std::path::Path::new("stl"), built, "STL")?;
-    Ok(LoadedModel {
-        warnings: model.warnings,
-        ..LoadedModel::single(mesh)
-    })
+    Ok(LoadedModel { warnings: model.warnings, ..LoadedModel::single(mesh) })
 }
 
 fn is_binary(bytes: &[u8]) -> bool {
@@ -49,10 +34,7 @@ fn binary(bytes: &[u8]) -> Result<Vec<Vec3>, String> {
     let n = u32::from_le_bytes([bytes[80], bytes[81], bytes[82], bytes[83]]) as usize;
     let body = &bytes[84..];
     if body.len() < n.saturating_mul(50) {
-        return Err(format!(
-            "header promises {n} triangles but the file holds {}",
-            body.len() / 50
-        ));
+        return Err(format!("header promises {n} triangles but the file holds {}", body.len() / 50));
     }
     let f = |o: usize| f32::from_le_bytes([body[o], body[o + 1], body[o + 2], body[o + 3]]);
     Ok((0..n)
@@ -62,28 +44,22 @@ fn binary(bytes: &[u8]) -> Result<Vec<Vec3>, String> {
 }
 
 fn ascii(bytes: &[u8]) -> Result<Vec<Vec3>, String> {
-    let text = std::str::from_utf8(bytes)
-        .map_err(|_| "not a binary STL and not UTF-8 text".to_string())?;
+    let text = std::str::from_utf8(bytes).map_err(|_| "not a binary STL and not UTF-8 text".to_string())?;
     let mut out = Vec::new();
     for (n, line) in text.lines().enumerate() {
         let mut words = line.split_whitespace();
         if words.next() != Some("vertex") {
             continue;
         }
-        let xyz: Vec<f32> = words
-            .map(str::parse)
-            .collect::<Result<_, _>>()
-            .map_err(|e| format!("line {}: {e}", n + 1))?;
+        let xyz: Vec<f32> =
+            words.map(str::parse).collect::<Result<_, _>>().map_err(|e| format!("line {}: {e}", n + 1))?;
         let [x, y, z] = xyz[..] else {
             return Err(format!("line {}: a vertex needs 3 numbers", n + 1));
         };
         out.push(Vec3::new(x, y, z));
     }
     if out.len() % 3 != 0 {
-        return Err(format!(
-            "{} vertices is not a whole number of facets",
-            out.len()
-        ));
+        return Err(format!("{} vertices is not a whole number of facets", out.len()));
     }
     Ok(out)
 }
