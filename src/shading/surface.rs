@@ -27,7 +27,6 @@ pub struct SurfacePoint {
 #[derive(Debug, Clone)]
 pub struct ObjectFrames {
     frames: Vec<(Affine3A, Mat3A)>,
-    eye: Vec3,
 }
 
 impl ObjectFrames {
@@ -35,7 +34,7 @@ impl ObjectFrames {
     #[must_use]
     pub fn new(scene: &Scene) -> Self {
         let frames = scene.objects.iter().map(|o| (o.transform, o.transform.matrix3.inverse().transpose())).collect();
-        ObjectFrames { frames, eye: scene.camera.eye }
+        ObjectFrames { frames }
     }
 
     /// The world-space vertices of an item's triangle.
@@ -67,7 +66,6 @@ impl ObjectFrames {
             a,
             e1,
             e2,
-            from_eye: FromEye::new(self.eye, a, e1, e2),
             geometric: e1.cross(e2).normalize_or(Vec3::Y),
             normals: idx.map(|i| Vec3::from(nm * glam::Vec3A::from(mesh.normals[i]))),
             uvs: (!mesh.uvs.is_empty()).then(|| idx.map(|i| mesh.uvs[i])),
@@ -84,36 +82,11 @@ pub struct PreparedTriangle {
     a: Vec3,
     e1: Vec3,
     e2: Vec3,
-    from_eye: FromEye,
     geometric: Vec3,
     normals: [Vec3; 3],
     uvs: Option<[Vec2; 3]>,
     /// Index into `Scene::materials`.
     pub material: usize,
-}
-
-/// Möller–Trumbore with the ray origin fixed at the eye (perspective pixel rays):
-/// every cross product that does not involve the direction d is constant per
-/// triangle, leaving `det = d·det`, `b1 = d·b1 / det`, `b2 = d·b2 / det`,
-/// `t = t / det` per pixel (scalar triple products rearranged).
-#[derive(Debug, Clone, Copy, Default)]
-pub struct FromEye {
-    /// e2 × e1.
-    pub det: Vec3,
-    /// e2 × (eye − a).
-    pub b1: Vec3,
-    /// (eye − a) × e1.
-    pub b2: Vec3,
-    /// e2 · ((eye − a) × e1).
-    pub t: f32,
-}
-
-impl FromEye {
-    fn new(eye: Vec3, a: Vec3, e1: Vec3, e2: Vec3) -> Self {
-        let tvec = eye - a;
-        let q = tvec.cross(e1);
-        FromEye { det: e2.cross(e1), b1: e2.cross(tvec), b2: q, t: e2.dot(q) }
-    }
 }
 
 /// The ray-independent data of a [`PreparedTriangle`], for batched shading.
@@ -131,8 +104,6 @@ pub struct TriangleGeometry {
     pub normals: [Vec3; 3],
     /// Vertex texture coordinates, if the mesh has them.
     pub uvs: Option<[Vec2; 3]>,
-    /// Intersection constants for rays from the eye.
-    pub from_eye: FromEye,
 }
 
 impl PreparedTriangle {
@@ -146,7 +117,6 @@ impl PreparedTriangle {
             geometric: self.geometric,
             normals: self.normals,
             uvs: self.uvs,
-            from_eye: self.from_eye,
         }
     }
 
