@@ -183,7 +183,7 @@ impl Block {
         out: &mut [Vec3],
     ) {
         let mut inputs = self.inputs();
-        let s = surface(&inputs, rays, x0, y);
+        let s = surface(&inputs, &RowRays::new(rays, y), x0);
         if self.sample_textures(&s, &coefficients_at) {
             let textured = self.inputs();
             (inputs.ka, inputs.kd, inputs.ks, inputs.ke) = (textured.ka, textured.kd, textured.ks, textured.ke);
@@ -224,12 +224,15 @@ impl Block {
 }
 
 /// Shades eight pixels that all show `tri` with the map-free coefficients `k`:
-/// the inputs are broadcast straight into vector registers, skipping the gather.
-pub fn shade_uniform(
+/// Shades a run of whole blocks (`out.len()` a multiple of eight) whose pixels all
+/// show `tri` with the map-free coefficients `k`, on the row `rays` describes,
+/// starting at column `x0`: the inputs are broadcast into vector registers once for
+/// the whole run, skipping the per-lane gather.
+pub fn shade_run(
     tri: &PreparedTriangle,
     k: &Coefficients,
-    rays: &PixelRays,
-    (x0, y): (usize, usize),
+    rays: &RowRays,
+    x0: usize,
     lighting: &Lighting,
     out: &mut [Vec3],
 ) {
@@ -248,10 +251,12 @@ pub fn shade_uniform(
         shininess: F::splat(n),
         whole: whole_exponent(n),
     };
-    let rgb = lighting.shade(&inputs, &surface(&inputs, rays, x0, y));
-    let (r, g, b) = (rgb.x.to_array(), rgb.y.to_array(), rgb.z.to_array());
-    for (i, px) in out.iter_mut().enumerate() {
-        *px = Vec3::new(r[i], g[i], b[i]);
+    for (b, out) in out.chunks_exact_mut(LANES).enumerate() {
+        let rgb = lighting.shade(&inputs, &surface(&inputs, rays, x0 + b * LANES));
+        let (r, g, b) = (rgb.x.to_array(), rgb.y.to_array(), rgb.z.to_array());
+        for (i, px) in out.iter_mut().enumerate() {
+            *px = Vec3::new(r[i], g[i], b[i]);
+        }
     }
 }
 
@@ -290,8 +295,8 @@ struct LaneSurface {
 /// Ray/plane intersection (Möller–Trumbore, as `surface::intersect_plane`) and
 /// normal interpolation for eight pixels.
 #[inline(always)]
-fn surface(inp: &LaneInputs, rays: &PixelRays, x0: usize, y: usize) -> LaneSurface {
-    let (origin, dir) = lane_rays(rays, x0, y);
+fn surface(inp: &LaneInputs, rays: &RowRays, x0: usize) -> LaneSurface {
+    let (origin, dir) = rays.at(x0);
     let pvec = dir.cross(inp.e2);
     let det = inp.e1.dot(pvec);
     let det = det.abs().simd_lt(F::splat(f32::MIN_POSITIVE)).select(F::splat(f32::MIN_POSITIVE), det);
@@ -396,18 +401,48 @@ fn incident(light: &Light, p: &V3) -> (V3, V3) {
     }
 }
 
-/// Origins and unit directions of the rays through pixels `x0 .. x0 + 8` of row `y`.
-#[inline(always)]
-fn lane_rays(rays: &PixelRays, x0: usize, y: usize) -> (V3, V3) {
-    const STEPS: F = F::new([0.5, 1.5, 2.5, 3.5, 4.5, 5.5, 6.5, 7.5]);
-    let xs = F::splat(x0 as f32) + STEPS;
-    let ndc_x = xs * F::splat(2.0 / rays.size.x) - F::ONE;
-    let ndc_y = F::splat(1.0 - 2.0 * (y as f32 + 0.5) / rays.size.y);
-    let offset = V3::splat(rays.right).scale(ndc_x).add(V3::splat(rays.up).scale(ndc_y));
-    if rays.ortho {
-        (V3::splat(rays.origin).add(offset), V3::splat(rays.forward.normalize()))
-    } else {
-        let d = V3::splat(rays.forward).add(offset);
-        (V3::splat(rays.origin), d.normalize_or(V3::splat(rays.forward)))
+/// The pixel rays of one image row, with the per-row work done once.
+#[derive(Debug, Clone, Copy)]
+pub struct RowRays {
+    /// Ray origin at the row's centre line (orthographic) or the eye.
+    origin: V3,
+    /// Direction (perspective) or origin offset (orthographic) at ndc x = 0.
+    base: V3,
+    /// Change per unit of ndc x.
+    right: V3,
+    /// Unit view direction (orthographic rays).
+    forward: V3,
+    ndc_scale: F,
+    ortho: bool,
+}
+
+impl RowRays {
+    /// The rays of row `y`.
+    #[must_use]
+    pub fn new(rays: &PixelRays, y: usize) -> Self {
+        let ndc_y = 1.0 - 2.0 * (y as f32 + 0.5) / rays.size.y;
+        let up = rays.up * ndc_y;
+        let (origin, base) = if rays.ortho { (rays.origin + up, Vec3::ZERO) } else { (rays.origin, rays.forward + up) };
+        RowRays {
+            origin: V3::splat(origin),
+            base: V3::splat(base),
+            right: V3::splat(rays.right),
+            forward: V3::splat(rays.forward.normalize()),
+            ndc_scale: F::splat(2.0 / rays.size.x),
+            ortho: rays.ortho,
+        }
+    }
+
+    /// Origins and unit directions of the rays through pixels `x0 .. x0 + 8`.
+    #[inline(always)]
+    fn at(&self, x0: usize) -> (V3, V3) {
+        const STEPS: F = F::new([0.5, 1.5, 2.5, 3.5, 4.5, 5.5, 6.5, 7.5]);
+        let ndc_x = (F::splat(x0 as f32) + STEPS) * self.ndc_scale - F::ONE;
+        let offset = self.base.add(self.right.scale(ndc_x));
+        if self.ortho {
+            (self.origin.add(offset), self.forward)
+        } else {
+            (self.origin, offset.normalize_or(self.forward))
+        }
     }
 }

@@ -39,17 +39,21 @@ pub fn shade_into(scene: &Scene, vb: &VisibilityBuffer, image: &mut LinearImage)
     let rows = image.pixels_mut().par_chunks_mut(w).zip(vb.items().par_chunks(w));
     let caches = || (TriangleCache::new(), lanes::Block::default());
     rows.enumerate().for_each_init(caches, |(cache, block), (y, (out, items))| {
-        for (c, (out, items)) in out.chunks_mut(lanes::LANES).zip(items.chunks(lanes::LANES)).enumerate() {
-            let first = items[0];
-            if items.len() == lanes::LANES && !first.is_none() && items.iter().all(|&i| i == first) {
-                let tri = cache.get(scene, &frames, first);
-                if let Some(k) = &constants[tri.material] {
-                    lanes::shade_uniform(tri, k, &rays, (c * lanes::LANES, y), &lighting, out);
-                    continue;
-                }
+        let row = lanes::RowRays::new(&rays, y);
+        let mut x = 0;
+        while x < w {
+            let end = (x + lanes::LANES).min(w);
+            let first = items[x];
+            let uniform = end - x == lanes::LANES && !first.is_none() && items[x..end].iter().all(|&i| i == first);
+            let tri = if uniform { Some(cache.get(scene, &frames, first)) } else { None };
+            if let Some((tri, k)) = tri.and_then(|t| Some((t, constants[t.material].as_ref()?))) {
+                let run = uniform_run(items, x, first);
+                lanes::shade_run(tri, k, &row, x, &lighting, &mut out[x..run]);
+                x = run;
+                continue;
             }
             block.clear();
-            for (i, (&item, px)) in items.iter().zip(out.iter_mut()).enumerate() {
+            for (i, (&item, px)) in items[x..end].iter().zip(out[x..end].iter_mut()).enumerate() {
                 if item.is_none() {
                     *px = scene.background;
                     continue;
@@ -58,10 +62,20 @@ pub fn shade_into(scene: &Scene, vb: &VisibilityBuffer, image: &mut LinearImage)
                 block.set(i, tri, constants[tri.material].as_ref());
             }
             if block.live.iter().any(|&l| l) {
-                block.shade(&rays, (c * lanes::LANES, y), &lighting, sample, out);
+                block.shade(&rays, (x, y), &lighting, sample, &mut out[x..end]);
             }
+            x = end;
         }
     });
+}
+
+/// End of the run of whole blocks from `x` (a full block of `item`) that all show `item`.
+fn uniform_run(items: &[ItemId], x: usize, item: ItemId) -> usize {
+    let mut end = x + lanes::LANES;
+    while end + lanes::LANES <= items.len() && items[end..end + lanes::LANES].iter().all(|&i| i == item) {
+        end += lanes::LANES;
+    }
+    end
 }
 
 /// A small direct-mapped cache of prepared triangles, one per worker: the rows a
