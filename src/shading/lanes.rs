@@ -171,19 +171,19 @@ impl Block {
         }
     }
 
-    /// Shades the block: `x0` is the first pixel's column on row `y`; lanes with a
+    /// Shades the block: `x0` is the first pixel's column on the row of `rays`; lanes with a
     /// textured material get their coefficients from `coefficients_at`. Writes the
     /// colours of live lanes to `out`.
     pub fn shade(
         &mut self,
-        rays: &PixelRays,
-        (x0, y): (usize, usize),
+        rays: &RowRays,
+        x0: usize,
         lighting: &Lighting,
         coefficients_at: impl Fn(&SurfacePoint) -> Coefficients,
         out: &mut [Vec3],
     ) {
         let mut inputs = self.inputs();
-        let s = surface(&inputs, &RowRays::new(rays, y), x0);
+        let s = surface(&inputs, rays, x0);
         if self.sample_textures(&s, &coefficients_at) {
             let textured = self.inputs();
             (inputs.ka, inputs.kd, inputs.ks, inputs.ke) = (textured.ka, textured.kd, textured.ks, textured.ke);

@@ -62,7 +62,7 @@ pub fn shade_into(scene: &Scene, vb: &VisibilityBuffer, image: &mut LinearImage)
                 block.set(i, tri, constants[tri.material].as_ref());
             }
             if block.live.iter().any(|&l| l) {
-                block.shade(&rays, (x, y), &lighting, sample, &mut out[x..end]);
+                block.shade(&row, x, &lighting, sample, &mut out[x..end]);
             }
             x = end;
         }
