@@ -167,7 +167,8 @@ fn gltf_cameras_and_lights() {
 }
 
 /// The eight-lane shading path computes what the scalar reference computes, on a
-/// scene with textures, every light type, both falloffs and a fractional exponent.
+/// scene with textures, every light type, both falloffs and a fractional exponent,
+/// and on an orthographic view.
 #[test]
 fn simd_shading_matches_the_scalar_reference() {
     let mut scene = kage::scene::demo::demo_scene().unwrap();
@@ -185,15 +186,18 @@ fn simd_shading_matches_the_scalar_reference() {
         falloff: Falloff::InverseSquare,
     });
     scene.materials[1].shininess = 17.5;
-    let frame = render(&scene, &RenderOptions::default()).unwrap();
-    let mut scalar = kage::resolve::LinearImage::new(scene.width, scene.height);
-    kage::shading::shade_into_scalar(&scene, &frame.visibility, &mut scalar);
-    let worst = frame
-        .image
-        .pixels()
-        .iter()
-        .zip(scalar.pixels())
-        .map(|(a, b)| (*a - *b).abs().max_element())
-        .fold(0.0f32, f32::max);
-    assert!(worst < 2e-3, "largest difference {worst}");
+    let ortho = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenes/cad-ortho.toml");
+    for scene in [scene, kage::scene::file::load_scene(&ortho).unwrap()] {
+        let frame = render(&scene, &RenderOptions::default()).unwrap();
+        let mut scalar = kage::resolve::LinearImage::new(scene.width, scene.height);
+        kage::shading::shade_into_scalar(&scene, &frame.visibility, &mut scalar);
+        let worst = frame
+            .image
+            .pixels()
+            .iter()
+            .zip(scalar.pixels())
+            .map(|(a, b)| (*a - *b).abs().max_element())
+            .fold(0.0f32, f32::max);
+        assert!(worst < 2e-3, "largest difference {worst}");
+    }
 }
