@@ -127,7 +127,7 @@ pub fn face_normal(p: &[Vec3], t: [u32; 3]) -> Vec3 {
 pub mod shapes {
     use super::*;
 
-    /// A square of side 1 in the XZ plane at y = 0, facing +y, uv over [0,1]².
+    /// A square of side 1 in the XZ plane at y = 0, facing +y, uv over the unit square.
     #[must_use]
     pub fn plane() -> Mesh {
         let positions = vec![

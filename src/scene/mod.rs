@@ -1,6 +1,6 @@
 //! The scene: what is drawn (objects with meshes and materials), how it is lit and
 //! from where it is seen. Scene files are parsed to plain records first
-//! ([`file`]), then meshes and textures are loaded ([`load`]) into this form.
+//! ([`mod@file`]), then meshes and textures are loaded ([`load`]) into this form.
 
 pub mod camera;
 pub mod demo;

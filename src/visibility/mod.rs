@@ -92,7 +92,7 @@ impl VisibilityBuffer {
     }
 
     /// Makes the buffer `width` × `height`, reusing its memory when it can. The
-    /// contents are undefined until the next [`super::rasterize`].
+    /// contents are undefined until the next [`rasterize`].
     pub fn resize(&mut self, width: u32, height: u32) {
         let n = width as usize * height as usize;
         self.width = width;

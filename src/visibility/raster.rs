@@ -92,7 +92,7 @@ struct ChunkBins {
 }
 
 /// Everything bands need to draw.
-struct Frame<'a> {
+struct PolygonPass<'a> {
     scene: &'a Scene,
     projected: Vec<Projected>,
     planes: ClipPlanes,
@@ -114,8 +114,15 @@ pub fn rasterize(scene: &Scene, vb: &mut VisibilityBuffer) -> RasterStats {
     );
     let viewport = Viewport { width: w as f32, height: h as f32 };
     let projected = scene.objects.iter().map(|o| project(scene, o, view_proj, &planes, viewport)).collect();
-    let frame =
-        Frame { scene, projected, planes, viewport, width: w as i64, height: h as i64, bands: h.div_ceil(BAND_ROWS) };
+    let frame = PolygonPass {
+        scene,
+        projected,
+        planes,
+        viewport,
+        width: w as i64,
+        height: h as i64,
+        bands: h.div_ceil(BAND_ROWS),
+    };
     let chunks = chunks(scene);
     let bins: Vec<ChunkBins> = chunks.par_iter().map(|c| frame.bin(c)).collect();
     let (depth, items) = vb.parts_mut();
@@ -162,7 +169,7 @@ fn chunks(scene: &Scene) -> Vec<Chunk> {
     out
 }
 
-impl Frame<'_> {
+impl PolygonPass<'_> {
     fn bin(&self, chunk: &Chunk) -> ChunkBins {
         let mut bins = ChunkBins { bands: vec![Vec::new(); self.bands], ..Default::default() };
         let p = &self.projected[chunk.object];
