@@ -6,15 +6,15 @@ use std::path::Path;
 use crate::error::{Error, Result};
 use crate::resolve::LinearImage;
 
-/// Writes `image` to `path` as `.png`, `.exr` or `.pfm`.
-pub fn write_image(image: &LinearImage, path: &Path) -> Result<()> {
+/// Writes `image` to `path` as `.png`, `.exr` or `.pfm`. `exposure` (a linear
+/// multiplier) applies to PNG only: float formats keep the rendered values.
+pub fn write_image(image: &LinearImage, path: &Path, exposure: f32) -> Result<()> {
     let fail = |message: String| Error::Output { path: path.to_path_buf(), message };
     let ext = path.extension().and_then(|e| e.to_str()).unwrap_or_default().to_ascii_lowercase();
     let (w, h) = (image.width(), image.height());
     match ext.as_str() {
-        "png" => {
-            image::save_buffer(path, &image.to_srgb8(), w, h, image::ColorType::Rgb8).map_err(|e| fail(e.to_string()))
-        }
+        "png" => image::save_buffer(path, &image.to_srgb8(exposure), w, h, image::ColorType::Rgb8)
+            .map_err(|e| fail(e.to_string())),
         "exr" => {
             let data: Vec<f32> = image.pixels().iter().flat_map(|p| p.to_array()).collect();
             let buf = image::Rgb32FImage::from_raw(w, h, data).ok_or_else(|| fail("buffer size".into()))?;

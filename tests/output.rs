@@ -23,7 +23,7 @@ fn scratch(name: &str) -> PathBuf {
 fn pfm_holds_the_linear_floats_bottom_row_first() {
     let img = gradient();
     let path = scratch("g.pfm");
-    write_image(&img, &path).unwrap();
+    write_image(&img, &path, 1.0).unwrap();
     let bytes = std::fs::read(&path).unwrap();
     let header = b"PF\n7 5\n-1.0\n";
     assert_eq!(&bytes[..header.len()], header);
@@ -38,21 +38,54 @@ fn pfm_holds_the_linear_floats_bottom_row_first() {
 }
 
 #[test]
-fn exr_round_trips_and_png_is_srgb() {
+fn exr_round_trips_unexposed_and_png_is_exposed_srgb() {
     let img = gradient();
     let exr = scratch("g.exr");
-    write_image(&img, &exr).unwrap();
+    write_image(&img, &exr, 2.0).unwrap();
     let back = image::open(&exr).unwrap().into_rgb32f();
     for (a, b) in back.pixels().zip(img.pixels()) {
         assert_eq!([a[0], a[1], a[2]], b.to_array());
     }
     let png = scratch("g.png");
-    write_image(&img, &png).unwrap();
+    write_image(&img, &png, 0.5).unwrap();
     let back = image::open(&png).unwrap().into_rgb8();
     for (a, b) in back.pixels().zip(img.pixels()) {
         for k in 0..3 {
-            let want = (linear_to_srgb(b[k].clamp(0.0, 1.0)) * 255.0).round() as i32;
+            let want = (linear_to_srgb((0.5 * b[k]).clamp(0.0, 1.0)) * 255.0).round() as i32;
             assert!((a[k] as i32 - want).abs() <= 1, "{} vs {want}", a[k]);
         }
     }
+}
+
+#[test]
+fn auto_exposure_brings_the_bright_end_to_white() {
+    use kage::resolve::Exposure;
+    let mut img = LinearImage::new(100, 1);
+    for (i, p) in img.pixels_mut().iter_mut().enumerate() {
+        *p = glam::Vec3::splat(4.0 * i as f32); // physical units, far above 1
+    }
+    let s = Exposure::Auto.scale(&img);
+    assert!((s * 4.0 * 95.0 - 0.9).abs() < 1e-4, "scale {s}");
+    assert_eq!(Exposure::Stops(2.0).scale(&img), 4.0);
+    assert_eq!(Exposure::Stops(0.0).scale(&LinearImage::new(1, 1)), 1.0);
+}
+
+#[test]
+fn exposure_in_scene_files_and_on_the_command_line() {
+    use kage::resolve::Exposure;
+    use kage::scene::file::SceneFile;
+    use kage::scene::load::FileSystem;
+    let fs = FileSystem { base: std::env::temp_dir() };
+    let build = |t: &str| SceneFile::parse(t, std::path::Path::new("e.toml")).and_then(|f| f.build(&fs));
+    let obj = "[[object]]\nshape = \"cube\"\n";
+    assert_eq!(build(&format!("[image]\nexposure = \"auto\"\n{obj}")).unwrap().exposure, Exposure::Auto);
+    assert_eq!(build(&format!("[image]\nexposure = -1.5\n{obj}")).unwrap().exposure, Exposure::Stops(-1.5));
+    let e = build(&format!("[image]\nexposure = \"bright\"\n{obj}")).unwrap_err().to_string();
+    assert!(e.starts_with("e.toml:2:12"), "{e}");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_kage"))
+        .args(["render", "--exposure", "lots", "-o", scratch("x.png").to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("neither a number of stops nor 'auto'"));
 }

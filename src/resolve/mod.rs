@@ -1,9 +1,50 @@
 //! Resolve: the linear float accumulation buffer becomes displayable 8-bit sRGB
-//! (clamp to [0, 1], then the sRGB transfer curve). Float outputs skip this stage.
+//! (exposure, clamp to [0, 1], then the sRGB transfer curve). Float outputs skip
+//! this stage and keep the buffer's values.
 
 use glam::Vec3;
 
 use crate::scene::texture::linear_to_srgb;
+
+/// How bright the 8-bit image is made.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Exposure {
+    /// Multiply by 2^stops (0: the buffer as it is).
+    Stops(f32),
+    /// Scale so the brightest 5% of pixels just reach white (for scenes lit in
+    /// physical units, such as glTF lights in candela).
+    Auto,
+}
+
+impl Default for Exposure {
+    fn default() -> Self {
+        Exposure::Stops(0.0)
+    }
+}
+
+impl Exposure {
+    /// The linear multiplier this exposure applies to `image`.
+    #[must_use]
+    pub fn scale(self, image: &LinearImage) -> f32 {
+        match self {
+            Exposure::Stops(ev) => ev.exp2(),
+            Exposure::Auto => {
+                let mut lum: Vec<f32> =
+                    image.pixels().iter().map(|p| p.dot(glam::Vec3::new(0.2126, 0.7152, 0.0722))).collect();
+                if lum.is_empty() {
+                    return 1.0;
+                }
+                let k = (lum.len() * 95 / 100).min(lum.len() - 1);
+                let (_, p95, _) = lum.select_nth_unstable_by(k, f32::total_cmp);
+                if *p95 > 0.0 && p95.is_finite() {
+                    (0.9 / *p95).clamp(1.0 / 4096.0, 4096.0)
+                } else {
+                    1.0
+                }
+            }
+        }
+    }
+}
 
 /// A linear-light RGB image, rows top to bottom.
 #[derive(Debug, Clone, PartialEq)]
@@ -57,13 +98,14 @@ impl LinearImage {
         self.pixels[y as usize * self.width as usize + x as usize]
     }
 
-    /// 8-bit sRGB, RGB interleaved, rows top to bottom.
+    /// 8-bit sRGB of the image times `scale` (the exposure), RGB interleaved, rows
+    /// top to bottom.
     #[must_use]
-    pub fn to_srgb8(&self) -> Vec<u8> {
+    pub fn to_srgb8(&self, scale: f32) -> Vec<u8> {
         self.pixels
             .iter()
             .flat_map(|p| p.to_array())
-            .map(|c| (linear_to_srgb(c.clamp(0.0, 1.0)) * 255.0 + 0.5) as u8)
+            .map(|c| (linear_to_srgb((c * scale).clamp(0.0, 1.0)) * 255.0 + 0.5) as u8)
             .collect()
     }
 }

@@ -18,6 +18,7 @@ use super::load::{self, AssetSource, LoadedModel};
 use super::mesh::shapes;
 use super::{framing, Camera, Falloff, Light, LightKind, Material, Object, Projection, Scene, Texture};
 use crate::error::{Error, Result, SourceLocation};
+use crate::resolve::Exposure;
 
 type V3 = [f32; 3];
 
@@ -53,6 +54,36 @@ struct ImageRec {
     height: Spanned<i64>,
     #[serde(default = "default_background")]
     background: V3,
+    #[serde(default)]
+    exposure: ExposureRec,
+}
+
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq)]
+#[serde(untagged)]
+enum ExposureRec {
+    Stops(f32),
+    Word(AutoWord),
+}
+
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+enum AutoWord {
+    Auto,
+}
+
+impl Default for ExposureRec {
+    fn default() -> Self {
+        ExposureRec::Stops(0.0)
+    }
+}
+
+impl From<ExposureRec> for Exposure {
+    fn from(e: ExposureRec) -> Exposure {
+        match e {
+            ExposureRec::Stops(ev) => Exposure::Stops(ev),
+            ExposureRec::Word(AutoWord::Auto) => Exposure::Auto,
+        }
+    }
 }
 
 fn default_width() -> Spanned<i64> {
@@ -67,7 +98,12 @@ fn default_background() -> V3 {
 
 impl Default for ImageRec {
     fn default() -> Self {
-        ImageRec { width: default_width(), height: default_height(), background: default_background() }
+        ImageRec {
+            width: default_width(),
+            height: default_height(),
+            background: default_background(),
+            exposure: ExposureRec::default(),
+        }
     }
 }
 
@@ -270,6 +306,7 @@ impl SceneFile {
             materials,
             objects: Vec::new(),
             warnings: Vec::new(),
+            exposure: self.image.exposure.into(),
         };
         let mut models = Vec::new();
         for o in &self.objects {
@@ -477,11 +514,16 @@ pub fn scene_for_model(path: &Path, width: u32, height: u32) -> Result<Scene> {
         materials: Vec::new(),
         objects: Vec::new(),
         warnings: Vec::new(),
+        exposure: Default::default(),
     };
     add_model(&mut scene, &model, &path.display().to_string(), Affine3A::IDENTITY, None);
     let (camera, lights) = framing(scene.bounds().expect("a model has parts"), width as f32 / height as f32);
     scene.camera = model.camera.unwrap_or(camera);
     scene.lights = if model.lights.is_empty() { lights } else { model.lights.clone() };
+    if !model.lights.is_empty() {
+        // The file's lights are in physical units (candela, lux): expose for them.
+        scene.exposure = Exposure::Auto;
+    }
     scene.validate()?;
     Ok(scene)
 }

@@ -50,6 +50,8 @@ pub struct Scene {
     pub height: u32,
     /// Linear RGB colour of pixels that see no object.
     pub background: Vec3,
+    /// Brightness of 8-bit output.
+    pub exposure: crate::resolve::Exposure,
     /// The eye.
     pub camera: Camera,
     /// Lights.

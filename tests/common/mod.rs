@@ -30,6 +30,7 @@ pub fn scene_with(mesh: Mesh, camera: Camera, width: u32, height: u32, two_sided
         materials: vec![Material { two_sided, ..Material::default() }],
         objects: vec![Object { name: "soup".into(), mesh: Arc::new(mesh), transform: Affine3A::IDENTITY, material: 0 }],
         warnings: Vec::new(),
+        exposure: Default::default(),
     }
 }
 

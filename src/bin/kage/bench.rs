@@ -133,6 +133,7 @@ fn peer_scene(path: &Path, width: u32, height: u32) -> Result<Scene> {
         materials: vec![material],
         objects: Vec::new(),
         warnings: Vec::new(),
+        exposure: Default::default(),
     };
     add_model(&mut scene, &model, "peer", Affine3A::IDENTITY, Some(0));
     Ok(scene)

@@ -9,6 +9,7 @@ mod report;
 use std::path::{Path, PathBuf};
 
 use clap::{Parser, Subcommand};
+use kage::resolve::Exposure;
 use kage::scene::{demo::demo_scene, file, Scene};
 use kage::{render, RenderOptions};
 
@@ -45,6 +46,21 @@ struct RenderArgs {
     /// Worker threads (default: one per core).
     #[arg(long)]
     threads: Option<usize>,
+    /// Brightness of PNG output: stops (e.g. 1.5, -1) or `auto`; overrides the scene.
+    #[arg(long, value_parser = parse_exposure, allow_hyphen_values = true)]
+    exposure: Option<Exposure>,
+}
+
+fn parse_exposure(s: &str) -> Result<Exposure, String> {
+    match s {
+        "auto" => Ok(Exposure::Auto),
+        _ => s
+            .parse::<f32>()
+            .ok()
+            .filter(|v| v.is_finite())
+            .map(Exposure::Stops)
+            .ok_or_else(|| format!("'{s}' is neither a number of stops nor 'auto'")),
+    }
 }
 
 fn main() -> miette::Result<()> {
@@ -78,7 +94,8 @@ fn render_command(args: &RenderArgs) -> kage::error::Result<()> {
         eprintln!("warning: {w}");
     }
     let frame = render(&scene, &RenderOptions { threads: args.threads })?;
-    kage::output::write_image(&frame.image, &args.output)?;
+    let exposure = args.exposure.unwrap_or(scene.exposure).scale(&frame.image);
+    kage::output::write_image(&frame.image, &args.output, exposure)?;
     if frame.visibility.items().iter().all(|i| i.is_none()) {
         eprintln!("warning: no object is in view: the image shows only the background (check the camera)");
     }
