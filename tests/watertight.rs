@@ -59,15 +59,15 @@ proptest! {
     }
 }
 
-/// A randomly triangulated square of side 40 in the XZ plane, front face up.
-fn ground(seed: u64) -> Mesh {
+/// A randomly triangulated square of side 40 × `scale` in the XZ plane, front face up.
+fn ground(seed: u64, scale: f64) -> Mesh {
     let mut s = seed;
     let mut rnd = || {
         s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
         (s >> 11) as f64 / (1u64 << 53) as f64
     };
-    let pts: Vec<DVec2> = (0..300).map(|_| DVec2::new(rnd() * 40.0 - 20.0, rnd() * 40.0 - 20.0)).collect();
-    let (v, tris) = triangulate(DVec2::splat(-20.0), DVec2::splat(20.0), &pts);
+    let pts: Vec<DVec2> = (0..300).map(|_| DVec2::new(rnd() * 40.0 - 20.0, rnd() * 40.0 - 20.0) * scale).collect();
+    let (v, tris) = triangulate(DVec2::splat(-20.0 * scale), DVec2::splat(20.0 * scale), &pts);
     // (x, y) of the 2-D triangulation → (x, 0, −y): counter-clockwise seen from +y.
     let positions = v.iter().map(|p| Vec3::new(p.x as f32, 0.0, -p.y as f32)).collect();
     let triangles = tris.iter().map(|t| t.map(|i| i as u32)).collect();
@@ -77,13 +77,15 @@ fn ground(seed: u64) -> Mesh {
 /// The camera stands on a huge triangulated ground, so many triangles cross the
 /// near plane and lie partly behind the eye. Every pixel the ray caster says sees
 /// the ground must be covered by the rasterizer, by the same triangle (up to
-/// pixel centres on shared edges), and no other pixel.
+/// pixel centres on shared edges), and no other pixel — also when the ground is a
+/// hundred million times larger than the view (clipping precision).
 #[test]
 fn ground_through_the_near_plane_has_no_holes_and_matches_rays() {
-    for (seed, projection) in [
-        (1, Projection::Perspective { fov_y_deg: 70.0 }),
-        (2, Projection::Perspective { fov_y_deg: 40.0 }),
-        (3, Projection::Orthographic { height: 3.0 }),
+    for (seed, projection, scale) in [
+        (1, Projection::Perspective { fov_y_deg: 70.0 }, 1.0),
+        (2, Projection::Perspective { fov_y_deg: 40.0 }, 1.0),
+        (3, Projection::Orthographic { height: 3.0 }, 1.0),
+        (4, Projection::Perspective { fov_y_deg: 60.0 }, 1e8),
     ] {
         let camera = Camera {
             eye: Vec3::new(0.3, 0.8, 2.0),
@@ -93,7 +95,7 @@ fn ground_through_the_near_plane_has_no_holes_and_matches_rays() {
             far: 100.0,
             projection,
         };
-        let scene = scene_with(ground(seed), camera, 120, 90, false);
+        let scene = scene_with(ground(seed, scale), camera, 120, 90, false);
         let mut vb = VisibilityBuffer::new(scene.width, scene.height);
         let stats = rasterize(&scene, &mut vb);
         assert!(stats.clipped > 0, "the test must exercise near-plane clipping");

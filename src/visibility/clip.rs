@@ -8,13 +8,17 @@
 //! The point where an edge crosses a plane is always computed from the inside
 //! vertex towards the outside one, so two triangles sharing an edge get bit-identical
 //! new vertices: clipping keeps meshes watertight.
+//!
+//! Clipping runs in f64: a triangle that needs it is usually huge (a ground plane
+//! reaching far behind the eye), and the part of it on screen is a tiny fraction of
+//! its extent, so f32's 7 digits would misplace the new vertices by many pixels.
 
-use glam::Vec4;
+use glam::{DVec4, Vec4};
 
 /// The clipping planes of one frame.
 #[derive(Debug, Clone, Copy)]
 pub struct ClipPlanes {
-    planes: [Vec4; 6],
+    planes: [DVec4; 6],
 }
 
 /// Most vertices a triangle can have after clipping by six planes.
@@ -24,15 +28,15 @@ impl ClipPlanes {
     /// Near `z ≤ w`, far `z ≥ far_factor·w` (reversed depth), and guard bands
     /// `|x| ≤ gx·w`, `|y| ≤ gy·w`.
     #[must_use]
-    pub fn new(far_factor: f32, gx: f32, gy: f32) -> Self {
+    pub fn new(far_factor: f64, gx: f64, gy: f64) -> Self {
         ClipPlanes {
             planes: [
-                Vec4::new(0.0, 0.0, -1.0, 1.0),
-                Vec4::new(0.0, 0.0, 1.0, -far_factor),
-                Vec4::new(-1.0, 0.0, 0.0, gx),
-                Vec4::new(1.0, 0.0, 0.0, gx),
-                Vec4::new(0.0, -1.0, 0.0, gy),
-                Vec4::new(0.0, 1.0, 0.0, gy),
+                DVec4::new(0.0, 0.0, -1.0, 1.0),
+                DVec4::new(0.0, 0.0, 1.0, -far_factor),
+                DVec4::new(-1.0, 0.0, 0.0, gx),
+                DVec4::new(1.0, 0.0, 0.0, gx),
+                DVec4::new(0.0, -1.0, 0.0, gy),
+                DVec4::new(0.0, 1.0, 0.0, gy),
             ],
         }
     }
@@ -40,6 +44,7 @@ impl ClipPlanes {
     /// One bit per plane the vertex is outside of (0: inside all).
     #[must_use]
     pub fn outcode(&self, v: Vec4) -> u8 {
+        let v = v.as_dvec4();
         self.planes.iter().enumerate().fold(0, |code, (i, p)| {
             let d = p.dot(v);
             code | (u8::from(d < 0.0 || d.is_nan()) << i)
@@ -49,8 +54,8 @@ impl ClipPlanes {
     /// Clips the triangle against the planes named in `mask`; returns the polygon's
     /// vertex count (0 if nothing is left). The polygon is convex and keeps the
     /// triangle's winding.
-    pub fn clip(&self, tri: [Vec4; 3], mask: u8, out: &mut [Vec4; MAX_CLIPPED]) -> usize {
-        let mut buf = [Vec4::ZERO; MAX_CLIPPED];
+    pub fn clip(&self, tri: [DVec4; 3], mask: u8, out: &mut [DVec4; MAX_CLIPPED]) -> usize {
+        let mut buf = [DVec4::ZERO; MAX_CLIPPED];
         out[..3].copy_from_slice(&tri);
         let mut n = 3;
         for (i, plane) in self.planes.iter().enumerate() {
@@ -67,7 +72,7 @@ impl ClipPlanes {
     }
 }
 
-fn clip_polygon(input: &[Vec4], plane: Vec4, out: &mut [Vec4; MAX_CLIPPED]) -> usize {
+fn clip_polygon(input: &[DVec4], plane: DVec4, out: &mut [DVec4; MAX_CLIPPED]) -> usize {
     let mut n = 0;
     for (i, &cur) in input.iter().enumerate() {
         let next = input[(i + 1) % input.len()];
@@ -93,10 +98,10 @@ mod tests {
     fn crossing_the_near_plane_keeps_the_front_part() {
         let planes = ClipPlanes::new(0.001, 100.0, 100.0);
         // z ≤ w is inside; the third vertex is behind the near plane.
-        let tri = [Vec4::new(0.0, 0.0, 0.5, 1.0), Vec4::new(1.0, 0.0, 0.5, 1.0), Vec4::new(0.0, 1.0, 2.0, 1.0)];
-        let mask = tri.iter().fold(0, |m, v| m | planes.outcode(*v));
+        let tri = [DDVec4::new(0.0, 0.0, 0.5, 1.0), DDVec4::new(1.0, 0.0, 0.5, 1.0), DDVec4::new(0.0, 1.0, 2.0, 1.0)];
+        let mask = tri.iter().fold(0, |m, v| m | planes.outcode(v.as_vec4()));
         assert_eq!(mask, 1);
-        let mut out = [Vec4::ZERO; MAX_CLIPPED];
+        let mut out = [DVec4::ZERO; MAX_CLIPPED];
         let n = planes.clip(tri, mask, &mut out);
         assert_eq!(n, 4);
         assert!(out[..n].iter().all(|v| v.z <= v.w + 1e-6));
@@ -105,15 +110,15 @@ mod tests {
     #[test]
     fn shared_edge_clips_to_identical_points() {
         let planes = ClipPlanes::new(0.001, 100.0, 100.0);
-        let (a, b) = (Vec4::new(0.3, -0.2, 0.2, 1.0), Vec4::new(-0.7, 0.9, 3.0, 1.0));
-        let t1 = [a, b, Vec4::new(1.0, 1.0, 0.1, 1.0)];
-        let t2 = [b, a, Vec4::new(-1.0, -1.0, 0.1, 1.0)];
-        let mut o1 = [Vec4::ZERO; MAX_CLIPPED];
-        let mut o2 = [Vec4::ZERO; MAX_CLIPPED];
+        let (a, b) = (DVec4::new(0.3, -0.2, 0.2, 1.0), DVec4::new(-0.7, 0.9, 3.0, 1.0));
+        let t1 = [a, b, DVec4::new(1.0, 1.0, 0.1, 1.0)];
+        let t2 = [b, a, DVec4::new(-1.0, -1.0, 0.1, 1.0)];
+        let mut o1 = [DVec4::ZERO; MAX_CLIPPED];
+        let mut o2 = [DVec4::ZERO; MAX_CLIPPED];
         let n1 = planes.clip(t1, 1, &mut o1);
         let n2 = planes.clip(t2, 1, &mut o2);
         let on_plane =
-            |o: &[Vec4]| o.iter().copied().filter(|v| v.z == v.w || (v.z - v.w).abs() < 1e-6).collect::<Vec<_>>();
+            |o: &[DVec4]| o.iter().copied().filter(|v| v.z == v.w || (v.z - v.w).abs() < 1e-6).collect::<Vec<_>>();
         let (p1, p2) = (on_plane(&o1[..n1]), on_plane(&o2[..n2]));
         assert!(p1.iter().any(|p| p2.contains(p)), "{p1:?} vs {p2:?}");
     }

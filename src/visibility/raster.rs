@@ -8,7 +8,7 @@
 
 use std::ops::Range;
 
-use glam::{Mat4, Vec4};
+use glam::{DMat4, DVec4, Mat4, Vec4};
 use rayon::prelude::*;
 
 use super::clip::{ClipPlanes, MAX_CLIPPED};
@@ -52,9 +52,10 @@ impl ScreenVertex {
     }
 }
 
-/// One object's vertices in clip space and, where inside all planes, on screen.
+/// One object's vertices: which planes each is outside of and, where inside all,
+/// its screen position; plus the object → clip matrix for the clipping path.
 struct Projected {
-    clip: Vec<Vec4>,
+    to_clip: DMat4,
     outcode: Vec<u8>,
     screen: Vec<ScreenVertex>,
     cull_back: bool,
@@ -68,12 +69,12 @@ struct Viewport {
 }
 
 impl Viewport {
-    fn to_screen(self, c: Vec4) -> ScreenVertex {
-        let inv_w = 1.0 / c.w as f64;
-        let sx = (c.x as f64 * inv_w * 0.5 + 0.5) * self.width as f64;
-        let sy = (0.5 - c.y as f64 * inv_w * 0.5) * self.height as f64;
+    fn to_screen(self, c: DVec4) -> ScreenVertex {
+        let inv_w = 1.0 / c.w;
+        let sx = (c.x * inv_w * 0.5 + 0.5) * self.width as f64;
+        let sy = (0.5 - c.y * inv_w * 0.5) * self.height as f64;
         let one = ONE as f64;
-        ScreenVertex { x: (sx * one).round() as i32, y: (sy * one).round() as i32, z: (c.z as f64 * inv_w) as f32 }
+        ScreenVertex { x: (sx * one).round() as i32, y: (sy * one).round() as i32, z: (c.z * inv_w) as f32 }
     }
 }
 
@@ -108,9 +109,9 @@ pub fn rasterize(scene: &Scene, vb: &mut VisibilityBuffer) -> RasterStats {
     let (w, h) = (vb.width() as usize, vb.height() as usize);
     let view_proj = scene.camera.view_projection(w as f32 / h as f32);
     let planes = ClipPlanes::new(
-        scene.camera.far_plane_factor(),
-        1.0 + 2.0 * GUARD_PX / w as f32,
-        1.0 + 2.0 * GUARD_PX / h as f32,
+        scene.camera.far_plane_factor() as f64,
+        1.0 + 2.0 * GUARD_PX as f64 / w as f64,
+        1.0 + 2.0 * GUARD_PX as f64 / h as f64,
     );
     let viewport = Viewport { width: w as f32, height: h as f32 };
     let projected = scene.objects.iter().map(|o| project(scene, o, view_proj, &planes, viewport)).collect();
@@ -146,14 +147,22 @@ fn project(
     viewport: Viewport,
 ) -> Projected {
     let m = view_proj * Mat4::from(object.transform);
-    let clip: Vec<Vec4> = object.mesh.positions.par_iter().map(|p| m * p.extend(1.0)).collect();
-    let outcode: Vec<u8> = clip.par_iter().map(|c| planes.outcode(*c)).collect();
-    let screen = clip
+    let (outcode, screen) = object
+        .mesh
+        .positions
         .par_iter()
-        .zip(&outcode)
-        .map(|(c, &o)| if o == 0 { viewport.to_screen(*c) } else { ScreenVertex::default() })
-        .collect();
-    Projected { clip, outcode, screen, cull_back: !scene.materials[object.material].two_sided }
+        .map(|p| {
+            let c: Vec4 = m * p.extend(1.0);
+            let code = planes.outcode(c);
+            (code, if code == 0 { viewport.to_screen(c.as_dvec4()) } else { ScreenVertex::default() })
+        })
+        .unzip();
+    Projected {
+        to_clip: view_proj.as_dmat4() * Mat4::from(object.transform).as_dmat4(),
+        outcode,
+        screen,
+        cull_back: !scene.materials[object.material].two_sided,
+    }
 }
 
 fn chunks(scene: &Scene) -> Vec<Chunk> {
@@ -181,9 +190,10 @@ impl PolygonPass<'_> {
                 self.bin_triangle(&mut bins, [p.screen[a], p.screen[b], p.screen[c]], p.cull_back, t);
             } else if codes[0] & codes[1] & codes[2] == 0 {
                 bins.clipped_count += 1;
+                let positions = &self.scene.objects[chunk.object].mesh.positions;
                 self.bin_clipped(
                     &mut bins,
-                    [p.clip[a], p.clip[b], p.clip[c]],
+                    [a, b, c].map(|i| p.to_clip * positions[i].as_dvec3().extend(1.0)),
                     codes[0] | codes[1] | codes[2],
                     p.cull_back,
                     t,
@@ -193,8 +203,8 @@ impl PolygonPass<'_> {
         bins
     }
 
-    fn bin_clipped(&self, bins: &mut ChunkBins, tri: [Vec4; 3], mask: u8, cull_back: bool, t: u32) {
-        let mut poly = [Vec4::ZERO; MAX_CLIPPED];
+    fn bin_clipped(&self, bins: &mut ChunkBins, tri: [DVec4; 3], mask: u8, cull_back: bool, t: u32) {
+        let mut poly = [DVec4::ZERO; MAX_CLIPPED];
         let n = self.planes.clip(tri, mask, &mut poly);
         let screen: Vec<ScreenVertex> = poly[..n].iter().map(|c| self.viewport.to_screen(*c)).collect();
         for k in 1..n.saturating_sub(1) {
