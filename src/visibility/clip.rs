@@ -98,7 +98,7 @@ mod tests {
     fn crossing_the_near_plane_keeps_the_front_part() {
         let planes = ClipPlanes::new(0.001, 100.0, 100.0);
         // z ≤ w is inside; the third vertex is behind the near plane.
-        let tri = [DDVec4::new(0.0, 0.0, 0.5, 1.0), DDVec4::new(1.0, 0.0, 0.5, 1.0), DDVec4::new(0.0, 1.0, 2.0, 1.0)];
+        let tri = [DVec4::new(0.0, 0.0, 0.5, 1.0), DVec4::new(1.0, 0.0, 0.5, 1.0), DVec4::new(0.0, 1.0, 2.0, 1.0)];
         let mask = tri.iter().fold(0, |m, v| m | planes.outcode(v.as_vec4()));
         assert_eq!(mask, 1);
         let mut out = [DVec4::ZERO; MAX_CLIPPED];
