@@ -13,6 +13,16 @@
 //! [`frame::render`] runs the whole chain; each stage is usable on its own, so tests
 //! can check coverage without shading and shading without files.
 //!
+//! ```
+//! // Render the built-in demo scene and look at what the centre pixel sees.
+//! let scene = kage::scene::demo::demo_scene()?;
+//! let frame = kage::render(&scene, &kage::RenderOptions::default())?;
+//! assert_eq!((frame.image.width(), frame.image.height()), (scene.width, scene.height));
+//! let item = frame.visibility.item(scene.width / 2, scene.height / 2);
+//! assert!(!item.is_none(), "the demo's objects fill the centre of the view");
+//! # Ok::<(), kage::Error>(())
+//! ```
+//!
 //! Conventions (handedness, depth range, pixel centres, fill rule) are fixed once in
 //! `ARCHITECTURE.md`.
 
