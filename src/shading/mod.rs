@@ -18,14 +18,6 @@ pub use surface::{ObjectFrames, PreparedTriangle, SurfacePoint};
 
 use phong::Coefficients;
 
-/// Shades every pixel of `vb` into a new linear image.
-#[must_use]
-pub fn shade_frame(scene: &Scene, vb: &VisibilityBuffer) -> LinearImage {
-    let mut image = LinearImage::new(vb.width(), vb.height());
-    shade_into(scene, vb, &mut image);
-    image
-}
-
 /// Shades every pixel of `vb` into `image` (same size), rows in parallel, eight
 /// pixels at a time ([`lanes`]).
 pub fn shade_into(scene: &Scene, vb: &VisibilityBuffer, image: &mut LinearImage) {
