@@ -29,6 +29,7 @@
 pub mod error;
 pub mod frame;
 pub mod output;
+pub mod raytrace;
 pub mod resolve;
 pub mod scene;
 pub mod shading;

@@ -1,0 +1,272 @@
+//! Bounding volume hierarchy: binned surface-area-heuristic build (as pbrt-v4's
+//! `BVHAggregate`, 16 bins), flattened depth-first, traversed near child first.
+//!
+//! The hierarchy knows only boxes. Traversal hands each leaf primitive to a closure
+//! that intersects it, so triangles today and CSG primitives later share one walker.
+
+use glam::Vec3;
+
+use crate::scene::Ray;
+
+/// An axis-aligned box.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Aabb {
+    /// Smallest corner.
+    pub min: Vec3,
+    /// Largest corner.
+    pub max: Vec3,
+}
+
+impl Aabb {
+    /// The empty box (the identity of [`Aabb::union`]).
+    pub const EMPTY: Aabb = Aabb { min: Vec3::INFINITY, max: Vec3::NEG_INFINITY };
+
+    /// The box around `points`.
+    #[must_use]
+    pub fn around(points: &[Vec3]) -> Aabb {
+        points.iter().fold(Aabb::EMPTY, |b, &p| Aabb { min: b.min.min(p), max: b.max.max(p) })
+    }
+
+    /// The box around both.
+    #[must_use]
+    pub fn union(self, o: Aabb) -> Aabb {
+        Aabb { min: self.min.min(o.min), max: self.max.max(o.max) }
+    }
+
+    /// Surface area (0 for the empty box).
+    #[must_use]
+    pub fn area(self) -> f32 {
+        let d = (self.max - self.min).max(Vec3::ZERO);
+        2.0 * (d.x * d.y + d.y * d.z + d.z * d.x)
+    }
+
+    /// Centre.
+    #[must_use]
+    pub fn centre(self) -> Vec3 {
+        (self.min + self.max) * 0.5
+    }
+
+    /// Entry distance of the ray (given as origin and 1/direction) if it meets the
+    /// box before `t_max`.
+    fn entry(&self, origin: Vec3, inv_dir: Vec3, t_max: f32) -> Option<f32> {
+        let t0 = (self.min - origin) * inv_dir;
+        let t1 = (self.max - origin) * inv_dir;
+        let near = t0.min(t1).max_element().max(0.0);
+        let far = t0.max(t1).min_element() * (1.0 + 2.0 * f32::EPSILON * 2.0);
+        (near <= far && near < t_max).then_some(near)
+    }
+}
+
+/// A node of the flattened tree.
+#[derive(Debug, Clone, Copy)]
+struct Node {
+    bounds: Aabb,
+    /// Leaf: first index into `order`; interior: index of the second child (the
+    /// first child follows its parent).
+    offset: u32,
+    /// Primitives in a leaf; 0 for interior nodes.
+    count: u16,
+    axis: u8,
+}
+
+/// A bounding volume hierarchy over primitives known by their boxes.
+#[derive(Debug, Clone)]
+pub struct Bvh {
+    nodes: Vec<Node>,
+    order: Vec<u32>,
+}
+
+const BINS: usize = 16;
+const LEAF_MAX: usize = 4;
+const PARALLEL_BELOW: usize = 4096;
+
+struct Item {
+    bounds: Aabb,
+    centre: Vec3,
+    index: u32,
+}
+
+enum BuildNode {
+    Leaf { bounds: Aabb, start: usize, count: usize },
+    Interior { bounds: Aabb, axis: u8, children: Box<[BuildNode; 2]> },
+}
+
+impl Bvh {
+    /// Builds the hierarchy over primitives with these boxes (parallel for large
+    /// inputs).
+    #[must_use]
+    pub fn build(bounds: &[Aabb]) -> Bvh {
+        let mut items: Vec<Item> =
+            bounds.iter().enumerate().map(|(i, b)| Item { bounds: *b, centre: b.centre(), index: i as u32 }).collect();
+        if items.is_empty() {
+            return Bvh { nodes: Vec::new(), order: Vec::new() };
+        }
+        let root = build_node(&mut items, 0);
+        let order = items.iter().map(|i| i.index).collect();
+        let mut nodes = Vec::with_capacity(2 * bounds.len() / LEAF_MAX + 1);
+        flatten(&root, &mut nodes);
+        Bvh { nodes, order }
+    }
+
+    /// The nearest primitive along `ray` before `t_max`: `hit(i, t_max)` intersects
+    /// primitive `i` and returns its distance if nearer than `t_max`. Returns the
+    /// primitive and distance.
+    pub fn intersect(
+        &self,
+        ray: &Ray,
+        mut t_max: f32,
+        mut hit: impl FnMut(u32, f32) -> Option<f32>,
+    ) -> Option<(u32, f32)> {
+        let mut best = None;
+        self.walk(ray, &mut t_max, |i, t_max| {
+            if let Some(t) = hit(i, *t_max) {
+                *t_max = t;
+                best = Some((i, t));
+            }
+            false
+        });
+        best
+    }
+
+    /// Whether any primitive blocks `ray` before `t_max` (stops at the first).
+    pub fn occluded(&self, ray: &Ray, mut t_max: f32, mut hit: impl FnMut(u32, f32) -> Option<f32>) -> bool {
+        let mut any = false;
+        self.walk(ray, &mut t_max, |i, t_max| {
+            any = hit(i, *t_max).is_some();
+            any
+        });
+        any
+    }
+
+    /// Visits the leaves the ray reaches, near first; `visit` returns true to stop.
+    fn walk(&self, ray: &Ray, t_max: &mut f32, mut visit: impl FnMut(u32, &mut f32) -> bool) {
+        if self.nodes.is_empty() {
+            return;
+        }
+        let inv = ray.dir.recip();
+        let negative = [inv.x < 0.0, inv.y < 0.0, inv.z < 0.0];
+        let mut stack = [0u32; 64];
+        let mut depth = 0;
+        let mut at = 0usize;
+        loop {
+            let node = &self.nodes[at];
+            if node.bounds.entry(ray.origin, inv, *t_max).is_some() {
+                if node.count > 0 {
+                    for &i in &self.order[node.offset as usize..node.offset as usize + node.count as usize] {
+                        if visit(i, t_max) {
+                            return;
+                        }
+                    }
+                } else {
+                    let (near, far) = if negative[node.axis as usize] {
+                        (node.offset as usize, at + 1)
+                    } else {
+                        (at + 1, node.offset as usize)
+                    };
+                    stack[depth] = far as u32;
+                    depth += 1;
+                    at = near;
+                    continue;
+                }
+            }
+            if depth == 0 {
+                return;
+            }
+            depth -= 1;
+            at = stack[depth] as usize;
+        }
+    }
+
+    /// Number of nodes.
+    #[must_use]
+    pub fn node_count(&self) -> usize {
+        self.nodes.len()
+    }
+}
+
+fn build_node(items: &mut [Item], start: usize) -> BuildNode {
+    let bounds = items.iter().fold(Aabb::EMPTY, |b, i| b.union(i.bounds));
+    if items.len() <= LEAF_MAX {
+        return BuildNode::Leaf { bounds, start, count: items.len() };
+    }
+    let centres = items.iter().fold(Aabb::EMPTY, |b, i| Aabb { min: b.min.min(i.centre), max: b.max.max(i.centre) });
+    let axis = (centres.max - centres.min).max_position();
+    let extent = centres.max[axis] - centres.min[axis];
+    let mid = match (extent > 0.0).then(|| best_split(items, axis, centres.min[axis], extent, bounds)).flatten() {
+        Some(split) => partition(items, |i| bin_of(i.centre[axis], centres.min[axis], extent) <= split),
+        None if items.len() <= 255 => return BuildNode::Leaf { bounds, start, count: items.len() },
+        None => {
+            items.sort_unstable_by(|a, b| a.centre[axis].total_cmp(&b.centre[axis]));
+            items.len() / 2
+        }
+    };
+    let (left, right) = items.split_at_mut(mid);
+    let (a, b) = if left.len() + right.len() > PARALLEL_BELOW {
+        rayon::join(|| build_node(left, start), || build_node(right, start + mid))
+    } else {
+        (build_node(left, start), build_node(right, start + mid))
+    };
+    BuildNode::Interior { bounds, axis: axis as u8, children: Box::new([a, b]) }
+}
+
+fn bin_of(c: f32, min: f32, extent: f32) -> usize {
+    (((c - min) / extent * BINS as f32) as usize).min(BINS - 1)
+}
+
+/// The last bin of the left side of the cheapest SAH split, or `None` if making a
+/// leaf is cheaper (or nothing separates).
+fn best_split(items: &[Item], axis: usize, min: f32, extent: f32, bounds: Aabb) -> Option<usize> {
+    let mut bins = [(Aabb::EMPTY, 0usize); BINS];
+    for i in items {
+        let b = &mut bins[bin_of(i.centre[axis], min, extent)];
+        *b = (b.0.union(i.bounds), b.1 + 1);
+    }
+    let mut right = [(0.0f32, 0usize); BINS];
+    let mut acc = (Aabb::EMPTY, 0);
+    for k in (1..BINS).rev() {
+        acc = (acc.0.union(bins[k].0), acc.1 + bins[k].1);
+        right[k] = (acc.0.area(), acc.1);
+    }
+    let mut left = (Aabb::EMPTY, 0);
+    let mut best: Option<(f32, usize)> = None;
+    for k in 0..BINS - 1 {
+        left = (left.0.union(bins[k].0), left.1 + bins[k].1);
+        let (ra, rn) = right[k + 1];
+        if left.1 == 0 || rn == 0 {
+            continue;
+        }
+        let cost = 0.125 + (left.0.area() * left.1 as f32 + ra * rn as f32) / bounds.area().max(f32::MIN_POSITIVE);
+        if best.is_none_or(|(c, _)| cost < c) {
+            best = Some((cost, k));
+        }
+    }
+    let (cost, k) = best?;
+    (items.len() > LEAF_MAX * 16 || cost < items.len() as f32).then_some(k)
+}
+
+/// Moves the items for which `left` holds to the front; returns how many.
+fn partition(items: &mut [Item], left: impl Fn(&Item) -> bool) -> usize {
+    let mut mid = 0;
+    for i in 0..items.len() {
+        if left(&items[i]) {
+            items.swap(i, mid);
+            mid += 1;
+        }
+    }
+    mid
+}
+
+fn flatten(node: &BuildNode, out: &mut Vec<Node>) {
+    match node {
+        BuildNode::Leaf { bounds, start, count } => {
+            out.push(Node { bounds: *bounds, offset: *start as u32, count: *count as u16, axis: 0 });
+        }
+        BuildNode::Interior { bounds, axis, children } => {
+            let at = out.len();
+            out.push(Node { bounds: *bounds, offset: 0, count: 0, axis: *axis });
+            flatten(&children[0], out);
+            out[at].offset = out.len() as u32;
+            flatten(&children[1], out);
+        }
+    }
+}
