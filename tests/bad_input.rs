@@ -148,3 +148,26 @@ fn too_many_threads_is_an_error_not_a_hang() {
     let (ok, err) = kage(&["render", "--threads", "1000000", "-o", out.to_str().unwrap()]);
     assert!(!ok && err.contains("threads requested"), "{err}");
 }
+
+#[test]
+fn compare_reports_metrics_and_refuses_mismatched_sizes() {
+    let dir = scratch("compare");
+    let (a, b, c) = (dir.join("a.pfm"), dir.join("b.pfm"), dir.join("c.pfm"));
+    for (p, w) in [(&a, "64"), (&b, "64"), (&c, "32")] {
+        let (ok, err) = kage(&["render", "--width", w, "--height", "32", "-o", p.to_str().unwrap()]);
+        assert!(ok, "{err}");
+    }
+    let out = Command::new(env!("CARGO_BIN_EXE_kage"))
+        .args(["compare", a.to_str().unwrap(), b.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success() && text.contains("rmse        0.000000") && text.contains("psnr        inf dB"),
+        "{text}"
+    );
+    let (ok, err) = kage(&["compare", a.to_str().unwrap(), c.to_str().unwrap()]);
+    assert!(!ok && err.contains("differ in size: 64x32 vs 32x32"), "{err}");
+    let (ok, err) = kage(&["compare", a.to_str().unwrap(), dir.join("missing.pfm").to_str().unwrap()]);
+    assert!(!ok && err.contains("missing.pfm"), "{err}");
+}

@@ -89,3 +89,24 @@ fn exposure_in_scene_files_and_on_the_command_line() {
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("neither a number of stops nor 'auto'"));
 }
+
+#[test]
+fn written_images_read_back() {
+    use kage::output::read_image;
+    let img = gradient();
+    for ext in ["pfm", "exr"] {
+        let path = scratch(&format!("rb.{ext}"));
+        write_image(&img, &path, 1.0).unwrap();
+        assert_eq!(read_image(&path).unwrap(), img, "{ext}");
+    }
+    let png = scratch("rb.png");
+    write_image(&img, &png, 1.0).unwrap();
+    let back = read_image(&png).unwrap();
+    for (a, b) in back.pixels().iter().zip(img.pixels()) {
+        // 8-bit sRGB quantisation, values clamped to [0, 1].
+        assert!((*a - b.clamp(glam::Vec3::ZERO, glam::Vec3::ONE)).abs().max_element() < 0.01, "{a} vs {b}");
+    }
+    let bad = scratch("bad.pfm");
+    std::fs::write(&bad, b"PF\n7 5\n-1.0\n\x00\x00").unwrap();
+    assert!(read_image(&bad).unwrap_err().to_string().contains("bytes of pixels"));
+}

@@ -28,6 +28,29 @@ enum Command {
     Render(RenderArgs),
     /// Time frames at 1920x1080 on the peers' procedural scenes and print a table.
     Bench(bench::BenchArgs),
+    /// Measure image A against reference B: RMSE, PSNR, max error, share over a
+    /// threshold, mask disagreement; optionally write a false-colour difference.
+    Compare(CompareArgs),
+}
+
+#[derive(clap::Args)]
+struct CompareArgs {
+    /// The image to judge (.png/.jpg read as sRGB, .exr/.pfm as linear).
+    a: PathBuf,
+    /// The reference image.
+    b: PathBuf,
+    /// Channel difference above which a pixel counts as differing.
+    #[arg(long, default_value_t = 0.01)]
+    threshold: f32,
+    /// Also compare as masks: a pixel is "on" when its mean channel is above LEVEL.
+    #[arg(long)]
+    mask: Option<f32>,
+    /// Write a false-colour difference image here.
+    #[arg(long)]
+    diff: Option<PathBuf>,
+    /// Difference shown as full red in the difference image.
+    #[arg(long, default_value_t = 0.1)]
+    diff_scale: f32,
 }
 
 #[derive(clap::Args)]
@@ -70,6 +93,7 @@ fn main() -> miette::Result<()> {
     match cli.command {
         Command::Render(args) => render_command(&args).map_err(report::to_report),
         Command::Bench(args) => bench::run(&args),
+        Command::Compare(args) => compare_command(&args).map_err(report::to_report),
     }
 }
 
@@ -109,5 +133,24 @@ fn render_command(args: &RenderArgs) -> kage::error::Result<()> {
         s.visibility_ms,
         s.shading_ms
     );
+    Ok(())
+}
+
+fn compare_command(args: &CompareArgs) -> kage::error::Result<()> {
+    let (a, b) = (kage::output::read_image(&args.a)?, kage::output::read_image(&args.b)?);
+    let c = kage::compare::compare(&a, &b, args.threshold)?;
+    println!("rmse        {:.6}", c.rmse);
+    println!("psnr        {:.2} dB", c.psnr);
+    println!("max error   {:.6}", c.max_error);
+    println!("over {:<6}  {:.4}% of pixels", args.threshold, 100.0 * c.share_over);
+    if let Some(level) = args.mask {
+        let m = kage::compare::mask_disagreement(&a, &b, level)?;
+        println!("mask @ {level:<4}  {:.4}% of pixels classified differently", 100.0 * m);
+    }
+    if let Some(path) = &args.diff {
+        let d = kage::compare::difference_image(&a, &b, args.diff_scale)?;
+        kage::output::write_image(&d, path, 1.0)?;
+        eprintln!("wrote {}", path.display());
+    }
     Ok(())
 }
