@@ -8,6 +8,7 @@
 //! `occluded` (anything before a distance?).
 
 pub mod bvh;
+pub mod reference;
 pub mod triangle;
 
 use glam::{Vec2, Vec3};

@@ -1,0 +1,146 @@
+//! The reference renderer: the same scene and the same shading model as the raster
+//! pipeline (seed 002 eq. 1), computed by rays. Primary visibility by tracing
+//! n × n stratified, jittered rays per pixel (an antialiased reference), hard
+//! shadows by shadow rays, area-light soft shadows by m × m stratified samples over
+//! each light's extent (a disc of radius `size` facing the point).
+//!
+//! With n = m = 1, shadows off and no area lights, every pixel whose primary hit
+//! agrees with the visibility buffer gets the rasterizer's colour (a test holds it).
+
+use glam::{Vec2, Vec3};
+use rayon::prelude::*;
+
+use super::TraceScene;
+use crate::resolve::LinearImage;
+use crate::scene::{Light, LightKind, Ray, Scene};
+use crate::shading::phong::{self, Coefficients, Components};
+use crate::shading::{ObjectFrames, SurfacePoint};
+
+/// How the reference is computed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ReferenceOptions {
+    /// Primary rays per pixel along each axis (n × n per pixel; 1 = the centre).
+    pub pixel_samples: u32,
+    /// Shadow rays per light along each axis for lights with a size (m × m).
+    pub light_samples: u32,
+    /// Trace shadow rays (off: every light reaches every point, like the raster
+    /// pipeline before shadows).
+    pub shadows: bool,
+}
+
+impl Default for ReferenceOptions {
+    fn default() -> Self {
+        ReferenceOptions { pixel_samples: 4, light_samples: 4, shadows: true }
+    }
+}
+
+/// Renders `scene` by rays; `progress` is called with each finished row count.
+pub fn render_reference(scene: &Scene, opts: &ReferenceOptions, progress: &(dyn Fn(u32) + Sync)) -> LinearImage {
+    let trace = TraceScene::new(scene);
+    let frames = ObjectFrames::new(scene);
+    let (w, h) = (scene.width, scene.height);
+    let rays = scene.camera.pixel_rays(Vec2::new(w as f32, h as f32));
+    let epsilon = scene.bounds().map_or(1e-4, |(lo, hi)| (hi - lo).length() * 1e-5);
+    let cx = Tracer { scene, trace: &trace, frames: &frames, opts: *opts, epsilon };
+    let done = std::sync::atomic::AtomicU32::new(0);
+    let mut image = LinearImage::new(w, h);
+    image.pixels_mut().par_chunks_mut(w as usize).enumerate().for_each(|(y, row)| {
+        for (x, px) in row.iter_mut().enumerate() {
+            *px = cx.pixel(&rays, x as u32, y as u32);
+        }
+        progress(done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1);
+    });
+    image
+}
+
+struct Tracer<'a> {
+    scene: &'a Scene,
+    trace: &'a TraceScene,
+    frames: &'a ObjectFrames,
+    opts: ReferenceOptions,
+    epsilon: f32,
+}
+
+impl Tracer<'_> {
+    fn pixel(&self, rays: &crate::scene::camera::PixelRays, x: u32, y: u32) -> Vec3 {
+        let n = self.opts.pixel_samples.max(1);
+        let mut sum = Vec3::ZERO;
+        for k in 0..n * n {
+            let offset = stratified(k, n, hash3(x, y, k));
+            sum += self.radiance(&rays.ray(Vec2::new(x as f32, y as f32) + offset));
+        }
+        sum / (n * n) as f32
+    }
+
+    fn radiance(&self, ray: &Ray) -> Vec3 {
+        let Some(hit) = self.trace.intersect(ray, f32::INFINITY) else { return self.scene.background };
+        let s = self.frames.prepare(self.scene, hit.item).surface(ray);
+        let material = &self.scene.materials[s.material];
+        let k = Coefficients::at(material, &s);
+        let mut acc = Components { emission: k.parts().3, ..Default::default() };
+        for (i, light) in self.scene.lights.iter().enumerate() {
+            let shadow = if self.opts.shadows { self.visibility(light, &s, i as u32) } else { 1.0 };
+            phong::add_light(&mut acc, light, &k, &s, shadow);
+        }
+        acc.total()
+    }
+
+    /// Fraction of the light's samples visible from the surface point.
+    fn visibility(&self, light: &Light, s: &SurfacePoint, salt: u32) -> f32 {
+        let origin = s.position + s.normal * self.epsilon;
+        let position = match light.kind {
+            LightKind::Directional { direction } => {
+                let ray = Ray { origin, dir: -direction };
+                return if self.trace.occluded(&ray, f32::INFINITY) { 0.0 } else { 1.0 };
+            }
+            LightKind::Point { position } | LightKind::Spot { position, .. } => position,
+        };
+        let m = if light.size > 0.0 { self.opts.light_samples.max(1) } else { 1 };
+        let axis = (position - s.position).normalize_or(Vec3::Y);
+        let (u, v) = axis.any_orthonormal_pair();
+        let mut lit = 0;
+        for k in 0..m * m {
+            let d = concentric_disc(stratified(k, m, hash3(salt, k, s.position.x.to_bits())));
+            let target = if m == 1 { position } else { position + light.size * (u * d.x + v * d.y) };
+            let to = target - origin;
+            let dist = to.length();
+            let ray = Ray { origin, dir: to / dist };
+            lit += u32::from(!self.trace.occluded(&ray, dist * (1.0 - 1e-4)));
+        }
+        lit as f32 / (m * m) as f32
+    }
+}
+
+/// Sample `k` of an n × n stratified grid over the unit square, jittered by `h`
+/// (n = 1: the centre).
+fn stratified(k: u32, n: u32, h: u32) -> Vec2 {
+    if n == 1 {
+        return Vec2::splat(0.5);
+    }
+    let jitter = Vec2::new((h & 0xffff) as f32 / 65536.0, (h >> 16) as f32 / 65536.0);
+    (Vec2::new((k % n) as f32, (k / n) as f32) + jitter) / n as f32
+}
+
+/// The unit square mapped onto the unit disc, area-preserving (Shirley–Chiu).
+fn concentric_disc(p: Vec2) -> Vec2 {
+    let q = 2.0 * p - Vec2::ONE;
+    if q == Vec2::ZERO {
+        return q;
+    }
+    let (r, theta) = if q.x.abs() > q.y.abs() {
+        (q.x, std::f32::consts::FRAC_PI_4 * (q.y / q.x))
+    } else {
+        (q.y, std::f32::consts::FRAC_PI_2 - std::f32::consts::FRAC_PI_4 * (q.x / q.y))
+    };
+    r * Vec2::new(theta.cos(), theta.sin())
+}
+
+/// A well-mixed 32-bit hash of three numbers (deterministic jitter).
+fn hash3(a: u32, b: u32, c: u32) -> u32 {
+    let mut h = a.wrapping_mul(0x9E37_79B1) ^ b.wrapping_mul(0x85EB_CA77) ^ c.wrapping_mul(0xC2B2_AE3D);
+    h ^= h >> 16;
+    h = h.wrapping_mul(0x7FEB_352D);
+    h ^= h >> 15;
+    h = h.wrapping_mul(0x846C_A68B);
+    h ^ (h >> 16)
+}
