@@ -12,6 +12,7 @@ use kage::scene::load::{self, FileSystem};
 use kage::scene::{file::add_model, Camera, Falloff, Light, LightKind, Material, Projection, Scene};
 use kage::{RenderOptions, Renderer};
 use miette::{miette, IntoDiagnostic, Result};
+use rayon::prelude::*;
 
 /// Options of `kage bench`.
 #[derive(clap::Args)]
@@ -35,6 +36,13 @@ pub struct BenchArgs {
     /// Only these scenes (comma-separated names).
     #[arg(long, default_value = "sphere10k,sphere100k,sphere1m")]
     scenes: String,
+    /// Benchmark the BVH (build time, primary-ray throughput) beside Embree
+    /// instead of the raster frame beside llvmpipe.
+    #[arg(long)]
+    rays: bool,
+    /// The Embree peer program (`scripts/build-peers.sh` builds it); skipped if absent.
+    #[arg(long, default_value = "target/peers/embree_bench")]
+    embree: PathBuf,
     /// Image width.
     #[arg(long, default_value_t = 1920)]
     width: u32,
@@ -54,6 +62,9 @@ struct Row {
 
 /// Runs the benchmark and prints the table.
 pub fn run(args: &BenchArgs) -> Result<()> {
+    if args.rays {
+        return run_rays(args);
+    }
     let lp = &args.llvmpipe;
     let mut rows = Vec::new();
     for name in args.scenes.split(',').map(str::trim) {
@@ -241,4 +252,117 @@ fn print_table(rows: &[Row], args: &BenchArgs) {
         args.rounds.max(1),
         rayon::current_num_threads()
     );
+}
+
+/// One row of the ray benchmark: (build ms, Mrays/s) for kage and Embree.
+struct RayRow {
+    name: String,
+    triangles: usize,
+    build_ms: f64,
+    mrays: f64,
+    peer: Option<(f64, f64)>,
+}
+
+fn run_rays(args: &BenchArgs) -> Result<()> {
+    let mut rows = Vec::new();
+    for name in args.scenes.split(',').map(str::trim) {
+        let mesh = ensure_mesh(args, name)?;
+        let scene = peer_scene(&mesh, args.width, args.height)?;
+        let mut best: Option<RayRow> = None;
+        for _ in 0..args.rounds.max(1) {
+            let (build_ms, mrays) = time_rays(&scene, args.frames);
+            let peer = args.embree.exists().then(|| run_embree(&args.embree, &mesh, args)).transpose()?;
+            let row = RayRow { name: name.to_string(), triangles: scene.triangle_count(), build_ms, mrays, peer };
+            best = Some(match best {
+                None => row,
+                Some(b) => RayRow {
+                    build_ms: b.build_ms.min(row.build_ms),
+                    mrays: b.mrays.max(row.mrays),
+                    peer: match (b.peer, row.peer) {
+                        (Some(p), Some(q)) => Some((p.0.min(q.0), p.1.max(q.1))),
+                        (p, q) => p.or(q),
+                    },
+                    ..row
+                },
+            });
+        }
+        rows.push(best.expect("one round"));
+        eprintln!("{name}: done");
+    }
+    println!("| scene | triangles | kage build ms | Embree build ms | build ratio | kage Mrays/s | Embree Mrays/s | rate ratio |");
+    println!("|---|---:|---:|---:|---:|---:|---:|---:|");
+    for r in &rows {
+        let (pb, pr, bratio, rratio) = match r.peer {
+            Some((b, m)) => {
+                (format!("{b:.1}"), format!("{m:.2}"), format!("{:.2}", r.build_ms / b), format!("{:.2}", r.mrays / m))
+            }
+            None => ("not built".into(), "not built".into(), "n/a".into(), "n/a".into()),
+        };
+        println!(
+            "| {} | {} | {:.1} | {pb} | {bratio} | {:.2} | {pr} | {rratio} |",
+            r.name, r.triangles, r.build_ms, r.mrays
+        );
+    }
+    println!(
+        "\n{}x{} primary rays (one per pixel centre, nearest hit, no shading), median of {} frames; build median of 5; best of {} rounds; {} threads.",
+        args.width,
+        args.height,
+        args.frames,
+        args.rounds.max(1),
+        rayon::current_num_threads()
+    );
+    Ok(())
+}
+
+/// Median BVH build time (ms) and primary-ray throughput (Mrays/s).
+fn time_rays(scene: &Scene, frames: usize) -> (f64, f64) {
+    use kage::raytrace::TraceScene;
+    let mut builds = Vec::new();
+    let mut trace = TraceScene::new(scene);
+    for _ in 0..5 {
+        let t = std::time::Instant::now();
+        trace = TraceScene::new(scene);
+        builds.push(t.elapsed().as_secs_f64() * 1e3);
+    }
+    let rays = scene.camera.pixel_rays(glam::Vec2::new(scene.width as f32, scene.height as f32));
+    let (w, h) = (scene.width, scene.height);
+    let mut times = Vec::new();
+    for _ in 0..frames.max(1) + 1 {
+        let t = std::time::Instant::now();
+        let hits: usize = (0..h)
+            .into_par_iter()
+            .map(|y| {
+                (0..w)
+                    .filter(|&x| {
+                        let ray = rays.ray(glam::Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
+                        trace.intersect(&ray, f32::INFINITY).is_some()
+                    })
+                    .count()
+            })
+            .sum();
+        std::hint::black_box(hits);
+        times.push(t.elapsed().as_secs_f64());
+    }
+    times.remove(0); // warm-up
+    (median(builds), (w * h) as f64 / median(times) / 1e6)
+}
+
+/// Runs Embree's primary-ray benchmark (rtcIntersect1, no shading) on the same mesh.
+fn run_embree(bin: &Path, mesh: &Path, args: &BenchArgs) -> Result<(f64, f64)> {
+    let out = Command::new(bin)
+        .args(["-t", "2", "-n", "-m", "primary", "-a", "1", "-f", &args.frames.to_string()])
+        .args(["-w", &args.width.to_string(), "-h", &args.height.to_string()])
+        .arg(mesh)
+        .output()
+        .into_diagnostic()?;
+    let text = String::from_utf8_lossy(&out.stdout);
+    let field = |line: &str, key: &str| -> Option<f64> {
+        line.split_whitespace().find_map(|w| w.strip_prefix(key)).and_then(|v| v.parse().ok())
+    };
+    let build = text.lines().find(|l| l.contains("what=build")).and_then(|l| field(l, "median_ms="));
+    let rate = text.lines().find(|l| l.contains("mode=primary")).and_then(|l| field(l, "mrays_s="));
+    match (build, rate) {
+        (Some(b), Some(r)) => Ok((b, r)),
+        _ => Err(miette!("Embree printed no build/primary results: {text}{}", String::from_utf8_lossy(&out.stderr))),
+    }
 }
