@@ -66,7 +66,6 @@ struct Node {
     offset: u32,
     /// Primitives in a leaf; 0 for interior nodes.
     count: u16,
-    axis: u8,
 }
 
 /// A bounding volume hierarchy over primitives known by their boxes.
@@ -88,7 +87,7 @@ struct Item {
 
 enum BuildNode {
     Leaf { bounds: Aabb, start: usize, count: usize },
-    Interior { bounds: Aabb, axis: u8, children: Box<[BuildNode; 2]> },
+    Interior { bounds: Aabb, children: Box<[BuildNode; 2]> },
 }
 
 impl Bvh {
@@ -138,43 +137,70 @@ impl Bvh {
         any
     }
 
-    /// Visits the leaves the ray reaches, near first; `visit` returns true to stop.
+    /// Visits the leaves the ray reaches, nearer child first (by entry distance);
+    /// `visit` returns true to stop. A postponed child is skipped when the ray has
+    /// since found a hit nearer than its box.
     fn walk(&self, ray: &Ray, t_max: &mut f32, mut visit: impl FnMut(u32, &mut f32) -> bool) {
-        if self.nodes.is_empty() {
+        let inv = ray.dir.recip();
+        let entry = |i: usize, t_max: f32| self.nodes[i].bounds.entry(ray.origin, inv, t_max);
+        if self.nodes.is_empty() || entry(0, *t_max).is_none() {
             return;
         }
-        let inv = ray.dir.recip();
-        let negative = [inv.x < 0.0, inv.y < 0.0, inv.z < 0.0];
-        let mut stack = [0u32; 64];
+        let mut stack = [(0u32, 0.0f32); 64];
         let mut depth = 0;
         let mut at = 0usize;
         loop {
             let node = &self.nodes[at];
-            if node.bounds.entry(ray.origin, inv, *t_max).is_some() {
-                if node.count > 0 {
-                    for &i in &self.order[node.offset as usize..node.offset as usize + node.count as usize] {
-                        if visit(i, t_max) {
-                            return;
-                        }
+            if node.count > 0 {
+                let first = node.offset as usize;
+                for &i in &self.order[first..first + node.count as usize] {
+                    if visit(i, t_max) {
+                        return;
                     }
-                } else {
-                    let (near, far) = if negative[node.axis as usize] {
-                        (node.offset as usize, at + 1)
-                    } else {
-                        (at + 1, node.offset as usize)
-                    };
-                    stack[depth] = far as u32;
-                    depth += 1;
-                    at = near;
-                    continue;
+                }
+            } else {
+                let (a, b) = (at + 1, node.offset as usize);
+                match (entry(a, *t_max), entry(b, *t_max)) {
+                    (Some(ta), Some(tb)) => {
+                        let ((near, _), (far, t_far)) = if ta <= tb { ((a, ta), (b, tb)) } else { ((b, tb), (a, ta)) };
+                        stack[depth] = (far as u32, t_far);
+                        depth += 1;
+                        at = near;
+                        continue;
+                    }
+                    (Some(_), None) => {
+                        at = a;
+                        continue;
+                    }
+                    (None, Some(_)) => {
+                        at = b;
+                        continue;
+                    }
+                    (None, None) => {}
                 }
             }
-            if depth == 0 {
-                return;
+            loop {
+                if depth == 0 {
+                    return;
+                }
+                depth -= 1;
+                let (next, t_entry) = stack[depth];
+                if t_entry < *t_max {
+                    at = next as usize;
+                    break;
+                }
             }
-            depth -= 1;
-            at = stack[depth] as usize;
         }
+    }
+
+    /// Renumbers the primitives in leaf order and returns the permutation: entry
+    /// `k` is the old index of the primitive now numbered `k`. Callers that store
+    /// primitive data reorder it with the permutation, so leaves read contiguous
+    /// memory.
+    pub fn renumber(&mut self) -> Vec<u32> {
+        let old = std::mem::take(&mut self.order);
+        self.order = (0..old.len() as u32).collect();
+        old
     }
 
     /// Number of nodes.
@@ -206,7 +232,7 @@ fn build_node(items: &mut [Item], start: usize) -> BuildNode {
     } else {
         (build_node(left, start), build_node(right, start + mid))
     };
-    BuildNode::Interior { bounds, axis: axis as u8, children: Box::new([a, b]) }
+    BuildNode::Interior { bounds, children: Box::new([a, b]) }
 }
 
 fn bin_of(c: f32, min: f32, extent: f32) -> usize {
@@ -259,11 +285,11 @@ fn partition(items: &mut [Item], left: impl Fn(&Item) -> bool) -> usize {
 fn flatten(node: &BuildNode, out: &mut Vec<Node>) {
     match node {
         BuildNode::Leaf { bounds, start, count } => {
-            out.push(Node { bounds: *bounds, offset: *start as u32, count: *count as u16, axis: 0 });
+            out.push(Node { bounds: *bounds, offset: *start as u32, count: *count as u16 });
         }
-        BuildNode::Interior { bounds, axis, children } => {
+        BuildNode::Interior { bounds, children } => {
             let at = out.len();
-            out.push(Node { bounds: *bounds, offset: 0, count: 0, axis: *axis });
+            out.push(Node { bounds: *bounds, offset: 0, count: 0 });
             flatten(&children[0], out);
             out[at].offset = out.len() as u32;
             flatten(&children[1], out);

@@ -61,7 +61,10 @@ impl TraceScene {
     #[must_use]
     pub fn from_triangles(triangles: Vec<[Vec3; 3]>, items: Vec<ItemId>) -> TraceScene {
         let bounds: Vec<Aabb> = triangles.par_iter().map(|t| Aabb::around(t)).collect();
-        let bvh = Bvh::build(&bounds);
+        let mut bvh = Bvh::build(&bounds);
+        let order = bvh.renumber();
+        let triangles = order.iter().map(|&i| triangles[i as usize]).collect();
+        let items = order.iter().map(|&i| items[i as usize]).collect();
         TraceScene { triangles, items, bvh }
     }
 
