@@ -15,10 +15,18 @@ use crate::visibility::{self, RasterStats, VisibilityBuffer};
 pub const MAX_THREADS: usize = 1024;
 
 /// How to render.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct RenderOptions {
     /// Worker threads (`None`: one per core).
     pub threads: Option<usize>,
+    /// Reflection/refraction bounces traced from the item buffer (seed 002 §4).
+    pub ray_depth: u32,
+}
+
+impl Default for RenderOptions {
+    fn default() -> Self {
+        RenderOptions { threads: None, ray_depth: 4 }
+    }
 }
 
 /// Timings and counts of one frame.
@@ -28,6 +36,10 @@ pub struct FrameStats {
     pub visibility_ms: f64,
     /// Milliseconds in the shading passes.
     pub shading_ms: f64,
+    /// Milliseconds tracing reflections and refraction from the item buffer.
+    pub traced_ms: f64,
+    /// Pixels that spawned secondary rays.
+    pub traced_pixels: usize,
     /// What the rasterizer did.
     pub raster: RasterStats,
     /// Bytes held by the frame's buffers (visibility buffer and image).
@@ -49,6 +61,7 @@ pub struct Frame {
 #[derive(Debug)]
 pub struct Renderer {
     pool: Option<rayon::ThreadPool>,
+    ray_depth: u32,
     frame: Frame,
 }
 
@@ -72,7 +85,7 @@ impl Renderer {
             visibility: VisibilityBuffer::new(0, 0),
             stats: FrameStats::default(),
         };
-        Ok(Renderer { pool, frame })
+        Ok(Renderer { pool, frame, ray_depth: options.ray_depth })
     }
 
     /// Renders `scene` (validated first) and returns the frame.
@@ -80,8 +93,8 @@ impl Renderer {
         scene.validate()?;
         let frame = &mut self.frame;
         match &self.pool {
-            None => render_into(scene, frame),
-            Some(pool) => pool.install(|| render_into(scene, frame)),
+            None => render_into(scene, frame, self.ray_depth),
+            Some(pool) => pool.install(|| render_into(scene, frame, self.ray_depth)),
         }
         Ok(&self.frame)
     }
@@ -100,7 +113,7 @@ pub fn render(scene: &Scene, options: &RenderOptions) -> Result<Frame> {
     Ok(r.into_frame())
 }
 
-fn render_into(scene: &Scene, frame: &mut Frame) {
+fn render_into(scene: &Scene, frame: &mut Frame, ray_depth: u32) {
     let t0 = Instant::now();
     frame.visibility.resize(scene.width, scene.height);
     frame.stats.raster = visibility::rasterize(scene, &mut frame.visibility);
@@ -108,7 +121,10 @@ fn render_into(scene: &Scene, frame: &mut Frame) {
     frame.image.resize(scene.width, scene.height);
     shading::shade_into(scene, &frame.visibility, &mut frame.image);
     let t2 = Instant::now();
+    frame.stats.traced_pixels =
+        crate::raytrace::item_buffer::add_traced(scene, &frame.visibility, &mut frame.image, ray_depth);
     frame.stats.visibility_ms = (t1 - t0).as_secs_f64() * 1e3;
     frame.stats.shading_ms = (t2 - t1).as_secs_f64() * 1e3;
+    frame.stats.traced_ms = t2.elapsed().as_secs_f64() * 1e3;
     frame.stats.buffer_bytes = frame.visibility.memory_bytes() + std::mem::size_of_val(frame.image.pixels());
 }

@@ -78,9 +78,9 @@ fn lights_add_up() {
 #[test]
 fn one_and_two_threads_give_identical_frames() {
     let scene = kage::scene::demo::demo_scene().unwrap();
-    let a = render(&scene, &RenderOptions { threads: Some(1) }).unwrap();
-    let b = render(&scene, &RenderOptions { threads: Some(2) }).unwrap();
-    let c = render(&scene, &RenderOptions { threads: Some(5) }).unwrap();
+    let a = render(&scene, &RenderOptions { threads: Some(1), ..Default::default() }).unwrap();
+    let b = render(&scene, &RenderOptions { threads: Some(2), ..Default::default() }).unwrap();
+    let c = render(&scene, &RenderOptions { threads: Some(5), ..Default::default() }).unwrap();
     assert_eq!(a.visibility.items(), b.visibility.items());
     assert_eq!(a.visibility.depths(), c.visibility.depths());
     assert_eq!(a.image, b.image);

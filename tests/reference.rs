@@ -16,7 +16,7 @@ fn one_ray_per_pixel_without_shadows_matches_the_rasterizer() {
     let frame = render(&scene, &RenderOptions::default()).unwrap();
     let mut scalar = LinearImage::new(scene.width, scene.height);
     kage::shading::shade_into_scalar(&scene, &frame.visibility, &mut scalar);
-    let opts = ReferenceOptions { pixel_samples: 1, light_samples: 1, shadows: false };
+    let opts = ReferenceOptions { pixel_samples: 1, light_samples: 1, shadows: false, max_depth: 0 };
     let reference = render_reference(&scene, &opts, &|_| {});
     let trace = TraceScene::new(&scene);
     let rays = scene.camera.pixel_rays(glam::Vec2::new(scene.width as f32, scene.height as f32));
@@ -44,18 +44,27 @@ fn shadows_only_darken_and_antialiasing_stays_close() {
     let mut scene = kage::scene::demo::demo_scene().unwrap();
     scene.width = 120;
     scene.height = 68;
-    let plain =
-        render_reference(&scene, &ReferenceOptions { pixel_samples: 1, light_samples: 1, shadows: false }, &|_| {});
-    let shadowed =
-        render_reference(&scene, &ReferenceOptions { pixel_samples: 1, light_samples: 3, shadows: true }, &|_| {});
+    let plain = render_reference(
+        &scene,
+        &ReferenceOptions { pixel_samples: 1, light_samples: 1, shadows: false, max_depth: 0 },
+        &|_| {},
+    );
+    let shadowed = render_reference(
+        &scene,
+        &ReferenceOptions { pixel_samples: 1, light_samples: 3, shadows: true, max_depth: 0 },
+        &|_| {},
+    );
     let mut darker = 0;
     for (p, s) in plain.pixels().iter().zip(shadowed.pixels()) {
         assert!(s.cmple(*p + glam::Vec3::splat(1e-5)).all(), "shadowed {s} brighter than unshadowed {p}");
         darker += usize::from((*p - *s).max_element() > 0.02);
     }
     assert!(darker > 200, "the demo's objects must cast visible shadows ({darker} pixels)");
-    let aa =
-        render_reference(&scene, &ReferenceOptions { pixel_samples: 3, light_samples: 1, shadows: false }, &|_| {});
+    let aa = render_reference(
+        &scene,
+        &ReferenceOptions { pixel_samples: 3, light_samples: 1, shadows: false, max_depth: 0 },
+        &|_| {},
+    );
     let c = kage::compare::compare(&aa, &plain, 0.05).unwrap();
     assert!(c.rmse < 0.05 && c.share_over < 0.2, "{c:?}");
 }

@@ -8,6 +8,7 @@
 //! `occluded` (anything before a distance?).
 
 pub mod bvh;
+pub mod item_buffer;
 pub mod reference;
 pub mod triangle;
 

@@ -26,11 +26,13 @@ pub struct ReferenceOptions {
     /// Trace shadow rays (off: every light reaches every point, like the raster
     /// pipeline before shadows).
     pub shadows: bool,
+    /// Reflection/refraction bounces followed from a surface (0: none).
+    pub max_depth: u32,
 }
 
 impl Default for ReferenceOptions {
     fn default() -> Self {
-        ReferenceOptions { pixel_samples: 4, light_samples: 4, shadows: true }
+        ReferenceOptions { pixel_samples: 4, light_samples: 4, shadows: true, max_depth: 4 }
     }
 }
 
@@ -40,8 +42,7 @@ pub fn render_reference(scene: &Scene, opts: &ReferenceOptions, progress: &(dyn 
     let frames = ObjectFrames::new(scene);
     let (w, h) = (scene.width, scene.height);
     let rays = scene.camera.pixel_rays(Vec2::new(w as f32, h as f32));
-    let epsilon = scene.bounds().map_or(1e-4, |(lo, hi)| (hi - lo).length() * 1e-5);
-    let cx = Tracer { scene, trace: &trace, frames: &frames, opts: *opts, epsilon };
+    let cx = Tracer::new(scene, &trace, &frames, *opts);
     let done = std::sync::atomic::AtomicU32::new(0);
     let mut image = LinearImage::new(w, h);
     image.pixels_mut().par_chunks_mut(w as usize).enumerate().for_each(|(y, row)| {
@@ -53,7 +54,9 @@ pub fn render_reference(scene: &Scene, opts: &ReferenceOptions, progress: &(dyn 
     image
 }
 
-struct Tracer<'a> {
+/// Shades points hit by rays: eq. 1 with shadow rays, plus mirror and glass
+/// bounces. Shared by the reference renderer and the item-buffer pass.
+pub struct Tracer<'a> {
     scene: &'a Scene,
     trace: &'a TraceScene,
     frames: &'a ObjectFrames,
@@ -61,18 +64,27 @@ struct Tracer<'a> {
     epsilon: f32,
 }
 
-impl Tracer<'_> {
+impl<'a> Tracer<'a> {
+    /// A tracer over `trace` (built from `scene`).
+    #[must_use]
+    pub fn new(scene: &'a Scene, trace: &'a TraceScene, frames: &'a ObjectFrames, opts: ReferenceOptions) -> Self {
+        let epsilon = scene.bounds().map_or(1e-4, |(lo, hi)| (hi - lo).length() * 1e-5);
+        Tracer { scene, trace, frames, opts, epsilon }
+    }
+
     fn pixel(&self, rays: &crate::scene::camera::PixelRays, x: u32, y: u32) -> Vec3 {
         let n = self.opts.pixel_samples.max(1);
         let mut sum = Vec3::ZERO;
         for k in 0..n * n {
             let offset = stratified(k, n, hash3(x, y, k));
-            sum += self.radiance(&rays.ray(Vec2::new(x as f32, y as f32) + offset));
+            sum += self.radiance(&rays.ray(Vec2::new(x as f32, y as f32) + offset), self.opts.max_depth);
         }
         sum / (n * n) as f32
     }
 
-    fn radiance(&self, ray: &Ray) -> Vec3 {
+    /// Light arriving along `ray` (unit direction), following `depth` bounces.
+    #[must_use]
+    pub fn radiance(&self, ray: &Ray, depth: u32) -> Vec3 {
         let Some(hit) = self.trace.intersect(ray, f32::INFINITY) else { return self.scene.background };
         let s = self.frames.prepare(self.scene, hit.item).surface(ray);
         let material = &self.scene.materials[s.material];
@@ -82,7 +94,35 @@ impl Tracer<'_> {
             let shadow = if self.opts.shadows { self.visibility(light, &s, i as u32) } else { 1.0 };
             phong::add_light(&mut acc, light, &k, &s, shadow);
         }
-        acc.total()
+        acc.total() + self.bounces(ray, &s, depth)
+    }
+
+    /// IrayTracing of seed 002 eq. 5 at `s`, seen along `ray`: Kr times the light of
+    /// the mirror ray plus Kt times the light of the refracted ray (total internal
+    /// reflection sends it back in), each followed `depth` bounces.
+    #[must_use]
+    pub fn bounces(&self, ray: &Ray, s: &SurfacePoint, depth: u32) -> Vec3 {
+        let m = &self.scene.materials[s.material];
+        if depth == 0 || !m.traces() {
+            return Vec3::ZERO;
+        }
+        let d = ray.dir;
+        let mut out = Vec3::ZERO;
+        if m.kr.max_element() > 0.0 {
+            let r = reflect(d, s.normal);
+            out += m.kr * self.radiance(&Ray { origin: s.position + s.normal * self.epsilon, dir: r }, depth - 1);
+        }
+        if m.kt.max_element() > 0.0 {
+            // Entering when the ray meets the front (outward) side of the surface.
+            let eta = if s.front { 1.0 / m.ior } else { m.ior };
+            let (dir, sign) = match refract(d, s.normal, eta) {
+                Some(t) => (t, -1.0),
+                None => (reflect(d, s.normal), 1.0),
+            };
+            let origin = s.position + s.normal * (sign * self.epsilon);
+            out += m.kt * self.radiance(&Ray { origin, dir }, depth - 1);
+        }
+        out
     }
 
     /// Fraction of the light's samples visible from the surface point.
@@ -109,6 +149,26 @@ impl Tracer<'_> {
         }
         lit as f32 / (m * m) as f32
     }
+}
+
+/// The mirror direction of unit `d` about unit normal `n`.
+#[must_use]
+pub fn reflect(d: Vec3, n: Vec3) -> Vec3 {
+    d - 2.0 * d.dot(n) * n
+}
+
+/// Snell refraction of unit `d` through a surface with unit normal `n` facing the
+/// incoming ray, `eta` = n_from / n_to; `None` past the critical angle (total
+/// internal reflection).
+#[must_use]
+pub fn refract(d: Vec3, n: Vec3, eta: f32) -> Option<Vec3> {
+    let cos_i = -d.dot(n);
+    let sin2_t = eta * eta * (1.0 - cos_i * cos_i);
+    if sin2_t > 1.0 {
+        return None;
+    }
+    let cos_t = (1.0 - sin2_t).sqrt();
+    Some((eta * d + (eta * cos_i - cos_t) * n).normalize())
 }
 
 /// Sample `k` of an n × n stratified grid over the unit square, jittered by `h`

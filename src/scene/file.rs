@@ -218,6 +218,11 @@ struct MaterialRec {
     ke_map: Option<Spanned<String>>,
     #[serde(default)]
     two_sided: bool,
+    #[serde(default)]
+    kr: V3,
+    #[serde(default)]
+    kt: V3,
+    ior: Option<Spanned<f32>>,
 }
 
 fn grey() -> V3 {
@@ -412,6 +417,15 @@ impl SceneFile {
                 emission: texture(&r.ke_map, true)?,
             },
             two_sided: r.two_sided,
+            kr: r.kr.into(),
+            kt: r.kt.into(),
+            ior: match &r.ior {
+                Some(ior) if !(ior.get_ref().is_finite() && *ior.get_ref() >= 1.0) => {
+                    return Err(self.invalid(ior.span(), "the index of refraction must be a finite number ≥ 1"))
+                }
+                Some(ior) => *ior.get_ref(),
+                None => 1.5,
+            },
         })
     }
 

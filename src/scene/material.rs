@@ -29,6 +29,21 @@ pub struct Material {
     pub maps: ComponentMaps,
     /// Draw back faces too (no culling); shading uses the side facing the eye.
     pub two_sided: bool,
+    /// Mirror reflectance Kr: the share of the reflected ray's light added (seed
+    /// 002 §4, traced from the item buffer).
+    pub kr: Vec3,
+    /// Transmittance Kt: the share of the refracted ray's light added.
+    pub kt: Vec3,
+    /// Index of refraction of the material (the outside is taken as 1).
+    pub ior: f32,
+}
+
+impl Material {
+    /// Whether shading this material needs secondary rays.
+    #[must_use]
+    pub fn traces(&self) -> bool {
+        self.kr.max_element() > 0.0 || self.kt.max_element() > 0.0
+    }
 }
 
 /// Optional texture per shading component.
@@ -55,6 +70,9 @@ impl Default for Material {
             ke: Vec3::ZERO,
             maps: ComponentMaps::default(),
             two_sided: false,
+            kr: Vec3::ZERO,
+            kt: Vec3::ZERO,
+            ior: 1.5,
         }
     }
 }

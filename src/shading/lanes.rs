@@ -214,6 +214,7 @@ impl Block {
                     to_eye: s.v.lane(i),
                     uv: Vec2::new(uu.as_array()[i], vv.as_array()[i]),
                     material: self.material[i],
+                    front: true,
                 };
                 let k = at(&point);
                 self.set_coefficients(i, &k);

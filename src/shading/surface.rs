@@ -21,6 +21,8 @@ pub struct SurfacePoint {
     pub uv: Vec2,
     /// Index into `Scene::materials`.
     pub material: usize,
+    /// Whether the eye sees the front (counter-clockwise, outward) side.
+    pub front: bool,
 }
 
 /// Object → world transforms for points and normals, computed once per frame.
@@ -130,7 +132,8 @@ impl PreparedTriangle {
         let to_eye = -ray.dir;
         let normal = if n.dot(to_eye) < 0.0 { -n } else { n };
         let uv = self.uvs.map_or(Vec2::ZERO, |u| u[0] * w[0] + u[1] * w[1] + u[2] * w[2]);
-        SurfacePoint { position: ray.origin + ray.dir * t, normal, to_eye, uv, material: self.material }
+        let front = self.geometric.dot(to_eye) >= 0.0;
+        SurfacePoint { position: ray.origin + ray.dir * t, normal, to_eye, uv, material: self.material, front }
     }
 }
 

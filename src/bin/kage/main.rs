@@ -81,6 +81,10 @@ struct RenderArgs {
     /// Reference: no shadow rays (like the raster pipeline before shadows).
     #[arg(long)]
     no_shadows: bool,
+    /// Reflection/refraction bounces for materials with `kr`/`kt` (item-buffer
+    /// tracing in the raster pipeline, recursion in the reference).
+    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(0..=16))]
+    ray_depth: u32,
     /// Brightness of PNG output: stops (e.g. 1.5, -1) or `auto`; overrides the scene.
     #[arg(long, value_parser = parse_exposure, allow_hyphen_values = true)]
     exposure: Option<Exposure>,
@@ -132,7 +136,7 @@ fn render_command(args: &RenderArgs) -> kage::error::Result<()> {
     if args.reference {
         return reference_command(args, &scene);
     }
-    let frame = render(&scene, &RenderOptions { threads: args.threads })?;
+    let frame = render(&scene, &RenderOptions { threads: args.threads, ray_depth: args.ray_depth })?;
     let exposure = args.exposure.unwrap_or(scene.exposure).scale(&frame.image);
     kage::output::write_image(&frame.image, &args.output, exposure)?;
     if frame.visibility.items().iter().all(|i| i.is_none()) {
@@ -140,13 +144,15 @@ fn render_command(args: &RenderArgs) -> kage::error::Result<()> {
     }
     let s = frame.stats;
     eprintln!(
-        "wrote {} ({}x{}, {} triangles): visibility {:.1} ms, shading {:.1} ms",
+        "wrote {} ({}x{}, {} triangles): visibility {:.1} ms, shading {:.1} ms, traced {:.1} ms ({} pixels)",
         args.output.display(),
         scene.width,
         scene.height,
         s.raster.triangles,
         s.visibility_ms,
-        s.shading_ms
+        s.shading_ms,
+        s.traced_ms,
+        s.traced_pixels
     );
     Ok(())
 }
@@ -173,8 +179,12 @@ fn compare_command(args: &CompareArgs) -> kage::error::Result<()> {
 fn reference_command(args: &RenderArgs, scene: &Scene) -> kage::error::Result<()> {
     use kage::raytrace::reference::{render_reference, ReferenceOptions};
     scene.validate()?;
-    let opts =
-        ReferenceOptions { pixel_samples: args.spp, light_samples: args.light_samples, shadows: !args.no_shadows };
+    let opts = ReferenceOptions {
+        pixel_samples: args.spp,
+        light_samples: args.light_samples,
+        shadows: !args.no_shadows,
+        max_depth: args.ray_depth,
+    };
     let bar = indicatif::ProgressBar::new(scene.height as u64);
     bar.set_style(
         indicatif::ProgressStyle::with_template("reference {bar:40} {pos}/{len} rows, {elapsed} (eta {eta})")

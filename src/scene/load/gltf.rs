@@ -125,6 +125,7 @@ impl Context<'_> {
                 emission: m.emissive_texture().map(|t| self.texture(&t.texture())).transpose()?,
             },
             two_sided: m.double_sided(),
+            ..Material::default()
         })
     }
 

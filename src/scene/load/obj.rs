@@ -85,5 +85,6 @@ fn material(m: &tobj::Material, dir: &Path, assets: &dyn AssetSource) -> Result<
             emission: None,
         },
         two_sided: false,
+        ..Material::default()
     })
 }

@@ -1,0 +1,48 @@
+//! Item-buffer ray tracing (seed 002 §4): reflections and refraction for the pixels
+//! that need them, starting from the visibility buffer.
+//!
+//! The primary hit of every pixel is already known — the item id the polygon pass
+//! left there — so it costs one ray/plane intersection with that triangle, no
+//! traversal. Only pixels whose material reflects or refracts spawn secondary rays
+//! (and the shadow rays seen in them), traced through the BVH to `depth` bounces;
+//! their light is added to the image as the IrayTracing term of eq. 5.
+
+use glam::Vec2;
+use rayon::prelude::*;
+
+use super::reference::{ReferenceOptions, Tracer};
+use super::TraceScene;
+use crate::resolve::LinearImage;
+use crate::scene::Scene;
+use crate::shading::ObjectFrames;
+use crate::visibility::VisibilityBuffer;
+
+/// Adds traced reflection and refraction to `image`; returns how many pixels were
+/// traced (0, without building a BVH, when no material reflects or refracts).
+pub fn add_traced(scene: &Scene, vb: &VisibilityBuffer, image: &mut LinearImage, depth: u32) -> usize {
+    if depth == 0 || !scene.materials.iter().any(|m| m.traces()) {
+        return 0;
+    }
+    let trace = TraceScene::new(scene);
+    let frames = ObjectFrames::new(scene);
+    let opts = ReferenceOptions { pixel_samples: 1, light_samples: 1, shadows: true, max_depth: depth };
+    let tracer = Tracer::new(scene, &trace, &frames, opts);
+    let w = vb.width() as usize;
+    let rays = scene.camera.pixel_rays(Vec2::new(w as f32, vb.height() as f32));
+    let rows = image.pixels_mut().par_chunks_mut(w).zip(vb.items().par_chunks(w));
+    rows.enumerate()
+        .map(|(y, (out, items))| {
+            let mut traced = 0;
+            for (x, (px, &item)) in out.iter_mut().zip(items).enumerate() {
+                if item.is_none() || !scene.materials[scene.objects[item.object as usize].material].traces() {
+                    continue;
+                }
+                let ray = rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
+                let s = frames.prepare(scene, item).surface(&ray);
+                *px += tracer.bounces(&ray, &s, depth);
+                traced += 1;
+            }
+            traced
+        })
+        .sum()
+}
