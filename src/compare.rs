@@ -78,16 +78,11 @@ fn ramp(x: f32) -> Vec3 {
 }
 
 fn same_size(a: &LinearImage, b: &LinearImage) -> Result<()> {
-    if (a.width(), a.height()) == (b.width(), b.height()) {
+    let (sa, sb) = ((a.width(), a.height()), (b.width(), b.height()));
+    if sa == sb {
         Ok(())
     } else {
-        Err(Error::Scene(format!(
-            "images differ in size: {}x{} vs {}x{}",
-            a.width(),
-            a.height(),
-            b.width(),
-            b.height()
-        )))
+        Err(Error::SizeMismatch { a: sa, b: sb })
     }
 }
 

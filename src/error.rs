@@ -114,6 +114,22 @@ pub enum Error {
     /// The scene has nothing that can be drawn, or a value makes the camera unusable.
     #[error("invalid scene: {0}")]
     Scene(String),
+    /// An image to measure could not be read or decoded.
+    #[error("cannot read image {}: {message}", path.display())]
+    ImageRead {
+        /// The image file.
+        path: PathBuf,
+        /// What the decoder said.
+        message: String,
+    },
+    /// Two images that must match in size do not.
+    #[error("images differ in size: {}x{} vs {}x{}", a.0, a.1, b.0, b.1)]
+    SizeMismatch {
+        /// Width and height of the first.
+        a: (u32, u32),
+        /// Width and height of the second.
+        b: (u32, u32),
+    },
     /// The output image could not be written.
     #[error("cannot write {}: {message}", path.display())]
     Output {

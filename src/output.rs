@@ -40,7 +40,7 @@ pub fn pfm_bytes(image: &LinearImage) -> Vec<u8> {
 /// Reads an image as linear RGB: `.exr` and `.pfm` as stored, 8-bit formats
 /// (`.png`, `.jpg`) decoded from sRGB.
 pub fn read_image(path: &Path) -> Result<LinearImage> {
-    let fail = |message: String| Error::TextureLoad { path: path.to_path_buf(), message };
+    let fail = |message: String| Error::ImageRead { path: path.to_path_buf(), message };
     let ext = path.extension().and_then(|e| e.to_str()).unwrap_or_default().to_ascii_lowercase();
     if ext == "pfm" {
         let bytes = std::fs::read(path).map_err(|source| Error::Read { path: path.to_path_buf(), source })?;

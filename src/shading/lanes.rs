@@ -214,7 +214,7 @@ impl Block {
                     to_eye: s.v.lane(i),
                     uv: Vec2::new(uu.as_array()[i], vv.as_array()[i]),
                     material: self.material[i],
-                    front: true,
+                    front: true, // maps do not depend on the side
                 };
                 let k = at(&point);
                 self.set_coefficients(i, &k);
