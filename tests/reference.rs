@@ -68,3 +68,25 @@ fn shadows_only_darken_and_antialiasing_stays_close() {
     let c = kage::compare::compare(&aa, &plain, 0.05).unwrap();
     assert!(c.rmse < 0.05 && c.share_over < 0.2, "{c:?}");
 }
+
+#[test]
+fn an_interrupted_reference_keeps_the_rows_already_traced() {
+    use kage::raytrace::reference::render_reference_until;
+    use std::sync::atomic::{AtomicBool, Ordering};
+    let mut scene = kage::scene::demo::demo_scene().unwrap();
+    scene.width = 64;
+    scene.height = 48;
+    let opts = ReferenceOptions { pixel_samples: 1, light_samples: 1, shadows: false, max_depth: 0 };
+    let full = render_reference(&scene, &opts, &|_| {});
+    let stop = AtomicBool::new(false);
+    // Stop after ten rows have been reported finished.
+    let (partial, rows) = render_reference_until(&scene, &opts, &|n| stop.store(n >= 10, Ordering::Relaxed), &stop);
+    assert!((10..48).contains(&rows), "{rows} rows");
+    let finished: Vec<u32> = (0..48).filter(|&y| partial.get(0, y) != glam::Vec3::ZERO).collect();
+    assert_eq!(finished.len(), rows as usize, "every traced row is kept, the others are black");
+    for &y in &finished {
+        for x in 0..64 {
+            assert_eq!(partial.get(x, y), full.get(x, y));
+        }
+    }
+}

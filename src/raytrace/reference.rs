@@ -7,6 +7,8 @@
 //! With n = m = 1, shadows off and no area lights, every pixel whose primary hit
 //! agrees with the visibility buffer gets the rasterizer's colour (a test holds it).
 
+use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
+
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
@@ -38,20 +40,35 @@ impl Default for ReferenceOptions {
 
 /// Renders `scene` by rays; `progress` is called with each finished row count.
 pub fn render_reference(scene: &Scene, opts: &ReferenceOptions, progress: &(dyn Fn(u32) + Sync)) -> LinearImage {
+    render_reference_until(scene, opts, progress, &AtomicBool::new(false)).0
+}
+
+/// As [`render_reference`], but rows not yet started when `stop` becomes true are
+/// left black: the rows already traced survive an interruption. Returns the image
+/// and how many rows were finished.
+pub fn render_reference_until(
+    scene: &Scene,
+    opts: &ReferenceOptions,
+    progress: &(dyn Fn(u32) + Sync),
+    stop: &AtomicBool,
+) -> (LinearImage, u32) {
     let trace = TraceScene::new(scene);
     let frames = ObjectFrames::new(scene);
     let (w, h) = (scene.width, scene.height);
     let rays = scene.camera.pixel_rays(Vec2::new(w as f32, h as f32));
     let cx = Tracer::new(scene, &trace, &frames, *opts);
-    let done = std::sync::atomic::AtomicU32::new(0);
+    let done = AtomicU32::new(0);
     let mut image = LinearImage::new(w, h);
     image.pixels_mut().par_chunks_mut(w as usize).enumerate().for_each(|(y, row)| {
+        if stop.load(Ordering::Relaxed) {
+            return;
+        }
         for (x, px) in row.iter_mut().enumerate() {
             *px = cx.pixel(&rays, x as u32, y as u32);
         }
-        progress(done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1);
+        progress(done.fetch_add(1, Ordering::Relaxed) + 1);
     });
-    image
+    (image, done.into_inner())
 }
 
 /// Shades points hit by rays: eq. 1 with shadow rays, plus mirror and glass

@@ -177,7 +177,7 @@ fn compare_command(args: &CompareArgs) -> kage::error::Result<()> {
 }
 
 fn reference_command(args: &RenderArgs, scene: &Scene) -> kage::error::Result<()> {
-    use kage::raytrace::reference::{render_reference, ReferenceOptions};
+    use kage::raytrace::reference::{render_reference_until, ReferenceOptions};
     scene.validate()?;
     let opts = ReferenceOptions {
         pixel_samples: args.spp,
@@ -191,8 +191,12 @@ fn reference_command(args: &RenderArgs, scene: &Scene) -> kage::error::Result<()
             .expect("valid template"),
     );
     let start = std::time::Instant::now();
-    let run = || render_reference(scene, &opts, &|_| bar.inc(1));
-    let image = match args.threads {
+    // Ctrl-C stops tracing new rows; the rows already done are written out.
+    let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+    let flag = stop.clone();
+    let _ = ctrlc::set_handler(move || flag.store(true, std::sync::atomic::Ordering::Relaxed));
+    let run = || render_reference_until(scene, &opts, &|_| bar.inc(1), &stop);
+    let (image, rows) = match args.threads {
         Some(n) => rayon::ThreadPoolBuilder::new()
             .num_threads(n.clamp(1, kage::frame::MAX_THREADS))
             .build()
@@ -201,6 +205,9 @@ fn reference_command(args: &RenderArgs, scene: &Scene) -> kage::error::Result<()
         None => run(),
     };
     bar.finish_and_clear();
+    if rows < scene.height {
+        eprintln!("interrupted: {rows} of {} rows traced; the rest of the image is black", scene.height);
+    }
     let exposure = args.exposure.unwrap_or(scene.exposure).scale(&image);
     kage::output::write_image(&image, &args.output, exposure)?;
     eprintln!(
@@ -211,5 +218,8 @@ fn reference_command(args: &RenderArgs, scene: &Scene) -> kage::error::Result<()
         args.light_samples,
         if opts.shadows { "on" } else { "off" },
     );
+    if rows < scene.height {
+        std::process::exit(130); // interrupted, as shells report Ctrl-C
+    }
     Ok(())
 }
