@@ -40,6 +40,11 @@ pub struct BenchArgs {
     /// instead of the raster frame beside llvmpipe.
     #[arg(long)]
     rays: bool,
+    /// Time seed 002 §4's hybrid (item buffer + traced secondary rays) against the
+    /// same image traced entirely by rays, on examples/scenes/reflections.toml with a
+    /// matte floor.
+    #[arg(long)]
+    hybrid: bool,
     /// The Embree peer program (`scripts/build-peers.sh` builds it); skipped if absent.
     #[arg(long, default_value = "target/peers/embree_bench")]
     embree: PathBuf,
@@ -64,6 +69,9 @@ struct Row {
 pub fn run(args: &BenchArgs) -> Result<()> {
     if args.rays {
         return run_rays(args);
+    }
+    if args.hybrid {
+        return run_hybrid(args);
     }
     let lp = &args.llvmpipe;
     let mut rows = Vec::new();
@@ -365,4 +373,70 @@ fn run_embree(bin: &Path, mesh: &Path, args: &BenchArgs) -> Result<(f64, f64)> {
         (Some(b), Some(r)) => Ok((b, r)),
         _ => Err(miette!("Embree printed no build/primary results: {text}{}", String::from_utf8_lossy(&out.stderr))),
     }
+}
+
+/// Item-buffer hybrid vs full ray tracing of the same image (two ray levels).
+fn run_hybrid(args: &BenchArgs) -> Result<()> {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenes/reflections.toml");
+    let mut scene = kage::scene::file::load_scene(&path).map_err(|e| miette!("{e}"))?;
+    (scene.width, scene.height) = (args.width, args.height);
+    // A matte floor leaves the balls as the reflecting pixels (about a fifth).
+    scene.materials.iter_mut().filter(|m| m.name == "floor").for_each(|m| m.kr = glam::Vec3::ZERO);
+    let depth = 2;
+    let mut renderer = Renderer::new(&RenderOptions { threads: None, ray_depth: depth }).map_err(|e| miette!("{e}"))?;
+    let (mut hybrid, mut full) = (Vec::new(), Vec::new());
+    let mut traced = 0;
+    let mut full_image = None;
+    for _ in 0..args.frames.max(1) {
+        let t = std::time::Instant::now();
+        traced = renderer.render(&scene).map_err(|e| miette!("{e}"))?.stats.traced_pixels;
+        hybrid.push(t.elapsed().as_secs_f64() * 1e3);
+        let t = std::time::Instant::now();
+        full_image = Some(trace_everything(&scene, depth));
+        full.push(t.elapsed().as_secs_f64() * 1e3);
+    }
+    let frame = renderer.into_frame();
+    let c = kage::compare::compare(&frame.image, &full_image.expect("one frame"), 0.01).map_err(|e| miette!("{e}"))?;
+    let (h, f) = (median(hybrid), median(full));
+    let share = 100.0 * traced as f64 / (scene.width as f64 * scene.height as f64);
+    println!("| scene | pixels traced | hybrid ms/frame | full trace ms/frame | speed-up | RMSE between them | pixels over 0.01 |");
+    println!("|---|---:|---:|---:|---:|---:|---:|");
+    println!(
+        "| reflections.toml {}x{} | {share:.1}% | {h:.1} | {f:.1} | {:.2}x | {:.5} | {:.3}% |",
+        scene.width,
+        scene.height,
+        f / h,
+        c.rmse,
+        100.0 * c.share_over
+    );
+    println!("\nTwo ray levels, shadow rays at the surfaces secondary rays reach, BVH built every frame in both; median of {} frames; {} threads.", args.frames.max(1), rayon::current_num_threads());
+    Ok(())
+}
+
+/// The hybrid's image computed entirely by rays: primary hits from the BVH, the
+/// same unshadowed eq. 1 at them, the same bounces.
+fn trace_everything(scene: &Scene, depth: u32) -> kage::resolve::LinearImage {
+    use kage::raytrace::reference::{ReferenceOptions, Tracer};
+    use kage::raytrace::TraceScene;
+    use kage::shading::{phong, ObjectFrames};
+    let trace = TraceScene::new(scene);
+    let frames = ObjectFrames::new(scene);
+    let opts = ReferenceOptions { pixel_samples: 1, light_samples: 1, shadows: true, max_depth: depth };
+    let tracer = Tracer::new(scene, &trace, &frames, opts);
+    let rays = scene.camera.pixel_rays(glam::Vec2::new(scene.width as f32, scene.height as f32));
+    let mut image = kage::resolve::LinearImage::new(scene.width, scene.height);
+    image.pixels_mut().par_chunks_mut(scene.width as usize).enumerate().for_each(|(y, row)| {
+        for (x, px) in row.iter_mut().enumerate() {
+            let ray = rays.ray(glam::Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
+            *px = match trace.intersect(&ray, f32::INFINITY) {
+                None => scene.background,
+                Some(hit) => {
+                    let s = frames.prepare(scene, hit.item).surface(&ray);
+                    phong::shade(&scene.lights, &scene.materials[s.material], &s).total()
+                        + tracer.bounces(&ray, &s, depth)
+                }
+            };
+        }
+    });
+    image
 }
