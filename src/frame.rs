@@ -68,18 +68,7 @@ pub struct Renderer {
 impl Renderer {
     /// A renderer with empty buffers.
     pub fn new(options: &RenderOptions) -> Result<Renderer> {
-        let pool = match options.threads {
-            None => None,
-            Some(n) if n > MAX_THREADS => {
-                return Err(Error::Scene(format!("{n} threads requested; at most {MAX_THREADS}")))
-            }
-            Some(n) => Some(
-                rayon::ThreadPoolBuilder::new()
-                    .num_threads(n.max(1))
-                    .build()
-                    .map_err(|e| Error::Scene(format!("cannot start {n} threads: {e}")))?,
-            ),
-        };
+        let pool = thread_pool(options.threads)?;
         let frame = Frame {
             image: LinearImage::new(0, 0),
             visibility: VisibilityBuffer::new(0, 0),
@@ -104,6 +93,20 @@ impl Renderer {
     pub fn into_frame(self) -> Frame {
         self.frame
     }
+}
+
+/// A pool of `threads` workers (`None`: rayon's global pool, one per core);
+/// refuses more than [`MAX_THREADS`].
+pub fn thread_pool(threads: Option<usize>) -> Result<Option<rayon::ThreadPool>> {
+    let Some(n) = threads else { return Ok(None) };
+    if n > MAX_THREADS {
+        return Err(Error::Scene(format!("{n} threads requested; at most {MAX_THREADS}")));
+    }
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(n.max(1))
+        .build()
+        .map(Some)
+        .map_err(|e| Error::Scene(format!("cannot start {n} threads: {e}")))
 }
 
 /// Renders `scene` once.

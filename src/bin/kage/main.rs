@@ -196,12 +196,8 @@ fn reference_command(args: &RenderArgs, scene: &Scene) -> kage::error::Result<()
     let flag = stop.clone();
     let _ = ctrlc::set_handler(move || flag.store(true, std::sync::atomic::Ordering::Relaxed));
     let run = || render_reference_until(scene, &opts, &|_| bar.inc(1), &stop);
-    let (image, rows) = match args.threads {
-        Some(n) => rayon::ThreadPoolBuilder::new()
-            .num_threads(n.clamp(1, kage::frame::MAX_THREADS))
-            .build()
-            .map_err(|e| kage::Error::Scene(e.to_string()))?
-            .install(run),
+    let (image, rows) = match kage::frame::thread_pool(args.threads)? {
+        Some(pool) => pool.install(run),
         None => run(),
     };
     bar.finish_and_clear();
