@@ -1,9 +1,12 @@
-//! One frame, start to finish: visibility pass → shading passes → resolve.
+//! One frame, start to finish: visibility pass → shading passes → traced term,
+//! repeated and averaged for jittered antialiasing (seed 002 §4) → resolve.
 //!
 //! A [`Renderer`] keeps its buffers between frames, as an interactive preview
 //! re-renders the same size again and again; [`render`] is the one-shot form.
 
 use std::time::Instant;
+
+use glam::Vec2;
 
 use crate::error::{Error, Result};
 use crate::resolve::LinearImage;
@@ -32,17 +35,20 @@ impl Default for RenderOptions {
 /// Timings and counts of one frame.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct FrameStats {
-    /// Milliseconds in the visibility (polygon) pass.
+    /// Milliseconds in the visibility (polygon) passes.
     pub visibility_ms: f64,
     /// Milliseconds in the shading passes.
     pub shading_ms: f64,
     /// Milliseconds tracing reflections and refraction from the item buffer.
     pub traced_ms: f64,
-    /// Pixels that spawned secondary rays.
+    /// Pixels that spawned secondary rays, summed over passes.
     pub traced_pixels: usize,
+    /// Visibility passes rendered (more than one when antialiased by jitter).
+    pub passes: u32,
     /// What the rasterizer did.
     pub raster: RasterStats,
-    /// Bytes held by the frame's buffers (visibility buffer and image).
+    /// Bytes held by the frame's buffers (visibility buffer, image and the
+    /// accumulation buffer of jittered passes).
     pub buffer_bytes: usize,
 }
 
@@ -51,7 +57,7 @@ pub struct FrameStats {
 pub struct Frame {
     /// Linear RGB result.
     pub image: LinearImage,
-    /// Depth and item id per pixel.
+    /// Depth and item id per pixel (of the last pass, when jittered).
     pub visibility: VisibilityBuffer,
     /// Timings and counts.
     pub stats: FrameStats,
@@ -63,6 +69,8 @@ pub struct Renderer {
     pool: Option<rayon::ThreadPool>,
     ray_depth: u32,
     frame: Frame,
+    /// Sum of the jittered passes.
+    accum: LinearImage,
 }
 
 impl Renderer {
@@ -74,16 +82,16 @@ impl Renderer {
             visibility: VisibilityBuffer::new(0, 0),
             stats: FrameStats::default(),
         };
-        Ok(Renderer { pool, frame, ray_depth: options.ray_depth })
+        Ok(Renderer { pool, frame, ray_depth: options.ray_depth, accum: LinearImage::new(0, 0) })
     }
 
     /// Renders `scene` (validated first) and returns the frame.
     pub fn render(&mut self, scene: &Scene) -> Result<&Frame> {
         scene.validate()?;
-        let frame = &mut self.frame;
+        let (frame, accum) = (&mut self.frame, &mut self.accum);
         match &self.pool {
-            None => render_into(scene, frame, self.ray_depth),
-            Some(pool) => pool.install(|| render_into(scene, frame, self.ray_depth)),
+            None => render_into(scene, frame, accum, self.ray_depth),
+            Some(pool) => pool.install(|| render_into(scene, frame, accum, self.ray_depth)),
         }
         Ok(&self.frame)
     }
@@ -116,7 +124,35 @@ pub fn render(scene: &Scene, options: &RenderOptions) -> Result<Frame> {
     Ok(r.into_frame())
 }
 
-fn render_into(scene: &Scene, frame: &mut Frame, ray_depth: u32) {
+fn render_into(scene: &Scene, frame: &mut Frame, accum: &mut LinearImage, ray_depth: u32) {
+    let offsets = scene.antialias.offsets();
+    frame.stats = FrameStats::default();
+    if offsets.len() == 1 && offsets[0] == Vec2::ZERO {
+        render_pass(scene, frame, ray_depth);
+    } else {
+        // Seed 002 §4: each pass shifts the image by a fraction of a pixel, so its
+        // item buffer samples another point of every pixel; the passes are averaged.
+        accum.resize(scene.width, scene.height);
+        accum.pixels_mut().fill(glam::Vec3::ZERO);
+        let mut pass = scene.clone();
+        let pixel = 2.0 / Vec2::new(scene.width as f32, scene.height as f32);
+        for &o in &offsets {
+            // Pixel offsets (y down) to NDC (y up).
+            pass.camera.shift = scene.camera.shift + Vec2::new(o.x, -o.y) * pixel;
+            render_pass(&pass, frame, ray_depth);
+            accum.pixels_mut().iter_mut().zip(frame.image.pixels()).for_each(|(a, &p)| *a += p);
+        }
+        let k = 1.0 / offsets.len() as f32;
+        frame.image.pixels_mut().iter_mut().zip(accum.pixels()).for_each(|(p, &a)| *p = a * k);
+    }
+    frame.stats.buffer_bytes = frame.visibility.memory_bytes()
+        + std::mem::size_of_val(frame.image.pixels())
+        + std::mem::size_of_val(accum.pixels());
+}
+
+/// One visibility pass, its shading and its traced term; adds its timings to the
+/// frame's statistics.
+fn render_pass(scene: &Scene, frame: &mut Frame, ray_depth: u32) {
     let t0 = Instant::now();
     frame.visibility.resize(scene.width, scene.height);
     frame.stats.raster = visibility::rasterize(scene, &mut frame.visibility);
@@ -124,10 +160,10 @@ fn render_into(scene: &Scene, frame: &mut Frame, ray_depth: u32) {
     frame.image.resize(scene.width, scene.height);
     shading::shade_into(scene, &frame.visibility, &mut frame.image);
     let t2 = Instant::now();
-    frame.stats.traced_pixels =
+    frame.stats.traced_pixels +=
         crate::raytrace::item_buffer::add_traced(scene, &frame.visibility, &mut frame.image, ray_depth);
-    frame.stats.visibility_ms = (t1 - t0).as_secs_f64() * 1e3;
-    frame.stats.shading_ms = (t2 - t1).as_secs_f64() * 1e3;
-    frame.stats.traced_ms = t2.elapsed().as_secs_f64() * 1e3;
-    frame.stats.buffer_bytes = frame.visibility.memory_bytes() + std::mem::size_of_val(frame.image.pixels());
+    frame.stats.visibility_ms += (t1 - t0).as_secs_f64() * 1e3;
+    frame.stats.shading_ms += (t2 - t1).as_secs_f64() * 1e3;
+    frame.stats.traced_ms += t2.elapsed().as_secs_f64() * 1e3;
+    frame.stats.passes += 1;
 }

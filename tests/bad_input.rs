@@ -54,6 +54,10 @@ fn semantic_errors_point_at_the_value() {
     assert!(e.contains("needs `position`"), "{e}");
     let e = parse_err("[image]\nwidth = 8\n");
     assert!(e.contains("no [[object]]"), "{e}");
+    let e = parse_err(&format!("[image]\nantialias = {{ method = \"blur\" }}\n{OK_OBJECT}"));
+    assert!(e.starts_with("bad.toml:2:24") && e.contains("unknown antialiasing method 'blur'"), "{e}");
+    let e = parse_err(&format!("[image]\nantialias = {{ method = \"jitter\", samples = 0 }}\n{OK_OBJECT}"));
+    assert!(e.starts_with("bad.toml:2:44") && e.contains("between 1 and 1024"), "{e}");
 }
 
 #[test]

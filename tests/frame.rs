@@ -19,6 +19,7 @@ fn plane_scene(light: Light) -> kage::Scene {
         near: 0.1,
         far: 10.0,
         projection: Projection::Orthographic { height: 0.5 },
+        shift: glam::Vec2::ZERO,
     };
     let mut s = common::scene_with(shapes::plane(), camera, 16, 16, false);
     s.lights = vec![light];

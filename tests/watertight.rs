@@ -94,6 +94,7 @@ fn ground_through_the_near_plane_has_no_holes_and_matches_rays() {
             near: 0.5,
             far: 100.0,
             projection,
+            shift: glam::Vec2::ZERO,
         };
         let scene = scene_with(ground(seed, scale), camera, 120, 90, false);
         let mut vb = VisibilityBuffer::new(scene.width, scene.height);

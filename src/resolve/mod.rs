@@ -2,7 +2,11 @@
 //! (exposure, clamp to [0, 1], then the sRGB transfer curve). Float outputs skip
 //! this stage and keep the buffer's values.
 
+pub mod jitter;
+
 use glam::Vec3;
+
+pub use jitter::Antialias;
 
 use crate::scene::texture::linear_to_srgb;
 

@@ -37,6 +37,10 @@ pub struct Camera {
     pub far: f32,
     /// Lens.
     pub projection: Projection,
+    /// Image-plane shift in normalised device units: the sample at a pixel centre
+    /// sees what the unshifted camera sees at that centre + `shift` (x right, y up).
+    /// Zero for a plain camera; jittered passes set a fraction of a pixel.
+    pub shift: Vec2,
 }
 
 /// A ray with origin and (not necessarily unit) direction.
@@ -66,6 +70,11 @@ impl Camera {
     /// View → clip matrix for an image of the given aspect (width / height), reversed z.
     #[must_use]
     pub fn projection(&self, aspect: f32) -> Mat4 {
+        // What lay at NDC p + shift lands on p: x_ndc −= shift.x, i.e. x_clip −= shift.x·w.
+        Mat4::from_translation(-self.shift.extend(0.0)) * self.lens(aspect)
+    }
+
+    fn lens(&self, aspect: f32) -> Mat4 {
         match self.projection {
             Projection::Perspective { fov_y_deg } => {
                 // z_clip = near, w = −z_view: depth = near / distance, 1 at near, → 0 far.
@@ -125,14 +134,13 @@ impl Camera {
             }
             Projection::Orthographic { height } => (Vec2::new(height * 0.5 * aspect, height * 0.5), true),
         };
-        PixelRays {
-            origin: self.eye,
-            right: inv_view.transform_vector3(Vec3::X) * scale.x,
-            up: inv_view.transform_vector3(Vec3::Y) * scale.y,
-            forward: inv_view.transform_vector3(Vec3::NEG_Z),
-            size,
-            ortho,
-        }
+        let right = inv_view.transform_vector3(Vec3::X) * scale.x;
+        let up = inv_view.transform_vector3(Vec3::Y) * scale.y;
+        let (forward, shift) = (inv_view.transform_vector3(Vec3::NEG_Z), right * self.shift.x + up * self.shift.y);
+        // The shift moves the image centre: the eye ray's aim (perspective) or the
+        // origin of the parallel rays (orthographic).
+        let (origin, forward) = if ortho { (self.eye + shift, forward) } else { (self.eye, forward + shift) };
+        PixelRays { origin, right, up, forward, size, ortho }
     }
 
     /// Checks the camera can form an image; returns what is wrong otherwise.
@@ -172,7 +180,8 @@ pub struct PixelRays {
     pub right: Vec3,
     /// World offset from the image centre to its top edge.
     pub up: Vec3,
-    /// Unit viewing direction (perspective: at unit distance).
+    /// From the eye to the image centre at unit viewing distance (orthographic:
+    /// the unit viewing direction).
     pub forward: Vec3,
     /// Image size in pixels.
     pub size: Vec2,
@@ -206,6 +215,7 @@ mod tests {
             near: 0.1,
             far: 50.0,
             projection,
+            shift: Vec2::ZERO,
         }
     }
 

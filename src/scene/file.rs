@@ -18,7 +18,8 @@ use super::load::{self, AssetSource, LoadedModel};
 use super::mesh::shapes;
 use super::{framing, Camera, Falloff, Light, LightKind, Material, Object, Projection, Scene, Texture};
 use crate::error::{Error, Result, SourceLocation};
-use crate::resolve::Exposure;
+use crate::resolve::jitter::MAX_JITTER_SAMPLES;
+use crate::resolve::{Antialias, Exposure};
 
 type V3 = [f32; 3];
 
@@ -56,6 +57,15 @@ struct ImageRec {
     background: V3,
     #[serde(default)]
     exposure: ExposureRec,
+    antialias: Option<Spanned<AntialiasRec>>,
+}
+
+/// `antialias = { method = "jitter", samples = 8 }` (or `method = "none"`).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct AntialiasRec {
+    method: Spanned<String>,
+    samples: Option<Spanned<i64>>,
 }
 
 #[derive(Debug, Deserialize, Clone, Copy, PartialEq)]
@@ -103,6 +113,7 @@ impl Default for ImageRec {
             height: default_height(),
             background: default_background(),
             exposure: ExposureRec::default(),
+            antialias: None,
         }
     }
 }
@@ -285,6 +296,24 @@ impl SceneFile {
         }
     }
 
+    fn antialias(&self) -> Result<Antialias> {
+        let Some(rec) = &self.image.antialias else { return Ok(Antialias::None) };
+        let rec = rec.get_ref();
+        match (rec.method.get_ref().as_str(), &rec.samples) {
+            ("none", None) => Ok(Antialias::None),
+            ("none", Some(n)) => Err(self.invalid(n.span(), "method \"none\" takes no samples")),
+            ("jitter", None) => Err(self.invalid(rec.method.span(), "method \"jitter\" needs `samples = n`")),
+            ("jitter", Some(n)) => match u32::try_from(*n.get_ref()) {
+                Ok(k @ 1..=MAX_JITTER_SAMPLES) => Ok(Antialias::Jitter(k)),
+                _ => Err(self.invalid(n.span(), format!("samples must be between 1 and {MAX_JITTER_SAMPLES}"))),
+            },
+            (other, _) => Err(self.invalid(
+                rec.method.span(),
+                format!("unknown antialiasing method '{other}' (expected \"none\" or \"jitter\")"),
+            )),
+        }
+    }
+
     /// Loads every mesh and texture and builds the scene.
     pub fn build(&self, assets: &dyn AssetSource) -> Result<Scene> {
         let (w, h) = (&self.image.width, &self.image.height);
@@ -312,6 +341,7 @@ impl SceneFile {
             objects: Vec::new(),
             warnings: Vec::new(),
             exposure: self.image.exposure.into(),
+            antialias: self.antialias()?,
         };
         let mut models = Vec::new();
         for o in &self.objects {
@@ -359,6 +389,7 @@ impl SceneFile {
             near: r.near,
             far: r.far,
             projection,
+            shift: glam::Vec2::ZERO,
         };
         cam.validate().map_err(|m| self.invalid(c.span(), m))?;
         Ok(cam)
@@ -529,6 +560,7 @@ pub fn scene_for_model(path: &Path, width: u32, height: u32) -> Result<Scene> {
         objects: Vec::new(),
         warnings: Vec::new(),
         exposure: Default::default(),
+        antialias: Default::default(),
     };
     add_model(&mut scene, &model, &path.display().to_string(), Affine3A::IDENTITY, None);
     let (camera, lights) = framing(scene.bounds().expect("a model has parts"), width as f32 / height as f32);

@@ -52,6 +52,8 @@ pub struct Scene {
     pub background: Vec3,
     /// Brightness of 8-bit output.
     pub exposure: crate::resolve::Exposure,
+    /// How edges are antialiased.
+    pub antialias: crate::resolve::Antialias,
     /// The eye.
     pub camera: Camera,
     /// Lights.
@@ -138,6 +140,7 @@ pub fn framing(bounds: (Vec3, Vec3), aspect: f32) -> (Camera, Vec<Light>) {
         near: (dist - r).max(dist * 1e-3) * 0.5,
         far: (dist + r) * 2.0,
         projection: Projection::Perspective { fov_y_deg },
+        shift: glam::Vec2::ZERO,
     };
     let key = Light {
         kind: LightKind::Point { position: c + r * Vec3::new(1.5, 3.0, 1.2) },

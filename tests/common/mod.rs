@@ -31,6 +31,7 @@ pub fn scene_with(mesh: Mesh, camera: Camera, width: u32, height: u32, two_sided
         objects: vec![Object { name: "soup".into(), mesh: Arc::new(mesh), transform: Affine3A::IDENTITY, material: 0 }],
         warnings: Vec::new(),
         exposure: Default::default(),
+        antialias: Default::default(),
     }
 }
 
@@ -61,7 +62,15 @@ pub fn random_camera(rng: &mut StdRng, ortho: bool) -> Camera {
     };
     // Sometimes the near plane cuts through the soup.
     let near = if rng.gen_bool(0.3) { dist - rng.gen_range(0.0..1.0) } else { 0.05 };
-    Camera { eye: dir * dist, target: Vec3::ZERO, up: Vec3::Y, near, far: dist + rng.gen_range(0.5..3.0), projection }
+    Camera {
+        eye: dir * dist,
+        target: Vec3::ZERO,
+        up: Vec3::Y,
+        near,
+        far: dist + rng.gen_range(0.5..3.0),
+        projection,
+        shift: glam::Vec2::ZERO,
+    }
 }
 
 /// What the brute-force caster sees at one pixel.

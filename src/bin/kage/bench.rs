@@ -140,6 +140,7 @@ fn peer_scene(path: &Path, width: u32, height: u32) -> Result<Scene> {
             near: 0.1 * r,
             far: 2.5 * r,
             projection: Projection::Perspective { fov_y_deg: 45.0 },
+            shift: glam::Vec2::ZERO,
         },
         lights: vec![Light {
             kind: LightKind::Point { position: c + r * Vec3::new(1.0, 1.6, -0.6) },
@@ -153,6 +154,7 @@ fn peer_scene(path: &Path, width: u32, height: u32) -> Result<Scene> {
         objects: Vec::new(),
         warnings: Vec::new(),
         exposure: Default::default(),
+        antialias: Default::default(),
     };
     add_model(&mut scene, &model, "peer", Affine3A::IDENTITY, Some(0));
     Ok(scene)
@@ -382,7 +384,8 @@ fn run_hybrid(args: &BenchArgs) -> Result<()> {
     (scene.width, scene.height) = (args.width, args.height);
     // A matte floor leaves the balls as the reflecting pixels (about a fifth).
     scene.materials.iter_mut().filter(|m| m.name == "floor").for_each(|m| m.kr = glam::Vec3::ZERO);
-    let depth = 2;
+    // "Traced up to the second ray" (seed 002 §4): primary + one bounce.
+    let depth = 1;
     let mut renderer = Renderer::new(&RenderOptions { threads: None, ray_depth: depth }).map_err(|e| miette!("{e}"))?;
     let (mut hybrid, mut full) = (Vec::new(), Vec::new());
     let mut traced = 0;

@@ -9,7 +9,7 @@ mod report;
 use std::path::{Path, PathBuf};
 
 use clap::{Parser, Subcommand};
-use kage::resolve::Exposure;
+use kage::resolve::{Antialias, Exposure};
 use kage::scene::{demo::demo_scene, file, Scene};
 use kage::{render, RenderOptions};
 
@@ -85,9 +85,25 @@ struct RenderArgs {
     /// tracing in the raster pipeline, recursion in the reference).
     #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(0..=16))]
     ray_depth: u32,
+    /// Antialiasing: `none`, or `jitter:N` (N sub-pixel-jittered passes averaged,
+    /// seed 002 §4); overrides the scene. The reference uses --spp instead.
+    #[arg(long, value_parser = parse_antialias)]
+    antialias: Option<Antialias>,
     /// Brightness of PNG output: stops (e.g. 1.5, -1) or `auto`; overrides the scene.
     #[arg(long, value_parser = parse_exposure, allow_hyphen_values = true)]
     exposure: Option<Exposure>,
+}
+
+fn parse_antialias(s: &str) -> Result<Antialias, String> {
+    let max = kage::resolve::jitter::MAX_JITTER_SAMPLES;
+    match s.split_once(':') {
+        None if s == "none" => Ok(Antialias::None),
+        Some(("jitter", n)) => match n.parse::<u32>() {
+            Ok(k @ 1..) if k <= max => Ok(Antialias::Jitter(k)),
+            _ => Err(format!("'{n}' is not a number of passes between 1 and {max}")),
+        },
+        _ => Err(format!("'{s}' is not an antialiasing method (expected 'none' or 'jitter:N', e.g. jitter:8)")),
+    }
 }
 
 fn parse_exposure(s: &str) -> Result<Exposure, String> {
@@ -129,7 +145,8 @@ fn load(input: Option<&Path>, width: Option<u32>, height: Option<u32>) -> kage::
 }
 
 fn render_command(args: &RenderArgs) -> kage::error::Result<()> {
-    let scene = load(args.input.as_deref(), args.width, args.height)?;
+    let mut scene = load(args.input.as_deref(), args.width, args.height)?;
+    scene.antialias = args.antialias.unwrap_or(scene.antialias);
     for w in &scene.warnings {
         eprintln!("warning: {w}");
     }
@@ -144,11 +161,13 @@ fn render_command(args: &RenderArgs) -> kage::error::Result<()> {
     }
     let s = frame.stats;
     eprintln!(
-        "wrote {} ({}x{}, {} triangles): visibility {:.1} ms, shading {:.1} ms, traced {:.1} ms ({} pixels)",
+        "wrote {} ({}x{}, {} triangles, {} pass{}): visibility {:.1} ms, shading {:.1} ms, traced {:.1} ms ({} pixels)",
         args.output.display(),
         scene.width,
         scene.height,
         s.raster.triangles,
+        s.passes,
+        if s.passes == 1 { "" } else { "es" },
         s.visibility_ms,
         s.shading_ms,
         s.traced_ms,

@@ -160,7 +160,7 @@ fn camera(cam: &gltf::Camera, at: Affine3A) -> Option<Camera> {
             (Projection::Orthographic { height: 2.0 * o.ymag() }, o.znear().max(1e-4), o.zfar())
         }
     };
-    let c = Camera { eye, target: eye + fwd, up, near, far, projection };
+    let c = Camera { eye, target: eye + fwd, up, near, far, projection, shift: glam::Vec2::ZERO };
     c.validate().ok().map(|_| c)
 }
 
