@@ -37,7 +37,13 @@ impl Default for RenderOptions {
 pub struct FrameStats {
     /// Milliseconds in the visibility (polygon) passes.
     pub visibility_ms: f64,
-    /// Milliseconds in the shading passes.
+    /// Milliseconds rendering shadow maps.
+    pub shadow_ms: f64,
+    /// Most bytes the shadow maps of one light held.
+    pub shadow_bytes: usize,
+    /// Shading passes run (summed over jittered passes).
+    pub shading_passes: u32,
+    /// Milliseconds in the shading passes (shadow maps aside).
     pub shading_ms: f64,
     /// Milliseconds tracing reflections and refraction from the item buffer.
     pub traced_ms: f64,
@@ -47,8 +53,9 @@ pub struct FrameStats {
     pub passes: u32,
     /// What the rasterizer did.
     pub raster: RasterStats,
-    /// Bytes held by the frame's buffers (visibility buffer, image and the
-    /// accumulation buffer of jittered passes).
+    /// Bytes held by the frame's buffers (visibility buffer, image, the
+    /// accumulation buffer of jittered passes and the largest light's shadow
+    /// maps).
     pub buffer_bytes: usize,
 }
 
@@ -69,6 +76,12 @@ pub struct Renderer {
     pool: Option<rayon::ThreadPool>,
     ray_depth: u32,
     frame: Frame,
+    scratch: Scratch,
+}
+
+/// Buffers a frame needs besides its own, kept between frames.
+#[derive(Debug)]
+struct Scratch {
     /// Sum of the jittered passes.
     accum: LinearImage,
 }
@@ -82,16 +95,17 @@ impl Renderer {
             visibility: VisibilityBuffer::new(0, 0),
             stats: FrameStats::default(),
         };
-        Ok(Renderer { pool, frame, ray_depth: options.ray_depth, accum: LinearImage::new(0, 0) })
+        let scratch = Scratch { accum: LinearImage::new(0, 0) };
+        Ok(Renderer { pool, frame, ray_depth: options.ray_depth, scratch })
     }
 
     /// Renders `scene` (validated first) and returns the frame.
     pub fn render(&mut self, scene: &Scene) -> Result<&Frame> {
         scene.validate()?;
-        let (frame, accum) = (&mut self.frame, &mut self.accum);
+        let (frame, scratch) = (&mut self.frame, &mut self.scratch);
         match &self.pool {
-            None => render_into(scene, frame, accum, self.ray_depth),
-            Some(pool) => pool.install(|| render_into(scene, frame, accum, self.ray_depth)),
+            None => render_into(scene, frame, scratch, self.ray_depth),
+            Some(pool) => pool.install(|| render_into(scene, frame, scratch, self.ray_depth)),
         }
         Ok(&self.frame)
     }
@@ -124,12 +138,13 @@ pub fn render(scene: &Scene, options: &RenderOptions) -> Result<Frame> {
     Ok(r.into_frame())
 }
 
-fn render_into(scene: &Scene, frame: &mut Frame, accum: &mut LinearImage, ray_depth: u32) {
+fn render_into(scene: &Scene, frame: &mut Frame, scratch: &mut Scratch, ray_depth: u32) {
     let offsets = scene.antialias.offsets();
     frame.stats = FrameStats::default();
     if offsets.len() == 1 && offsets[0] == Vec2::ZERO {
         render_pass(scene, frame, ray_depth);
     } else {
+        let accum = &mut scratch.accum;
         // Seed 002 §4: each pass shifts the image by a fraction of a pixel, so its
         // item buffer samples another point of every pixel; the passes are averaged.
         accum.resize(scene.width, scene.height);
@@ -147,7 +162,8 @@ fn render_into(scene: &Scene, frame: &mut Frame, accum: &mut LinearImage, ray_de
     }
     frame.stats.buffer_bytes = frame.visibility.memory_bytes()
         + std::mem::size_of_val(frame.image.pixels())
-        + std::mem::size_of_val(accum.pixels());
+        + std::mem::size_of_val(scratch.accum.pixels())
+        + frame.stats.shadow_bytes;
 }
 
 /// One visibility pass, its shading and its traced term; adds its timings to the
@@ -158,12 +174,15 @@ fn render_pass(scene: &Scene, frame: &mut Frame, ray_depth: u32) {
     frame.stats.raster = visibility::rasterize(scene, &mut frame.visibility);
     let t1 = Instant::now();
     frame.image.resize(scene.width, scene.height);
-    shading::shade_into(scene, &frame.visibility, &mut frame.image);
+    let lit = shading::shade_lit(scene, &frame.visibility, &mut frame.image);
     let t2 = Instant::now();
     frame.stats.traced_pixels +=
         crate::raytrace::item_buffer::add_traced(scene, &frame.visibility, &mut frame.image, ray_depth);
     frame.stats.visibility_ms += (t1 - t0).as_secs_f64() * 1e3;
-    frame.stats.shading_ms += (t2 - t1).as_secs_f64() * 1e3;
+    frame.stats.shading_ms += (t2 - t1).as_secs_f64() * 1e3 - lit.shadow_ms;
+    frame.stats.shadow_ms += lit.shadow_ms;
+    frame.stats.shadow_bytes = frame.stats.shadow_bytes.max(lit.shadow_bytes);
+    frame.stats.shading_passes += lit.passes;
     frame.stats.traced_ms += t2.elapsed().as_secs_f64() * 1e3;
     frame.stats.passes += 1;
 }

@@ -4,10 +4,10 @@
 //! `SPEC.md`) as one frame pipeline. The module tree follows the frame's data flow:
 //!
 //! ```text
-//! scene ──► visibility ──► shading ──► resolve ──► image
-//! (files,    (rasterizer    (seed 002     (tone,      (PNG, EXR,
-//!  meshes,    into the       eq. 1 per     gamma)      PFM)
-//!  lights)    item buffer)   light)
+//! scene ──► visibility ──► shadows ──► shading ──► raytrace ──► resolve ──► image
+//! (files,    (rasterizer    (shadow      (seed 002    (item-buffer   (jitter    (PNG, EXR,
+//!  meshes,    into the       term per     eq. 1,       reflections,   average,   PFM)
+//!  lights)    item buffer)   light)       per light)   refraction)    exposure)
 //! ```
 //!
 //! [`frame::render`] runs the whole chain; each stage is usable on its own, so tests
@@ -34,6 +34,7 @@ pub mod raytrace;
 pub mod resolve;
 pub mod scene;
 pub mod shading;
+pub mod shadows;
 pub mod visibility;
 
 pub use error::{Error, SourceLocation};

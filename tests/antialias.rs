@@ -61,6 +61,8 @@ fn mirror_scene() -> Scene {
     scene.camera.eye = Vec3::new(0.0, 1.2, 4.0);
     scene.camera.target = Vec3::new(0.0, 0.2, 0.0);
     scene.camera.far = 100.0;
+    // Compared with a reference without shadow rays.
+    scene.lights[0].shadow = kage::scene::ShadowSettings::NONE;
     let mirror =
         Material { ka: Vec3::ZERO, kd: Vec3::splat(0.1), ks: Vec3::ZERO, kr: Vec3::splat(0.9), ..Material::default() };
     let glow = Material { ke: Vec3::new(1.0, 0.3, 0.1), ..Material::default() };

@@ -16,7 +16,10 @@ use toml::Spanned;
 
 use super::load::{self, AssetSource, LoadedModel};
 use super::mesh::shapes;
-use super::{framing, Camera, Falloff, Light, LightKind, Material, Object, Projection, Scene, Texture};
+use super::{
+    framing, Camera, Falloff, Light, LightKind, Material, Object, Projection, Scene, ShadowMethod, ShadowSettings,
+    Texture,
+};
 use crate::error::{Error, Result, SourceLocation};
 use crate::resolve::jitter::MAX_JITTER_SAMPLES;
 use crate::resolve::{Antialias, Exposure};
@@ -201,6 +204,28 @@ struct LightRec {
     outer_angle: f32,
     #[serde(default)]
     falloff: FalloffRec,
+    shadow: Option<Spanned<ShadowRec>>,
+    only: Option<Vec<Spanned<String>>>,
+}
+
+/// `shadow = { method = "map", resolution = 2048, bias = 1.0, slope = 1.5, pcf = 1 }`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ShadowRec {
+    #[serde(default)]
+    method: ShadowMethodRec,
+    resolution: Option<Spanned<i64>>,
+    bias: Option<f32>,
+    slope: Option<f32>,
+    pcf: Option<Spanned<i64>>,
+}
+
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default)]
+#[serde(rename_all = "kebab-case")]
+enum ShadowMethodRec {
+    None,
+    #[default]
+    Map,
 }
 
 fn inner() -> f32 {
@@ -344,9 +369,13 @@ impl SceneFile {
             antialias: self.antialias()?,
         };
         let mut models = Vec::new();
+        let mut produced = Vec::new();
         for o in &self.objects {
+            let first = scene.objects.len();
             models.push(self.object(o, &by_name, assets, &mut scene)?);
+            produced.push((o.get_ref().name.clone(), first..scene.objects.len()));
         }
+        self.resolve_only(&mut scene, &produced)?;
         if scene.objects.is_empty() {
             return Err(self.invalid(0..0, "the scene has no [[object]]: there is nothing to draw"));
         }
@@ -427,7 +456,66 @@ impl SceneFile {
             FalloffRec::None => Falloff::None,
             FalloffRec::InverseSquare => Falloff::InverseSquare,
         };
-        Ok(Light { kind, color: r.color.into(), intensity: r.intensity, ambient: r.ambient, size: r.size, falloff })
+        Ok(Light {
+            kind,
+            color: r.color.into(),
+            intensity: r.intensity,
+            ambient: r.ambient,
+            size: r.size,
+            falloff,
+            shadow: self.shadow(r.shadow.as_ref())?,
+            only: None, // resolved once the objects exist
+        })
+    }
+
+    fn shadow(&self, rec: Option<&Spanned<ShadowRec>>) -> Result<ShadowSettings> {
+        let mut s = ShadowSettings::default();
+        let Some(rec) = rec else { return Ok(s) };
+        let r = rec.get_ref();
+        s.method = match r.method {
+            ShadowMethodRec::None => ShadowMethod::None,
+            ShadowMethodRec::Map => ShadowMethod::Map,
+        };
+        let count = |v: &Option<Spanned<i64>>, lo: i64, hi: i64, what: &str| -> Result<Option<u32>> {
+            match v {
+                Some(n) if !(lo..=hi).contains(n.get_ref()) => {
+                    Err(self.invalid(n.span(), format!("{what} must be between {lo} and {hi}")))
+                }
+                Some(n) => Ok(Some(*n.get_ref() as u32)),
+                None => Ok(None),
+            }
+        };
+        s.resolution = count(&r.resolution, 16, 16384, "shadow resolution")?.unwrap_or(s.resolution);
+        s.pcf = count(&r.pcf, 1, 15, "pcf")?.unwrap_or(s.pcf);
+        for (v, slot) in [(r.bias, &mut s.bias), (r.slope, &mut s.slope)] {
+            if let Some(v) = v {
+                if !(v.is_finite() && v >= 0.0) {
+                    return Err(self.invalid(rec.span(), "shadow bias and slope must be finite and ≥ 0"));
+                }
+                *slot = v;
+            }
+        }
+        Ok(s)
+    }
+
+    /// Turns each light's `only = [names]` into object indices: a name means every
+    /// object its [[object]] record produced.
+    fn resolve_only(&self, scene: &mut Scene, produced: &[(Option<String>, Range<usize>)]) -> Result<()> {
+        for (light, rec) in scene.lights.iter_mut().zip(&self.lights) {
+            let Some(names) = &rec.get_ref().only else { continue };
+            let mut objects = Vec::new();
+            for name in names {
+                let hits: Vec<_> =
+                    produced.iter().filter(|(n, _)| n.as_deref() == Some(name.get_ref().as_str())).collect();
+                if hits.is_empty() {
+                    let msg = format!("no [[object]] named '{}' for this light to light", name.get_ref());
+                    return Err(self.invalid(name.span(), msg));
+                }
+                objects.extend(hits.into_iter().flat_map(|(_, r)| r.clone()));
+            }
+            light.only = Some(objects);
+        }
+        Ok(())
     }
 
     fn material(&self, r: &MaterialRec, assets: &dyn AssetSource) -> Result<Material> {

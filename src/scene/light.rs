@@ -54,6 +54,68 @@ pub struct Light {
     pub size: f32,
     /// Distance attenuation for point and spot lights.
     pub falloff: Falloff,
+    /// How this light's shadows are computed.
+    pub shadow: ShadowSettings,
+    /// Selective lighting (seed 002 §3.3): when set, only these objects (indices
+    /// into `Scene::objects`) receive this light, ambient included; every object
+    /// still hides the ones behind it.
+    pub only: Option<Vec<usize>>,
+}
+
+impl Default for Light {
+    /// A white point light of intensity 1 at the origin, no ambient, shadow-mapped.
+    fn default() -> Self {
+        Light {
+            kind: LightKind::Point { position: Vec3::ZERO },
+            color: Vec3::ONE,
+            intensity: 1.0,
+            ambient: 0.0,
+            size: 0.0,
+            falloff: Falloff::None,
+            shadow: ShadowSettings::default(),
+            only: None,
+        }
+    }
+}
+
+/// Which technique computes a light's shadow term `shadow_i(x, y)` ∈ [0, 1].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ShadowMethod {
+    /// The light reaches every point it faces.
+    None,
+    /// A depth map rendered from the light (spot: perspective; directional:
+    /// orthographic, fitted to the view; point: a cube of six maps).
+    #[default]
+    Map,
+}
+
+/// A light's shadow technique and its parameters.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ShadowSettings {
+    /// The technique.
+    pub method: ShadowMethod,
+    /// Texels along each side of a shadow map (each face, for a cube).
+    pub resolution: u32,
+    /// Constant depth bias, in shadow-map texels (world size of one texel at the
+    /// receiver's distance): against acne from depth quantisation.
+    pub bias: f32,
+    /// Slope-scaled bias, in texels per unit of tan θ (θ between the normal and
+    /// the light): against acne on surfaces seen at grazing angles by the light.
+    pub slope: f32,
+    /// Percentage-closer filtering: k × k texel tests averaged (1: one test).
+    pub pcf: u32,
+}
+
+impl Default for ShadowSettings {
+    fn default() -> Self {
+        ShadowSettings { method: ShadowMethod::Map, resolution: 2048, bias: 1.0, slope: 1.5, pcf: 1 }
+    }
+}
+
+impl ShadowSettings {
+    /// No shadows.
+    pub const NONE: ShadowSettings =
+        ShadowSettings { method: ShadowMethod::None, resolution: 2048, bias: 1.0, slope: 1.5, pcf: 1 };
 }
 
 /// Light arriving at a point: unit direction towards the light and the radiance

@@ -16,7 +16,7 @@ use std::sync::Arc;
 use glam::{Affine3A, Vec3};
 
 pub use camera::{Camera, Projection, Ray};
-pub use light::{Falloff, Light, LightKind};
+pub use light::{Falloff, Light, LightKind, ShadowMethod, ShadowSettings};
 pub use material::{ComponentMaps, Material};
 pub use mesh::Mesh;
 pub use texture::Texture;
@@ -149,6 +149,7 @@ pub fn framing(bounds: (Vec3, Vec3), aspect: f32) -> (Camera, Vec<Light>) {
         ambient: 0.12,
         size: 0.05 * r,
         falloff: Falloff::None,
+        ..Light::default()
     };
     let fill = Light {
         kind: LightKind::Directional { direction: Vec3::new(1.0, -0.3, 0.6).normalize() },
@@ -157,6 +158,7 @@ pub fn framing(bounds: (Vec3, Vec3), aspect: f32) -> (Camera, Vec<Light>) {
         ambient: 0.0,
         size: 0.0,
         falloff: Falloff::None,
+        ..Light::default()
     };
     (camera, vec![key, fill])
 }

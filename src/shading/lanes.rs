@@ -15,9 +15,30 @@ use super::phong::Coefficients;
 use super::surface::{PreparedTriangle, SurfacePoint};
 use crate::scene::camera::PixelRays;
 use crate::scene::{Falloff, Light, LightKind};
+use crate::shadows::ShadowTerm;
 
 /// Pixels shaded together.
 pub const LANES: usize = 8;
+
+/// How a pass writes its colour into the accumulation buffer.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Blend {
+    /// The first pass of a frame: replaces what is there.
+    Replace,
+    /// Every later pass: adds to it (seed 002 eq. 4's sum).
+    Add,
+}
+
+impl Blend {
+    /// Writes `c` into `px`.
+    #[inline(always)]
+    pub fn apply(self, px: &mut Vec3, c: Vec3) {
+        match self {
+            Blend::Replace => *px = c,
+            Blend::Add => *px += c,
+        }
+    }
+}
 
 type F = f32x8;
 
@@ -180,6 +201,7 @@ impl Block {
         x0: usize,
         lighting: &Lighting,
         coefficients_at: impl Fn(&SurfacePoint) -> Coefficients,
+        blend: Blend,
         out: &mut [Vec3],
     ) {
         let mut inputs = self.inputs();
@@ -192,7 +214,7 @@ impl Block {
         let rgb = lighting.shade(&inputs, &s);
         for (i, px) in out.iter_mut().enumerate() {
             if self.live[i] {
-                *px = rgb.lane(i);
+                blend.apply(px, rgb.lane(i));
             }
         }
     }
@@ -235,6 +257,7 @@ pub fn shade_run(
     rays: &RowRays,
     x0: usize,
     lighting: &Lighting,
+    blend: Blend,
     out: &mut [Vec3],
 ) {
     let g = tri.geometry();
@@ -256,7 +279,7 @@ pub fn shade_run(
         let rgb = lighting.shade(&inputs, &surface(&inputs, rays, x0 + b * LANES));
         let (r, g, b) = (rgb.x.to_array(), rgb.y.to_array(), rgb.z.to_array());
         for (i, px) in out.iter_mut().enumerate() {
-            *px = Vec3::new(r[i], g[i], b[i]);
+            blend.apply(px, Vec3::new(r[i], g[i], b[i]));
         }
     }
 }
@@ -313,37 +336,71 @@ fn surface(inp: &LaneInputs, rays: &RowRays, x0: usize) -> LaneSurface {
     LaneSurface { p: origin.add(dir.scale(t)), n, v, weights: [b0, b1, b2] }
 }
 
-/// The lights of a frame, with their summed ambient colour.
+/// What one shading pass adds (seed 002 eq. 4): the ambient of some lights, the
+/// shadowed diffuse and specular of some lights, and perhaps emission.
 #[derive(Debug, Clone)]
 pub struct Lighting<'a> {
-    lights: &'a [Light],
+    direct: Vec<(&'a Light, &'a ShadowTerm)>,
     ambient: Vec3,
+    emission: bool,
 }
 
 impl<'a> Lighting<'a> {
-    /// Prepares `lights` for lane shading.
+    /// Every light's ambient, diffuse and specular, unshadowed, plus emission.
     #[must_use]
     pub fn new(lights: &'a [Light]) -> Self {
-        Lighting { lights, ambient: lights.iter().map(|l| l.color * l.ambient).sum() }
+        let direct = lights.iter().map(|l| (l, &ShadowTerm::Unshadowed)).collect();
+        Lighting { direct, ambient: lights.iter().map(|l| l.color * l.ambient).sum(), emission: true }
     }
 
-    /// Seed 002 eq. 1 summed over the lights, per lane.
+    /// The ambient terms of `ambient`, the diffuse and specular terms of `direct`
+    /// (each multiplied by its shadow term) and, if `emission`, Ke.
+    #[must_use]
+    pub fn pass(
+        ambient: impl IntoIterator<Item = &'a Light>,
+        direct: Vec<(&'a Light, &'a ShadowTerm)>,
+        emission: bool,
+    ) -> Self {
+        Lighting { direct, ambient: ambient.into_iter().map(|l| l.color * l.ambient).sum(), emission }
+    }
+
+    /// Seed 002 eq. 1 summed over the pass's lights, per lane.
     #[inline(always)]
     fn shade(&self, inp: &LaneInputs, s: &LaneSurface) -> V3 {
         let mut diffuse = V3::splat(Vec3::ZERO);
         let mut specular = V3::splat(Vec3::ZERO);
-        for light in self.lights {
+        for &(light, term) in &self.direct {
             let (l, radiance) = incident(light, &s.p);
             let cos_theta = s.n.dot(l);
             let lit = cos_theta.simd_gt(F::ZERO);
+            let radiance = if term.casts() { radiance.scale(shadow(term, s, cos_theta)) } else { radiance };
             let r = s.n.scale(cos_theta + cos_theta).sub(l);
             let cos_alpha = r.dot(s.v).max(F::ZERO);
             let spec = power(cos_alpha, inp.shininess, inp.whole);
             diffuse = diffuse.add(radiance.scale(lit.select(cos_theta, F::ZERO)));
             specular = specular.add(radiance.scale(lit.select(spec, F::ZERO)));
         }
-        inp.ka.mul(V3::splat(self.ambient)).add(inp.kd.mul(diffuse)).add(inp.ks.mul(specular)).add(inp.ke)
+        let lit = inp.ka.mul(V3::splat(self.ambient)).add(inp.kd.mul(diffuse)).add(inp.ks.mul(specular));
+        if self.emission {
+            lit.add(inp.ke)
+        } else {
+            lit
+        }
     }
+}
+
+/// The shadow term per lane, looked up one lane at a time where the surface faces
+/// the light (elsewhere the diffuse and specular terms are zero anyway).
+#[inline(always)]
+fn shadow(term: &ShadowTerm, s: &LaneSurface, cos_theta: F) -> F {
+    let cos = cos_theta.to_array();
+    let mut out = [0.0f32; LANES];
+    for (i, o) in out.iter_mut().enumerate() {
+        if cos[i] > 0.0 {
+            *o = term.lit(s.p.lane(i), cos[i]);
+        }
+    }
+    F::new(out)
 }
 
 /// `x^n` per lane for x ≥ 0: by repeated squaring when every lane has the same

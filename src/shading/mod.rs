@@ -3,31 +3,63 @@
 //! float accumulation buffer. Pixels that see nothing get the background colour.
 
 pub mod lanes;
+pub mod passes;
 pub mod phong;
 pub mod surface;
 
-use glam::Vec2;
+use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
 use crate::resolve::LinearImage;
 use crate::scene::Scene;
+use crate::shadows::ShadowTerm;
 use crate::visibility::{ItemId, VisibilityBuffer};
 
+pub use lanes::{Blend, Lighting};
+pub use passes::{shade_lit, PassStats};
 pub use phong::Components;
 pub use surface::{ObjectFrames, PreparedTriangle, SurfacePoint};
 
 use phong::Coefficients;
 
-/// Shades every pixel of `vb` into `image` (same size), rows in parallel, eight
-/// pixels at a time ([`lanes`]).
+/// One pass over the visibility buffer (seed 002 §3): what it adds, how it writes,
+/// and which objects receive it.
+#[derive(Debug, Clone)]
+pub struct ShadingPass<'a> {
+    /// The terms this pass computes.
+    pub lighting: lanes::Lighting<'a>,
+    /// Replace (the frame's first pass, which also writes the background) or add.
+    pub blend: Blend,
+    /// Per object: whether it receives this pass (`None`: all do). Selective
+    /// lighting (§3.3): the visibility buffer already holds the depth of ALL
+    /// objects, so a light that lists some objects only reaches the pixels where
+    /// one of them is the visible surface.
+    pub receivers: Option<Vec<bool>>,
+}
+
+impl ShadingPass<'_> {
+    fn receives(&self, item: ItemId) -> bool {
+        !item.is_none() && self.receivers.as_ref().is_none_or(|r| r[item.object as usize])
+    }
+}
+
+/// Shades every pixel of `vb` into `image` (same size) with every light,
+/// unshadowed: one pass replacing the image.
 pub fn shade_into(scene: &Scene, vb: &VisibilityBuffer, image: &mut LinearImage) {
+    let pass = ShadingPass { lighting: lanes::Lighting::new(&scene.lights), blend: Blend::Replace, receivers: None };
+    shade_pass(scene, vb, image, &pass);
+}
+
+/// Runs one pass over `vb` into `image` (same size), rows in parallel, eight pixels
+/// at a time ([`lanes`]).
+pub fn shade_pass(scene: &Scene, vb: &VisibilityBuffer, image: &mut LinearImage, pass: &ShadingPass) {
     assert_eq!((image.width(), image.height()), (vb.width(), vb.height()), "image and buffer sizes");
     let w = vb.width() as usize;
     let frames = ObjectFrames::new(scene);
     let rays = scene.camera.pixel_rays(Vec2::new(w as f32, vb.height() as f32));
     let constants: Vec<Option<Coefficients>> = scene.materials.iter().map(Coefficients::constant).collect();
     let sample = |s: &SurfacePoint| Coefficients::at(&scene.materials[s.material], s);
-    let lighting = lanes::Lighting::new(&scene.lights);
+    let (lighting, blend) = (&pass.lighting, pass.blend);
     let rows = image.pixels_mut().par_chunks_mut(w).zip(vb.items().par_chunks(w));
     let caches = || (TriangleCache::new(), lanes::Block::default());
     rows.enumerate().for_each_init(caches, |(cache, block), (y, (out, items))| {
@@ -36,25 +68,27 @@ pub fn shade_into(scene: &Scene, vb: &VisibilityBuffer, image: &mut LinearImage)
         while x < w {
             let end = (x + lanes::LANES).min(w);
             let first = items[x];
-            let uniform = end - x == lanes::LANES && !first.is_none() && items[x..end].iter().all(|&i| i == first);
+            let uniform = end - x == lanes::LANES && pass.receives(first) && items[x..end].iter().all(|&i| i == first);
             let tri = if uniform { Some(cache.get(scene, &frames, first)) } else { None };
             if let Some((tri, k)) = tri.and_then(|t| Some((t, constants[t.material].as_ref()?))) {
                 let run = uniform_run(items, x, first);
-                lanes::shade_run(tri, k, &row, x, &lighting, &mut out[x..run]);
+                lanes::shade_run(tri, k, &row, x, lighting, blend, &mut out[x..run]);
                 x = run;
                 continue;
             }
             block.clear();
             for (i, (&item, px)) in items[x..end].iter().zip(out[x..end].iter_mut()).enumerate() {
-                if item.is_none() {
-                    *px = scene.background;
+                if !pass.receives(item) {
+                    if blend == Blend::Replace {
+                        *px = if item.is_none() { scene.background } else { Vec3::ZERO };
+                    }
                     continue;
                 }
                 let tri = cache.get(scene, &frames, item);
                 block.set(i, tri, constants[tri.material].as_ref());
             }
             if block.live.iter().any(|&l| l) {
-                block.shade(&row, x, &lighting, sample, &mut out[x..end]);
+                block.shade(&row, x, lighting, sample, blend, &mut out[x..end]);
             }
             x = end;
         }
@@ -94,21 +128,32 @@ impl TriangleCache {
     }
 }
 
-/// The scalar reference of [`shade_into`]: one pixel at a time through
-/// [`PreparedTriangle::surface`] and [`phong::shade`].
-pub fn shade_into_scalar(scene: &Scene, vb: &VisibilityBuffer, image: &mut LinearImage) {
+/// The scalar reference of [`shade_lit`]: one pixel at a time through
+/// [`PreparedTriangle::surface`] and [`phong::add_light`], with each light's
+/// shadow term from `terms` (one per light) and its selective-lighting list.
+pub fn shade_into_scalar(scene: &Scene, vb: &VisibilityBuffer, image: &mut LinearImage, terms: &[ShadowTerm]) {
     let w = vb.width() as usize;
     let frames = ObjectFrames::new(scene);
     let rays = scene.camera.pixel_rays(Vec2::new(w as f32, vb.height() as f32));
     let rows = image.pixels_mut().par_chunks_mut(w).zip(vb.items().par_chunks(w));
     rows.enumerate().for_each(|(y, (out, items))| {
         for (x, (px, &item)) in out.iter_mut().zip(items).enumerate() {
-            *px = if item.is_none() {
-                scene.background
-            } else {
-                let s = frames.surface(scene, item, &rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5)));
-                phong::shade(&scene.lights, &scene.materials[s.material], &s).total()
-            };
+            if item.is_none() {
+                *px = scene.background;
+                continue;
+            }
+            let s = frames.surface(scene, item, &rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5)));
+            let k = Coefficients::at(&scene.materials[s.material], &s);
+            let mut acc = Components { emission: k.parts().3, ..Default::default() };
+            for (light, term) in scene.lights.iter().zip(terms) {
+                if light.only.as_ref().is_some_and(|o| !o.contains(&(item.object as usize))) {
+                    continue;
+                }
+                let cos_theta = s.normal.dot(light.incident(s.position).to_light);
+                let shadow = if cos_theta > 0.0 { term.lit(s.position, cos_theta) } else { 1.0 };
+                phong::add_light(&mut acc, light, &k, &s, shadow);
+            }
+            *px = acc.total();
         }
     });
 }

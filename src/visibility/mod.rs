@@ -11,7 +11,7 @@ pub mod clip;
 pub mod raster;
 pub mod scan;
 
-pub use raster::{rasterize, RasterStats};
+pub use raster::{rasterize, rasterize_from, Faces, RasterStats};
 
 /// What a pixel sees: an object and one of its triangles.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -44,6 +44,8 @@ pub struct VisibilityBuffer {
     height: u32,
     depth: Vec<f32>,
     items: Vec<ItemId>,
+    /// False for a depth-only buffer (shadow maps), whose `items` stay empty.
+    with_items: bool,
 }
 
 impl VisibilityBuffer {
@@ -52,7 +54,16 @@ impl VisibilityBuffer {
     #[must_use]
     pub fn new(width: u32, height: u32) -> Self {
         let n = width as usize * height as usize;
-        VisibilityBuffer { width, height, depth: vec![0.0; n], items: vec![ItemId::NONE; n] }
+        VisibilityBuffer { width, height, depth: vec![0.0; n], items: vec![ItemId::NONE; n], with_items: true }
+    }
+
+    /// A buffer that keeps depth only ([`VisibilityBuffer::items`] is empty): a
+    /// shadow map needs no item ids, and skipping them saves two thirds of the
+    /// memory.
+    #[must_use]
+    pub fn depth_only(width: u32, height: u32) -> Self {
+        let n = width as usize * height as usize;
+        VisibilityBuffer { width, height, depth: vec![0.0; n], items: Vec::new(), with_items: false }
     }
 
     /// Width in pixels.
@@ -73,13 +84,13 @@ impl VisibilityBuffer {
         &self.depth
     }
 
-    /// Item of every pixel, row-major.
+    /// Item of every pixel, row-major (empty for a depth-only buffer).
     #[must_use]
     pub fn items(&self) -> &[ItemId] {
         &self.items
     }
 
-    /// Item at pixel (x, y).
+    /// Item at pixel (x, y) (panics on a depth-only buffer).
     #[must_use]
     pub fn item(&self, x: u32, y: u32) -> ItemId {
         self.items[y as usize * self.width as usize + x as usize]
@@ -98,7 +109,9 @@ impl VisibilityBuffer {
         self.width = width;
         self.height = height;
         self.depth.resize(n, 0.0);
-        self.items.resize(n, ItemId::NONE);
+        if self.with_items {
+            self.items.resize(n, ItemId::NONE);
+        }
     }
 
     /// Forgets everything drawn.

@@ -14,7 +14,7 @@ use rayon::prelude::*;
 use super::clip::{ClipPlanes, MAX_CLIPPED};
 use super::scan::{column_range, row_range, scan_triangle, signed_area2, FixedPoint, SpanSink, ONE};
 use super::{ItemId, VisibilityBuffer};
-use crate::scene::Scene;
+use crate::scene::{Camera, Scene};
 
 /// Rows per band: the unit of parallel work and of binning.
 pub const BAND_ROWS: usize = 16;
@@ -103,18 +103,34 @@ struct PolygonPass<'a> {
     bands: usize,
 }
 
-/// Draws every object of `scene` into `vb`, which is cleared first (each band
-/// clears its own rows, in parallel, just before drawing them).
+/// Which faces a polygon pass draws.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Faces {
+    /// Back faces are culled unless the material is two-sided (the eye's pass).
+    AsMaterials,
+    /// Every face, front or back (depth passes from lights: open meshes cast too).
+    All,
+}
+
+/// Draws every object of `scene` seen by the scene's camera into `vb`, which is
+/// cleared first (each band clears its own rows, in parallel, just before drawing
+/// them).
 pub fn rasterize(scene: &Scene, vb: &mut VisibilityBuffer) -> RasterStats {
+    rasterize_from(scene, &scene.camera, Faces::AsMaterials, vb)
+}
+
+/// As [`rasterize`], seen by `camera` (a light's, for a shadow map) and drawing
+/// `faces`.
+pub fn rasterize_from(scene: &Scene, camera: &Camera, faces: Faces, vb: &mut VisibilityBuffer) -> RasterStats {
     let (w, h) = (vb.width() as usize, vb.height() as usize);
-    let view_proj = scene.camera.view_projection(w as f32 / h as f32);
+    let view_proj = camera.view_projection(w as f32 / h as f32);
     let planes = ClipPlanes::new(
-        scene.camera.far_plane_factor() as f64,
+        camera.far_plane_factor() as f64,
         1.0 + 2.0 * GUARD_PX as f64 / w as f64,
         1.0 + 2.0 * GUARD_PX as f64 / h as f64,
     );
     let viewport = Viewport { width: w as f32, height: h as f32 };
-    let projected = scene.objects.iter().map(|o| project(scene, o, view_proj, &planes, viewport)).collect();
+    let projected = scene.objects.iter().map(|o| project(scene, o, view_proj, &planes, viewport, faces)).collect();
     let frame = PolygonPass {
         scene,
         projected,
@@ -127,11 +143,14 @@ pub fn rasterize(scene: &Scene, vb: &mut VisibilityBuffer) -> RasterStats {
     let chunks = chunks(scene);
     let bins: Vec<ChunkBins> = chunks.par_iter().map(|c| frame.bin(c)).collect();
     let (depth, items) = vb.parts_mut();
-    depth
-        .par_chunks_mut(w * BAND_ROWS)
-        .zip(items.par_chunks_mut(w * BAND_ROWS))
-        .enumerate()
-        .for_each(|(band, (d, i))| frame.draw_band(band, d, i, &chunks, &bins));
+    let band_len = w * BAND_ROWS;
+    if items.is_empty() {
+        let bands = depth.par_chunks_mut(band_len).enumerate();
+        bands.for_each(|(band, d)| frame.draw_band(band, d, &mut [], &chunks, &bins));
+    } else {
+        let bands = depth.par_chunks_mut(band_len).zip(items.par_chunks_mut(band_len)).enumerate();
+        bands.for_each(|(band, (d, i))| frame.draw_band(band, d, i, &chunks, &bins));
+    }
     RasterStats {
         triangles: scene.triangle_count(),
         binned: bins.iter().map(|b| b.binned).sum(),
@@ -145,6 +164,7 @@ fn project(
     view_proj: Mat4,
     planes: &ClipPlanes,
     viewport: Viewport,
+    faces: Faces,
 ) -> Projected {
     let m = view_proj * Mat4::from(object.transform);
     let (outcode, screen) = object
@@ -161,7 +181,7 @@ fn project(
         to_clip: view_proj.as_dmat4() * Mat4::from(object.transform).as_dmat4(),
         outcode,
         screen,
-        cull_back: !scene.materials[object.material].two_sided,
+        cull_back: faces == Faces::AsMaterials && !scene.materials[object.material].two_sided,
     }
 }
 
@@ -289,7 +309,7 @@ impl DepthPlane {
 }
 
 /// Writes spans into a band's rows with a z-test (larger depth wins, ties keep the
-/// earlier triangle).
+/// earlier triangle); depth only when the band has no item slice.
 struct DepthSink<'a> {
     depth: &'a mut [f32],
     items: &'a mut [ItemId],
@@ -308,6 +328,13 @@ impl SpanSink for DepthSink<'_> {
         let base = ((y - self.row0) * self.width) as usize;
         let row_z = self.plane.c + self.plane.dy * y as f64;
         let depth = &mut self.depth[base + x0 as usize..base + x1 as usize];
+        if self.items.is_empty() {
+            for (k, d) in depth.iter_mut().enumerate() {
+                let z = (row_z + self.plane.dx * (x0 + k as i64) as f64) as f32;
+                *d = d.max(z);
+            }
+            return;
+        }
         let items = &mut self.items[base + x0 as usize..base + x1 as usize];
         for (k, (d, it)) in depth.iter_mut().zip(items.iter_mut()).enumerate() {
             let z = (row_z + self.plane.dx * (x0 + k as i64) as f64) as f32;

@@ -26,6 +26,7 @@ pub fn scene_with(mesh: Mesh, camera: Camera, width: u32, height: u32, two_sided
             ambient: 0.1,
             size: 0.0,
             falloff: Falloff::None,
+            ..Light::default()
         }],
         materials: vec![Material { two_sided, ..Material::default() }],
         objects: vec![Object { name: "soup".into(), mesh: Arc::new(mesh), transform: Affine3A::IDENTITY, material: 0 }],

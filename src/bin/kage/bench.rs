@@ -149,6 +149,8 @@ fn peer_scene(path: &Path, width: u32, height: u32) -> Result<Scene> {
             ambient: 0.1,
             size: 0.0,
             falloff: Falloff::None,
+            shadow: kage::scene::ShadowSettings::NONE,
+            only: None,
         }],
         materials: vec![material],
         objects: Vec::new(),

@@ -161,7 +161,7 @@ fn render_command(args: &RenderArgs) -> kage::error::Result<()> {
     }
     let s = frame.stats;
     eprintln!(
-        "wrote {} ({}x{}, {} triangles, {} pass{}): visibility {:.1} ms, shading {:.1} ms, traced {:.1} ms ({} pixels)",
+        "wrote {} ({}x{}, {} triangles, {} pass{}): visibility {:.1} ms, shadow maps {:.1} ms, shading {:.1} ms, traced {:.1} ms ({} pixels)",
         args.output.display(),
         scene.width,
         scene.height,
@@ -169,6 +169,7 @@ fn render_command(args: &RenderArgs) -> kage::error::Result<()> {
         s.passes,
         if s.passes == 1 { "" } else { "es" },
         s.visibility_ms,
+        s.shadow_ms,
         s.shading_ms,
         s.traced_ms,
         s.traced_pixels

@@ -176,5 +176,13 @@ fn light(l: &gltf::khr_lights_punctual::Light, at: Affine3A) -> Light {
             Falloff::InverseSquare,
         ),
     };
-    Light { kind, color: l.color().into(), intensity: l.intensity(), ambient: 0.0, size: 0.0, falloff }
+    Light {
+        kind,
+        color: l.color().into(),
+        intensity: l.intensity(),
+        ambient: 0.0,
+        size: 0.0,
+        falloff,
+        ..Light::default()
+    }
 }

@@ -1,0 +1,67 @@
+//! The frame's shading passes, summed as seed 002 eq. 4 says.
+//!
+//! The paper renders ambient, diffuse and specular per light as separate hardware
+//! passes and adds them. The sum does not depend on how terms are grouped into
+//! passes, so kage groups them by what they need:
+//!
+//! 1. one pass replaces the buffer with emission, the ambient of every light that
+//!    lights all objects, and the diffuse and specular of every light that has
+//!    neither a shadow nor an object list — all in one sweep;
+//! 2. then each light with a shadow term or an object list gets its own pass: its
+//!    shadow maps are rendered, its diffuse and specular are added multiplied by
+//!    its shadow term (and, if selective, its ambient, on its objects only), and its
+//!    maps are dropped — so memory does not grow with the number of lights and
+//!    time grows linearly with them.
+
+use std::time::Instant;
+
+use super::{shade_pass, Blend, Lighting, ShadingPass};
+use crate::resolve::LinearImage;
+use crate::scene::{Light, Scene, ShadowMethod};
+use crate::shadows::ShadowTerm;
+use crate::visibility::VisibilityBuffer;
+
+/// What the passes of one frame cost.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct PassStats {
+    /// Shading passes run.
+    pub passes: u32,
+    /// Milliseconds spent rendering shadow maps.
+    pub shadow_ms: f64,
+    /// Largest memory the shadow maps of one light held.
+    pub shadow_bytes: usize,
+}
+
+static UNSHADOWED: ShadowTerm = ShadowTerm::Unshadowed;
+
+/// Whether `light` needs a pass of its own.
+fn own_pass(light: &Light) -> bool {
+    light.shadow.method != ShadowMethod::None || light.only.is_some()
+}
+
+/// Shades `vb` into `image` with every light of `scene`, shadows included.
+pub fn shade_lit(scene: &Scene, vb: &VisibilityBuffer, image: &mut LinearImage) -> PassStats {
+    let mut stats = PassStats::default();
+    let fused = scene.lights.iter().filter(|l| !own_pass(l)).map(|l| (l, &UNSHADOWED)).collect();
+    let ambient = scene.lights.iter().filter(|l| l.only.is_none());
+    let base = ShadingPass { lighting: Lighting::pass(ambient, fused, true), blend: Blend::Replace, receivers: None };
+    shade_pass(scene, vb, image, &base);
+    stats.passes = 1;
+    for light in scene.lights.iter().filter(|l| own_pass(l)) {
+        let t = Instant::now();
+        let term = ShadowTerm::build(scene, light);
+        stats.shadow_ms += t.elapsed().as_secs_f64() * 1e3;
+        stats.shadow_bytes = stats.shadow_bytes.max(term.memory_bytes());
+        let receivers = light.only.as_ref().map(|only| (0..scene.objects.len()).map(|i| only.contains(&i)).collect());
+        // A light that lights every object had its ambient added in the first pass.
+        let ambient = light.only.is_some().then_some(light);
+        let pass = ShadingPass {
+            lighting: Lighting::pass(ambient, vec![(light, &term)], false),
+            blend: Blend::Add,
+            receivers,
+        };
+        shade_pass(scene, vb, image, &pass);
+        stats.passes += 1;
+    }
+    stats
+}

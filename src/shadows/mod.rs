@@ -1,0 +1,183 @@
+//! Shadows: the shadow term `shadow_i(x, y)` ∈ [0, 1] of seed 002 eq. 4, one per
+//! light, multiplying that light's diffuse and specular components (never its
+//! ambient).
+//!
+//! This is the plain version — shadow maps ([`map`]) placed per light type:
+//! a spot light sees its cone through one perspective map, a point light through a
+//! cube of six 90° maps, a directional light through one orthographic map fitted to
+//! the part of the scene the camera sees. The silhouette-line buffer (seed 000) and
+//! the two-map soft shadows (seed 001) plug into the same [`ShadowTerm`].
+
+pub mod map;
+
+use glam::{Vec2, Vec3};
+
+pub use map::DepthMap;
+
+use crate::scene::{Camera, Light, LightKind, Projection, Scene, ShadowMethod, ShadowSettings};
+
+/// Widest spot cone (half-angle, degrees) one perspective map covers; wider spots
+/// use a cube like point lights.
+const MAX_SPOT_HALF_ANGLE_DEG: f32 = 75.0;
+
+/// How one light's shadow term is evaluated.
+#[derive(Debug, Clone)]
+pub enum ShadowTerm {
+    /// No shadow: the light reaches every point.
+    Unshadowed,
+    /// One map (spot, directional).
+    Map(DepthMap, ShadowSettings),
+    /// Six maps around a point (point lights, wide spots): +x, −x, +y, −y, +z, −z,
+    /// each at half the configured resolution.
+    Cube(Box<[DepthMap; 6]>, Vec3, ShadowSettings),
+}
+
+impl ShadowTerm {
+    /// Builds the term of `light` in `scene`, rendering its maps.
+    #[must_use]
+    pub fn build(scene: &Scene, light: &Light) -> ShadowTerm {
+        let settings = light.shadow;
+        let Some(bounds) = scene.bounds().filter(|_| settings.method == ShadowMethod::Map) else {
+            return ShadowTerm::Unshadowed;
+        };
+        let res = settings.resolution.max(1);
+        match light.kind {
+            LightKind::Spot { position, direction, outer, .. } if outer.to_degrees() <= MAX_SPOT_HALF_ANGLE_DEG => {
+                let fov = (2.0 * outer.to_degrees() + 2.0).min(170.0);
+                let cam = light_camera(position, direction, Projection::Perspective { fov_y_deg: fov }, bounds);
+                ShadowTerm::Map(DepthMap::render(scene, &cam, res), settings)
+            }
+            LightKind::Point { position } | LightKind::Spot { position, .. } => {
+                // Six faces at half the resolution: about 1.5 single maps of memory.
+                let res = (res / 2).max(16);
+                let faces = [Vec3::X, Vec3::NEG_X, Vec3::Y, Vec3::NEG_Y, Vec3::Z, Vec3::NEG_Z].map(|axis| {
+                    let cam = light_camera(position, axis, Projection::Perspective { fov_y_deg: 90.0 }, bounds);
+                    DepthMap::render(scene, &cam, res)
+                });
+                ShadowTerm::Cube(Box::new(faces), position, settings)
+            }
+            LightKind::Directional { direction } => {
+                let cam =
+                    fitted_orthographic(&scene.camera, scene.width as f32 / scene.height as f32, direction, bounds);
+                ShadowTerm::Map(DepthMap::render(scene, &cam, res), settings)
+            }
+        }
+    }
+
+    /// The terms of every light of `scene`.
+    #[must_use]
+    pub fn build_all(scene: &Scene) -> Vec<ShadowTerm> {
+        scene.lights.iter().map(|l| ShadowTerm::build(scene, l)).collect()
+    }
+
+    /// Whether this term can shadow anything.
+    #[must_use]
+    pub fn casts(&self) -> bool {
+        !matches!(self, ShadowTerm::Unshadowed)
+    }
+
+    /// `shadow_i` at world point `p` with N·L = `cos_theta`: 1 lit, 0 in shadow.
+    #[must_use]
+    pub fn lit(&self, p: Vec3, cos_theta: f32) -> f32 {
+        match self {
+            ShadowTerm::Unshadowed => 1.0,
+            ShadowTerm::Map(map, s) => map.lit(p, cos_theta, s),
+            ShadowTerm::Cube(faces, centre, s) => {
+                let d = p - *centre;
+                let a = d.abs();
+                let face = if a.x >= a.y && a.x >= a.z {
+                    usize::from(d.x < 0.0)
+                } else if a.y >= a.z {
+                    2 + usize::from(d.y < 0.0)
+                } else {
+                    4 + usize::from(d.z < 0.0)
+                };
+                faces[face].lit(p, cos_theta, s)
+            }
+        }
+    }
+
+    /// Bytes held by the maps.
+    #[must_use]
+    pub fn memory_bytes(&self) -> usize {
+        match self {
+            ShadowTerm::Unshadowed => 0,
+            ShadowTerm::Map(m, _) => m.memory_bytes(),
+            ShadowTerm::Cube(f, ..) => f.iter().map(DepthMap::memory_bytes).sum(),
+        }
+    }
+}
+
+/// A camera at `eye` looking along `axis` whose depth range holds `bounds`.
+fn light_camera(eye: Vec3, axis: Vec3, projection: Projection, bounds: (Vec3, Vec3)) -> Camera {
+    let (lo, hi) = bounds;
+    let r = ((hi - lo).length() * 0.5).max(1e-6);
+    let far = (eye - (lo + hi) * 0.5).length() + 2.0 * r;
+    Camera {
+        eye,
+        target: eye + axis,
+        up: up_for(axis),
+        near: (r * 1e-4).min(far * 1e-3),
+        far,
+        projection,
+        shift: Vec2::ZERO,
+    }
+}
+
+/// An up vector not parallel to `axis`.
+fn up_for(axis: Vec3) -> Vec3 {
+    if axis.normalize().y.abs() > 0.99 {
+        Vec3::Z
+    } else {
+        Vec3::Y
+    }
+}
+
+/// The orthographic light camera of a directional light travelling along `dir`:
+/// across the light, the intersection of the scene's bounds with what the eye sees
+/// (its view frustum cut at the far side of the scene); along it, the whole scene,
+/// so casters outside the view still cast into it.
+fn fitted_orthographic(eye: &Camera, aspect: f32, dir: Vec3, bounds: (Vec3, Vec3)) -> Camera {
+    let dir = dir.normalize();
+    let up = up_for(dir);
+    let right = dir.cross(up).normalize();
+    let up = right.cross(dir);
+    let to_light = |p: Vec3| Vec3::new(p.dot(right), p.dot(up), p.dot(dir));
+    let (lo, hi) = bounds;
+    let corners: Vec<Vec3> = (0..8)
+        .map(|k| Vec3::new([lo.x, hi.x][k & 1], [lo.y, hi.y][(k >> 1) & 1], [lo.z, hi.z][(k >> 2) & 1]))
+        .collect();
+    let (mut slo, mut shi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
+    for &c in &corners {
+        let l = to_light(c);
+        (slo, shi) = (slo.min(l), shi.max(l));
+    }
+    // The eye's frustum, from its near plane to the farthest scene corner.
+    let rays = eye.pixel_rays(Vec2::new(aspect, 1.0));
+    let fwd = (eye.target - eye.eye).normalize();
+    let reach = corners.iter().map(|&c| (c - eye.eye).dot(fwd)).fold(eye.near, f32::max).min(eye.far);
+    let (mut flo, mut fhi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
+    for (x, y) in [(0.0, 0.0), (aspect, 0.0), (0.0, 1.0), (aspect, 1.0)] {
+        let ray = rays.ray(Vec2::new(x, y));
+        let along = ray.dir.dot(fwd).max(1e-6);
+        for t in [eye.near, reach] {
+            let l = to_light(ray.origin + ray.dir * (t / along));
+            (flo, fhi) = (flo.min(l), fhi.max(l));
+        }
+    }
+    let (xy_lo, xy_hi) = (slo.truncate().max(flo.truncate()), shi.truncate().min(fhi.truncate()));
+    let (xy_lo, xy_hi) = if xy_lo.cmple(xy_hi).all() { (xy_lo, xy_hi) } else { (slo.truncate(), shi.truncate()) };
+    let size = (xy_hi - xy_lo).max_element().max(1e-6) * 1.02;
+    let centre = (xy_lo + xy_hi) * 0.5;
+    let margin = (shi.z - slo.z).max(1e-6) * 0.01 + 1e-6;
+    let eye_pos = right * centre.x + up * centre.y + dir * (slo.z - margin);
+    Camera {
+        eye: eye_pos,
+        target: eye_pos + dir,
+        up,
+        near: margin * 0.5,
+        far: shi.z - slo.z + 2.0 * margin,
+        projection: Projection::Orthographic { height: size },
+        shift: Vec2::ZERO,
+    }
+}
