@@ -1,0 +1,177 @@
+//! Shadows and light passes (seed 002 §3.3) against independent answers: shadow
+//! maps against shadow rays through the BVH, the exact ambient-only colour of a
+//! fully shadowed point, selective lighting, and the additivity of lights.
+
+mod common;
+
+use std::path::Path;
+use std::sync::Arc;
+
+use glam::{Affine3A, Vec2, Vec3};
+use kage::raytrace::TraceScene;
+use kage::scene::mesh::shapes;
+use kage::scene::{Light, LightKind, Material, Object, Ray, Scene, ShadowSettings};
+use kage::shading::ObjectFrames;
+use kage::shadows::ShadowTerm;
+use kage::{render, RenderOptions};
+
+/// For every pixel of `scene`'s view whose surface faces a light, whether the
+/// shadow map calls it lit (term ≥ 0.5) and whether a shadow ray reaches the
+/// light: returns (misclassified, compared) over all lights.
+fn map_vs_rays(scene: &Scene) -> (usize, usize) {
+    let frame = render(scene, &RenderOptions::default()).expect("render");
+    let trace = TraceScene::new(scene);
+    let frames = ObjectFrames::new(scene);
+    let terms = ShadowTerm::build_all(scene);
+    let rays = scene.camera.pixel_rays(Vec2::new(scene.width as f32, scene.height as f32));
+    let eps = scene.bounds().map_or(1e-4, |(lo, hi)| (hi - lo).length() * 1e-5);
+    let (mut wrong, mut total) = (0, 0);
+    for y in 0..scene.height {
+        for x in 0..scene.width {
+            let item = frame.visibility.item(x, y);
+            if item.is_none() {
+                continue;
+            }
+            let s = frames.surface(scene, item, &rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5)));
+            for (light, term) in scene.lights.iter().zip(&terms) {
+                let to = light.incident(s.position).to_light;
+                let cos = s.normal.dot(to);
+                if cos <= 0.05 || !term.casts() {
+                    continue;
+                }
+                let origin = s.position + s.normal * eps;
+                let (dir, dist) = match light.kind {
+                    LightKind::Directional { direction } => (-direction, f32::INFINITY),
+                    LightKind::Point { position } | LightKind::Spot { position, .. } => {
+                        let d = position - origin;
+                        (d.normalize(), d.length() * (1.0 - 1e-4))
+                    }
+                };
+                let ray_lit = !trace.occluded(&Ray { origin, dir }, dist);
+                let map_lit = term.lit(s.position, cos) >= 0.5;
+                wrong += usize::from(ray_lit != map_lit);
+                total += 1;
+            }
+        }
+    }
+    (wrong, total)
+}
+
+#[test]
+fn shadow_maps_agree_with_shadow_rays_on_the_example_scenes() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenes");
+    let mut scenes = vec![("demo", kage::scene::demo::demo_scene().unwrap())];
+    for name in ["spotlights", "cad-ortho", "reflections"] {
+        scenes.push((name, kage::scene::file::load_scene(&dir.join(format!("{name}.toml"))).unwrap()));
+    }
+    for (name, mut scene) in scenes {
+        (scene.width, scene.height) = (320, 200);
+        let (wrong, total) = map_vs_rays(&scene);
+        let share = wrong as f64 / total as f64;
+        eprintln!("{name}: {wrong} of {total} lit tests disagree ({:.3}%)", 100.0 * share);
+        assert!(total > 10_000, "{name}: only {total} tests");
+        assert!(share < 0.005, "{name}: {wrong} of {total} shadow-map tests disagree with shadow rays");
+    }
+}
+
+/// A ground square under a directional light straight down, a roof square above it.
+fn roofed(ambient: f32) -> Scene {
+    let camera = kage::scene::Camera {
+        eye: Vec3::new(0.0, 5.0, 0.001),
+        target: Vec3::ZERO,
+        up: Vec3::NEG_Z,
+        near: 0.1,
+        far: 20.0,
+        projection: kage::scene::Projection::Orthographic { height: 4.0 },
+        shift: Vec2::ZERO,
+    };
+    let mut scene = common::scene_with(shapes::plane(), camera, 64, 64, false);
+    scene.objects[0].transform = Affine3A::from_scale(Vec3::splat(4.0));
+    scene.materials[0].ke = Vec3::new(0.01, 0.02, 0.03);
+    let roof = Affine3A::from_scale_rotation_translation(Vec3::splat(1.0), glam::Quat::IDENTITY, Vec3::Y);
+    scene.materials.push(Material { two_sided: true, ..Material::default() });
+    scene.objects.push(Object { name: "roof".into(), mesh: Arc::new(shapes::plane()), transform: roof, material: 1 });
+    scene.lights = vec![Light {
+        kind: LightKind::Directional { direction: Vec3::new(0.8, -1.0, 0.05).normalize() },
+        ambient,
+        ..Light::default()
+    }];
+    scene
+}
+
+#[test]
+fn a_fully_shadowed_point_receives_exactly_ambient_and_emission() {
+    let scene = roofed(0.3);
+    let frame = render(&scene, &RenderOptions::default()).unwrap();
+    let m = &scene.materials[0];
+    let want = m.ka * 0.3 + m.ke;
+    // The roof hides the ground's centre from the eye; its shadow falls 1 unit
+    // lower, moved by the light's tilt (0.8 in x, 0.05 in z), partly in view.
+    let ground = |x: u32, y: u32| frame.visibility.item(x, y).object == 0;
+    let (mut shadowed, mut lit) = (0, 0);
+    for y in 0..64 {
+        for x in 0..64 {
+            if !ground(x, y) {
+                continue;
+            }
+            let p = frame.image.get(x, y);
+            // World x, z of the pixel centre (orthographic, 4 units over 64 pixels).
+            let (wx, wz) = ((x as f32 + 0.5) / 16.0 - 2.0, (y as f32 + 0.5) / 16.0 - 2.0);
+            // The roof's shadow on the ground: the roof square moved by the light's
+            // tilt over a drop of 1 unit, shrunk by a texel margin.
+            let (sx, sz) = (wx - 0.8, wz - 0.05);
+            if sx.abs() < 0.45 && sz.abs() < 0.45 {
+                assert!(
+                    (p - want).abs().max_element() < 1e-5,
+                    "({x}, {y}) in shadow: {p} vs ambient + emission {want}"
+                );
+                shadowed += 1;
+            } else if sx.abs() > 0.55 || sz.abs() > 0.55 {
+                assert!((p - want).min_element() > 0.1, "({x}, {y}) lit: {p}");
+                lit += 1;
+            }
+        }
+    }
+    assert!(shadowed > 20 && lit > 1000, "{shadowed} shadowed, {lit} lit ground pixels");
+}
+
+#[test]
+fn one_light_of_intensity_two_equals_two_coincident_lights_with_shadows() {
+    let mut one = roofed(0.2);
+    one.lights[0].intensity = 2.0;
+    let mut two = roofed(0.1);
+    two.lights.push(two.lights[0].clone());
+    let (a, b) = (render(&one, &RenderOptions::default()).unwrap(), render(&two, &RenderOptions::default()).unwrap());
+    assert_eq!(b.stats.shading_passes, 3, "one base pass and one pass per shadowed light");
+    for (p, q) in a.image.pixels().iter().zip(b.image.pixels()) {
+        assert!((*p - *q).abs().max_element() < 1e-5, "{p} vs {q}");
+    }
+}
+
+#[test]
+fn a_selective_light_changes_only_its_objects_and_others_still_hide_them() {
+    // Roof (object 1) in front of the ground (object 0) as the eye sees it.
+    let mut base = roofed(0.1);
+    base.lights[0].shadow = ShadowSettings::NONE;
+    let mut with = base.clone();
+    with.lights.push(Light {
+        kind: LightKind::Point { position: Vec3::new(0.5, 3.0, 0.5) },
+        color: Vec3::new(1.0, 0.2, 0.1),
+        ambient: 0.2,
+        only: Some(vec![0]),
+        ..Light::default()
+    });
+    let (a, b) = (render(&base, &RenderOptions::default()).unwrap(), render(&with, &RenderOptions::default()).unwrap());
+    let (mut changed, mut hidden) = (0, 0);
+    for (i, item) in b.visibility.items().iter().enumerate() {
+        let (p, q) = (a.image.pixels()[i], b.image.pixels()[i]);
+        if item.object == 0 {
+            changed += usize::from((q - p).max_element() > 0.05);
+        } else {
+            assert_eq!(p, q, "pixel {i} shows object {} which the light does not list", item.object);
+            hidden += usize::from(item.object == 1);
+        }
+    }
+    assert!(hidden > 200, "the roof hides part of the ground ({hidden} pixels)");
+    assert!(changed * 10 > b.visibility.items().iter().filter(|i| i.object == 0).count() * 9, "{changed}");
+}
