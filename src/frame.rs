@@ -6,12 +6,14 @@
 
 use std::time::Instant;
 
-use glam::Vec2;
+use glam::{Vec2, Vec3};
+use rayon::prelude::*;
 
 use crate::error::{Error, Result};
+use crate::raytrace::item_buffer;
 use crate::resolve::LinearImage;
 use crate::scene::Scene;
-use crate::shading;
+use crate::shading::{self, Component, ComponentSet, Target};
 use crate::visibility::{self, RasterStats, VisibilityBuffer};
 
 /// Most worker threads a renderer accepts.
@@ -24,11 +26,14 @@ pub struct RenderOptions {
     pub threads: Option<usize>,
     /// Reflection/refraction bounces traced from the item buffer (seed 002 §4).
     pub ray_depth: u32,
+    /// Components also written out on their own ([`Frame::aovs`]); they sum to
+    /// the final image.
+    pub aovs: ComponentSet,
 }
 
 impl Default for RenderOptions {
     fn default() -> Self {
-        RenderOptions { threads: None, ray_depth: 4 }
+        RenderOptions { threads: None, ray_depth: 4, aovs: ComponentSet::EMPTY }
     }
 }
 
@@ -66,6 +71,8 @@ pub struct Frame {
     pub image: LinearImage,
     /// Depth and item id per pixel (of the last pass, when jittered).
     pub visibility: VisibilityBuffer,
+    /// The requested components, each on its own (seed 002 Fig. 4).
+    pub aovs: Vec<(Component, LinearImage)>,
     /// Timings and counts.
     pub stats: FrameStats,
 }
@@ -74,16 +81,18 @@ pub struct Frame {
 #[derive(Debug)]
 pub struct Renderer {
     pool: Option<rayon::ThreadPool>,
-    ray_depth: u32,
+    options: RenderOptions,
     frame: Frame,
     scratch: Scratch,
 }
 
 /// Buffers a frame needs besides its own, kept between frames.
-#[derive(Debug)]
+#[derive(Debug, Default)]
 struct Scratch {
     /// Sum of the jittered passes.
     accum: LinearImage,
+    /// One jittered pass's components (when AOVs are requested).
+    aovs: Vec<LinearImage>,
 }
 
 impl Renderer {
@@ -94,18 +103,19 @@ impl Renderer {
             image: LinearImage::new(0, 0),
             visibility: VisibilityBuffer::new(0, 0),
             stats: FrameStats::default(),
+            aovs: Vec::new(),
         };
-        let scratch = Scratch { accum: LinearImage::new(0, 0) };
-        Ok(Renderer { pool, frame, ray_depth: options.ray_depth, scratch })
+        Ok(Renderer { pool, frame, options: *options, scratch: Scratch::default() })
     }
 
     /// Renders `scene` (validated first) and returns the frame.
     pub fn render(&mut self, scene: &Scene) -> Result<&Frame> {
         scene.validate()?;
         let (frame, scratch) = (&mut self.frame, &mut self.scratch);
+        let options = &self.options;
         match &self.pool {
-            None => render_into(scene, frame, scratch, self.ray_depth),
-            Some(pool) => pool.install(|| render_into(scene, frame, scratch, self.ray_depth)),
+            None => render_into(scene, frame, scratch, options),
+            Some(pool) => pool.install(|| render_into(scene, frame, scratch, options)),
         }
         Ok(&self.frame)
     }
@@ -138,46 +148,75 @@ pub fn render(scene: &Scene, options: &RenderOptions) -> Result<Frame> {
     Ok(r.into_frame())
 }
 
-fn render_into(scene: &Scene, frame: &mut Frame, scratch: &mut Scratch, ray_depth: u32) {
+fn render_into(scene: &Scene, frame: &mut Frame, scratch: &mut Scratch, options: &RenderOptions) {
     let offsets = scene.antialias.offsets();
     frame.stats = FrameStats::default();
+    let (w, h) = (scene.width, scene.height);
+    frame.aovs = options.aovs.iter().map(|c| (c, LinearImage::new(w, h))).collect();
+    scratch.aovs.resize_with(frame.aovs.len(), LinearImage::default);
+    scratch.aovs.iter_mut().for_each(|a| a.resize(w, h));
     if offsets.len() == 1 && offsets[0] == Vec2::ZERO {
-        render_pass(scene, frame, ray_depth);
+        render_pass(scene, frame, &mut scratch.aovs, options.ray_depth);
+        frame.aovs.iter_mut().zip(&mut scratch.aovs).for_each(|((_, a), s)| std::mem::swap(a, s));
     } else {
-        let accum = &mut scratch.accum;
         // Seed 002 §4: each pass shifts the image by a fraction of a pixel, so its
         // item buffer samples another point of every pixel; the passes are averaged.
-        accum.resize(scene.width, scene.height);
-        accum.pixels_mut().fill(glam::Vec3::ZERO);
+        scratch.accum.resize(w, h);
+        scratch.accum.pixels_mut().fill(Vec3::ZERO);
         let mut pass = scene.clone();
-        let pixel = 2.0 / Vec2::new(scene.width as f32, scene.height as f32);
+        let pixel = 2.0 / Vec2::new(w as f32, h as f32);
+        let k = 1.0 / offsets.len() as f32;
         for &o in &offsets {
             // Pixel offsets (y down) to NDC (y up).
             pass.camera.shift = scene.camera.shift + Vec2::new(o.x, -o.y) * pixel;
-            render_pass(&pass, frame, ray_depth);
-            accum.pixels_mut().iter_mut().zip(frame.image.pixels()).for_each(|(a, &p)| *a += p);
+            render_pass(&pass, frame, &mut scratch.aovs, options.ray_depth);
+            add_scaled(&mut scratch.accum, &frame.image, k);
+            frame.aovs.iter_mut().zip(&scratch.aovs).for_each(|((_, a), s)| add_scaled(a, s, k));
         }
-        let k = 1.0 / offsets.len() as f32;
-        frame.image.pixels_mut().iter_mut().zip(accum.pixels()).for_each(|(p, &a)| *p = a * k);
+        std::mem::swap(&mut frame.image, &mut scratch.accum);
     }
     frame.stats.buffer_bytes = frame.visibility.memory_bytes()
         + std::mem::size_of_val(frame.image.pixels())
         + std::mem::size_of_val(scratch.accum.pixels())
+        + (frame.aovs.len() + scratch.aovs.len()) * std::mem::size_of_val(frame.image.pixels())
         + frame.stats.shadow_bytes;
 }
 
-/// One visibility pass, its shading and its traced term; adds its timings to the
-/// frame's statistics.
-fn render_pass(scene: &Scene, frame: &mut Frame, ray_depth: u32) {
+/// `acc += k · img`.
+fn add_scaled(acc: &mut LinearImage, img: &LinearImage, k: f32) {
+    acc.pixels_mut().par_iter_mut().zip(img.pixels().par_iter()).for_each(|(a, &p)| *a += p * k);
+}
+
+/// One visibility pass, its shading and its traced term into `frame.image`, and
+/// the components `frame.aovs` names into `aovs` (same order); adds its timings to
+/// the frame's statistics.
+fn render_pass(scene: &Scene, frame: &mut Frame, aovs: &mut [LinearImage], ray_depth: u32) {
     let t0 = Instant::now();
     frame.visibility.resize(scene.width, scene.height);
     frame.stats.raster = visibility::rasterize(scene, &mut frame.visibility);
     let t1 = Instant::now();
     frame.image.resize(scene.width, scene.height);
-    let lit = shading::shade_lit(scene, &frame.visibility, &mut frame.image);
+    let mut targets = vec![Target { parts: ComponentSet::ALL, image: &mut frame.image }];
+    let mut traced_aov = None;
+    for ((c, _), image) in frame.aovs.iter().zip(aovs.iter_mut()) {
+        if *c == Component::Traced {
+            traced_aov = Some(image);
+        } else {
+            targets.push(Target { parts: ComponentSet::only(*c), image });
+        }
+    }
+    let lit = shading::shade_lit(scene, &frame.visibility, &mut targets);
     let t2 = Instant::now();
-    frame.stats.traced_pixels +=
-        crate::raytrace::item_buffer::add_traced(scene, &frame.visibility, &mut frame.image, ray_depth);
+    let vb = &frame.visibility;
+    frame.stats.traced_pixels += match traced_aov {
+        None => item_buffer::add_traced(scene, vb, &mut frame.image, ray_depth),
+        Some(t) => {
+            t.pixels_mut().fill(Vec3::ZERO);
+            let n = item_buffer::add_traced(scene, vb, t, ray_depth);
+            add_scaled(&mut frame.image, t, 1.0);
+            n
+        }
+    };
     frame.stats.visibility_ms += (t1 - t0).as_secs_f64() * 1e3;
     frame.stats.shading_ms += (t2 - t1).as_secs_f64() * 1e3 - lit.shadow_ms;
     frame.stats.shadow_ms += lit.shadow_ms;

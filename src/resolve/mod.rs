@@ -51,7 +51,7 @@ impl Exposure {
 }
 
 /// A linear-light RGB image, rows top to bottom.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct LinearImage {
     width: u32,
     height: u32,

@@ -11,7 +11,7 @@
 use glam::{Vec2, Vec3};
 use wide::f32x8;
 
-use super::phong::Coefficients;
+use super::phong::{Coefficients, Component, ComponentSet};
 use super::surface::{PreparedTriangle, SurfacePoint};
 use crate::scene::camera::PixelRays;
 use crate::scene::{Falloff, Light, LightKind};
@@ -343,6 +343,8 @@ pub struct Lighting<'a> {
     direct: Vec<(&'a Light, &'a ShadowTerm)>,
     ambient: Vec3,
     emission: bool,
+    diffuse: f32,
+    specular: f32,
 }
 
 impl<'a> Lighting<'a> {
@@ -350,7 +352,7 @@ impl<'a> Lighting<'a> {
     #[must_use]
     pub fn new(lights: &'a [Light]) -> Self {
         let direct = lights.iter().map(|l| (l, &ShadowTerm::Unshadowed)).collect();
-        Lighting { direct, ambient: lights.iter().map(|l| l.color * l.ambient).sum(), emission: true }
+        Lighting::pass(lights, direct, true)
     }
 
     /// The ambient terms of `ambient`, the diffuse and specular terms of `direct`
@@ -361,7 +363,28 @@ impl<'a> Lighting<'a> {
         direct: Vec<(&'a Light, &'a ShadowTerm)>,
         emission: bool,
     ) -> Self {
-        Lighting { direct, ambient: ambient.into_iter().map(|l| l.color * l.ambient).sum(), emission }
+        let ambient = ambient.into_iter().map(|l| l.color * l.ambient).sum();
+        Lighting { direct, ambient, emission, diffuse: 1.0, specular: 1.0 }
+    }
+
+    /// The same pass keeping only the components in `parts` (an AOV).
+    #[must_use]
+    pub fn restricted(&self, parts: ComponentSet) -> Self {
+        let keep = |c| f32::from(u8::from(parts.contains(c)));
+        Lighting {
+            direct: self.direct.clone(),
+            ambient: self.ambient * keep(Component::Ambient),
+            emission: self.emission && parts.contains(Component::Emission),
+            diffuse: self.diffuse * keep(Component::Diffuse),
+            specular: self.specular * keep(Component::Specular),
+        }
+    }
+
+    /// Whether the pass adds nothing at all.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        let direct = !self.direct.is_empty() && (self.diffuse > 0.0 || self.specular > 0.0);
+        !direct && self.ambient == Vec3::ZERO && !self.emission
     }
 
     /// Seed 002 eq. 1 summed over the pass's lights, per lane.
@@ -369,7 +392,8 @@ impl<'a> Lighting<'a> {
     fn shade(&self, inp: &LaneInputs, s: &LaneSurface) -> V3 {
         let mut diffuse = V3::splat(Vec3::ZERO);
         let mut specular = V3::splat(Vec3::ZERO);
-        for &(light, term) in &self.direct {
+        let direct = if self.diffuse > 0.0 || self.specular > 0.0 { self.direct.as_slice() } else { &[] };
+        for &(light, term) in direct {
             let (l, radiance) = incident(light, &s.p);
             let cos_theta = s.n.dot(l);
             let lit = cos_theta.simd_gt(F::ZERO);
@@ -380,7 +404,8 @@ impl<'a> Lighting<'a> {
             diffuse = diffuse.add(radiance.scale(lit.select(cos_theta, F::ZERO)));
             specular = specular.add(radiance.scale(lit.select(spec, F::ZERO)));
         }
-        let lit = inp.ka.mul(V3::splat(self.ambient)).add(inp.kd.mul(diffuse)).add(inp.ks.mul(specular));
+        let (kd, ks) = (inp.kd.scale(F::splat(self.diffuse)), inp.ks.scale(F::splat(self.specular)));
+        let lit = inp.ka.mul(V3::splat(self.ambient)).add(kd.mul(diffuse)).add(ks.mul(specular));
         if self.emission {
             lit.add(inp.ke)
         } else {

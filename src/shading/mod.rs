@@ -16,8 +16,9 @@ use crate::shadows::ShadowTerm;
 use crate::visibility::{ItemId, VisibilityBuffer};
 
 pub use lanes::{Blend, Lighting};
-pub use passes::{shade_lit, PassStats};
+pub use passes::{shade_lit, PassStats, Target};
 pub use phong::Components;
+pub use phong::{Component, ComponentSet};
 pub use surface::{ObjectFrames, PreparedTriangle, SurfacePoint};
 
 use phong::Coefficients;
@@ -30,6 +31,8 @@ pub struct ShadingPass<'a> {
     pub lighting: lanes::Lighting<'a>,
     /// Replace (the frame's first pass, which also writes the background) or add.
     pub blend: Blend,
+    /// What a replacing pass writes where no object is seen.
+    pub background: Vec3,
     /// Per object: whether it receives this pass (`None`: all do). Selective
     /// lighting (§3.3): the visibility buffer already holds the depth of ALL
     /// objects, so a light that lists some objects only reaches the pixels where
@@ -46,7 +49,12 @@ impl ShadingPass<'_> {
 /// Shades every pixel of `vb` into `image` (same size) with every light,
 /// unshadowed: one pass replacing the image.
 pub fn shade_into(scene: &Scene, vb: &VisibilityBuffer, image: &mut LinearImage) {
-    let pass = ShadingPass { lighting: lanes::Lighting::new(&scene.lights), blend: Blend::Replace, receivers: None };
+    let pass = ShadingPass {
+        lighting: lanes::Lighting::new(&scene.lights),
+        blend: Blend::Replace,
+        background: scene.background,
+        receivers: None,
+    };
     shade_pass(scene, vb, image, &pass);
 }
 
@@ -80,7 +88,7 @@ pub fn shade_pass(scene: &Scene, vb: &VisibilityBuffer, image: &mut LinearImage,
             for (i, (&item, px)) in items[x..end].iter().zip(out[x..end].iter_mut()).enumerate() {
                 if !pass.receives(item) {
                     if blend == Blend::Replace {
-                        *px = if item.is_none() { scene.background } else { Vec3::ZERO };
+                        *px = if item.is_none() { pass.background } else { Vec3::ZERO };
                     }
                     continue;
                 }

@@ -15,7 +15,9 @@
 
 use std::time::Instant;
 
-use super::{shade_pass, Blend, Lighting, ShadingPass};
+use glam::Vec3;
+
+use super::{shade_pass, Blend, Component, ComponentSet, Lighting, ShadingPass};
 use crate::resolve::LinearImage;
 use crate::scene::{Light, Scene, ShadowMethod};
 use crate::shadows::ShadowTerm;
@@ -39,13 +41,24 @@ fn own_pass(light: &Light) -> bool {
     light.shadow.method != ShadowMethod::None || light.only.is_some()
 }
 
-/// Shades `vb` into `image` with every light of `scene`, shadows included.
-pub fn shade_lit(scene: &Scene, vb: &VisibilityBuffer, image: &mut LinearImage) -> PassStats {
+/// An image a frame's passes write: the final image (every component) or one
+/// component on its own.
+#[derive(Debug)]
+pub struct Target<'a> {
+    /// The components this image receives.
+    pub parts: ComponentSet,
+    /// Where they go (the visibility buffer's size).
+    pub image: &'a mut LinearImage,
+}
+
+/// Shades `vb` with every light of `scene`, shadows included, into each target:
+/// each pass runs once per target, restricted to the target's components, so the
+/// shadow maps of a light are rendered once for all targets.
+pub fn shade_lit(scene: &Scene, vb: &VisibilityBuffer, targets: &mut [Target]) -> PassStats {
     let mut stats = PassStats::default();
     let fused = scene.lights.iter().filter(|l| !own_pass(l)).map(|l| (l, &UNSHADOWED)).collect();
     let ambient = scene.lights.iter().filter(|l| l.only.is_none());
-    let base = ShadingPass { lighting: Lighting::pass(ambient, fused, true), blend: Blend::Replace, receivers: None };
-    shade_pass(scene, vb, image, &base);
+    run(scene, vb, targets, &Lighting::pass(ambient, fused, true), Blend::Replace, None);
     stats.passes = 1;
     for light in scene.lights.iter().filter(|l| own_pass(l)) {
         let t = Instant::now();
@@ -55,13 +68,28 @@ pub fn shade_lit(scene: &Scene, vb: &VisibilityBuffer, image: &mut LinearImage) 
         let receivers = light.only.as_ref().map(|only| (0..scene.objects.len()).map(|i| only.contains(&i)).collect());
         // A light that lights every object had its ambient added in the first pass.
         let ambient = light.only.is_some().then_some(light);
-        let pass = ShadingPass {
-            lighting: Lighting::pass(ambient, vec![(light, &term)], false),
-            blend: Blend::Add,
-            receivers,
-        };
-        shade_pass(scene, vb, image, &pass);
+        run(scene, vb, targets, &Lighting::pass(ambient, vec![(light, &term)], false), Blend::Add, receivers);
         stats.passes += 1;
     }
     stats
+}
+
+/// One pass into every target.
+fn run(
+    scene: &Scene,
+    vb: &VisibilityBuffer,
+    targets: &mut [Target],
+    lighting: &Lighting,
+    blend: Blend,
+    receivers: Option<Vec<bool>>,
+) {
+    for t in targets {
+        let lighting = lighting.restricted(t.parts);
+        if blend == Blend::Add && lighting.is_empty() {
+            continue;
+        }
+        let background = if t.parts.contains(Component::Emission) { scene.background } else { Vec3::ZERO };
+        let pass = ShadingPass { lighting, blend, background, receivers: receivers.clone() };
+        shade_pass(scene, vb, t.image, &pass);
+    }
 }

@@ -31,6 +31,80 @@ impl Components {
     }
 }
 
+/// One term of seed 002 eq. 4/5, as a pass writes it out on its own (an AOV, the
+/// paper's Fig. 4).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Component {
+    /// Σ Ia_i · Ka · Mapa.
+    Ambient,
+    /// Σ shadow_i · Id_i · Kd · cosθ · Mapd.
+    Diffuse,
+    /// Σ shadow_i · Is_i · Ks · (cosα)^n · Maps.
+    Specular,
+    /// Ke · Mape, and the background colour of pixels that see nothing.
+    Emission,
+    /// IrayTracing: reflection and refraction traced from the item buffer.
+    Traced,
+}
+
+impl Component {
+    /// Every component, in the order of eq. 5.
+    pub const ALL: [Component; 5] =
+        [Component::Ambient, Component::Diffuse, Component::Specular, Component::Emission, Component::Traced];
+
+    /// Lower-case name (`--aov` and file names).
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Component::Ambient => "ambient",
+            Component::Diffuse => "diffuse",
+            Component::Specular => "specular",
+            Component::Emission => "emission",
+            Component::Traced => "traced",
+        }
+    }
+
+    /// The component called `name`.
+    #[must_use]
+    pub fn from_name(name: &str) -> Option<Component> {
+        Component::ALL.into_iter().find(|c| c.name() == name)
+    }
+}
+
+/// A set of [`Component`]s.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ComponentSet(u8);
+
+impl ComponentSet {
+    /// Every component: the final image.
+    pub const ALL: ComponentSet = ComponentSet(0x1f);
+    /// No component.
+    pub const EMPTY: ComponentSet = ComponentSet(0);
+
+    /// The set of `components`.
+    #[must_use]
+    pub fn of(components: &[Component]) -> ComponentSet {
+        ComponentSet(components.iter().fold(0, |m, &c| m | 1 << c as u8))
+    }
+
+    /// The components in the set, in the order of [`Component::ALL`].
+    pub fn iter(self) -> impl Iterator<Item = Component> {
+        Component::ALL.into_iter().filter(move |&c| self.contains(c))
+    }
+
+    /// Just `c`.
+    #[must_use]
+    pub fn only(c: Component) -> ComponentSet {
+        ComponentSet(1 << c as u8)
+    }
+
+    /// Whether `c` is in the set.
+    #[must_use]
+    pub fn contains(self, c: Component) -> bool {
+        self.0 & (1 << c as u8) != 0
+    }
+}
+
 /// The material's coefficients at a point, with their maps applied.
 #[derive(Debug, Clone, Copy)]
 pub struct Coefficients {

@@ -388,7 +388,8 @@ fn run_hybrid(args: &BenchArgs) -> Result<()> {
     scene.materials.iter_mut().filter(|m| m.name == "floor").for_each(|m| m.kr = glam::Vec3::ZERO);
     // "Traced up to the second ray" (seed 002 §4): primary + one bounce.
     let depth = 1;
-    let mut renderer = Renderer::new(&RenderOptions { threads: None, ray_depth: depth }).map_err(|e| miette!("{e}"))?;
+    let mut renderer =
+        Renderer::new(&RenderOptions { ray_depth: depth, ..RenderOptions::default() }).map_err(|e| miette!("{e}"))?;
     let (mut hybrid, mut full) = (Vec::new(), Vec::new());
     let mut traced = 0;
     let mut full_image = None;

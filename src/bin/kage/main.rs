@@ -11,6 +11,7 @@ use std::path::{Path, PathBuf};
 use clap::{Parser, Subcommand};
 use kage::resolve::{Antialias, Exposure};
 use kage::scene::{demo::demo_scene, file, Scene};
+use kage::shading::{Component, ComponentSet};
 use kage::{render, RenderOptions};
 
 /// A CPU renderer for design previews.
@@ -89,9 +90,37 @@ struct RenderArgs {
     /// seed 002 §4); overrides the scene. The reference uses --spp instead.
     #[arg(long, value_parser = parse_antialias)]
     antialias: Option<Antialias>,
+    /// Also write these components, each on its own (seed 002 Fig. 4), next to the
+    /// output as NAME.COMPONENT.EXT: a comma list of ambient, diffuse, specular,
+    /// emission (with the background), traced; or `all`. They sum to the image.
+    #[arg(long, value_parser = parse_components)]
+    aov: Option<ComponentSet>,
     /// Brightness of PNG output: stops (e.g. 1.5, -1) or `auto`; overrides the scene.
     #[arg(long, value_parser = parse_exposure, allow_hyphen_values = true)]
     exposure: Option<Exposure>,
+}
+
+/// `out.png` → `out.diffuse.png`.
+fn aov_path(output: &Path, name: &str) -> PathBuf {
+    let stem = output.file_stem().and_then(|s| s.to_str()).unwrap_or("kage");
+    let ext = output.extension().and_then(|e| e.to_str()).unwrap_or("png");
+    output.with_file_name(format!("{stem}.{name}.{ext}"))
+}
+
+fn parse_components(s: &str) -> Result<ComponentSet, String> {
+    if s == "all" {
+        return Ok(ComponentSet::ALL);
+    }
+    let list: Result<Vec<Component>, String> = s
+        .split(',')
+        .map(|name| {
+            Component::from_name(name.trim()).ok_or_else(|| {
+                let known: Vec<&str> = Component::ALL.iter().map(|c| c.name()).collect();
+                format!("'{name}' is not a component (expected 'all' or some of {})", known.join(", "))
+            })
+        })
+        .collect();
+    Ok(ComponentSet::of(&list?))
 }
 
 fn parse_antialias(s: &str) -> Result<Antialias, String> {
@@ -153,9 +182,16 @@ fn render_command(args: &RenderArgs) -> kage::error::Result<()> {
     if args.reference {
         return reference_command(args, &scene);
     }
-    let frame = render(&scene, &RenderOptions { threads: args.threads, ray_depth: args.ray_depth })?;
+    let aovs = args.aov.unwrap_or(ComponentSet::EMPTY);
+    let frame = render(&scene, &RenderOptions { threads: args.threads, ray_depth: args.ray_depth, aovs })?;
     let exposure = args.exposure.unwrap_or(scene.exposure).scale(&frame.image);
     kage::output::write_image(&frame.image, &args.output, exposure)?;
+    for (c, image) in &frame.aovs {
+        // The same exposure as the final image, so the components add up to it.
+        let path = aov_path(&args.output, c.name());
+        kage::output::write_image(image, &path, exposure)?;
+        eprintln!("wrote {} ({} component)", path.display(), c.name());
+    }
     if frame.visibility.items().iter().all(|i| i.is_none()) {
         eprintln!("warning: no object is in view: the image shows only the background (check the camera)");
     }

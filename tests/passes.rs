@@ -1,0 +1,51 @@
+//! Multi-pass rendering (seed 002 eq. 4/5): the component passes, written out on
+//! their own, sum to the final image.
+
+use std::path::Path;
+
+use glam::Vec3;
+use kage::resolve::Antialias;
+use kage::shading::{Component, ComponentSet};
+use kage::{render, RenderOptions};
+
+fn example(name: &str) -> kage::Scene {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenes").join(name);
+    let mut scene = kage::scene::file::load_scene(&path).unwrap();
+    (scene.width, scene.height) = (192, 108);
+    scene
+}
+
+#[test]
+fn component_images_sum_to_the_final_image() {
+    for (name, antialias) in [
+        ("reflections.toml", Antialias::None),
+        ("spotlights.toml", Antialias::None),
+        ("demo.toml", Antialias::Jitter(4)),
+    ] {
+        let mut scene = example(name);
+        scene.antialias = antialias;
+        let options = RenderOptions { aovs: ComponentSet::ALL, ..RenderOptions::default() };
+        let frame = render(&scene, &options).unwrap();
+        assert_eq!(frame.aovs.iter().map(|(c, _)| *c).collect::<Vec<_>>(), Component::ALL.to_vec());
+        let mut nonzero = [0usize; 5];
+        for (i, p) in frame.image.pixels().iter().enumerate() {
+            let sum: Vec3 = frame.aovs.iter().map(|(_, a)| a.pixels()[i]).sum();
+            assert!(
+                (sum - *p).abs().max_element() <= 1e-5 * p.max_element().max(1.0),
+                "{name} pixel {i}: {sum} vs {p}"
+            );
+            for (k, (_, a)) in frame.aovs.iter().enumerate() {
+                nonzero[k] += usize::from(a.pixels()[i].max_element() > 1e-4);
+            }
+        }
+        // Every component but the traced one (only reflections.toml traces) shows up.
+        let traced = name == "reflections.toml";
+        for (k, c) in Component::ALL.iter().enumerate() {
+            let expect = *c != Component::Traced || traced;
+            assert_eq!(nonzero[k] > 20, expect, "{name}: {} component has {} pixels", c.name(), nonzero[k]);
+        }
+        // The final image is the same with or without AOVs.
+        let plain = render(&scene, &RenderOptions::default()).unwrap();
+        assert_eq!(plain.image, frame.image, "{name}: AOVs change the image");
+    }
+}
