@@ -13,7 +13,7 @@ use crate::error::{Error, Result};
 use crate::raytrace::item_buffer;
 use crate::resolve::LinearImage;
 use crate::scene::Scene;
-use crate::shading::{self, Component, ComponentSet, Target};
+use crate::shading::{self, fog, Component, ComponentSet, Target};
 use crate::visibility::{self, RasterStats, VisibilityBuffer};
 
 /// Most worker threads a renderer accepts.
@@ -205,23 +205,32 @@ fn render_pass(scene: &Scene, frame: &mut Frame, aovs: &mut [LinearImage], ray_d
             targets.push(Target { parts: ComponentSet::only(*c), image });
         }
     }
-    let lit = shading::shade_lit(scene, &frame.visibility, &mut targets);
-    let t2 = Instant::now();
     let vb = &frame.visibility;
-    frame.stats.traced_pixels += match traced_aov {
-        None => item_buffer::add_traced(scene, vb, &mut frame.image, ray_depth),
+    let lit = shading::shade_lit(scene, vb, &mut targets);
+    let t2 = Instant::now();
+    frame.stats.traced_pixels += match &mut traced_aov {
+        None => item_buffer::add_traced(scene, vb, targets[0].image, ray_depth),
         Some(t) => {
             t.pixels_mut().fill(Vec3::ZERO);
             let n = item_buffer::add_traced(scene, vb, t, ray_depth);
-            add_scaled(&mut frame.image, t, 1.0);
+            add_scaled(targets[0].image, t, 1.0);
             n
         }
     };
+    let t3 = Instant::now();
+    if let Some(fog) = &scene.fog {
+        let amounts = fog::fog_amounts(scene, fog, vb);
+        targets.extend(traced_aov.map(|image| Target { parts: ComponentSet::only(Component::Traced), image }));
+        for t in &mut targets {
+            let color = if t.parts.contains(Component::Fog) { fog.color } else { Vec3::ZERO };
+            fog::apply(t.image, &amounts, color);
+        }
+    }
     frame.stats.visibility_ms += (t1 - t0).as_secs_f64() * 1e3;
-    frame.stats.shading_ms += (t2 - t1).as_secs_f64() * 1e3 - lit.shadow_ms;
+    frame.stats.shading_ms += ((t2 - t1) + t3.elapsed()).as_secs_f64() * 1e3 - lit.shadow_ms;
     frame.stats.shadow_ms += lit.shadow_ms;
     frame.stats.shadow_bytes = frame.stats.shadow_bytes.max(lit.shadow_bytes);
     frame.stats.shading_passes += lit.passes;
-    frame.stats.traced_ms += t2.elapsed().as_secs_f64() * 1e3;
+    frame.stats.traced_ms += (t3 - t2).as_secs_f64() * 1e3;
     frame.stats.passes += 1;
 }

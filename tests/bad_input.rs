@@ -54,6 +54,13 @@ fn semantic_errors_point_at_the_value() {
     assert!(e.contains("needs `position`"), "{e}");
     let e = parse_err("[image]\nwidth = 8\n");
     assert!(e.contains("no [[object]]"), "{e}");
+    let e = parse_err(&format!("[fog]\nmode = \"linear\"\ndensity = 0.1\n{OK_OBJECT}"));
+    assert!(e.starts_with("bad.toml:1:1") && e.contains("linear fog needs `end`"), "{e}");
+    let e =
+        parse_err(&format!("[[light]]\ntype = \"point\"\nposition = [0, 1, 0]\nshadow = {{ pcf = 0 }}\n{OK_OBJECT}"));
+    assert!(e.starts_with("bad.toml:4:18") && e.contains("pcf must be between 1 and 15"), "{e}");
+    let e = parse_err(&format!("[[light]]\ntype = \"point\"\nposition = [0, 1, 0]\nonly = [\"teapot\"]\n{OK_OBJECT}"));
+    assert!(e.starts_with("bad.toml:4:9") && e.contains("no [[object]] named 'teapot'"), "{e}");
     let e = parse_err(&format!("[image]\nantialias = {{ method = \"blur\" }}\n{OK_OBJECT}"));
     assert!(e.starts_with("bad.toml:2:24") && e.contains("unknown antialiasing method 'blur'"), "{e}");
     let e = parse_err(&format!("[image]\nantialias = {{ method = \"jitter\", samples = 0 }}\n{OK_OBJECT}"));

@@ -24,10 +24,14 @@ fn component_images_sum_to_the_final_image() {
     ] {
         let mut scene = example(name);
         scene.antialias = antialias;
+        if name == "spotlights.toml" {
+            let mode = kage::shading::fog::FogMode::Exp2 { density: 0.12 };
+            scene.fog = Some(kage::shading::fog::Fog { mode, color: Vec3::new(0.3, 0.3, 0.35) });
+        }
         let options = RenderOptions { aovs: ComponentSet::ALL, ..RenderOptions::default() };
         let frame = render(&scene, &options).unwrap();
         assert_eq!(frame.aovs.iter().map(|(c, _)| *c).collect::<Vec<_>>(), Component::ALL.to_vec());
-        let mut nonzero = [0usize; 5];
+        let mut nonzero = [0usize; 6];
         for (i, p) in frame.image.pixels().iter().enumerate() {
             let sum: Vec3 = frame.aovs.iter().map(|(_, a)| a.pixels()[i]).sum();
             assert!(
@@ -38,10 +42,14 @@ fn component_images_sum_to_the_final_image() {
                 nonzero[k] += usize::from(a.pixels()[i].max_element() > 1e-4);
             }
         }
-        // Every component but the traced one (only reflections.toml traces) shows up.
-        let traced = name == "reflections.toml";
+        // Every component shows up where the scene has it: only reflections.toml
+        // traces, only spotlights.toml (here) has fog.
         for (k, c) in Component::ALL.iter().enumerate() {
-            let expect = *c != Component::Traced || traced;
+            let expect = match c {
+                Component::Traced => name == "reflections.toml",
+                Component::Fog => name == "spotlights.toml",
+                _ => true,
+            };
             assert_eq!(nonzero[k] > 20, expect, "{name}: {} component has {} pixels", c.name(), nonzero[k]);
         }
         // The final image is the same with or without AOVs.

@@ -175,3 +175,33 @@ fn a_selective_light_changes_only_its_objects_and_others_still_hide_them() {
     assert!(hidden > 200, "the roof hides part of the ground ({hidden} pixels)");
     assert!(changed * 10 > b.visibility.items().iter().filter(|i| i.object == 0).count() * 9, "{changed}");
 }
+
+#[test]
+fn fog_in_a_shadow_is_the_lerp_to_the_fog_colour_not_black() {
+    use kage::shading::fog::{Fog, FogMode};
+    let plain = roofed(0.3);
+    let mut foggy = plain.clone();
+    // The orthographic eye is 5 units above the ground: f = (5 − 2) / (8 − 2) = 0.5
+    // (to 1e-4: the view is tilted by 0.001 / 5 to keep `up` off the view axis).
+    let fog = Fog { mode: FogMode::Linear { start: 2.0, end: 8.0 }, color: Vec3::new(0.6, 0.7, 0.9) };
+    foggy.fog = Some(fog);
+    let (a, b) =
+        (render(&plain, &RenderOptions::default()).unwrap(), render(&foggy, &RenderOptions::default()).unwrap());
+    let m = &plain.materials[0];
+    let shadowed = m.ka * 0.3 + m.ke;
+    let (mut in_shadow, mut ground) = (0, 0);
+    for (i, item) in b.visibility.items().iter().enumerate() {
+        if item.object != 0 {
+            continue;
+        }
+        let (p, q) = (a.image.pixels()[i], b.image.pixels()[i]);
+        let want = p.lerp(fog.color, 0.5);
+        assert!((q - want).abs().max_element() < 1e-4, "pixel {i}: fogged {q}, lerp({p}, fog, 0.5) = {want}");
+        ground += 1;
+        if (p - shadowed).abs().max_element() < 1e-6 {
+            in_shadow += 1;
+            assert!(q.min_element() > 0.3, "a fogged shadow is not black: {q}");
+        }
+    }
+    assert!(in_shadow > 20 && ground > 3000, "{in_shadow} shadowed of {ground} ground pixels");
+}

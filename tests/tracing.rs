@@ -49,6 +49,7 @@ fn mirror_scene() -> Scene {
         background: Vec3::ZERO,
         exposure: Default::default(),
         antialias: Default::default(),
+        fog: None,
         camera: Camera {
             eye: Vec3::new(0.0, 0.0, 5.0),
             target: Vec3::ZERO,

@@ -23,6 +23,7 @@ use super::{
 use crate::error::{Error, Result, SourceLocation};
 use crate::resolve::jitter::MAX_JITTER_SAMPLES;
 use crate::resolve::{Antialias, Exposure};
+use crate::shading::fog::{Fog, FogMode};
 
 type V3 = [f32; 3];
 
@@ -39,6 +40,7 @@ pub struct SceneFile {
     materials: Vec<Spanned<MaterialRec>>,
     #[serde(default, rename = "object")]
     objects: Vec<Spanned<ObjectRec>>,
+    fog: Option<Spanned<FogRec>>,
     #[serde(skip)]
     origin: Option<Origin>,
 }
@@ -61,6 +63,30 @@ struct ImageRec {
     #[serde(default)]
     exposure: ExposureRec,
     antialias: Option<Spanned<AntialiasRec>>,
+}
+
+/// `[fog]`: `mode` linear (`start`, `end`), exp or exp2 (`density`), `color`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FogRec {
+    mode: FogModeRec,
+    #[serde(default = "fog_color")]
+    color: V3,
+    start: Option<f32>,
+    end: Option<f32>,
+    density: Option<f32>,
+}
+
+fn fog_color() -> V3 {
+    [0.7, 0.72, 0.75]
+}
+
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+enum FogModeRec {
+    Linear,
+    Exp,
+    Exp2,
 }
 
 /// `antialias = { method = "jitter", samples = 8 }` (or `method = "none"`).
@@ -321,6 +347,30 @@ impl SceneFile {
         }
     }
 
+    fn fog(&self) -> Result<Option<Fog>> {
+        let Some(rec) = &self.fog else { return Ok(None) };
+        let r = rec.get_ref();
+        let bad = |msg: &str| Err(self.invalid(rec.span(), msg.to_string()));
+        let finite = |v: Option<f32>| v.is_none_or(|v| v.is_finite() && v >= 0.0);
+        if !(finite(r.start)
+            && finite(r.end)
+            && finite(r.density)
+            && r.color.iter().all(|c| c.is_finite() && *c >= 0.0))
+        {
+            return bad("fog distances, density and colour must be finite and ≥ 0");
+        }
+        let mode = match (r.mode, r.start, r.end, r.density) {
+            (FogModeRec::Linear, start, Some(end), None) if end > start.unwrap_or(0.0) => {
+                FogMode::Linear { start: start.unwrap_or(0.0), end }
+            }
+            (FogModeRec::Linear, ..) => return bad("linear fog needs `end` (> `start`, default 0) and no `density`"),
+            (FogModeRec::Exp, None, None, Some(density)) => FogMode::Exp { density },
+            (FogModeRec::Exp2, None, None, Some(density)) => FogMode::Exp2 { density },
+            _ => return bad("exp and exp2 fog need `density` and no `start`/`end`"),
+        };
+        Ok(Some(Fog { mode, color: r.color.into() }))
+    }
+
     fn antialias(&self) -> Result<Antialias> {
         let Some(rec) = &self.image.antialias else { return Ok(Antialias::None) };
         let rec = rec.get_ref();
@@ -367,6 +417,7 @@ impl SceneFile {
             warnings: Vec::new(),
             exposure: self.image.exposure.into(),
             antialias: self.antialias()?,
+            fog: self.fog()?,
         };
         let mut models = Vec::new();
         let mut produced = Vec::new();
@@ -649,6 +700,7 @@ pub fn scene_for_model(path: &Path, width: u32, height: u32) -> Result<Scene> {
         warnings: Vec::new(),
         exposure: Default::default(),
         antialias: Default::default(),
+        fog: None,
     };
     add_model(&mut scene, &model, &path.display().to_string(), Affine3A::IDENTITY, None);
     let (camera, lights) = framing(scene.bounds().expect("a model has parts"), width as f32 / height as f32);

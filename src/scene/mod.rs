@@ -54,6 +54,8 @@ pub struct Scene {
     pub exposure: crate::resolve::Exposure,
     /// How edges are antialiased.
     pub antialias: crate::resolve::Antialias,
+    /// Fog (seed 002 §3.5), if any.
+    pub fog: Option<crate::shading::fog::Fog>,
     /// The eye.
     pub camera: Camera,
     /// Lights.

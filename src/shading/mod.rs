@@ -2,6 +2,7 @@
 //! the surface is reconstructed from the item id and lit by eq. 1 into a linear
 //! float accumulation buffer. Pixels that see nothing get the background colour.
 
+pub mod fog;
 pub mod lanes;
 pub mod passes;
 pub mod phong;

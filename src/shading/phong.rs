@@ -45,12 +45,20 @@ pub enum Component {
     Emission,
     /// IrayTracing: reflection and refraction traced from the item buffer.
     Traced,
+    /// Fog (§3.5): f(d) · fog colour on every visible surface, shadows or not.
+    Fog,
 }
 
 impl Component {
     /// Every component, in the order of eq. 5.
-    pub const ALL: [Component; 5] =
-        [Component::Ambient, Component::Diffuse, Component::Specular, Component::Emission, Component::Traced];
+    pub const ALL: [Component; 6] = [
+        Component::Ambient,
+        Component::Diffuse,
+        Component::Specular,
+        Component::Emission,
+        Component::Traced,
+        Component::Fog,
+    ];
 
     /// Lower-case name (`--aov` and file names).
     #[must_use]
@@ -61,6 +69,7 @@ impl Component {
             Component::Specular => "specular",
             Component::Emission => "emission",
             Component::Traced => "traced",
+            Component::Fog => "fog",
         }
     }
 
@@ -77,7 +86,7 @@ pub struct ComponentSet(u8);
 
 impl ComponentSet {
     /// Every component: the final image.
-    pub const ALL: ComponentSet = ComponentSet(0x1f);
+    pub const ALL: ComponentSet = ComponentSet(0x3f);
     /// No component.
     pub const EMPTY: ComponentSet = ComponentSet(0);
 

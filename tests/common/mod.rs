@@ -33,6 +33,7 @@ pub fn scene_with(mesh: Mesh, camera: Camera, width: u32, height: u32, two_sided
         warnings: Vec::new(),
         exposure: Default::default(),
         antialias: Default::default(),
+        fog: None,
     }
 }
 

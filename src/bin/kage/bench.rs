@@ -157,6 +157,7 @@ fn peer_scene(path: &Path, width: u32, height: u32) -> Result<Scene> {
         warnings: Vec::new(),
         exposure: Default::default(),
         antialias: Default::default(),
+        fog: None,
     };
     add_model(&mut scene, &model, "peer", Affine3A::IDENTITY, Some(0));
     Ok(scene)
