@@ -414,18 +414,14 @@ impl<'a> Lighting<'a> {
     }
 }
 
-/// The shadow term per lane, looked up one lane at a time where the surface faces
-/// the light (elsewhere the diffuse and specular terms are zero anyway).
+/// The shadow term per lane (where the surface faces away from the light it is
+/// irrelevant: the diffuse and specular terms are zero there anyway).
 #[inline(always)]
 fn shadow(term: &ShadowTerm, s: &LaneSurface, cos_theta: F) -> F {
-    let cos = cos_theta.to_array();
-    let mut out = [0.0f32; LANES];
-    for (i, o) in out.iter_mut().enumerate() {
-        if cos[i] > 0.0 {
-            *o = term.lit(s.p.lane(i), cos[i]);
-        }
+    if !cos_theta.simd_gt(F::ZERO).any() {
+        return F::ZERO;
     }
-    F::new(out)
+    term.lit_lanes([s.p.x, s.p.y, s.p.z], cos_theta)
 }
 
 /// `x^n` per lane for x ≥ 0: by repeated squaring when every lane has the same

@@ -5,13 +5,14 @@
 //! passes, so kage groups them by what they need:
 //!
 //! 1. one pass replaces the buffer with emission, the ambient of every light that
-//!    lights all objects, and the diffuse and specular of every light that has
-//!    neither a shadow nor an object list — all in one sweep;
-//! 2. then each light with a shadow term or an object list gets its own pass: its
-//!    shadow maps are rendered, its diffuse and specular are added multiplied by
-//!    its shadow term (and, if selective, its ambient, on its objects only), and its
-//!    maps are dropped — so memory does not grow with the number of lights and
-//!    time grows linearly with them.
+//!    lights all objects, and the diffuse and specular — times its shadow term — of
+//!    every such light whose shadow maps fit a memory budget together: one sweep
+//!    reconstructs each pixel's surface once for all of them;
+//! 2. then each remaining light — selective ones (§3.3), and shadowed ones past
+//!    the budget — gets its own pass: its maps are rendered, its diffuse and
+//!    specular (and, if selective, its ambient, on its objects only) are added,
+//!    and its maps are dropped, so memory stays bounded however many lights there
+//!    are, and time grows linearly with them.
 
 use std::time::Instant;
 
@@ -19,7 +20,7 @@ use glam::Vec3;
 
 use super::{shade_pass, Blend, Component, ComponentSet, Lighting, ShadingPass};
 use crate::resolve::LinearImage;
-use crate::scene::{Light, Scene, ShadowMethod};
+use crate::scene::{Light, Scene};
 use crate::shadows::ShadowTerm;
 use crate::visibility::VisibilityBuffer;
 
@@ -30,15 +31,8 @@ pub struct PassStats {
     pub passes: u32,
     /// Milliseconds spent rendering shadow maps.
     pub shadow_ms: f64,
-    /// Largest memory the shadow maps of one light held.
+    /// Most bytes of shadow maps held at once.
     pub shadow_bytes: usize,
-}
-
-static UNSHADOWED: ShadowTerm = ShadowTerm::Unshadowed;
-
-/// Whether `light` needs a pass of its own.
-fn own_pass(light: &Light) -> bool {
-    light.shadow.method != ShadowMethod::None || light.only.is_some()
 }
 
 /// An image a frame's passes write: the final image (every component) or one
@@ -51,19 +45,33 @@ pub struct Target<'a> {
     pub image: &'a mut LinearImage,
 }
 
+/// Most bytes of shadow maps held at once for the first, fused pass.
+pub const FUSED_SHADOW_BUDGET: usize = 256 << 20;
+
 /// Shades `vb` with every light of `scene`, shadows included, into each target:
 /// each pass runs once per target, restricted to the target's components, so the
 /// shadow maps of a light are rendered once for all targets.
 pub fn shade_lit(scene: &Scene, vb: &VisibilityBuffer, targets: &mut [Target]) -> PassStats {
     let mut stats = PassStats::default();
-    let fused = scene.lights.iter().filter(|l| !own_pass(l)).map(|l| (l, &UNSHADOWED)).collect();
+    let mut budget = FUSED_SHADOW_BUDGET;
+    let (mut fused, mut own) = (Vec::new(), Vec::new());
+    for light in &scene.lights {
+        let bytes = ShadowTerm::bytes_needed(light);
+        if light.only.is_none() && bytes <= budget {
+            budget -= bytes;
+            fused.push((light, build(scene, light, &mut stats)));
+        } else {
+            own.push(light);
+        }
+    }
+    stats.shadow_bytes = FUSED_SHADOW_BUDGET - budget;
+    let direct = fused.iter().map(|(l, t)| (*l, t)).collect();
     let ambient = scene.lights.iter().filter(|l| l.only.is_none());
-    run(scene, vb, targets, &Lighting::pass(ambient, fused, true), Blend::Replace, None);
+    run(scene, vb, targets, &Lighting::pass(ambient, direct, true), Blend::Replace, None);
     stats.passes = 1;
-    for light in scene.lights.iter().filter(|l| own_pass(l)) {
-        let t = Instant::now();
-        let term = ShadowTerm::build(scene, light);
-        stats.shadow_ms += t.elapsed().as_secs_f64() * 1e3;
+    drop(fused);
+    for light in own {
+        let term = build(scene, light, &mut stats);
         stats.shadow_bytes = stats.shadow_bytes.max(term.memory_bytes());
         let receivers = light.only.as_ref().map(|only| (0..scene.objects.len()).map(|i| only.contains(&i)).collect());
         // A light that lights every object had its ambient added in the first pass.
@@ -72,6 +80,14 @@ pub fn shade_lit(scene: &Scene, vb: &VisibilityBuffer, targets: &mut [Target]) -
         stats.passes += 1;
     }
     stats
+}
+
+/// The shadow term of `light`, timed into `stats`.
+fn build(scene: &Scene, light: &Light, stats: &mut PassStats) -> ShadowTerm {
+    let t = Instant::now();
+    let term = ShadowTerm::build(scene, light);
+    stats.shadow_ms += t.elapsed().as_secs_f64() * 1e3;
+    term
 }
 
 /// One pass into every target.

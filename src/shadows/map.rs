@@ -9,6 +9,7 @@
 //! the slope term the depth change across one texel of a surface the light grazes.
 
 use glam::{Mat4, Vec3};
+use wide::f32x8;
 
 use crate::scene::{Camera, Projection, Scene, ShadowSettings};
 use crate::visibility::{rasterize_from, Faces, VisibilityBuffer};
@@ -58,10 +59,11 @@ impl DepthMap {
         }
     }
 
-    /// Whether `p` projects inside this map (in front of the light, within its
-    /// square); the texel position if so.
+    /// Where `p` falls in the map: texel coordinates and distance along the
+    /// light's axis; `None` outside the map (or behind the light).
+    #[inline]
     #[must_use]
-    pub fn texel_of(&self, p: Vec3) -> Option<(f32, f32)> {
+    pub fn project(&self, p: Vec3) -> Option<(f32, f32, f32)> {
         let c = self.view_proj * p.extend(1.0);
         if c.w <= 0.0 {
             return None;
@@ -69,7 +71,9 @@ impl DepthMap {
         let (x, y) = (c.x / c.w, c.y / c.w);
         let n = self.resolution as f32;
         let (u, v) = ((x * 0.5 + 0.5) * n, (0.5 - y * 0.5) * n);
-        (u >= 0.0 && v >= 0.0 && u < n && v < n).then_some((u, v))
+        // Perspective: w is the distance along the axis; orthographic: w = 1.
+        let d = if self.ortho { (p - self.eye).dot(self.axis) } else { c.w };
+        (u >= 0.0 && v >= 0.0 && u < n && v < n).then_some((u, v, d))
     }
 
     /// Fraction of the k × k texels around `p`'s projection whose surface does not
@@ -77,11 +81,7 @@ impl DepthMap {
     /// the map are lit.
     #[must_use]
     pub fn lit(&self, p: Vec3, cos_theta: f32, settings: &ShadowSettings) -> f32 {
-        let Some((u, v)) = self.texel_of(p) else { return 1.0 };
-        let d = (p - self.eye).dot(self.axis);
-        if !self.ortho && d < self.near {
-            return 1.0;
-        }
+        let Some((u, v, d)) = self.project(p) else { return 1.0 };
         let texel = if self.ortho { self.texel } else { self.texel * d };
         let c = cos_theta.clamp(1e-3, 1.0);
         let tan = ((1.0 - c * c).sqrt() / c).min(MAX_SLOPE);
@@ -90,27 +90,91 @@ impl DepthMap {
         // sloped receiver is deeper: scale the slope term with the filter radius.
         let reach = 1.0 + (k - 1) as f32 * 0.5;
         let limit = d - texel * (settings.bias + settings.slope * tan * reach);
+        // Lit where the stored surface is at least `limit` away: compared in the
+        // stored reversed depth, which falls with distance, so one division per
+        // lookup instead of one per texel.
+        let z_limit = if self.ortho {
+            ((self.far - limit) / (self.far - self.near)).max(0.0)
+        } else if limit > self.near {
+            self.near / limit
+        } else {
+            return 1.0; // the receiver is at the light
+        };
         let (cu, cv) = (u as i32, v as i32);
         let last = self.resolution as i32 - 1;
+        let depth = self.depth.depths();
         let mut lit = 0u32;
         for dy in 0..k {
+            let y = (cv + dy - k / 2).clamp(0, last) as usize * self.resolution as usize;
             for dx in 0..k {
                 let x = (cu + dx - k / 2).clamp(0, last) as usize;
-                let y = (cv + dy - k / 2).clamp(0, last) as usize;
-                lit += u32::from(self.distance(self.depth.depths()[y * self.resolution as usize + x]) >= limit);
+                lit += u32::from(depth[y + x] <= z_limit);
             }
         }
         lit as f32 / (k * k) as f32
     }
 
-    /// Distance along the axis of a texel holding reversed depth `z` (∞: empty).
-    #[inline]
-    fn distance(&self, z: f32) -> f32 {
-        match (z > 0.0, self.ortho) {
-            (false, _) => f32::INFINITY,
-            (true, false) => self.near / z,
-            (true, true) => self.far - z * (self.far - self.near),
+    /// [`DepthMap::lit`] for eight points at once (`p` as x, y and z lanes): the
+    /// projection, bias and depth limit as vector arithmetic, the texel reads one
+    /// lane at a time.
+    #[must_use]
+    pub fn lit_lanes(&self, p: [f32x8; 3], cos_theta: f32x8, settings: &ShadowSettings) -> f32x8 {
+        let m = self.view_proj;
+        let row = |r: usize| {
+            let (a, b, c, d) = (m.x_axis[r], m.y_axis[r], m.z_axis[r], m.w_axis[r]);
+            p[0].mul_add(f32x8::splat(a), p[1].mul_add(f32x8::splat(b), p[2].mul_add(f32x8::splat(c), f32x8::splat(d))))
+        };
+        let (cx, cy, cw) = (row(0), row(1), row(3));
+        let n = f32x8::splat(self.resolution as f32);
+        let half = f32x8::splat(0.5);
+        let inv_w = f32x8::ONE / cw;
+        let u = (cx * inv_w).mul_add(half, half) * n;
+        let v = (half - cy * inv_w * half) * n;
+        let zero = f32x8::ZERO;
+        let inside = cw.simd_gt(zero) & u.simd_ge(zero) & v.simd_ge(zero) & u.simd_lt(n) & v.simd_lt(n);
+        let d = if self.ortho {
+            let e = self.eye;
+            let a = self.axis;
+            (p[0] - f32x8::splat(e.x)) * f32x8::splat(a.x)
+                + (p[1] - f32x8::splat(e.y)) * f32x8::splat(a.y)
+                + (p[2] - f32x8::splat(e.z)) * f32x8::splat(a.z)
+        } else {
+            cw
+        };
+        let texel = if self.ortho { f32x8::splat(self.texel) } else { d * f32x8::splat(self.texel) };
+        let c = cos_theta.max(f32x8::splat(1e-3)).min(f32x8::ONE);
+        let tan = ((f32x8::ONE - c * c).sqrt() / c).min(f32x8::splat(MAX_SLOPE));
+        let k = settings.pcf.max(1) as i32;
+        let reach = 1.0 + (k - 1) as f32 * 0.5;
+        let bias = f32x8::splat(settings.bias) + tan * f32x8::splat(settings.slope * reach);
+        let limit = d - texel * bias;
+        let z_limit = if self.ortho {
+            ((f32x8::splat(self.far) - limit) / f32x8::splat(self.far - self.near)).max(zero)
+        } else {
+            let near = f32x8::splat(self.near);
+            limit.simd_gt(near).select(near / limit, f32x8::splat(f32::INFINITY))
+        };
+        let (inside, u, v, z_limit) = (inside.to_array(), u.to_array(), v.to_array(), z_limit.to_array());
+        let (last, res) = (self.resolution as i32 - 1, self.resolution as usize);
+        let depth = self.depth.depths();
+        let share = 1.0 / (k * k) as f32;
+        let mut out = [1.0f32; 8];
+        for i in 0..8 {
+            if inside[i] == 0.0 {
+                continue;
+            }
+            let (cu, cv) = (u[i] as i32, v[i] as i32);
+            let mut lit = 0u32;
+            for dy in 0..k {
+                let y = (cv + dy - k / 2).clamp(0, last) as usize * res;
+                for dx in 0..k {
+                    let x = (cu + dx - k / 2).clamp(0, last) as usize;
+                    lit += u32::from(depth[y + x] <= z_limit[i]);
+                }
+            }
+            out[i] = lit as f32 * share;
         }
+        f32x8::new(out)
     }
 
     /// Bytes held by the map.

@@ -11,6 +11,7 @@
 pub mod map;
 
 use glam::{Vec2, Vec3};
+use wide::f32x8;
 
 pub use map::DepthMap;
 
@@ -48,7 +49,7 @@ impl ShadowTerm {
                 ShadowTerm::Map(DepthMap::render(scene, &cam, res), settings)
             }
             LightKind::Point { position } | LightKind::Spot { position, .. } => {
-                // Six faces at half the resolution: about 1.5 single maps of memory.
+                // Six faces at half the resolution: 1.5 single maps of memory.
                 let res = (res / 2).max(16);
                 let faces = [Vec3::X, Vec3::NEG_X, Vec3::Y, Vec3::NEG_Y, Vec3::Z, Vec3::NEG_Z].map(|axis| {
                     let cam = light_camera(position, axis, Projection::Perspective { fov_y_deg: 90.0 }, bounds);
@@ -60,6 +61,24 @@ impl ShadowTerm {
                 let cam =
                     fitted_orthographic(&scene.camera, scene.width as f32 / scene.height as f32, direction, bounds);
                 ShadowTerm::Map(DepthMap::render(scene, &cam, res), settings)
+            }
+        }
+    }
+
+    /// Bytes the maps of `light` will hold (before they are rendered).
+    #[must_use]
+    pub fn bytes_needed(light: &Light) -> usize {
+        if light.shadow.method == ShadowMethod::None {
+            return 0;
+        }
+        let res = light.shadow.resolution.max(1) as usize;
+        let single = res * res * std::mem::size_of::<f32>();
+        match light.kind {
+            LightKind::Spot { outer, .. } if outer.to_degrees() <= MAX_SPOT_HALF_ANGLE_DEG => single,
+            LightKind::Directional { .. } => single,
+            LightKind::Point { .. } | LightKind::Spot { .. } => {
+                let face = (res / 2).max(16);
+                6 * face * face * std::mem::size_of::<f32>()
             }
         }
     }
@@ -93,6 +112,19 @@ impl ShadowTerm {
                     4 + usize::from(d.z < 0.0)
                 };
                 faces[face].lit(p, cos_theta, s)
+            }
+        }
+    }
+
+    /// [`ShadowTerm::lit`] for eight points (x, y, z lanes) with N·L `cos_theta`.
+    #[must_use]
+    pub fn lit_lanes(&self, p: [f32x8; 3], cos_theta: f32x8) -> f32x8 {
+        match self {
+            ShadowTerm::Unshadowed => f32x8::ONE,
+            ShadowTerm::Map(map, s) => map.lit_lanes(p, cos_theta, s),
+            ShadowTerm::Cube(..) => {
+                let (x, y, z, c) = (p[0].to_array(), p[1].to_array(), p[2].to_array(), cos_theta.to_array());
+                f32x8::new(std::array::from_fn(|i| self.lit(Vec3::new(x[i], y[i], z[i]), c[i])))
             }
         }
     }

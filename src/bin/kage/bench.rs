@@ -9,7 +9,7 @@ use std::process::Command;
 
 use glam::{Affine3A, Vec3};
 use kage::scene::load::{self, FileSystem};
-use kage::scene::{file::add_model, Camera, Falloff, Light, LightKind, Material, Projection, Scene};
+use kage::scene::{file::add_model, Camera, Falloff, Light, LightKind, Material, Projection, Scene, ShadowSettings};
 use kage::{RenderOptions, Renderer};
 use miette::{miette, IntoDiagnostic, Result};
 use rayon::prelude::*;
@@ -36,6 +36,10 @@ pub struct BenchArgs {
     /// Only these scenes (comma-separated names).
     #[arg(long, default_value = "sphere10k,sphere100k,sphere1m")]
     scenes: String,
+    /// The peer's modes to run, comma-separated: `phong` (no shadows), `shadow1`
+    /// (a 2048² shadow map, one test per pixel), `shadow4` (2 x 2 PCF).
+    #[arg(long, default_value = "phong")]
+    modes: String,
     /// Benchmark the BVH (build time, primary-ray throughput) beside Embree
     /// instead of the raster frame beside llvmpipe.
     #[arg(long)]
@@ -60,6 +64,7 @@ struct Row {
     name: String,
     triangles: usize,
     visibility_ms: f64,
+    shadow_ms: f64,
     shading_ms: f64,
     total_ms: f64,
     peer: Option<(f64, Option<f64>)>,
@@ -75,15 +80,17 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     }
     let lp = &args.llvmpipe;
     let mut rows = Vec::new();
-    for name in args.scenes.split(',').map(str::trim) {
+    let runs = args.scenes.split(',').flat_map(|s| args.modes.split(',').map(move |m| (s.trim(), m.trim())));
+    for (name, mode) in runs {
         let mesh = ensure_mesh(args, name)?;
-        let scene = peer_scene(&mesh, args.width, args.height)?;
+        let scene = peer_scene(&mesh, args.width, args.height, mode)?;
+        let label = format!("{name} {mode}");
         // Rounds alternate kage and the peer; each keeps its best round, so a burst
         // of load from a neighbour on a shared machine hurts neither side's number.
         let mut best: Option<Row> = None;
         for _ in 0..args.rounds.max(1) {
-            let (row, image) = time_kage(name, &scene, args.frames)?;
-            let peer = lp.exists().then(|| run_llvmpipe(lp, &mesh, args, &image)).transpose()?;
+            let (row, image) = time_kage(&label, &scene, args.frames)?;
+            let peer = lp.exists().then(|| run_llvmpipe(lp, &mesh, args, mode, &image)).transpose()?;
             best = Some(match best {
                 None => Row { peer, ..row },
                 Some(b) => Row {
@@ -96,7 +103,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             });
         }
         rows.push(best.expect("at least one round"));
-        eprintln!("{name}: done");
+        eprintln!("{label}: done");
     }
     print_table(&rows, args);
     Ok(())
@@ -114,8 +121,9 @@ fn ensure_mesh(args: &BenchArgs, name: &str) -> Result<PathBuf> {
     Ok(path)
 }
 
-/// The peers' scene convention (peer_common.h) around the loaded mesh.
-fn peer_scene(path: &Path, width: u32, height: u32) -> Result<Scene> {
+/// The peers' scene convention (peer_common.h) around the loaded mesh, lit for
+/// the peer's `mode`.
+fn peer_scene(path: &Path, width: u32, height: u32, mode: &str) -> Result<Scene> {
     let fs = FileSystem { base: path.parent().unwrap_or(Path::new(".")).to_path_buf() };
     let model = load::model(Path::new(path.file_name().unwrap_or_default()), &fs).map_err(|e| miette!("{e}"))?;
     let albedo = Vec3::new(0.75, 0.72, 0.65);
@@ -142,16 +150,7 @@ fn peer_scene(path: &Path, width: u32, height: u32) -> Result<Scene> {
             projection: Projection::Perspective { fov_y_deg: 45.0 },
             shift: glam::Vec2::ZERO,
         },
-        lights: vec![Light {
-            kind: LightKind::Point { position: c + r * Vec3::new(1.0, 1.6, -0.6) },
-            color: Vec3::ONE,
-            intensity: 1.0,
-            ambient: 0.1,
-            size: 0.0,
-            falloff: Falloff::None,
-            shadow: kage::scene::ShadowSettings::NONE,
-            only: None,
-        }],
+        lights: vec![peer_light(c, r, mode)?],
         materials: vec![material],
         objects: Vec::new(),
         warnings: Vec::new(),
@@ -163,6 +162,28 @@ fn peer_scene(path: &Path, width: u32, height: u32) -> Result<Scene> {
     Ok(scene)
 }
 
+/// The peers' point light at c + r·(1, 1.6, −0.6). With shadows, the peer renders
+/// one perspective 2048² map aimed at the mesh's centre, its cone just holding
+/// the bounding sphere: kage's equivalent is a spot light with that cone (no
+/// falloff inside it, so the shading is the point light's).
+fn peer_light(c: Vec3, r: f32, mode: &str) -> Result<Light> {
+    let position = c + r * Vec3::new(1.0, 1.6, -0.6);
+    let half = (r / (position - c).length()).min(0.99).asin() * 1.05;
+    let (kind, shadow) = match mode {
+        "phong" => (LightKind::Point { position }, ShadowSettings::NONE),
+        "shadow1" | "shadow4" => (
+            LightKind::Spot { position, direction: (c - position).normalize(), inner: half, outer: half },
+            ShadowSettings {
+                resolution: 2048,
+                pcf: if mode == "shadow4" { 2 } else { 1 },
+                ..ShadowSettings::default()
+            },
+        ),
+        _ => return Err(miette!("unknown mode '{mode}' (expected phong, shadow1 or shadow4)")),
+    };
+    Ok(Light { kind, ambient: 0.1, falloff: Falloff::None, shadow, ..Light::default() })
+}
+
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
     v[v.len() / 2]
@@ -171,12 +192,13 @@ fn median(mut v: Vec<f64>) -> f64 {
 fn time_kage(name: &str, scene: &Scene, frames: usize) -> Result<(Row, kage::resolve::LinearImage)> {
     let mut renderer = Renderer::new(&RenderOptions::default()).map_err(|e| miette!("{e}"))?;
     renderer.render(scene).map_err(|e| miette!("{e}"))?; // warm-up
-    let (mut vis, mut shade, mut total) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut vis, mut shadow, mut shade, mut total) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for _ in 0..frames.max(1) {
         let t = std::time::Instant::now();
         let stats = renderer.render(scene).map_err(|e| miette!("{e}"))?.stats;
         total.push(t.elapsed().as_secs_f64() * 1e3);
         vis.push(stats.visibility_ms);
+        shadow.push(stats.shadow_ms);
         shade.push(stats.shading_ms);
     }
     let frame = renderer.into_frame();
@@ -184,6 +206,7 @@ fn time_kage(name: &str, scene: &Scene, frames: usize) -> Result<(Row, kage::res
         name: name.to_string(),
         triangles: scene.triangle_count(),
         visibility_ms: median(vis),
+        shadow_ms: median(shadow),
         shading_ms: median(shade),
         total_ms: median(total),
         peer: None,
@@ -197,6 +220,7 @@ fn run_llvmpipe(
     bin: &Path,
     mesh: &Path,
     args: &BenchArgs,
+    mode: &str,
     ours: &kage::resolve::LinearImage,
 ) -> Result<(f64, Option<f64>)> {
     let prefix = std::env::temp_dir().join("kage_bench_llvmpipe");
@@ -210,7 +234,7 @@ fn run_llvmpipe(
             "-f",
             &args.frames.to_string(),
             "-m",
-            "phong",
+            mode,
             "-o",
         ])
         .arg(&prefix)
@@ -223,7 +247,7 @@ fn run_llvmpipe(
         .find_map(|w| w.strip_prefix("median_ms="))
         .and_then(|v| v.parse().ok())
         .ok_or_else(|| miette!("llvmpipe printed no median_ms: {text}{}", String::from_utf8_lossy(&out.stderr)))?;
-    let png = PathBuf::from(format!("{}_phong.png", prefix.display()));
+    let png = PathBuf::from(format!("{}_{mode}.png", prefix.display()));
     Ok((ms, rmse_against(&png, ours)))
 }
 
@@ -241,8 +265,8 @@ fn rmse_against(png: &Path, ours: &kage::resolve::LinearImage) -> Option<f64> {
 }
 
 fn print_table(rows: &[Row], args: &BenchArgs) {
-    println!("| scene | triangles | visibility ms | shading ms | kage ms/frame | llvmpipe ms/frame | kage / llvmpipe | RMSE vs llvmpipe (0-255) |");
-    println!("|---|---:|---:|---:|---:|---:|---:|---:|");
+    println!("| scene, mode | triangles | visibility ms | shadow map ms | shading ms | kage ms/frame | llvmpipe ms/frame | kage / llvmpipe | RMSE vs llvmpipe (0-255) |");
+    println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|");
     for r in rows {
         let (peer, ratio, rmse) = match r.peer {
             Some((ms, rmse)) => (
@@ -253,8 +277,8 @@ fn print_table(rows: &[Row], args: &BenchArgs) {
             None => ("not built".into(), "n/a".into(), "n/a".into()),
         };
         println!(
-            "| {} | {} | {:.1} | {:.1} | {:.1} | {peer} | {ratio} | {rmse} |",
-            r.name, r.triangles, r.visibility_ms, r.shading_ms, r.total_ms
+            "| {} | {} | {:.1} | {:.1} | {:.1} | {:.1} | {peer} | {ratio} | {rmse} |",
+            r.name, r.triangles, r.visibility_ms, r.shadow_ms, r.shading_ms, r.total_ms
         );
     }
     println!(
@@ -280,7 +304,7 @@ fn run_rays(args: &BenchArgs) -> Result<()> {
     let mut rows = Vec::new();
     for name in args.scenes.split(',').map(str::trim) {
         let mesh = ensure_mesh(args, name)?;
-        let scene = peer_scene(&mesh, args.width, args.height)?;
+        let scene = peer_scene(&mesh, args.width, args.height, "phong")?;
         let mut best: Option<RayRow> = None;
         for _ in 0..args.rounds.max(1) {
             let (build_ms, mrays) = time_rays(&scene, args.frames);
