@@ -4,7 +4,8 @@
 //! The hierarchy knows only boxes. Traversal hands each leaf primitive to a closure
 //! that intersects it, so triangles today and CSG primitives later share one walker.
 
-use glam::Vec3;
+use glam::{Vec3, Vec3A};
+use rayon::prelude::*;
 
 use crate::scene::Ray;
 
@@ -45,27 +46,37 @@ impl Aabb {
     pub fn centre(self) -> Vec3 {
         (self.min + self.max) * 0.5
     }
+}
+
+/// A node of the flattened tree. Its box is kept in 16-byte SIMD vectors, so
+/// the slab test is a handful of vector instructions.
+#[derive(Debug, Clone, Copy)]
+struct Node {
+    min: Vec3A,
+    max: Vec3A,
+    /// Leaf: first index into `order`; interior: index of the second child (the
+    /// first child follows its parent).
+    offset: u32,
+    /// Primitives in a leaf; 0 for interior nodes.
+    count: u16,
+}
+
+impl Node {
+    fn new(b: &Box3A, offset: u32, count: u16) -> Node {
+        Node { min: b.min, max: b.max, offset, count }
+    }
 
     /// Entry distance of the ray (given as origin and 1/direction) if it meets the
-    /// box before `t_max`.
-    fn entry(&self, origin: Vec3, inv_dir: Vec3, t_max: f32) -> Option<f32> {
+    /// box before `t_max` (slab test; the far distance is widened by a few ulps so
+    /// a ray grazing a face is not lost to rounding).
+    #[inline(always)]
+    fn entry(&self, origin: Vec3A, inv_dir: Vec3A, t_max: f32) -> Option<f32> {
         let t0 = (self.min - origin) * inv_dir;
         let t1 = (self.max - origin) * inv_dir;
         let near = t0.min(t1).max_element().max(0.0);
         let far = t0.max(t1).min_element() * (1.0 + 2.0 * f32::EPSILON * 2.0);
         (near <= far && near < t_max).then_some(near)
     }
-}
-
-/// A node of the flattened tree.
-#[derive(Debug, Clone, Copy)]
-struct Node {
-    bounds: Aabb,
-    /// Leaf: first index into `order`; interior: index of the second child (the
-    /// first child follows its parent).
-    offset: u32,
-    /// Primitives in a leaf; 0 for interior nodes.
-    count: u16,
 }
 
 /// A bounding volume hierarchy over primitives known by their boxes.
@@ -78,16 +89,45 @@ pub struct Bvh {
 const BINS: usize = 16;
 const LEAF_MAX: usize = 4;
 const PARALLEL_BELOW: usize = 4096;
+/// Nodes larger than this scan their items in parallel.
+const PARALLEL_SCAN: usize = 1 << 16;
+
+/// A box in 16-byte SIMD vectors, for the build: whole-vector loads and stores
+/// (a `Vec3` box is stored with masked moves, which stall the binning loop).
+#[derive(Debug, Clone, Copy)]
+struct Box3A {
+    min: Vec3A,
+    max: Vec3A,
+}
+
+impl Box3A {
+    const EMPTY: Box3A = Box3A { min: Vec3A::INFINITY, max: Vec3A::NEG_INFINITY };
+
+    #[inline(always)]
+    fn union(self, o: Box3A) -> Box3A {
+        Box3A { min: self.min.min(o.min), max: self.max.max(o.max) }
+    }
+
+    #[inline(always)]
+    fn grow(self, p: Vec3A) -> Box3A {
+        Box3A { min: self.min.min(p), max: self.max.max(p) }
+    }
+
+    fn area(self) -> f32 {
+        let d = (self.max - self.min).max(Vec3A::ZERO);
+        2.0 * (d.x * d.y + d.y * d.z + d.z * d.x)
+    }
+}
 
 struct Item {
-    bounds: Aabb,
-    centre: Vec3,
+    bounds: Box3A,
+    centre: Vec3A,
     index: u32,
 }
 
 enum BuildNode {
-    Leaf { bounds: Aabb, start: usize, count: usize },
-    Interior { bounds: Aabb, children: Box<[BuildNode; 2]> },
+    Leaf { bounds: Box3A, start: usize, count: usize },
+    Interior { bounds: Box3A, children: Box<[BuildNode; 2]> },
 }
 
 impl Bvh {
@@ -95,8 +135,11 @@ impl Bvh {
     /// inputs).
     #[must_use]
     pub fn build(bounds: &[Aabb]) -> Bvh {
-        let mut items: Vec<Item> =
-            bounds.iter().enumerate().map(|(i, b)| Item { bounds: *b, centre: b.centre(), index: i as u32 }).collect();
+        let item = |(i, b): (usize, &Aabb)| {
+            let bounds = Box3A { min: b.min.into(), max: b.max.into() };
+            Item { bounds, centre: (bounds.min + bounds.max) * 0.5, index: i as u32 }
+        };
+        let mut items: Vec<Item> = bounds.iter().enumerate().map(item).collect();
         if items.is_empty() {
             return Bvh { nodes: Vec::new(), order: Vec::new() };
         }
@@ -142,7 +185,8 @@ impl Bvh {
     /// since found a hit nearer than its box.
     fn walk(&self, ray: &Ray, t_max: &mut f32, mut visit: impl FnMut(u32, &mut f32) -> bool) {
         let inv = ray.dir.recip();
-        let entry = |i: usize, t_max: f32| self.nodes[i].bounds.entry(ray.origin, inv, t_max);
+        let (origin, inv) = (Vec3A::from(ray.origin), Vec3A::from(inv));
+        let entry = |i: usize, t_max: f32| self.nodes[i].entry(origin, inv, t_max);
         if self.nodes.is_empty() || entry(0, *t_max).is_none() {
             return;
         }
@@ -211,11 +255,10 @@ impl Bvh {
 }
 
 fn build_node(items: &mut [Item], start: usize) -> BuildNode {
-    let bounds = items.iter().fold(Aabb::EMPTY, |b, i| b.union(i.bounds));
+    let (bounds, centres) = extents(items);
     if items.len() <= LEAF_MAX {
         return BuildNode::Leaf { bounds, start, count: items.len() };
     }
-    let centres = items.iter().fold(Aabb::EMPTY, |b, i| Aabb { min: b.min.min(i.centre), max: b.max.max(i.centre) });
     let axis = (centres.max - centres.min).max_position();
     let extent = centres.max[axis] - centres.min[axis];
     let mid = match (extent > 0.0).then(|| best_split(items, axis, centres.min[axis], extent, bounds)).flatten() {
@@ -235,25 +278,57 @@ fn build_node(items: &mut [Item], start: usize) -> BuildNode {
     BuildNode::Interior { bounds, children: Box::new([a, b]) }
 }
 
+/// The box around the items and the box around their centres (in parallel for
+/// large nodes: near the root, one node holds all the work).
+fn extents(items: &[Item]) -> (Box3A, Box3A) {
+    let scan = |items: &[Item]| {
+        let (mut b, mut c) = (Box3A::EMPTY, Box3A::EMPTY);
+        for i in items {
+            b = b.union(i.bounds);
+            c = c.grow(i.centre);
+        }
+        (b, c)
+    };
+    if items.len() > PARALLEL_SCAN {
+        let merge = |(a, c): (Box3A, Box3A), (b, d): (Box3A, Box3A)| (a.union(b), c.union(d));
+        items.par_chunks(PARALLEL_SCAN / 4).map(scan).reduce(|| (Box3A::EMPTY, Box3A::EMPTY), merge)
+    } else {
+        scan(items)
+    }
+}
+
 fn bin_of(c: f32, min: f32, extent: f32) -> usize {
-    (((c - min) / extent * BINS as f32) as usize).min(BINS - 1)
+    (((c - min) * (BINS as f32 / extent)) as usize).min(BINS - 1)
 }
 
 /// The last bin of the left side of the cheapest SAH split, or `None` if making a
 /// leaf is cheaper (or nothing separates).
-fn best_split(items: &[Item], axis: usize, min: f32, extent: f32, bounds: Aabb) -> Option<usize> {
-    let mut bins = [(Aabb::EMPTY, 0usize); BINS];
-    for i in items {
-        let b = &mut bins[bin_of(i.centre[axis], min, extent)];
-        *b = (b.0.union(i.bounds), b.1 + 1);
-    }
+fn best_split(items: &[Item], axis: usize, min: f32, extent: f32, bounds: Box3A) -> Option<usize> {
+    type Bins = [(Box3A, usize); BINS];
+    let fill = |items: &[Item]| {
+        let mut bins: Bins = [(Box3A::EMPTY, 0); BINS];
+        for i in items {
+            let b = &mut bins[bin_of(i.centre[axis], min, extent)];
+            *b = (b.0.union(i.bounds), b.1 + 1);
+        }
+        bins
+    };
+    let bins = if items.len() > PARALLEL_SCAN {
+        let merge = |mut a: Bins, b: Bins| {
+            a.iter_mut().zip(b).for_each(|(x, y)| *x = (x.0.union(y.0), x.1 + y.1));
+            a
+        };
+        items.par_chunks(PARALLEL_SCAN / 4).map(fill).reduce(|| [(Box3A::EMPTY, 0); BINS], merge)
+    } else {
+        fill(items)
+    };
     let mut right = [(0.0f32, 0usize); BINS];
-    let mut acc = (Aabb::EMPTY, 0);
+    let mut acc = (Box3A::EMPTY, 0);
     for k in (1..BINS).rev() {
         acc = (acc.0.union(bins[k].0), acc.1 + bins[k].1);
         right[k] = (acc.0.area(), acc.1);
     }
-    let mut left = (Aabb::EMPTY, 0);
+    let mut left = (Box3A::EMPTY, 0);
     let mut best: Option<(f32, usize)> = None;
     for k in 0..BINS - 1 {
         left = (left.0.union(bins[k].0), left.1 + bins[k].1);
@@ -285,11 +360,11 @@ fn partition(items: &mut [Item], left: impl Fn(&Item) -> bool) -> usize {
 fn flatten(node: &BuildNode, out: &mut Vec<Node>) {
     match node {
         BuildNode::Leaf { bounds, start, count } => {
-            out.push(Node { bounds: *bounds, offset: *start as u32, count: *count as u16 });
+            out.push(Node::new(bounds, *start as u32, *count as u16));
         }
         BuildNode::Interior { bounds, children } => {
             let at = out.len();
-            out.push(Node { bounds: *bounds, offset: 0, count: 0 });
+            out.push(Node::new(bounds, 0, 0));
             flatten(&children[0], out);
             out[at].offset = out.len() as u32;
             flatten(&children[1], out);

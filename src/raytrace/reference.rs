@@ -108,6 +108,9 @@ impl<'a> Tracer<'a> {
         let k = Coefficients::at(material, &s);
         let mut acc = Components { emission: k.parts().3, ..Default::default() };
         for (i, light) in self.scene.lights.iter().enumerate() {
+            if light.only.as_ref().is_some_and(|o| !o.contains(&(hit.item.object as usize))) {
+                continue; // selective lighting (seed 002 §3.3)
+            }
             let shadow = if self.opts.shadows { self.visibility(light, &s, i as u32) } else { 1.0 };
             phong::add_light(&mut acc, light, &k, &s, shadow);
         }

@@ -54,12 +54,13 @@ pub const FUSED_SHADOW_BUDGET: usize = 256 << 20;
 pub fn shade_lit(scene: &Scene, vb: &VisibilityBuffer, targets: &mut [Target]) -> PassStats {
     let mut stats = PassStats::default();
     let mut budget = FUSED_SHADOW_BUDGET;
+    let bounds = scene.bounds().unwrap_or_default();
     let (mut fused, mut own) = (Vec::new(), Vec::new());
     for light in &scene.lights {
         let bytes = ShadowTerm::bytes_needed(light);
         if light.only.is_none() && bytes <= budget {
             budget -= bytes;
-            fused.push((light, build(scene, light, &mut stats)));
+            fused.push((light, build(scene, light, bounds, &mut stats)));
         } else {
             own.push(light);
         }
@@ -71,7 +72,7 @@ pub fn shade_lit(scene: &Scene, vb: &VisibilityBuffer, targets: &mut [Target]) -
     stats.passes = 1;
     drop(fused);
     for light in own {
-        let term = build(scene, light, &mut stats);
+        let term = build(scene, light, bounds, &mut stats);
         stats.shadow_bytes = stats.shadow_bytes.max(term.memory_bytes());
         let receivers = light.only.as_ref().map(|only| (0..scene.objects.len()).map(|i| only.contains(&i)).collect());
         // A light that lights every object had its ambient added in the first pass.
@@ -83,9 +84,9 @@ pub fn shade_lit(scene: &Scene, vb: &VisibilityBuffer, targets: &mut [Target]) -
 }
 
 /// The shadow term of `light`, timed into `stats`.
-fn build(scene: &Scene, light: &Light, stats: &mut PassStats) -> ShadowTerm {
+fn build(scene: &Scene, light: &Light, bounds: (Vec3, Vec3), stats: &mut PassStats) -> ShadowTerm {
     let t = Instant::now();
-    let term = ShadowTerm::build(scene, light);
+    let term = ShadowTerm::build_within(scene, light, bounds);
     stats.shadow_ms += t.elapsed().as_secs_f64() * 1e3;
     term
 }

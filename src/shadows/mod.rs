@@ -37,10 +37,19 @@ impl ShadowTerm {
     /// Builds the term of `light` in `scene`, rendering its maps.
     #[must_use]
     pub fn build(scene: &Scene, light: &Light) -> ShadowTerm {
+        match scene.bounds() {
+            Some(bounds) => ShadowTerm::build_within(scene, light, bounds),
+            None => ShadowTerm::Unshadowed,
+        }
+    }
+
+    /// [`ShadowTerm::build`] with the scene's bounds already known.
+    #[must_use]
+    pub fn build_within(scene: &Scene, light: &Light, bounds: (Vec3, Vec3)) -> ShadowTerm {
         let settings = light.shadow;
-        let Some(bounds) = scene.bounds().filter(|_| settings.method == ShadowMethod::Map) else {
+        if settings.method == ShadowMethod::None {
             return ShadowTerm::Unshadowed;
-        };
+        }
         let res = settings.resolution.max(1);
         match light.kind {
             LightKind::Spot { position, direction, outer, .. } if outer.to_degrees() <= MAX_SPOT_HALF_ANGLE_DEG => {

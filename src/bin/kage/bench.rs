@@ -49,6 +49,10 @@ pub struct BenchArgs {
     /// matte floor.
     #[arg(long)]
     hybrid: bool,
+    /// Time frames as lights grow (1, 4, 16, 100 spot lights round the first
+    /// scene), with and without shadow maps.
+    #[arg(long)]
+    lights: bool,
     /// The Embree peer program (`scripts/build-peers.sh` builds it); skipped if absent.
     #[arg(long, default_value = "target/peers/embree_bench")]
     embree: PathBuf,
@@ -77,6 +81,9 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     }
     if args.hybrid {
         return run_hybrid(args);
+    }
+    if args.lights {
+        return run_lights(args);
     }
     let lp = &args.llvmpipe;
     let mut rows = Vec::new();
@@ -440,16 +447,22 @@ fn run_hybrid(args: &BenchArgs) -> Result<()> {
         c.rmse,
         100.0 * c.share_over
     );
-    println!("\nTwo ray levels, shadow rays at the surfaces secondary rays reach, BVH built every frame in both; median of {} frames; {} threads.", args.frames.max(1), rayon::current_num_threads());
+    println!(
+        "\nTwo ray levels (primary + one bounce); primary shadows from shadow maps (hybrid) or shadow rays (full trace); \
+         shadow rays at the surfaces secondary rays reach in both; BVH built every frame in both; median of {} frames; {} threads.",
+        args.frames.max(1),
+        rayon::current_num_threads()
+    );
     Ok(())
 }
 
-/// The hybrid's image computed entirely by rays: primary hits from the BVH, the
-/// same unshadowed eq. 1 at them, the same bounces.
+/// The hybrid's image computed entirely by rays, as a plain ray tracer would:
+/// primary hits from the BVH, shadow rays at them (where the hybrid reads shadow
+/// maps), the same bounces.
 fn trace_everything(scene: &Scene, depth: u32) -> kage::resolve::LinearImage {
     use kage::raytrace::reference::{ReferenceOptions, Tracer};
     use kage::raytrace::TraceScene;
-    use kage::shading::{phong, ObjectFrames};
+    use kage::shading::ObjectFrames;
     let trace = TraceScene::new(scene);
     let frames = ObjectFrames::new(scene);
     let opts = ReferenceOptions { pixel_samples: 1, light_samples: 1, shadows: true, max_depth: depth };
@@ -458,16 +471,63 @@ fn trace_everything(scene: &Scene, depth: u32) -> kage::resolve::LinearImage {
     let mut image = kage::resolve::LinearImage::new(scene.width, scene.height);
     image.pixels_mut().par_chunks_mut(scene.width as usize).enumerate().for_each(|(y, row)| {
         for (x, px) in row.iter_mut().enumerate() {
-            let ray = rays.ray(glam::Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
-            *px = match trace.intersect(&ray, f32::INFINITY) {
-                None => scene.background,
-                Some(hit) => {
-                    let s = frames.prepare(scene, hit.item).surface(&ray);
-                    phong::shade(&scene.lights, &scene.materials[s.material], &s).total()
-                        + tracer.bounces(&ray, &s, depth)
-                }
-            };
+            *px = tracer.radiance(&rays.ray(glam::Vec2::new(x as f32 + 0.5, y as f32 + 0.5)), depth);
         }
     });
     image
+}
+
+/// Milliseconds per frame as the number of lights grows, with and without shadow
+/// maps: seed 002's "a light is only more passes" says the cost is linear.
+fn run_lights(args: &BenchArgs) -> Result<()> {
+    let name = args.scenes.split(',').next().unwrap_or("sphere100k").trim();
+    let mesh = ensure_mesh(args, name)?;
+    let base = peer_scene(&mesh, args.width, args.height, "shadow1")?;
+    let (lo, hi) = base.bounds().ok_or_else(|| miette!("empty scene"))?;
+    let c = (lo + hi) * 0.5;
+    println!(
+        "| lights | shadows | visibility ms | shadow map ms | shading ms | ms/frame | ms per light | shading passes |"
+    );
+    println!("|---:|---|---:|---:|---:|---:|---:|---:|");
+    for n in [1usize, 4, 16, 100] {
+        for shadows in [false, true] {
+            let mut scene = base.clone();
+            scene.lights = (0..n).map(|i| ring_light(&base.lights[0], c, i, n, shadows)).collect();
+            let (row, _) = time_kage(name, &scene, args.frames)?;
+            let mut renderer = Renderer::new(&RenderOptions::default()).map_err(|e| miette!("{e}"))?;
+            let passes = renderer.render(&scene).map_err(|e| miette!("{e}"))?.stats.shading_passes;
+            println!(
+                "| {n} | {} | {:.1} | {:.1} | {:.1} | {:.1} | {:.2} | {passes} |",
+                if shadows { "2048² map each" } else { "none" },
+                row.visibility_ms,
+                row.shadow_ms,
+                row.shading_ms,
+                row.total_ms,
+                row.total_ms / n as f64
+            );
+        }
+    }
+    println!(
+        "\n{name}, {}x{}, spot lights on a ring above the mesh (intensity 1/n each), median of {} frames, {} threads.",
+        args.width,
+        args.height,
+        args.frames,
+        rayon::current_num_threads()
+    );
+    Ok(())
+}
+
+/// Light `i` of `n` on a ring above the scene: the peer light turned about the
+/// vertical through the centre.
+fn ring_light(peer: &Light, c: Vec3, i: usize, n: usize, shadows: bool) -> Light {
+    let LightKind::Spot { position, inner, outer, .. } = peer.kind else { return peer.clone() };
+    let turn = glam::Quat::from_rotation_y(i as f32 * std::f32::consts::TAU / n as f32);
+    let position = c + turn * (position - c);
+    Light {
+        kind: LightKind::Spot { position, direction: (c - position).normalize(), inner, outer },
+        intensity: 1.0 / n as f32,
+        ambient: 0.1 / n as f32,
+        shadow: if shadows { peer.shadow } else { ShadowSettings::NONE },
+        ..peer.clone()
+    }
 }
