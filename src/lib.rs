@@ -32,6 +32,7 @@ pub mod frame;
 pub mod output;
 pub mod raytrace;
 pub mod resolve;
+pub mod sampling;
 pub mod scene;
 pub mod shading;
 pub mod shadows;

@@ -211,3 +211,29 @@ fn fog_in_a_shadow_is_the_lerp_to_the_fog_colour_not_black() {
     }
     assert!(in_shadow > 20 && ground > 3000, "{in_shadow} shadowed of {ground} ground pixels");
 }
+
+#[test]
+fn jittered_area_lights_approach_the_reference_penumbra() {
+    use kage::raytrace::reference::{render_reference, ReferenceOptions};
+    let mut scene = kage::scene::demo::demo_scene().unwrap();
+    (scene.width, scene.height) = (240, 135);
+    scene.lights.truncate(1); // the point light with size 0.3
+    assert!(scene.lights[0].size > 0.0);
+    let opts = ReferenceOptions { pixel_samples: 1, light_samples: 6, shadows: true, max_depth: 0 };
+    let truth = render_reference(&scene, &opts, &|_| {});
+    let mut errors = Vec::new();
+    for samples in [1, 16] {
+        scene.lights[0].shadow.samples = samples;
+        let frame = render(&scene, &RenderOptions::default()).unwrap();
+        errors.push(kage::compare::compare(&frame.image, &truth, 0.05).unwrap());
+    }
+    let (hard, soft) = (&errors[0], &errors[1]);
+    assert!(
+        soft.rmse < 0.5 * hard.rmse && soft.share_over < 0.3 * hard.share_over,
+        "16 jittered maps: rmse {:.4}, {:.4} over 0.05; one map: rmse {:.4}, {:.4} over",
+        soft.rmse,
+        soft.share_over,
+        hard.rmse,
+        hard.share_over
+    );
+}

@@ -9,6 +9,8 @@
 
 use glam::Vec2;
 
+use crate::sampling::radical_inverse;
+
 /// How a frame is antialiased.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Antialias {
@@ -35,17 +37,6 @@ impl Antialias {
                 .collect(),
         }
     }
-}
-
-/// The digits of `i` in `base` mirrored about the radix point (van der Corput).
-fn radical_inverse(mut i: u32, base: u32) -> f32 {
-    let (mut value, mut scale) = (0.0f64, 1.0f64 / base as f64);
-    while i > 0 {
-        value += (i % base) as f64 * scale;
-        i /= base;
-        scale /= base as f64;
-    }
-    value as f32
 }
 
 #[cfg(test)]

@@ -244,6 +244,7 @@ struct ShadowRec {
     bias: Option<f32>,
     slope: Option<f32>,
     pcf: Option<Spanned<i64>>,
+    samples: Option<Spanned<i64>>,
 }
 
 #[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default)]
@@ -538,6 +539,7 @@ impl SceneFile {
         };
         s.resolution = count(&r.resolution, 16, 16384, "shadow resolution")?.unwrap_or(s.resolution);
         s.pcf = count(&r.pcf, 1, 15, "pcf")?.unwrap_or(s.pcf);
+        s.samples = count(&r.samples, 1, 256, "shadow samples")?.unwrap_or(s.samples);
         for (v, slot) in [(r.bias, &mut s.bias), (r.slope, &mut s.slope)] {
             if let Some(v) = v {
                 if !(v.is_finite() && v >= 0.0) {

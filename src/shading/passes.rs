@@ -55,8 +55,11 @@ pub fn shade_lit(scene: &Scene, vb: &VisibilityBuffer, targets: &mut [Target]) -
     let mut stats = PassStats::default();
     let mut budget = FUSED_SHADOW_BUDGET;
     let bounds = scene.bounds().unwrap_or_default();
+    let centre = (bounds.0 + bounds.1) * 0.5;
+    // Area lights become several jittered lights (§3.3), each with its own maps.
+    let lights: Vec<Light> = scene.lights.iter().flat_map(|l| l.jittered(centre)).collect();
     let (mut fused, mut own) = (Vec::new(), Vec::new());
-    for light in &scene.lights {
+    for light in &lights {
         let bytes = ShadowTerm::bytes_needed(light);
         if light.only.is_none() && bytes <= budget {
             budget -= bytes;
@@ -67,7 +70,7 @@ pub fn shade_lit(scene: &Scene, vb: &VisibilityBuffer, targets: &mut [Target]) -
     }
     stats.shadow_bytes = FUSED_SHADOW_BUDGET - budget;
     let direct = fused.iter().map(|(l, t)| (*l, t)).collect();
-    let ambient = scene.lights.iter().filter(|l| l.only.is_none());
+    let ambient = lights.iter().filter(|l| l.only.is_none());
     run(scene, vb, targets, &Lighting::pass(ambient, direct, true), Blend::Replace, None);
     stats.passes = 1;
     drop(fused);

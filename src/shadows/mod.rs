@@ -110,18 +110,7 @@ impl ShadowTerm {
         match self {
             ShadowTerm::Unshadowed => 1.0,
             ShadowTerm::Map(map, s) => map.lit(p, cos_theta, s),
-            ShadowTerm::Cube(faces, centre, s) => {
-                let d = p - *centre;
-                let a = d.abs();
-                let face = if a.x >= a.y && a.x >= a.z {
-                    usize::from(d.x < 0.0)
-                } else if a.y >= a.z {
-                    2 + usize::from(d.y < 0.0)
-                } else {
-                    4 + usize::from(d.z < 0.0)
-                };
-                faces[face].lit(p, cos_theta, s)
-            }
+            ShadowTerm::Cube(faces, centre, s) => faces[cube_face(p - *centre)].lit(p, cos_theta, s),
         }
     }
 
@@ -131,9 +120,15 @@ impl ShadowTerm {
         match self {
             ShadowTerm::Unshadowed => f32x8::ONE,
             ShadowTerm::Map(map, s) => map.lit_lanes(p, cos_theta, s),
-            ShadowTerm::Cube(..) => {
-                let (x, y, z, c) = (p[0].to_array(), p[1].to_array(), p[2].to_array(), cos_theta.to_array());
-                f32x8::new(std::array::from_fn(|i| self.lit(Vec3::new(x[i], y[i], z[i]), c[i])))
+            ShadowTerm::Cube(faces, centre, s) => {
+                let (x, y, z) = (p[0].to_array(), p[1].to_array(), p[2].to_array());
+                let face: [usize; 8] = std::array::from_fn(|i| cube_face(Vec3::new(x[i], y[i], z[i]) - *centre));
+                if face.iter().all(|&f| f == face[0]) {
+                    // Neighbouring pixels usually look into the same face.
+                    return faces[face[0]].lit_lanes(p, cos_theta, s);
+                }
+                let c = cos_theta.to_array();
+                f32x8::new(std::array::from_fn(|i| faces[face[i]].lit(Vec3::new(x[i], y[i], z[i]), c[i], s)))
             }
         }
     }
@@ -146,6 +141,19 @@ impl ShadowTerm {
             ShadowTerm::Map(m, _) => m.memory_bytes(),
             ShadowTerm::Cube(f, ..) => f.iter().map(DepthMap::memory_bytes).sum(),
         }
+    }
+}
+
+/// The cube face (+x, −x, +y, −y, +z, −z) that direction `d` from the centre
+/// looks into.
+fn cube_face(d: Vec3) -> usize {
+    let a = d.abs();
+    if a.x >= a.y && a.x >= a.z {
+        usize::from(d.x < 0.0)
+    } else if a.y >= a.z {
+        2 + usize::from(d.y < 0.0)
+    } else {
+        4 + usize::from(d.z < 0.0)
     }
 }
 
