@@ -6,7 +6,6 @@ use kage::raytrace::reference::{render_reference, ReferenceOptions};
 use kage::raytrace::TraceScene;
 use kage::resolve::LinearImage;
 use kage::scene::{Ray, ShadowSettings};
-use kage::shadows::ShadowTerm;
 use kage::{render, RenderOptions};
 
 #[test]
@@ -17,8 +16,7 @@ fn one_ray_per_pixel_without_shadows_matches_the_rasterizer() {
     scene.lights.iter_mut().for_each(|l| l.shadow = ShadowSettings::NONE);
     let frame = render(&scene, &RenderOptions::default()).unwrap();
     let mut scalar = LinearImage::new(scene.width, scene.height);
-    let unshadowed = vec![ShadowTerm::Unshadowed; scene.lights.len()];
-    kage::shading::shade_into_scalar(&scene, &frame.visibility, &mut scalar, &unshadowed);
+    kage::shading::shade_into_scalar(&scene, &frame.visibility, &mut scalar);
     let opts = ReferenceOptions { pixel_samples: 1, light_samples: 1, shadows: false, max_depth: 0 };
     let reference = render_reference(&scene, &opts, &|_| {});
     let trace = TraceScene::new(&scene);

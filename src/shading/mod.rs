@@ -17,7 +17,7 @@ use crate::shadows::ShadowTerm;
 use crate::visibility::{ItemId, VisibilityBuffer};
 
 pub use lanes::{Blend, Lighting};
-pub use passes::{shade_lit, PassStats, Target};
+pub use passes::{frame_lights, shade_lit, PassStats, Target};
 pub use phong::Components;
 pub use phong::{Component, ComponentSet};
 pub use surface::{ObjectFrames, PreparedTriangle, SurfacePoint};
@@ -138,9 +138,12 @@ impl TriangleCache {
 }
 
 /// The scalar reference of [`shade_lit`]: one pixel at a time through
-/// [`PreparedTriangle::surface`] and [`phong::add_light`], with each light's
-/// shadow term from `terms` (one per light) and its selective-lighting list.
-pub fn shade_into_scalar(scene: &Scene, vb: &VisibilityBuffer, image: &mut LinearImage, terms: &[ShadowTerm]) {
+/// [`PreparedTriangle::surface`] and [`phong::add_light`], with the frame's
+/// lights ([`passes::frame_lights`]), each one's shadow term and its
+/// selective-lighting list.
+pub fn shade_into_scalar(scene: &Scene, vb: &VisibilityBuffer, image: &mut LinearImage) {
+    let lights = passes::frame_lights(scene);
+    let terms: Vec<ShadowTerm> = lights.iter().map(|l| ShadowTerm::build(scene, l)).collect();
     let w = vb.width() as usize;
     let frames = ObjectFrames::new(scene);
     let rays = scene.camera.pixel_rays(Vec2::new(w as f32, vb.height() as f32));
@@ -154,7 +157,7 @@ pub fn shade_into_scalar(scene: &Scene, vb: &VisibilityBuffer, image: &mut Linea
             let s = frames.surface(scene, item, &rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5)));
             let k = Coefficients::at(&scene.materials[s.material], &s);
             let mut acc = Components { emission: k.parts().3, ..Default::default() };
-            for (light, term) in scene.lights.iter().zip(terms) {
+            for (light, term) in lights.iter().zip(&terms) {
                 if light.only.as_ref().is_some_and(|o| !o.contains(&(item.object as usize))) {
                     continue;
                 }

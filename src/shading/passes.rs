@@ -46,7 +46,15 @@ pub struct Target<'a> {
 }
 
 /// Most bytes of shadow maps held at once for the first, fused pass.
-pub const FUSED_SHADOW_BUDGET: usize = 256 << 20;
+pub const FUSED_SHADOW_BUDGET: usize = 64 << 20;
+
+/// The lights a frame is shaded with: the scene's, with each area light replaced
+/// by its jittered samples (§3.3; [`Light::jittered`]).
+#[must_use]
+pub fn frame_lights(scene: &Scene) -> Vec<Light> {
+    let centre = scene.bounds().map_or(glam::Vec3::ZERO, |(lo, hi)| (lo + hi) * 0.5);
+    scene.lights.iter().flat_map(|l| l.jittered(centre)).collect()
+}
 
 /// Shades `vb` with every light of `scene`, shadows included, into each target:
 /// each pass runs once per target, restricted to the target's components, so the
@@ -55,9 +63,8 @@ pub fn shade_lit(scene: &Scene, vb: &VisibilityBuffer, targets: &mut [Target]) -
     let mut stats = PassStats::default();
     let mut budget = FUSED_SHADOW_BUDGET;
     let bounds = scene.bounds().unwrap_or_default();
-    let centre = (bounds.0 + bounds.1) * 0.5;
     // Area lights become several jittered lights (§3.3), each with its own maps.
-    let lights: Vec<Light> = scene.lights.iter().flat_map(|l| l.jittered(centre)).collect();
+    let lights = frame_lights(scene);
     let (mut fused, mut own) = (Vec::new(), Vec::new());
     for light in &lights {
         let bytes = ShadowTerm::bytes_needed(light);
