@@ -119,9 +119,11 @@ impl Default for ShadowSettings {
 impl Light {
     /// Seed 002 §3.3's soft shadows by jittering: a shadowed point or spot light
     /// with a `size` becomes `shadow.samples` lights spread over the disc of that
-    /// radius facing `towards`, each carrying 1/n of the light; any other light is
-    /// itself. The disc points are stratified (Halton 2, 3 through an
-    /// area-preserving square-to-disc map), the same on every frame.
+    /// radius facing `towards`, each carrying 1/n of the light and a shadow map of
+    /// half the resolution (the averaged penumbra hides the coarser texels; the n
+    /// maps cost n/4 of full ones); any other light is itself. The disc points are
+    /// stratified (Halton 2, 3 through an area-preserving square-to-disc map), the
+    /// same on every frame.
     #[must_use]
     pub fn jittered(&self, towards: Vec3) -> Vec<Light> {
         let n = self.shadow.samples.max(1);
@@ -147,7 +149,14 @@ impl Light {
                     }
                     _ => LightKind::Point { position: moved },
                 };
-                Light { kind, intensity: self.intensity / n as f32, ambient: self.ambient / n as f32, ..self.clone() }
+                let shadow = ShadowSettings { resolution: (self.shadow.resolution / 2).max(16), ..self.shadow };
+                Light {
+                    kind,
+                    intensity: self.intensity / n as f32,
+                    ambient: self.ambient / n as f32,
+                    shadow,
+                    ..self.clone()
+                }
             })
             .collect()
     }
