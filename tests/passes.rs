@@ -21,6 +21,7 @@ fn component_images_sum_to_the_final_image() {
         ("reflections.toml", Antialias::None),
         ("spotlights.toml", Antialias::None),
         ("demo.toml", Antialias::Jitter(4)),
+        ("environment.toml", Antialias::None),
     ] {
         let mut scene = example(name);
         scene.antialias = antialias;
@@ -31,7 +32,7 @@ fn component_images_sum_to_the_final_image() {
         let options = RenderOptions { aovs: ComponentSet::ALL, ..RenderOptions::default() };
         let frame = render(&scene, &options).unwrap();
         assert_eq!(frame.aovs.iter().map(|(c, _)| *c).collect::<Vec<_>>(), Component::ALL.to_vec());
-        let mut nonzero = [0usize; 6];
+        let mut nonzero = [0usize; Component::ALL.len()];
         for (i, p) in frame.image.pixels().iter().enumerate() {
             let sum: Vec3 = frame.aovs.iter().map(|(_, a)| a.pixels()[i]).sum();
             assert!(
@@ -42,12 +43,14 @@ fn component_images_sum_to_the_final_image() {
                 nonzero[k] += usize::from(a.pixels()[i].max_element() > 1e-4);
             }
         }
-        // Every component shows up where the scene has it: only reflections.toml
-        // traces, only spotlights.toml (here) has fog.
+        // Every component shows up where the scene has it: reflections.toml and
+        // environment.toml trace, only spotlights.toml (here) has fog, only
+        // environment.toml a reflection map.
         for (k, c) in Component::ALL.iter().enumerate() {
             let expect = match c {
-                Component::Traced => name == "reflections.toml",
+                Component::Traced => name == "reflections.toml" || name == "environment.toml",
                 Component::Fog => name == "spotlights.toml",
+                Component::Reflection => name == "environment.toml",
                 _ => true,
             };
             assert_eq!(nonzero[k] > 20, expect, "{name}: {} component has {} pixels", c.name(), nonzero[k]);

@@ -50,6 +50,7 @@ fn mirror_scene() -> Scene {
         exposure: Default::default(),
         antialias: Default::default(),
         fog: None,
+        environment: None,
         camera: Camera {
             eye: Vec3::new(0.0, 0.0, 5.0),
             target: Vec3::ZERO,

@@ -103,7 +103,7 @@ impl<'a> Tracer<'a> {
     /// Light arriving along `ray` (unit direction), following `depth` bounces.
     #[must_use]
     pub fn radiance(&self, ray: &Ray, depth: u32) -> Vec3 {
-        let Some(hit) = self.trace.intersect(ray, f32::INFINITY) else { return self.scene.background };
+        let Some(hit) = self.trace.intersect(ray, f32::INFINITY) else { return self.scene.background_along(ray.dir) };
         let s = self.frames.prepare(self.scene, hit.item).surface(ray);
         let material = &self.scene.materials[s.material];
         let k = Coefficients::at(material, &s);
@@ -115,7 +115,18 @@ impl<'a> Tracer<'a> {
             let shadow = if self.opts.shadows { self.visibility(light, &s, i as u32) } else { 1.0 };
             phong::add_light(&mut acc, light, &k, &s, shadow);
         }
-        acc.total() + self.bounces(ray, &s, depth)
+        acc.total() + self.reflection_map(&s) + self.bounces(ray, &s, depth)
+    }
+
+    /// Ie of eq. 4: Km times the environment in the mirror direction at `s`.
+    fn reflection_map(&self, s: &SurfacePoint) -> Vec3 {
+        let km = self.scene.materials[s.material].km;
+        match &self.scene.environment {
+            Some(env) if km.max_element() > 0.0 => {
+                km * env.radiance(2.0 * s.normal.dot(s.to_eye) * s.normal - s.to_eye)
+            }
+            _ => Vec3::ZERO,
+        }
     }
 
     /// IrayTracing of seed 002 eq. 5 at `s`, seen along `ray`: Kr times the light of

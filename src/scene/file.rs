@@ -17,8 +17,8 @@ use toml::Spanned;
 use super::load::{self, AssetSource, LoadedModel};
 use super::mesh::shapes;
 use super::{
-    framing, Camera, Falloff, Light, LightKind, Material, Object, Projection, Scene, ShadowMethod, ShadowSettings,
-    Texture,
+    framing, Camera, Environment, Falloff, Light, LightKind, Material, Object, Projection, Scene, ShadowMethod,
+    ShadowSettings, Texture,
 };
 use crate::error::{Error, Result, SourceLocation};
 use crate::resolve::jitter::MAX_JITTER_SAMPLES;
@@ -41,6 +41,7 @@ pub struct SceneFile {
     #[serde(default, rename = "object")]
     objects: Vec<Spanned<ObjectRec>>,
     fog: Option<Spanned<FogRec>>,
+    environment: Option<Spanned<EnvironmentRec>>,
     #[serde(skip)]
     origin: Option<Origin>,
 }
@@ -286,6 +287,25 @@ struct MaterialRec {
     #[serde(default)]
     kt: V3,
     ior: Option<Spanned<f32>>,
+    #[serde(default)]
+    km: V3,
+}
+
+/// `[environment]`: an equirectangular image around the scene.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct EnvironmentRec {
+    map: Spanned<String>,
+    #[serde(default = "one")]
+    intensity: f32,
+    #[serde(default)]
+    rotate: f32,
+    #[serde(default = "yes")]
+    background: bool,
+}
+
+fn yes() -> bool {
+    true
 }
 
 fn grey() -> V3 {
@@ -346,6 +366,19 @@ impl SceneFile {
             location: Box::new(SourceLocation::new(origin.path, origin.text, span)),
             message: message.into(),
         }
+    }
+
+    fn environment(&self, assets: &dyn AssetSource) -> Result<Option<Environment>> {
+        let Some(rec) = &self.environment else { return Ok(None) };
+        let r = rec.get_ref();
+        if !(r.intensity.is_finite() && r.intensity >= 0.0 && r.rotate.is_finite()) {
+            return Err(self.invalid(rec.span(), "environment intensity must be finite and ≥ 0, rotate finite"));
+        }
+        let path = Path::new(r.map.get_ref());
+        // HDR formats hold linear radiance; PNG and JPEG hold sRGB-encoded colours.
+        let ext = path.extension().and_then(|e| e.to_str()).unwrap_or_default().to_ascii_lowercase();
+        let map = load::texture(path, !matches!(ext.as_str(), "exr" | "hdr"), assets)?;
+        Ok(Some(Environment { map, intensity: r.intensity, rotation: r.rotate.to_radians(), visible: r.background }))
     }
 
     fn fog(&self) -> Result<Option<Fog>> {
@@ -419,6 +452,7 @@ impl SceneFile {
             exposure: self.image.exposure.into(),
             antialias: self.antialias()?,
             fog: self.fog()?,
+            environment: self.environment(assets)?,
         };
         let mut models = Vec::new();
         let mut produced = Vec::new();
@@ -591,6 +625,7 @@ impl SceneFile {
             two_sided: r.two_sided,
             kr: r.kr.into(),
             kt: r.kt.into(),
+            km: r.km.into(),
             ior: match &r.ior {
                 Some(ior) if !(ior.get_ref().is_finite() && *ior.get_ref() >= 1.0) => {
                     return Err(self.invalid(ior.span(), "the index of refraction must be a finite number ≥ 1"))
@@ -703,6 +738,7 @@ pub fn scene_for_model(path: &Path, width: u32, height: u32) -> Result<Scene> {
         exposure: Default::default(),
         antialias: Default::default(),
         fog: None,
+        environment: None,
     };
     add_model(&mut scene, &model, &path.display().to_string(), Affine3A::IDENTITY, None);
     let (camera, lights) = framing(scene.bounds().expect("a model has parts"), width as f32 / height as f32);

@@ -36,6 +36,9 @@ pub struct Material {
     pub kt: Vec3,
     /// Index of refraction of the material (the outside is taken as 1).
     pub ior: f32,
+    /// Reflection-map coefficient Km (seed 002 eq. 4's Ke · Mape): the share of the
+    /// environment seen in the mirror direction that is added, without tracing.
+    pub km: Vec3,
 }
 
 impl Material {
@@ -73,6 +76,7 @@ impl Default for Material {
             kr: Vec3::ZERO,
             kt: Vec3::ZERO,
             ior: 1.5,
+            km: Vec3::ZERO,
         }
     }
 }

@@ -4,6 +4,7 @@
 
 pub mod camera;
 pub mod demo;
+pub mod environment;
 pub mod file;
 pub mod light;
 pub mod load;
@@ -16,6 +17,7 @@ use std::sync::Arc;
 use glam::{Affine3A, Vec3};
 
 pub use camera::{Camera, Projection, Ray};
+pub use environment::Environment;
 pub use light::{Falloff, Light, LightKind, ShadowMethod, ShadowSettings};
 pub use material::{ComponentMaps, Material};
 pub use mesh::Mesh;
@@ -56,6 +58,8 @@ pub struct Scene {
     pub antialias: crate::resolve::Antialias,
     /// Fog (seed 002 §3.5), if any.
     pub fog: Option<crate::shading::fog::Fog>,
+    /// The environment map (reflection map of eq. 4 and optional background).
+    pub environment: Option<Environment>,
     /// The eye.
     pub camera: Camera,
     /// Lights.
@@ -113,6 +117,16 @@ impl Scene {
             }
             Some((lo, hi))
         })
+    }
+
+    /// What a ray leaving the scene along `dir` sees: the environment if it is
+    /// visible, else the background colour.
+    #[must_use]
+    pub fn background_along(&self, dir: Vec3) -> Vec3 {
+        match &self.environment {
+            Some(env) if env.visible => env.radiance(dir),
+            _ => self.background,
+        }
     }
 
     /// Number of triangles over all objects.

@@ -6,6 +6,7 @@ pub mod fog;
 pub mod lanes;
 pub mod passes;
 pub mod phong;
+pub mod reflection_map;
 pub mod surface;
 
 use glam::{Vec2, Vec3};

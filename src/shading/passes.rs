@@ -18,6 +18,7 @@ use std::time::Instant;
 
 use glam::Vec3;
 
+use super::reflection_map::{add_reflection_map, flat_background};
 use super::{shade_pass, Blend, Component, ComponentSet, Lighting, ShadingPass};
 use crate::resolve::LinearImage;
 use crate::scene::{Light, Scene};
@@ -90,6 +91,7 @@ pub fn shade_lit(scene: &Scene, vb: &VisibilityBuffer, targets: &mut [Target]) -
         run(scene, vb, targets, &Lighting::pass(ambient, vec![(light, &term)], false), Blend::Add, receivers);
         stats.passes += 1;
     }
+    add_reflection_map(scene, vb, targets);
     stats
 }
 
@@ -115,7 +117,7 @@ fn run(
         if blend == Blend::Add && lighting.is_empty() {
             continue;
         }
-        let background = if t.parts.contains(Component::Emission) { scene.background } else { Vec3::ZERO };
+        let background = if t.parts.contains(Component::Emission) { flat_background(scene) } else { Vec3::ZERO };
         let pass = ShadingPass { lighting, blend, background, receivers: receivers.clone() };
         shade_pass(scene, vb, t.image, &pass);
     }

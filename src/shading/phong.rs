@@ -47,14 +47,17 @@ pub enum Component {
     Traced,
     /// Fog (§3.5): f(d) · fog colour on every visible surface, shadows or not.
     Fog,
+    /// Km · Mape(R): the environment in the mirror direction, without tracing.
+    Reflection,
 }
 
 impl Component {
     /// Every component, in the order of eq. 5.
-    pub const ALL: [Component; 6] = [
+    pub const ALL: [Component; 7] = [
         Component::Ambient,
         Component::Diffuse,
         Component::Specular,
+        Component::Reflection,
         Component::Emission,
         Component::Traced,
         Component::Fog,
@@ -70,6 +73,7 @@ impl Component {
             Component::Emission => "emission",
             Component::Traced => "traced",
             Component::Fog => "fog",
+            Component::Reflection => "reflection",
         }
     }
 
@@ -86,7 +90,7 @@ pub struct ComponentSet(u8);
 
 impl ComponentSet {
     /// Every component: the final image.
-    pub const ALL: ComponentSet = ComponentSet(0x3f);
+    pub const ALL: ComponentSet = ComponentSet(0x7f);
     /// No component.
     pub const EMPTY: ComponentSet = ComponentSet(0);
 

@@ -34,6 +34,7 @@ pub fn scene_with(mesh: Mesh, camera: Camera, width: u32, height: u32, two_sided
         exposure: Default::default(),
         antialias: Default::default(),
         fog: None,
+        environment: None,
     }
 }
 

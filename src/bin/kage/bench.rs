@@ -164,6 +164,7 @@ fn peer_scene(path: &Path, width: u32, height: u32, mode: &str) -> Result<Scene>
         exposure: Default::default(),
         antialias: Default::default(),
         fog: None,
+        environment: None,
     };
     add_model(&mut scene, &model, "peer", Affine3A::IDENTITY, Some(0));
     Ok(scene)

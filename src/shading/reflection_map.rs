@@ -1,0 +1,61 @@
+//! The reflection-map pass of seed 002 eq. 4, run once per frame:
+//! Ie(x, y) = Km · Mape(R), the environment image looked up along the view's
+//! mirror direction R = 2(N·V)N − V at each surface whose material has a Km — a
+//! reflection with no ray traced, which is all the paper's hardware could do.
+//! The same pass writes the environment as the background where it is visible.
+
+use glam::{Vec2, Vec3};
+use rayon::prelude::*;
+
+use super::{Component, ObjectFrames, Target};
+use crate::scene::Scene;
+use crate::visibility::VisibilityBuffer;
+
+/// Adds Km · Mape(R) to every target holding the reflection component, and the
+/// visible environment's background to every target holding the emission
+/// component (the first pass left those pixels black).
+pub fn add_reflection_map(scene: &Scene, vb: &VisibilityBuffer, targets: &mut [Target]) {
+    let Some(env) = &scene.environment else { return };
+    let reflecting: Vec<bool> = scene.materials.iter().map(|m| m.km.max_element() > 0.0).collect();
+    if !env.visible && !reflecting.contains(&true) {
+        return;
+    }
+    let w = vb.width() as usize;
+    let frames = ObjectFrames::new(scene);
+    let rays = scene.camera.pixel_rays(Vec2::new(w as f32, vb.height() as f32));
+    for t in targets {
+        let (reflection, background) = (t.parts.contains(Component::Reflection), t.parts.contains(Component::Emission));
+        if !(reflection || background && env.visible) {
+            continue;
+        }
+        let rows = t.image.pixels_mut().par_chunks_mut(w).zip(vb.items().par_chunks(w));
+        rows.enumerate().for_each(|(y, (out, items))| {
+            for (x, (px, &item)) in out.iter_mut().zip(items).enumerate() {
+                let ray = || rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
+                if item.is_none() {
+                    if background && env.visible {
+                        *px += env.radiance(ray().dir);
+                    }
+                    continue;
+                }
+                let material = scene.objects[item.object as usize].material;
+                if reflection && reflecting[material] {
+                    let s = frames.surface(scene, item, &ray());
+                    let r = 2.0 * s.normal.dot(s.to_eye) * s.normal - s.to_eye;
+                    *px += scene.materials[material].km * env.radiance(r);
+                }
+            }
+        });
+    }
+}
+
+/// What the first pass writes where no object is seen in a target holding the
+/// emission component: the background colour, or black when the environment
+/// shows there instead (added by [`add_reflection_map`]).
+#[must_use]
+pub fn flat_background(scene: &Scene) -> Vec3 {
+    match &scene.environment {
+        Some(env) if env.visible => Vec3::ZERO,
+        _ => scene.background,
+    }
+}
