@@ -23,6 +23,8 @@ use super::{
 use crate::error::{Error, Result, SourceLocation};
 use crate::resolve::jitter::MAX_JITTER_SAMPLES;
 use crate::resolve::{Antialias, Exposure};
+use crate::scene::material::Filter;
+use crate::scene::texture::Wrap;
 use crate::shading::fog::{Fog, FogMode};
 
 type V3 = [f32; 3];
@@ -289,6 +291,27 @@ struct MaterialRec {
     ior: Option<Spanned<f32>>,
     #[serde(default)]
     km: V3,
+    #[serde(default)]
+    filter: FilterRec,
+    #[serde(default)]
+    wrap: WrapRec,
+}
+
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default)]
+#[serde(rename_all = "kebab-case")]
+enum FilterRec {
+    #[default]
+    Trilinear,
+    Bilinear,
+}
+
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default)]
+#[serde(rename_all = "kebab-case")]
+enum WrapRec {
+    #[default]
+    Repeat,
+    Clamp,
+    Mirror,
 }
 
 /// `[environment]`: an equirectangular image around the scene.
@@ -606,8 +629,18 @@ impl SceneFile {
     }
 
     fn material(&self, r: &MaterialRec, assets: &dyn AssetSource) -> Result<Material> {
+        let wrap = match r.wrap {
+            WrapRec::Repeat => Wrap::Repeat,
+            WrapRec::Clamp => Wrap::Clamp,
+            WrapRec::Mirror => Wrap::Mirror,
+        };
         let texture = |p: &Option<Spanned<String>>, srgb: bool| -> Result<Option<Arc<Texture>>> {
-            p.as_ref().map(|p| load::texture(Path::new(p.get_ref()), srgb, assets)).transpose()
+            let load = |p: &Spanned<String>| {
+                let mut t = load::texture(Path::new(p.get_ref()), srgb, assets)?;
+                Arc::make_mut(&mut t).wrap = wrap;
+                Ok(t)
+            };
+            p.as_ref().map(load).transpose()
         };
         Ok(Material {
             name: r.name.get_ref().clone(),
@@ -621,6 +654,10 @@ impl SceneFile {
                 diffuse: texture(&r.kd_map, true)?,
                 specular: texture(&r.ks_map, true)?,
                 emission: texture(&r.ke_map, true)?,
+                filter: match r.filter {
+                    FilterRec::Trilinear => Filter::Trilinear,
+                    FilterRec::Bilinear => Filter::Bilinear,
+                },
             },
             two_sided: r.two_sided,
             kr: r.kr.into(),

@@ -60,6 +60,19 @@ pub struct ComponentMaps {
     pub specular: Option<Arc<Texture>>,
     /// Multiplies Ke.
     pub emission: Option<Arc<Texture>>,
+    /// How the maps are filtered.
+    pub filter: Filter,
+}
+
+/// Texture filtering.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Filter {
+    /// The finest level, bilinear (sharp; shimmers where texels are smaller
+    /// than pixels).
+    Bilinear,
+    /// The mip level matching each pixel's texture footprint, trilinear.
+    #[default]
+    Trilinear,
 }
 
 impl Default for Material {

@@ -1,39 +1,49 @@
-//! Colour textures, decoded once to linear RGB and sampled bilinearly with repeat.
+//! Colour textures, decoded once to linear RGB, with a mip chain: sampled
+//! bilinearly at the finest level, or trilinearly at the level matching a
+//! footprint (the texture-space size of the pixel), with a wrap mode.
 
 use glam::{Vec2, Vec3};
 
-/// A decoded texture in linear RGB.
+/// What happens outside [0, 1] texture coordinates.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Wrap {
+    /// The image tiles.
+    #[default]
+    Repeat,
+    /// The edge texels extend.
+    Clamp,
+    /// The image tiles, every other copy mirrored.
+    Mirror,
+}
+
+impl Wrap {
+    /// Texel index `i` of a row of `n`, wrapped.
+    fn index(self, i: i64, n: i64) -> i64 {
+        match self {
+            Wrap::Repeat => i.rem_euclid(n),
+            Wrap::Clamp => i.clamp(0, n - 1),
+            Wrap::Mirror => {
+                let k = i.rem_euclid(2 * n);
+                if k < n {
+                    k
+                } else {
+                    2 * n - 1 - k
+                }
+            }
+        }
+    }
+}
+
+/// One level of the mip chain.
 #[derive(Debug, Clone)]
-pub struct Texture {
+struct Level {
     width: u32,
     height: u32,
     texels: Vec<Vec3>,
 }
 
-impl Texture {
-    /// Decodes an encoded image (PNG or JPEG). `srgb` says whether its values are
-    /// sRGB-encoded colours (true for colour maps) or already linear.
-    pub fn decode(bytes: &[u8], srgb: bool) -> Result<Texture, String> {
-        let img = image::load_from_memory(bytes).map_err(|e| e.to_string())?.into_rgb32f();
-        let (width, height) = img.dimensions();
-        if width == 0 || height == 0 {
-            return Err("the image has no pixels".into());
-        }
-        let decode = |c: f32| if srgb { srgb_to_linear(c) } else { c };
-        let texels = img.pixels().map(|p| Vec3::new(decode(p[0]), decode(p[1]), decode(p[2]))).collect();
-        Ok(Texture { width, height, texels })
-    }
-
-    /// A texture from linear texels, row 0 at the top. Panics if the sizes disagree.
-    #[must_use]
-    pub fn from_texels(width: u32, height: u32, texels: Vec<Vec3>) -> Texture {
-        assert_eq!(texels.len(), (width * height) as usize, "texel count");
-        Texture { width, height, texels }
-    }
-
-    /// Bilinear sample at `uv` (origin top-left, texel centres at +0.5), repeating.
-    #[must_use]
-    pub fn sample(&self, uv: Vec2) -> Vec3 {
+impl Level {
+    fn bilinear(&self, uv: Vec2, wrap: Wrap) -> Vec3 {
         let (w, h) = (self.width as i64, self.height as i64);
         let x = uv.x * self.width as f32 - 0.5;
         let y = uv.y * self.height as f32 - 0.5;
@@ -42,11 +52,98 @@ impl Texture {
         }
         let (x0, y0) = (x.floor(), y.floor());
         let (fx, fy) = (x - x0, y - y0);
-        let at = |i: i64, j: i64| self.texels[(j.rem_euclid(h) * w + i.rem_euclid(w)) as usize];
+        let at = |i: i64, j: i64| self.texels[(wrap.index(j, h) * w + wrap.index(i, w)) as usize];
         let (i, j) = (x0 as i64, y0 as i64);
         let top = at(i, j).lerp(at(i + 1, j), fx);
         let bottom = at(i, j + 1).lerp(at(i + 1, j + 1), fx);
         top.lerp(bottom, fy)
+    }
+
+    /// The next coarser level: each texel the mean of (up to) 2 × 2 texels.
+    fn halved(&self) -> Level {
+        let (w, h) = ((self.width / 2).max(1), (self.height / 2).max(1));
+        let texels = (0..h)
+            .flat_map(|y| (0..w).map(move |x| (x, y)))
+            .map(|(x, y)| {
+                let xs = [2 * x, (2 * x + 1).min(self.width - 1)];
+                let ys = [2 * y, (2 * y + 1).min(self.height - 1)];
+                let sum: Vec3 =
+                    ys.iter().flat_map(|&j| xs.iter().map(move |&i| (i, j))).map(|(i, j)| self.texel(i, j)).sum();
+                sum * 0.25
+            })
+            .collect();
+        Level { width: w, height: h, texels }
+    }
+
+    fn texel(&self, x: u32, y: u32) -> Vec3 {
+        self.texels[(y * self.width + x) as usize]
+    }
+}
+
+/// A decoded texture in linear RGB with its mip chain.
+#[derive(Debug, Clone)]
+pub struct Texture {
+    levels: Vec<Level>,
+    /// Wrap mode of every lookup.
+    pub wrap: Wrap,
+}
+
+impl Texture {
+    /// Decodes an encoded image (PNG, JPEG or OpenEXR). `srgb` says whether its
+    /// values are sRGB-encoded colours (true for colour maps) or already linear.
+    pub fn decode(bytes: &[u8], srgb: bool) -> Result<Texture, String> {
+        let img = image::load_from_memory(bytes).map_err(|e| e.to_string())?.into_rgb32f();
+        let (width, height) = img.dimensions();
+        if width == 0 || height == 0 {
+            return Err("the image has no pixels".into());
+        }
+        let decode = |c: f32| if srgb { srgb_to_linear(c) } else { c };
+        let texels = img.pixels().map(|p| Vec3::new(decode(p[0]), decode(p[1]), decode(p[2]))).collect();
+        Ok(Texture::from_texels(width, height, texels))
+    }
+
+    /// A texture from linear texels, row 0 at the top, repeating. Panics if the
+    /// sizes disagree.
+    #[must_use]
+    pub fn from_texels(width: u32, height: u32, texels: Vec<Vec3>) -> Texture {
+        assert_eq!(texels.len(), (width * height) as usize, "texel count");
+        let mut levels = vec![Level { width, height, texels }];
+        while let Some(last) = levels.last().filter(|l| l.width > 1 || l.height > 1) {
+            let next = last.halved();
+            levels.push(next);
+        }
+        Texture { levels, wrap: Wrap::Repeat }
+    }
+
+    /// Width and height of the finest level.
+    #[must_use]
+    pub fn size(&self) -> (u32, u32) {
+        (self.levels[0].width, self.levels[0].height)
+    }
+
+    /// Bilinear sample of the finest level at `uv` (origin top-left, texel centres
+    /// at +0.5).
+    #[must_use]
+    pub fn sample(&self, uv: Vec2) -> Vec3 {
+        self.levels[0].bilinear(uv, self.wrap)
+    }
+
+    /// Trilinear sample for a pixel whose neighbours to the right and below are
+    /// `duv[0]` and `duv[1]` away in texture space: the level whose texels match
+    /// the longer of the two steps, blended with the next. A zero footprint is the
+    /// bilinear sample of the finest level.
+    #[must_use]
+    pub fn sample_footprint(&self, uv: Vec2, duv: [Vec2; 2]) -> Vec3 {
+        let size = Vec2::new(self.levels[0].width as f32, self.levels[0].height as f32);
+        let step = (duv[0] * size).length().max((duv[1] * size).length());
+        let lod = if step > 1.0 && step.is_finite() { step.log2() } else { 0.0 };
+        let top = self.levels.len() - 1;
+        let k = (lod.floor() as usize).min(top);
+        let a = self.levels[k].bilinear(uv, self.wrap);
+        if k == top {
+            return a;
+        }
+        a.lerp(self.levels[k + 1].bilinear(uv, self.wrap), lod - k as f32)
     }
 }
 
@@ -83,6 +180,29 @@ mod tests {
         // u = 0 lies halfway between the last texel (wrapped) and the first.
         assert!((t.sample(Vec2::new(0.0, 0.5)).x - 0.5).abs() < 1e-6);
         assert_eq!(t.sample(Vec2::new(1.25, 0.5)), Vec3::ZERO);
+    }
+
+    #[test]
+    fn wrap_modes_fold_coordinates() {
+        let n = 4;
+        let idx = |w: Wrap| [-2, -1, 0, 3, 4, 5].map(|i| w.index(i, n));
+        assert_eq!(idx(Wrap::Repeat), [2, 3, 0, 3, 0, 1]);
+        assert_eq!(idx(Wrap::Clamp), [0, 0, 0, 3, 3, 3]);
+        assert_eq!(idx(Wrap::Mirror), [1, 0, 0, 3, 3, 2]);
+    }
+
+    #[test]
+    fn the_mip_chain_keeps_the_mean_and_wide_footprints_reach_it() {
+        // A 64 × 64 checker of single texels: every level above the first is grey.
+        let texels = (0..64 * 64).map(|i| Vec3::splat(((i % 64 + i / 64) % 2) as f32)).collect();
+        let t = Texture::from_texels(64, 64, texels);
+        assert_eq!(t.levels.len(), 7);
+        assert!(t.levels.iter().skip(1).all(|l| l.texels.iter().all(|c| (c.x - 0.5).abs() < 1e-6)));
+        let uv = Vec2::new(0.3, 0.7);
+        // One texel per pixel: the finest level; four texels per pixel: level 2.
+        assert_eq!(t.sample_footprint(uv, [Vec2::new(1.0 / 64.0, 0.0), Vec2::ZERO]), t.sample(uv));
+        let wide = t.sample_footprint(uv, [Vec2::new(4.0 / 64.0, 0.0), Vec2::new(0.0, 1.0 / 64.0)]);
+        assert!((wide.x - 0.5).abs() < 1e-6, "{wide}");
     }
 
     #[test]

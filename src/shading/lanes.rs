@@ -206,7 +206,7 @@ impl Block {
     ) {
         let mut inputs = self.inputs();
         let s = surface(&inputs, rays, x0);
-        if self.sample_textures(&s, &coefficients_at) {
+        if self.sample_textures(&inputs, &s, rays, x0, &coefficients_at) {
             let textured = self.inputs();
             (inputs.ka, inputs.kd, inputs.ks, inputs.ke) = (textured.ka, textured.kd, textured.ks, textured.ke);
             (inputs.shininess, inputs.whole) = (textured.shininess, textured.whole);
@@ -219,22 +219,37 @@ impl Block {
         }
     }
 
-    /// Samples the maps of textured lanes; false if there were none.
-    fn sample_textures(&mut self, s: &LaneSurface, at: &impl Fn(&SurfacePoint) -> Coefficients) -> bool {
+    /// Samples the maps of textured lanes; false if there were none. Each lane's
+    /// footprint comes from ray differentials: the same triangle's plane met by
+    /// the rays one pixel to the right and one row below.
+    fn sample_textures(
+        &mut self,
+        inputs: &LaneInputs,
+        s: &LaneSurface,
+        rays: &RowRays,
+        x0: usize,
+        at: &impl Fn(&SurfacePoint) -> Coefficients,
+    ) -> bool {
         if !self.textured.iter().zip(&self.live).any(|(t, l)| *t && *l) {
             return false;
         }
-        let [b0, b1, b2] = s.weights;
         let (u, w) = (self.u.load(), self.v.load());
-        let uu = u.x * b0 + u.y * b1 + u.z * b2;
-        let vv = w.x * b0 + w.y * b1 + w.z * b2;
+        let uv_of = |s: &LaneSurface| {
+            let [b0, b1, b2] = s.weights;
+            ((u.x * b0 + u.y * b1 + u.z * b2).to_array(), (w.x * b0 + w.y * b1 + w.z * b2).to_array())
+        };
+        let (uu, vv) = uv_of(s);
+        let (ur, vr) = uv_of(&surface(inputs, rays, x0 + 1));
+        let (ud, vd) = uv_of(&surface(inputs, &rays.below(), x0));
         for i in 0..LANES {
             if self.textured[i] && self.live[i] {
+                let uv = Vec2::new(uu[i], vv[i]);
                 let point = SurfacePoint {
                     position: s.p.lane(i),
                     normal: s.n.lane(i),
                     to_eye: s.v.lane(i),
-                    uv: Vec2::new(uu.as_array()[i], vv.as_array()[i]),
+                    uv,
+                    duv: [Vec2::new(ur[i], vr[i]) - uv, Vec2::new(ud[i], vd[i]) - uv],
                     material: self.material[i],
                     front: true, // maps do not depend on the side
                 };
@@ -493,6 +508,9 @@ pub struct RowRays {
     forward: V3,
     ndc_scale: F,
     ortho: bool,
+    /// From this row's rays to the next row's: added to the origin
+    /// (orthographic) or the direction base (perspective).
+    down: V3,
 }
 
 impl RowRays {
@@ -509,7 +527,20 @@ impl RowRays {
             forward: V3::splat(rays.forward.normalize()),
             ndc_scale: F::splat(2.0 / rays.size.x),
             ortho: rays.ortho,
+            down: V3::splat(rays.up * (-2.0 / rays.size.y)),
         }
+    }
+
+    /// The rays of the next row down.
+    #[must_use]
+    pub fn below(&self) -> RowRays {
+        let mut r = *self;
+        if self.ortho {
+            r.origin = r.origin.add(self.down);
+        } else {
+            r.base = r.base.add(self.down);
+        }
+        r
     }
 
     /// Origins and unit directions of the rays through pixels `x0 .. x0 + 8`.

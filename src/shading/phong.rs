@@ -8,6 +8,7 @@
 use glam::Vec3;
 
 use super::surface::SurfacePoint;
+use crate::scene::material::Filter;
 use crate::scene::{Light, Material};
 
 /// The components of seed 002 eq. 4, summed over lights.
@@ -148,7 +149,12 @@ impl Coefficients {
     /// Samples every map of `m` at the point's uv.
     #[must_use]
     pub fn at(m: &Material, s: &SurfacePoint) -> Self {
-        let map = |t: &Option<std::sync::Arc<crate::scene::Texture>>| t.as_ref().map_or(Vec3::ONE, |t| t.sample(s.uv));
+        let map = |t: &Option<std::sync::Arc<crate::scene::Texture>>| {
+            t.as_ref().map_or(Vec3::ONE, |t| match m.maps.filter {
+                Filter::Trilinear => t.sample_footprint(s.uv, s.duv),
+                Filter::Bilinear => t.sample(s.uv),
+            })
+        };
         Coefficients {
             ka: m.ka * map(&m.maps.ambient),
             kd: m.kd * map(&m.maps.diffuse),

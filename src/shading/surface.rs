@@ -19,6 +19,9 @@ pub struct SurfacePoint {
     pub to_eye: Vec3,
     /// Texture coordinates (zero if the mesh has none).
     pub uv: Vec2,
+    /// Texture-space steps to the neighbouring pixels' points (right, below), for
+    /// mip-level selection; zero where unknown (secondary rays): finest level.
+    pub duv: [Vec2; 2],
     /// Index into `Scene::materials`.
     pub material: usize,
     /// Whether the eye sees the front (counter-clockwise, outward) side.
@@ -133,7 +136,15 @@ impl PreparedTriangle {
         let normal = if n.dot(to_eye) < 0.0 { -n } else { n };
         let uv = self.uvs.map_or(Vec2::ZERO, |u| u[0] * w[0] + u[1] * w[1] + u[2] * w[2]);
         let front = self.geometric.dot(to_eye) >= 0.0;
-        SurfacePoint { position: ray.origin + ray.dir * t, normal, to_eye, uv, material: self.material, front }
+        SurfacePoint {
+            position: ray.origin + ray.dir * t,
+            normal,
+            to_eye,
+            uv,
+            duv: [Vec2::ZERO; 2],
+            material: self.material,
+            front,
+        }
     }
 }
 

@@ -123,6 +123,7 @@ impl Context<'_> {
                 diffuse: base_map,
                 specular: None,
                 emission: m.emissive_texture().map(|t| self.texture(&t.texture())).transpose()?,
+                filter: Default::default(),
             },
             two_sided: m.double_sided(),
             ..Material::default()

@@ -83,6 +83,7 @@ fn material(m: &tobj::Material, dir: &Path, assets: &dyn AssetSource) -> Result<
             diffuse: map(&m.diffuse_texture)?,
             specular: map(&m.specular_texture)?,
             emission: None,
+            filter: Default::default(),
         },
         two_sided: false,
         ..Material::default()
