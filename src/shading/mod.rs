@@ -155,7 +155,12 @@ pub fn shade_into_scalar(scene: &Scene, vb: &VisibilityBuffer, image: &mut Linea
                 *px = scene.background;
                 continue;
             }
-            let s = frames.surface(scene, item, &rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5)));
+            let at = |dx: f32, dy: f32| {
+                frames.surface(scene, item, &rays.ray(Vec2::new(x as f32 + 0.5 + dx, y as f32 + 0.5 + dy)))
+            };
+            let mut s = at(0.0, 0.0);
+            // Ray differentials: the same triangle met one pixel right and one below.
+            s.duv = [at(1.0, 0.0).uv - s.uv, at(0.0, 1.0).uv - s.uv];
             let k = Coefficients::at(&scene.materials[s.material], &s);
             let mut acc = Components { emission: k.parts().3, ..Default::default() };
             for (light, term) in lights.iter().zip(&terms) {
