@@ -2,7 +2,8 @@
 //! pipeline (seed 002 eq. 1), computed by rays. Primary visibility by tracing
 //! n × n stratified, jittered rays per pixel (an antialiased reference), hard
 //! shadows by shadow rays, area-light soft shadows by m × m stratified samples over
-//! each light's extent (a disc of radius `size` facing the point).
+//! each light's extent (a disc of radius `size` facing the point). Textures are
+//! read at their finest level: the reference filters them by supersampling.
 //!
 //! With n = m = 1, shadows off and no area lights, every pixel whose primary hit
 //! agrees with the visibility buffer gets the rasterizer's colour (a test holds it).
