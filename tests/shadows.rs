@@ -218,6 +218,8 @@ fn jittered_area_lights_approach_the_reference_penumbra() {
     let mut scene = kage::scene::demo::demo_scene().unwrap();
     (scene.width, scene.height) = (240, 135);
     scene.lights.truncate(1); // the point light with size 0.3
+                              // The reference filters textures by supersampling (finest level): so here too.
+    scene.materials.iter_mut().for_each(|m| m.maps.filter = kage::scene::material::Filter::Bilinear);
     assert!(scene.lights[0].size > 0.0);
     let opts = ReferenceOptions { pixel_samples: 1, light_samples: 6, shadows: true, max_depth: 0 };
     let truth = render_reference(&scene, &opts, &|_| {});
