@@ -13,7 +13,7 @@ use crate::error::{Error, Result};
 use crate::raytrace::item_buffer;
 use crate::resolve::LinearImage;
 use crate::scene::Scene;
-use crate::shading::{self, fog, Component, ComponentSet, Target};
+use crate::shading::{self, fog, translucency, Component, ComponentSet, Target};
 use crate::visibility::{self, RasterStats, VisibilityBuffer};
 
 /// Most worker threads a renderer accepts.
@@ -54,6 +54,8 @@ pub struct FrameStats {
     pub traced_ms: f64,
     /// Pixels that spawned secondary rays, summed over passes.
     pub traced_pixels: usize,
+    /// Translucent fragments blended (summed over passes).
+    pub translucent_fragments: usize,
     /// Visibility passes rendered (more than one when antialiased by jitter).
     pub passes: u32,
     /// What the rasterizer did.
@@ -218,13 +220,20 @@ fn render_pass(scene: &Scene, frame: &mut Frame, aovs: &mut [LinearImage], ray_d
         }
     };
     let t3 = Instant::now();
+    targets.extend(traced_aov.map(|image| Target { parts: ComponentSet::only(Component::Traced), image }));
     if let Some(fog) = &scene.fog {
         let amounts = fog::fog_amounts(scene, fog, vb);
-        targets.extend(traced_aov.map(|image| Target { parts: ComponentSet::only(Component::Traced), image }));
         for t in &mut targets {
             let color = if t.parts.contains(Component::Fog) { fog.color } else { Vec3::ZERO };
             fog::apply(t.image, &amounts, color);
         }
+    }
+    // Translucent surfaces last, over everything opaque (seed 002 §3.4).
+    let layers = visibility::fragments(scene, vb);
+    if !layers.is_empty() {
+        let lights = shading::frame_lights(scene);
+        frame.stats.translucent_fragments +=
+            translucency::composite(scene, layers, scene.translucency, &lights, &mut targets);
     }
     frame.stats.visibility_ms += (t1 - t0).as_secs_f64() * 1e3;
     frame.stats.shading_ms += ((t2 - t1) + t3.elapsed()).as_secs_f64() * 1e3 - lit.shadow_ms;

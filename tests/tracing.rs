@@ -51,6 +51,7 @@ fn mirror_scene() -> Scene {
         antialias: Default::default(),
         fog: None,
         environment: None,
+        translucency: Default::default(),
         camera: Camera {
             eye: Vec3::new(0.0, 0.0, 5.0),
             target: Vec3::ZERO,

@@ -26,6 +26,7 @@ use crate::resolve::{Antialias, Exposure};
 use crate::scene::material::Filter;
 use crate::scene::texture::Wrap;
 use crate::shading::fog::{Fog, FogMode};
+use crate::shading::translucency::TranslucencyOrder;
 
 type V3 = [f32; 3];
 
@@ -66,6 +67,25 @@ struct ImageRec {
     #[serde(default)]
     exposure: ExposureRec,
     antialias: Option<Spanned<AntialiasRec>>,
+    #[serde(default)]
+    translucency: TranslucencyRec,
+}
+
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default)]
+#[serde(rename_all = "kebab-case")]
+enum TranslucencyRec {
+    #[default]
+    Sorted,
+    Unsorted,
+}
+
+impl From<TranslucencyRec> for TranslucencyOrder {
+    fn from(r: TranslucencyRec) -> Self {
+        match r {
+            TranslucencyRec::Sorted => TranslucencyOrder::Sorted,
+            TranslucencyRec::Unsorted => TranslucencyOrder::Unsorted,
+        }
+    }
 }
 
 /// `[fog]`: `mode` linear (`start`, `end`), exp or exp2 (`density`), `color`.
@@ -146,6 +166,7 @@ impl Default for ImageRec {
             background: default_background(),
             exposure: ExposureRec::default(),
             antialias: None,
+            translucency: TranslucencyRec::default(),
         }
     }
 }
@@ -291,6 +312,7 @@ struct MaterialRec {
     ior: Option<Spanned<f32>>,
     #[serde(default)]
     km: V3,
+    opacity: Option<Spanned<f32>>,
     #[serde(default)]
     filter: FilterRec,
     #[serde(default)]
@@ -476,6 +498,7 @@ impl SceneFile {
             antialias: self.antialias()?,
             fog: self.fog()?,
             environment: self.environment(assets)?,
+            translucency: self.image.translucency.into(),
         };
         let mut models = Vec::new();
         let mut produced = Vec::new();
@@ -663,6 +686,13 @@ impl SceneFile {
             kr: r.kr.into(),
             kt: r.kt.into(),
             km: r.km.into(),
+            opacity: match &r.opacity {
+                Some(a) if !(0.0..=1.0).contains(a.get_ref()) => {
+                    return Err(self.invalid(a.span(), "opacity must be between 0 and 1"))
+                }
+                Some(a) => *a.get_ref(),
+                None => 1.0,
+            },
             ior: match &r.ior {
                 Some(ior) if !(ior.get_ref().is_finite() && *ior.get_ref() >= 1.0) => {
                     return Err(self.invalid(ior.span(), "the index of refraction must be a finite number ≥ 1"))
@@ -776,6 +806,7 @@ pub fn scene_for_model(path: &Path, width: u32, height: u32) -> Result<Scene> {
         antialias: Default::default(),
         fog: None,
         environment: None,
+        translucency: Default::default(),
     };
     add_model(&mut scene, &model, &path.display().to_string(), Affine3A::IDENTITY, None);
     let (camera, lights) = framing(scene.bounds().expect("a model has parts"), width as f32 / height as f32);

@@ -39,9 +39,18 @@ pub struct Material {
     /// Reflection-map coefficient Km (seed 002 eq. 4's Ke · Mape): the share of the
     /// environment seen in the mirror direction that is added, without tracing.
     pub km: Vec3,
+    /// Opacity α (seed 002 §3.4): below 1 the surface is translucent and blended
+    /// over what lies behind it.
+    pub opacity: f32,
 }
 
 impl Material {
+    /// Whether the material is translucent (drawn after the opaque surfaces).
+    #[must_use]
+    pub fn translucent(&self) -> bool {
+        self.opacity < 1.0
+    }
+
     /// Whether shading this material needs secondary rays.
     #[must_use]
     pub fn traces(&self) -> bool {
@@ -90,6 +99,7 @@ impl Default for Material {
             kt: Vec3::ZERO,
             ior: 1.5,
             km: Vec3::ZERO,
+            opacity: 1.0,
         }
     }
 }

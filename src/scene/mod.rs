@@ -60,6 +60,8 @@ pub struct Scene {
     pub fog: Option<crate::shading::fog::Fog>,
     /// The environment map (reflection map of eq. 4 and optional background).
     pub environment: Option<Environment>,
+    /// How translucent surfaces are ordered (seed 002 §3.4).
+    pub translucency: crate::shading::translucency::TranslucencyOrder,
     /// The eye.
     pub camera: Camera,
     /// Lights.

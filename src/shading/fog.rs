@@ -61,6 +61,18 @@ impl Fog {
         };
         f.clamp(0.0, 1.0)
     }
+
+    /// The fog amount at world point `p` seen by `camera` (the same distance as
+    /// [`fog_amounts`] measures: along the ray, or from the image plane when
+    /// orthographic).
+    #[must_use]
+    pub fn amount_at(&self, camera: &Camera, p: Vec3) -> f32 {
+        let d = match camera.projection {
+            Projection::Perspective { .. } => (p - camera.eye).length(),
+            Projection::Orthographic { .. } => (p - camera.eye).dot((camera.target - camera.eye).normalize()),
+        };
+        self.amount(d)
+    }
 }
 
 /// Per pixel, the fog amount f(d) of the surface it sees (0 where it sees nothing).

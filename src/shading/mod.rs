@@ -8,6 +8,7 @@ pub mod passes;
 pub mod phong;
 pub mod reflection_map;
 pub mod surface;
+pub mod translucency;
 
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;

@@ -11,7 +11,7 @@ pub mod clip;
 pub mod raster;
 pub mod scan;
 
-pub use raster::{rasterize, rasterize_from, Faces, RasterStats};
+pub use raster::{fragments, rasterize, rasterize_from, Faces, Fragment, RasterStats};
 
 /// What a pixel sees: an object and one of its triangles.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]

@@ -14,7 +14,7 @@ use rayon::prelude::*;
 use super::clip::{ClipPlanes, MAX_CLIPPED};
 use super::scan::{column_range, row_range, scan_triangle, signed_area2, FixedPoint, SpanSink, ONE};
 use super::{ItemId, VisibilityBuffer};
-use crate::scene::{Camera, Scene};
+use crate::scene::{Camera, Material, Scene};
 
 /// Rows per band: the unit of parallel work and of binning.
 pub const BAND_ROWS: usize = 16;
@@ -112,49 +112,113 @@ pub enum Faces {
     All,
 }
 
-/// Draws every object of `scene` seen by the scene's camera into `vb`, which is
-/// cleared first (each band clears its own rows, in parallel, just before drawing
-/// them).
+/// Draws every opaque object of `scene` seen by the scene's camera into `vb`,
+/// which is cleared first (each band clears its own rows, in parallel, just before
+/// drawing them). Translucent objects are left to [`fragments`].
 pub fn rasterize(scene: &Scene, vb: &mut VisibilityBuffer) -> RasterStats {
-    rasterize_from(scene, &scene.camera, Faces::AsMaterials, vb)
+    let pass = PolygonPass::new(scene, &scene.camera, Faces::AsMaterials, vb.width(), vb.height());
+    pass.draw(&chunks(scene, |m| !m.translucent()), vb)
 }
 
-/// As [`rasterize`], seen by `camera` (a light's, for a shadow map) and drawing
-/// `faces`.
+/// Draws every object of `scene`, opaque or not, seen by `camera` (a light's, for
+/// a shadow map), drawing `faces`, into `vb`.
 pub fn rasterize_from(scene: &Scene, camera: &Camera, faces: Faces, vb: &mut VisibilityBuffer) -> RasterStats {
-    let (w, h) = (vb.width() as usize, vb.height() as usize);
-    let view_proj = camera.view_projection(w as f32 / h as f32);
-    let planes = ClipPlanes::new(
-        camera.far_plane_factor() as f64,
-        1.0 + 2.0 * GUARD_PX as f64 / w as f64,
-        1.0 + 2.0 * GUARD_PX as f64 / h as f64,
-    );
-    let viewport = Viewport { width: w as f32, height: h as f32 };
-    let projected = scene.objects.iter().map(|o| project(scene, o, view_proj, &planes, viewport, faces)).collect();
-    let frame = PolygonPass {
-        scene,
-        projected,
-        planes,
-        viewport,
-        width: w as i64,
-        height: h as i64,
-        bands: h.div_ceil(BAND_ROWS),
-    };
-    let chunks = chunks(scene);
-    let bins: Vec<ChunkBins> = chunks.par_iter().map(|c| frame.bin(c)).collect();
-    let (depth, items) = vb.parts_mut();
-    let band_len = w * BAND_ROWS;
-    if items.is_empty() {
-        let bands = depth.par_chunks_mut(band_len).enumerate();
-        bands.for_each(|(band, d)| frame.draw_band(band, d, &mut [], &chunks, &bins));
-    } else {
-        let bands = depth.par_chunks_mut(band_len).zip(items.par_chunks_mut(band_len)).enumerate();
-        bands.for_each(|(band, (d, i))| frame.draw_band(band, d, i, &chunks, &bins));
+    let pass = PolygonPass::new(scene, camera, faces, vb.width(), vb.height());
+    pass.draw(&chunks(scene, |_| true), vb)
+}
+
+/// A sample of a translucent surface at a pixel centre.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Fragment {
+    /// Row-major pixel index.
+    pub pixel: u32,
+    /// Reversed depth (larger is nearer).
+    pub depth: f32,
+    /// The triangle.
+    pub item: ItemId,
+}
+
+/// Every fragment of the translucent objects of `scene` (seen by its camera) that
+/// lies in front of the opaque surface `opaque` holds at its pixel: the same scan
+/// conversion as [`rasterize`], writing a list instead of a z-buffer. Fragments
+/// come band by band, and within a pixel in scene order (object, triangle).
+#[must_use]
+pub fn fragments(scene: &Scene, opaque: &VisibilityBuffer) -> Vec<Fragment> {
+    let chunks = chunks(scene, |m| m.translucent());
+    if chunks.is_empty() {
+        return Vec::new();
     }
-    RasterStats {
-        triangles: scene.triangle_count(),
-        binned: bins.iter().map(|b| b.binned).sum(),
-        clipped: bins.iter().map(|b| b.clipped_count).sum(),
+    let (w, h) = (opaque.width(), opaque.height());
+    let pass = PolygonPass::new(scene, &scene.camera, Faces::AsMaterials, w, h);
+    let bins: Vec<ChunkBins> = chunks.par_iter().map(|c| pass.bin(c)).collect();
+    let band_len = w as usize * BAND_ROWS;
+    let bands = opaque.depths().par_chunks(band_len).enumerate();
+    let per_band: Vec<Vec<Fragment>> = bands
+        .map(|(band, depth)| {
+            let row0 = (band * BAND_ROWS) as i64;
+            let mut sink = FragmentSink {
+                opaque: depth,
+                width: pass.width,
+                row0,
+                plane: DepthPlane::default(),
+                item: ItemId::NONE,
+                out: Vec::new(),
+            };
+            pass.draw_band(band, &mut sink, &chunks, &bins);
+            sink.out
+        })
+        .collect();
+    per_band.concat()
+}
+
+impl<'a> PolygonPass<'a> {
+    fn new(scene: &'a Scene, camera: &Camera, faces: Faces, width: u32, height: u32) -> Self {
+        let (w, h) = (width as usize, height as usize);
+        let view_proj = camera.view_projection(w as f32 / h as f32);
+        let planes = ClipPlanes::new(
+            camera.far_plane_factor() as f64,
+            1.0 + 2.0 * GUARD_PX as f64 / w as f64,
+            1.0 + 2.0 * GUARD_PX as f64 / h as f64,
+        );
+        let viewport = Viewport { width: w as f32, height: h as f32 };
+        let projected = scene.objects.iter().map(|o| project(scene, o, view_proj, &planes, viewport, faces)).collect();
+        PolygonPass {
+            scene,
+            projected,
+            planes,
+            viewport,
+            width: w as i64,
+            height: h as i64,
+            bands: h.div_ceil(BAND_ROWS),
+        }
+    }
+
+    /// Bins `chunks` and draws them into `vb`, bands in parallel, each band
+    /// clearing its own rows first.
+    fn draw(&self, chunks: &[Chunk], vb: &mut VisibilityBuffer) -> RasterStats {
+        let bins: Vec<ChunkBins> = chunks.par_iter().map(|c| self.bin(c)).collect();
+        let (w, row0) = (self.width, |band: usize| (band * BAND_ROWS) as i64);
+        let (depth, items) = vb.parts_mut();
+        let band_len = w as usize * BAND_ROWS;
+        let draw = |band: usize, depth: &mut [f32], items: &mut [ItemId]| {
+            depth.fill(0.0);
+            items.fill(ItemId::NONE);
+            let (plane, item) = (DepthPlane::default(), ItemId::NONE);
+            let mut sink = DepthSink { depth, items, width: w, row0: row0(band), plane, item };
+            self.draw_band(band, &mut sink, chunks, &bins);
+        };
+        if items.is_empty() {
+            depth.par_chunks_mut(band_len).enumerate().for_each(|(band, d)| draw(band, d, &mut []));
+        } else {
+            let bands = depth.par_chunks_mut(band_len).zip(items.par_chunks_mut(band_len)).enumerate();
+            bands.for_each(|(band, (d, i))| draw(band, d, i));
+        }
+        let drawn: usize = chunks.iter().map(|c| c.triangles.len()).sum();
+        RasterStats {
+            triangles: drawn,
+            binned: bins.iter().map(|b| b.binned).sum(),
+            clipped: bins.iter().map(|b| b.clipped_count).sum(),
+        }
     }
 }
 
@@ -185,9 +249,10 @@ fn project(
     }
 }
 
-fn chunks(scene: &Scene) -> Vec<Chunk> {
+/// The objects whose material `include` accepts, cut into chunks.
+fn chunks(scene: &Scene, include: impl Fn(&Material) -> bool) -> Vec<Chunk> {
     let mut out = Vec::new();
-    for (object, o) in scene.objects.iter().enumerate() {
+    for (object, o) in scene.objects.iter().enumerate().filter(|(_, o)| include(&scene.materials[o.material])) {
         let n = o.mesh.triangles.len() as u32;
         out.extend(
             (0..n)
@@ -260,13 +325,10 @@ impl PolygonPass<'_> {
         Some(rows.start as usize / BAND_ROWS..(rows.end as usize - 1) / BAND_ROWS + 1)
     }
 
-    fn draw_band(&self, band: usize, depth: &mut [f32], items: &mut [ItemId], chunks: &[Chunk], bins: &[ChunkBins]) {
+    /// Scan-converts the triangles binned into `band` into `sink`, in scene order.
+    fn draw_band(&self, band: usize, sink: &mut impl BandSink, chunks: &[Chunk], bins: &[ChunkBins]) {
         let row0 = (band * BAND_ROWS) as i64;
         let rows = row0..(row0 + BAND_ROWS as i64).min(self.height);
-        depth.fill(0.0);
-        items.fill(ItemId::NONE);
-        let mut sink =
-            DepthSink { depth, items, width: self.width, row0, plane: DepthPlane::default(), item: ItemId::NONE };
         for (chunk, bin) in chunks.iter().zip(bins) {
             let p = &self.projected[chunk.object];
             let tris = &self.scene.objects[chunk.object].mesh.triangles;
@@ -276,9 +338,8 @@ impl PolygonPass<'_> {
                 } else {
                     (tris[entry as usize].map(|i| p.screen[i as usize]), entry)
                 };
-                sink.item = ItemId { object: chunk.object as u32, triangle: t };
-                sink.plane = DepthPlane::new(&v);
-                scan_triangle(&v.map(ScreenVertex::point), rows.clone(), &mut sink);
+                sink.triangle(ItemId { object: chunk.object as u32, triangle: t }, DepthPlane::new(&v));
+                scan_triangle(&v.map(ScreenVertex::point), rows.clone(), sink);
             }
         }
     }
@@ -305,6 +366,48 @@ impl DepthPlane {
         let dx = ((z1 - z0) * (y2 - y0) - (z2 - z0) * (y1 - y0)) / area;
         let dy = ((z2 - z0) * (x1 - x0) - (z1 - z0) * (x2 - x0)) / area;
         DepthPlane { c: z0 + dx * (0.5 - x0) + dy * (0.5 - y0), dx, dy }
+    }
+}
+
+/// Where a band's spans go: told each triangle before its spans.
+trait BandSink: SpanSink {
+    fn triangle(&mut self, item: ItemId, plane: DepthPlane);
+}
+
+impl BandSink for DepthSink<'_> {
+    fn triangle(&mut self, item: ItemId, plane: DepthPlane) {
+        (self.item, self.plane) = (item, plane);
+    }
+}
+
+/// Lists the samples of a band's spans that lie in front of the opaque depth.
+struct FragmentSink<'a> {
+    opaque: &'a [f32],
+    width: i64,
+    row0: i64,
+    plane: DepthPlane,
+    item: ItemId,
+    out: Vec<Fragment>,
+}
+
+impl BandSink for FragmentSink<'_> {
+    fn triangle(&mut self, item: ItemId, plane: DepthPlane) {
+        (self.item, self.plane) = (item, plane);
+    }
+}
+
+impl SpanSink for FragmentSink<'_> {
+    fn span(&mut self, y: i64, x0: i64, x1: i64) {
+        let (x0, x1) = (x0.max(0), x1.min(self.width));
+        let row_z = self.plane.c + self.plane.dy * y as f64;
+        let base = (y - self.row0) * self.width;
+        for x in x0..x1 {
+            let z = (row_z + self.plane.dx * x as f64) as f32;
+            if z > self.opaque[(base + x) as usize] {
+                let pixel = (y * self.width + x) as u32;
+                self.out.push(Fragment { pixel, depth: z, item: self.item });
+            }
+        }
     }
 }
 

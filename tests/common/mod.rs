@@ -35,6 +35,7 @@ pub fn scene_with(mesh: Mesh, camera: Camera, width: u32, height: u32, two_sided
         antialias: Default::default(),
         fog: None,
         environment: None,
+        translucency: Default::default(),
     }
 }
 

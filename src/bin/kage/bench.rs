@@ -165,6 +165,7 @@ fn peer_scene(path: &Path, width: u32, height: u32, mode: &str) -> Result<Scene>
         antialias: Default::default(),
         fog: None,
         environment: None,
+        translucency: Default::default(),
     };
     add_model(&mut scene, &model, "peer", Affine3A::IDENTITY, Some(0));
     Ok(scene)

@@ -1,0 +1,154 @@
+//! Translucency (seed 002 §3.4): opaque surfaces first, then translucent ones
+//! blended over them, far to near, with alpha = the material's opacity.
+//!
+//! The paper sorts translucent objects far to near and draws them with alpha
+//! blending; where they cannot be sorted it draws them in any order with z-writes
+//! off, and notes that overlaps then come out wrong. kage sorts finer than the
+//! paper: the polygon pass lists every translucent fragment in front of the opaque
+//! surface ([`crate::visibility::fragments`]) and the fragments of each pixel are
+//! sorted by depth, so intersecting translucent surfaces blend correctly on each
+//! side of their intersection. [`TranslucencyOrder::Unsorted`] keeps the paper's
+//! fallback — drawing order, z-write off — for comparison.
+//!
+//! Blending "over", far to near, gives a pixel
+//! `C = T · C_opaque + Σ_k w_k · S_k` with `w_k = α_k · Π_{j nearer} (1 − α_j)` and
+//! `T = Π (1 − α_k)`: linear in each fragment's shaded colour S_k. So the opaque
+//! image (every component) is scaled by T once, and each light's contribution to
+//! each fragment is added with its weight — one light at a time, its shadow maps
+//! rendered and dropped as in the opaque passes. Each fragment gets its own fog.
+
+use glam::{Vec2, Vec3};
+use rayon::prelude::*;
+
+use super::phong::{self, Coefficients, Components};
+use super::{Component, ObjectFrames, SurfacePoint, Target};
+use crate::scene::{Light, Scene};
+use crate::shadows::ShadowTerm;
+use crate::visibility::Fragment;
+
+/// How translucent fragments are ordered in a pixel.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum TranslucencyOrder {
+    /// By depth, far to near (correct wherever surfaces overlap or intersect).
+    #[default]
+    Sorted,
+    /// In drawing order (scene order), as the paper's z-write-off fallback.
+    Unsorted,
+}
+
+/// One translucent fragment, ready to be added.
+struct Layer {
+    pixel: usize,
+    weight: f32,
+    surface: SurfacePoint,
+    k: Coefficients,
+    object: usize,
+    fog: f32,
+    lit: Components,
+}
+
+/// Blends `fragments` (in front of the opaque surfaces) into every target, lit by
+/// `lights` (the frame's). Returns how many fragments were blended.
+pub fn composite(
+    scene: &Scene,
+    mut fragments: Vec<Fragment>,
+    order: TranslucencyOrder,
+    lights: &[Light],
+    targets: &mut [Target],
+) -> usize {
+    if fragments.is_empty() {
+        return 0;
+    }
+    // Nearest first within each pixel: by depth, or the last drawn first.
+    match order {
+        TranslucencyOrder::Sorted => {
+            fragments.par_sort_by(|a, b| a.pixel.cmp(&b.pixel).then(b.depth.total_cmp(&a.depth)))
+        }
+        TranslucencyOrder::Unsorted => {
+            let mut indexed: Vec<(usize, Fragment)> = fragments.into_iter().enumerate().collect();
+            indexed.par_sort_by(|(i, a), (j, b)| a.pixel.cmp(&b.pixel).then(j.cmp(i)));
+            fragments = indexed.into_iter().map(|(_, f)| f).collect();
+        }
+    }
+    let (w, h) = (targets[0].image.width(), targets[0].image.height());
+    let mut transmittance = vec![1.0f32; w as usize * h as usize];
+    let weights = front_to_back_weights(scene, &fragments, &mut transmittance);
+    for t in targets.iter_mut() {
+        t.image.pixels_mut().par_iter_mut().zip(transmittance.par_iter()).for_each(|(p, &tr)| *p *= tr);
+    }
+    let mut layers = prepare(scene, &fragments, &weights, w, h);
+    let bounds = scene.bounds().unwrap_or_default();
+    for light in lights {
+        let term = ShadowTerm::build_within(scene, light, bounds);
+        layers.par_iter_mut().filter(|l| light.only.as_ref().is_none_or(|o| o.contains(&l.object))).for_each(|l| {
+            let s = &l.surface;
+            let cos = s.normal.dot(light.incident(s.position).to_light);
+            let shadow = if cos > 0.0 { term.lit(s.position, cos) } else { 1.0 };
+            phong::add_light(&mut l.lit, light, &l.k, s, shadow);
+        });
+    }
+    for t in targets.iter_mut() {
+        add_layers(scene, &layers, t);
+    }
+    layers.len()
+}
+
+/// Each fragment's weight α · (transmittance of the fragments nearer than it);
+/// leaves each pixel's total transmittance in `transmittance`.
+fn front_to_back_weights(scene: &Scene, fragments: &[Fragment], transmittance: &mut [f32]) -> Vec<f32> {
+    fragments
+        .iter()
+        .map(|f| {
+            let alpha = scene.materials[scene.objects[f.item.object as usize].material].opacity;
+            let t = &mut transmittance[f.pixel as usize];
+            let weight = alpha * *t;
+            *t *= 1.0 - alpha;
+            weight
+        })
+        .collect()
+}
+
+/// The surface, coefficients, emission and fog of every fragment.
+fn prepare(scene: &Scene, fragments: &[Fragment], weights: &[f32], w: u32, h: u32) -> Vec<Layer> {
+    let frames = ObjectFrames::new(scene);
+    let rays = scene.camera.pixel_rays(Vec2::new(w as f32, h as f32));
+    fragments
+        .par_iter()
+        .zip(weights.par_iter())
+        .map(|(f, &weight)| {
+            let (x, y) = (f.pixel % w, f.pixel / w);
+            let surface = frames.surface(scene, f.item, &rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5)));
+            let k = Coefficients::at(&scene.materials[surface.material], &surface);
+            let fog = scene.fog.map_or(0.0, |fog| fog.amount_at(&scene.camera, surface.position));
+            let lit = Components { emission: k.parts().3, ..Default::default() };
+            Layer { pixel: f.pixel as usize, weight, surface, k, object: f.item.object as usize, fog, lit }
+        })
+        .collect()
+}
+
+/// Adds each layer's share of `t`'s components to `t`.
+fn add_layers(scene: &Scene, layers: &[Layer], t: &mut Target) {
+    let parts = t.parts;
+    let want = |c| if parts.contains(c) { 1.0 } else { 0.0 };
+    let (ambient, diffuse, specular, emission) =
+        (want(Component::Ambient), want(Component::Diffuse), want(Component::Specular), want(Component::Emission));
+    let fog_colour = scene.fog.filter(|_| parts.contains(Component::Fog)).map_or(Vec3::ZERO, |f| f.color);
+    let pixels = t.image.pixels_mut();
+    for l in layers {
+        let c = l.lit;
+        let mut colour = c.ambient * ambient + c.diffuse * diffuse + c.specular * specular + c.emission * emission;
+        if parts.contains(Component::Reflection) {
+            colour += reflection_map(scene, &l.surface);
+        }
+        pixels[l.pixel] += l.weight * (colour * (1.0 - l.fog) + fog_colour * l.fog);
+    }
+}
+
+/// Km · Mape(R) at `s` (zero without an environment).
+fn reflection_map(scene: &Scene, s: &SurfacePoint) -> Vec3 {
+    let km = scene.materials[s.material].km;
+    match &scene.environment {
+        Some(env) if km.max_element() > 0.0 => km * env.radiance(2.0 * s.normal.dot(s.to_eye) * s.normal - s.to_eye),
+        _ => Vec3::ZERO,
+    }
+}
