@@ -60,3 +60,30 @@ fn component_images_sum_to_the_final_image() {
         assert_eq!(plain.image, frame.image, "{name}: AOVs change the image");
     }
 }
+
+/// A component with two maps is two passes added (§3.2): Kd·(A + B) = Kd·A + Kd·B.
+#[test]
+fn two_maps_on_a_component_add_like_two_passes() {
+    use std::sync::Arc;
+    let checker = |a: f32, b: f32| {
+        let texels = (0..16).map(|i| Vec3::splat(if (i % 4 + i / 4) % 2 == 0 { a } else { b })).collect();
+        Arc::new(kage::scene::Texture::from_texels(4, 4, texels))
+    };
+    let (a, b) = (checker(0.2, 0.7), checker(0.5, 0.1));
+    let mut scene = example("demo.toml");
+    scene.lights.iter_mut().for_each(|l| l.ambient = 0.0);
+    let with = |maps: Vec<Arc<kage::scene::Texture>>| {
+        let mut s = scene.clone();
+        for m in &mut s.materials {
+            (m.ks, m.ke, m.maps.ambient, m.maps.diffuse) = (Vec3::ZERO, Vec3::ZERO, Vec::new(), maps.clone());
+        }
+        render(&s, &RenderOptions::default()).unwrap()
+    };
+    let (both, only_a, only_b) = (with(vec![a.clone(), b.clone()]), with(vec![a]), with(vec![b]));
+    for (i, item) in both.visibility.items().iter().enumerate() {
+        if !item.is_none() {
+            let (p, q) = (both.image.pixels()[i], only_a.image.pixels()[i] + only_b.image.pixels()[i]);
+            assert!((p - q).abs().max_element() < 1e-5, "pixel {i}: {p} vs {q}");
+        }
+    }
+}

@@ -30,7 +30,7 @@ fn checkered_ground(filter: Filter) -> kage::Scene {
     let texels = (0..256 * 256).map(|i| Vec3::splat(if (i % 256 + i / 256) % 2 == 0 { 0.9 } else { 0.1 })).collect();
     let m = &mut scene.materials[0];
     m.ks = Vec3::ZERO;
-    m.maps.diffuse = Some(Arc::new(Texture::from_texels(256, 256, texels)));
+    m.maps.diffuse = vec![Arc::new(Texture::from_texels(256, 256, texels))];
     m.maps.ambient = m.maps.diffuse.clone();
     m.maps.filter = filter;
     scene

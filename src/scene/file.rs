@@ -299,10 +299,10 @@ struct MaterialRec {
     shininess: f32,
     #[serde(default)]
     ke: V3,
-    ka_map: Option<Spanned<String>>,
-    kd_map: Option<Spanned<String>>,
-    ks_map: Option<Spanned<String>>,
-    ke_map: Option<Spanned<String>>,
+    ka_map: Option<MapsRec>,
+    kd_map: Option<MapsRec>,
+    ks_map: Option<MapsRec>,
+    ke_map: Option<MapsRec>,
     #[serde(default)]
     two_sided: bool,
     #[serde(default)]
@@ -317,6 +317,23 @@ struct MaterialRec {
     filter: FilterRec,
     #[serde(default)]
     wrap: WrapRec,
+}
+
+/// One texture path, or a list of them (one added pass each).
+#[derive(Debug, Deserialize)]
+#[serde(untagged)]
+enum MapsRec {
+    One(String),
+    Many(Vec<String>),
+}
+
+impl MapsRec {
+    fn paths(&self) -> &[String] {
+        match self {
+            MapsRec::One(p) => std::slice::from_ref(p),
+            MapsRec::Many(v) => v,
+        }
+    }
 }
 
 #[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default)]
@@ -419,10 +436,8 @@ impl SceneFile {
         if !(r.intensity.is_finite() && r.intensity >= 0.0 && r.rotate.is_finite()) {
             return Err(self.invalid(rec.span(), "environment intensity must be finite and ≥ 0, rotate finite"));
         }
-        let path = Path::new(r.map.get_ref());
-        // HDR formats hold linear radiance; PNG and JPEG hold sRGB-encoded colours.
-        let ext = path.extension().and_then(|e| e.to_str()).unwrap_or_default().to_ascii_lowercase();
-        let map = load::texture(path, !matches!(ext.as_str(), "exr" | "hdr"), assets)?;
+        // PNG and JPEG hold sRGB-encoded colours; EXR linear radiance (the loader knows).
+        let map = load::texture(Path::new(r.map.get_ref()), true, assets)?;
         Ok(Some(Environment { map, intensity: r.intensity, rotation: r.rotate.to_radians(), visible: r.background }))
     }
 
@@ -657,13 +672,13 @@ impl SceneFile {
             WrapRec::Clamp => Wrap::Clamp,
             WrapRec::Mirror => Wrap::Mirror,
         };
-        let texture = |p: &Option<Spanned<String>>, srgb: bool| -> Result<Option<Arc<Texture>>> {
-            let load = |p: &Spanned<String>| {
-                let mut t = load::texture(Path::new(p.get_ref()), srgb, assets)?;
+        let texture = |maps: &Option<MapsRec>, srgb: bool| -> Result<Vec<Arc<Texture>>> {
+            let load = |p: &String| {
+                let mut t = load::texture(Path::new(p), srgb, assets)?;
                 Arc::make_mut(&mut t).wrap = wrap;
                 Ok(t)
             };
-            p.as_ref().map(load).transpose()
+            maps.as_ref().map_or(&[][..], MapsRec::paths).iter().map(load).collect()
         };
         Ok(Material {
             name: r.name.get_ref().clone(),

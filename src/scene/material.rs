@@ -58,17 +58,19 @@ impl Material {
     }
 }
 
-/// Optional texture per shading component.
+/// The textures of each shading component (seed 002 §3.2, attribute mapping).
+/// A component with several maps is several passes added: Kd · (map₁ + map₂ + …);
+/// with none, the coefficient alone.
 #[derive(Debug, Clone, Default)]
 pub struct ComponentMaps {
-    /// Multiplies Ka.
-    pub ambient: Option<Arc<Texture>>,
-    /// Multiplies Kd.
-    pub diffuse: Option<Arc<Texture>>,
-    /// Multiplies Ks.
-    pub specular: Option<Arc<Texture>>,
-    /// Multiplies Ke.
-    pub emission: Option<Arc<Texture>>,
+    /// Multiply Ka.
+    pub ambient: Vec<Arc<Texture>>,
+    /// Multiply Kd.
+    pub diffuse: Vec<Arc<Texture>>,
+    /// Multiply Ks.
+    pub specular: Vec<Arc<Texture>>,
+    /// Multiply Ke.
+    pub emission: Vec<Arc<Texture>>,
     /// How the maps are filtered.
     pub filter: Filter,
 }

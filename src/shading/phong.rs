@@ -142,18 +142,24 @@ impl Coefficients {
     pub fn constant(m: &Material) -> Option<Self> {
         let maps = &m.maps;
         let none =
-            maps.ambient.is_none() && maps.diffuse.is_none() && maps.specular.is_none() && maps.emission.is_none();
+            maps.ambient.is_empty() && maps.diffuse.is_empty() && maps.specular.is_empty() && maps.emission.is_empty();
         none.then_some(Coefficients { ka: m.ka, kd: m.kd, ks: m.ks, ke: m.ke, n: m.shininess })
     }
 
     /// Samples every map of `m` at the point's uv.
     #[must_use]
     pub fn at(m: &Material, s: &SurfacePoint) -> Self {
-        let map = |t: &Option<std::sync::Arc<crate::scene::Texture>>| {
-            t.as_ref().map_or(Vec3::ONE, |t| match m.maps.filter {
-                Filter::Trilinear => t.sample_footprint(s.uv, s.duv),
-                Filter::Bilinear => t.sample(s.uv),
-            })
+        let sample = |t: &crate::scene::Texture| match m.maps.filter {
+            Filter::Trilinear => t.sample_footprint(s.uv, s.duv),
+            Filter::Bilinear => t.sample(s.uv),
+        };
+        // No map: the coefficient; several: one pass per map, added.
+        let map = |maps: &[std::sync::Arc<crate::scene::Texture>]| {
+            if maps.is_empty() {
+                Vec3::ONE
+            } else {
+                maps.iter().map(|t| sample(t)).sum()
+            }
         };
         Coefficients {
             ka: m.ka * map(&m.maps.ambient),

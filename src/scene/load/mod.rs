@@ -143,6 +143,9 @@ pub fn read(path: &Path, assets: &dyn AssetSource) -> Result<Vec<u8>> {
 
 /// Loads a colour (`srgb`) or data texture.
 pub fn texture(path: &Path, srgb: bool, assets: &dyn AssetSource) -> Result<Arc<Texture>> {
+    // OpenEXR and Radiance HDR hold linear values whatever they depict.
+    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or_default().to_ascii_lowercase();
+    let srgb = srgb && !matches!(ext.as_str(), "exr" | "hdr");
     let bytes = read(path, assets)?;
     Texture::decode(&bytes, srgb)
         .map(Arc::new)

@@ -79,10 +79,10 @@ fn material(m: &tobj::Material, dir: &Path, assets: &dyn AssetSource) -> Result<
         ke: Vec3::ZERO,
         maps: crate::scene::ComponentMaps {
             // Ka follows Kd, so an untextured ambient would flatten a textured surface.
-            ambient: map(&m.ambient_texture.clone().or_else(|| m.diffuse_texture.clone()))?,
-            diffuse: map(&m.diffuse_texture)?,
-            specular: map(&m.specular_texture)?,
-            emission: None,
+            ambient: map(&m.ambient_texture.clone().or_else(|| m.diffuse_texture.clone()))?.into_iter().collect(),
+            diffuse: map(&m.diffuse_texture)?.into_iter().collect(),
+            specular: map(&m.specular_texture)?.into_iter().collect(),
+            emission: Vec::new(),
             filter: Default::default(),
         },
         two_sided: false,
