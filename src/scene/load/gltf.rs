@@ -105,7 +105,7 @@ impl Context<'_> {
 
     fn material(&self, m: &gltf::Material) -> Result<Material, String> {
         let pbr = m.pbr_metallic_roughness();
-        let [r, g, b, _] = pbr.base_color_factor();
+        let [r, g, b, a] = pbr.base_color_factor();
         let base = Vec3::new(r, g, b);
         let metal = pbr.metallic_factor().clamp(0.0, 1.0);
         let alpha = pbr.roughness_factor().clamp(0.05, 1.0).powi(2);
@@ -126,6 +126,9 @@ impl Context<'_> {
                 filter: Default::default(),
             },
             two_sided: m.double_sided(),
+            // BLEND materials are translucent with the base colour's alpha; MASK and
+            // OPAQUE ones are drawn opaque (alpha cut-outs are not supported).
+            opacity: if m.alpha_mode() == gltf::material::AlphaMode::Blend { a.clamp(0.0, 1.0) } else { 1.0 },
             ..Material::default()
         })
     }
