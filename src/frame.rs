@@ -14,6 +14,7 @@ use crate::raytrace::item_buffer;
 use crate::resolve::LinearImage;
 use crate::scene::Scene;
 use crate::shading::{self, fog, translucency, Component, ComponentSet, Target};
+use crate::shadows::MapPool;
 use crate::visibility::{self, RasterStats, VisibilityBuffer};
 
 /// Most worker threads a renderer accepts.
@@ -95,6 +96,8 @@ struct Scratch {
     accum: LinearImage,
     /// One jittered pass's components (when AOVs are requested).
     aovs: Vec<LinearImage>,
+    /// Shadow-map buffers, reused from light to light and frame to frame.
+    maps: MapPool,
 }
 
 impl Renderer {
@@ -158,7 +161,7 @@ fn render_into(scene: &Scene, frame: &mut Frame, scratch: &mut Scratch, options:
     scratch.aovs.resize_with(frame.aovs.len(), LinearImage::default);
     scratch.aovs.iter_mut().for_each(|a| a.resize(w, h));
     if offsets.len() == 1 && offsets[0] == Vec2::ZERO {
-        render_pass(scene, frame, &mut scratch.aovs, options.ray_depth);
+        render_pass(scene, frame, &mut scratch.aovs, &mut scratch.maps, options.ray_depth);
         frame.aovs.iter_mut().zip(&mut scratch.aovs).for_each(|((_, a), s)| std::mem::swap(a, s));
     } else {
         // Seed 002 §4: each pass shifts the image by a fraction of a pixel, so its
@@ -171,7 +174,7 @@ fn render_into(scene: &Scene, frame: &mut Frame, scratch: &mut Scratch, options:
         for &o in &offsets {
             // Pixel offsets (y down) to NDC (y up).
             pass.camera.shift = scene.camera.shift + Vec2::new(o.x, -o.y) * pixel;
-            render_pass(&pass, frame, &mut scratch.aovs, options.ray_depth);
+            render_pass(&pass, frame, &mut scratch.aovs, &mut scratch.maps, options.ray_depth);
             add_scaled(&mut scratch.accum, &frame.image, k);
             frame.aovs.iter_mut().zip(&scratch.aovs).for_each(|((_, a), s)| add_scaled(a, s, k));
         }
@@ -181,7 +184,7 @@ fn render_into(scene: &Scene, frame: &mut Frame, scratch: &mut Scratch, options:
         + std::mem::size_of_val(frame.image.pixels())
         + std::mem::size_of_val(scratch.accum.pixels())
         + (frame.aovs.len() + scratch.aovs.len()) * std::mem::size_of_val(frame.image.pixels())
-        + frame.stats.shadow_bytes;
+        + scratch.maps.memory_bytes();
 }
 
 /// `acc += k · img`.
@@ -192,7 +195,7 @@ fn add_scaled(acc: &mut LinearImage, img: &LinearImage, k: f32) {
 /// One visibility pass, its shading and its traced term into `frame.image`, and
 /// the components `frame.aovs` names into `aovs` (same order); adds its timings to
 /// the frame's statistics.
-fn render_pass(scene: &Scene, frame: &mut Frame, aovs: &mut [LinearImage], ray_depth: u32) {
+fn render_pass(scene: &Scene, frame: &mut Frame, aovs: &mut [LinearImage], maps: &mut MapPool, ray_depth: u32) {
     let t0 = Instant::now();
     frame.visibility.resize(scene.width, scene.height);
     frame.stats.raster = visibility::rasterize(scene, &mut frame.visibility);
@@ -208,7 +211,7 @@ fn render_pass(scene: &Scene, frame: &mut Frame, aovs: &mut [LinearImage], ray_d
         }
     }
     let vb = &frame.visibility;
-    let lit = shading::shade_lit(scene, vb, &mut targets);
+    let lit = shading::shade_lit(scene, vb, &mut targets, maps);
     let t2 = Instant::now();
     frame.stats.traced_pixels += match &mut traced_aov {
         None => item_buffer::add_traced(scene, vb, targets[0].image, ray_depth),
@@ -233,7 +236,7 @@ fn render_pass(scene: &Scene, frame: &mut Frame, aovs: &mut [LinearImage], ray_d
     if !layers.is_empty() {
         let lights = shading::frame_lights(scene);
         frame.stats.translucent_fragments +=
-            translucency::composite(scene, layers, scene.translucency, &lights, &mut targets);
+            translucency::composite(scene, layers, scene.translucency, &lights, &mut targets, maps);
     }
     frame.stats.visibility_ms += (t1 - t0).as_secs_f64() * 1e3;
     frame.stats.shading_ms += ((t2 - t1) + t3.elapsed()).as_secs_f64() * 1e3 - lit.shadow_ms;

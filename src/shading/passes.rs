@@ -22,7 +22,7 @@ use super::reflection_map::{add_reflection_map, flat_background};
 use super::{shade_pass, Blend, Component, ComponentSet, Lighting, ShadingPass};
 use crate::resolve::LinearImage;
 use crate::scene::{Light, Scene};
-use crate::shadows::ShadowTerm;
+use crate::shadows::{MapPool, ShadowTerm};
 use crate::visibility::VisibilityBuffer;
 
 /// What the passes of one frame cost.
@@ -59,8 +59,9 @@ pub fn frame_lights(scene: &Scene) -> Vec<Light> {
 
 /// Shades `vb` with every light of `scene`, shadows included, into each target:
 /// each pass runs once per target, restricted to the target's components, so the
-/// shadow maps of a light are rendered once for all targets.
-pub fn shade_lit(scene: &Scene, vb: &VisibilityBuffer, targets: &mut [Target]) -> PassStats {
+/// shadow maps of a light are rendered once for all targets. Map buffers come
+/// from `pool` and go back to it.
+pub fn shade_lit(scene: &Scene, vb: &VisibilityBuffer, targets: &mut [Target], pool: &mut MapPool) -> PassStats {
     let mut stats = PassStats::default();
     let mut budget = FUSED_SHADOW_BUDGET;
     let bounds = scene.bounds().unwrap_or_default();
@@ -71,7 +72,7 @@ pub fn shade_lit(scene: &Scene, vb: &VisibilityBuffer, targets: &mut [Target]) -
         let bytes = ShadowTerm::bytes_needed(light);
         if light.only.is_none() && bytes <= budget {
             budget -= bytes;
-            fused.push((light, build(scene, light, bounds, &mut stats)));
+            fused.push((light, build(scene, light, bounds, pool, &mut stats)));
         } else {
             own.push(light);
         }
@@ -81,24 +82,25 @@ pub fn shade_lit(scene: &Scene, vb: &VisibilityBuffer, targets: &mut [Target]) -
     let ambient = lights.iter().filter(|l| l.only.is_none());
     run(scene, vb, targets, &Lighting::pass(ambient, direct, true), Blend::Replace, None);
     stats.passes = 1;
-    drop(fused);
+    fused.into_iter().for_each(|(_, term)| pool.recycle(term));
     for light in own {
-        let term = build(scene, light, bounds, &mut stats);
+        let term = build(scene, light, bounds, pool, &mut stats);
         stats.shadow_bytes = stats.shadow_bytes.max(term.memory_bytes());
         let receivers = light.only.as_ref().map(|only| (0..scene.objects.len()).map(|i| only.contains(&i)).collect());
         // A light that lights every object had its ambient added in the first pass.
         let ambient = light.only.is_some().then_some(light);
         run(scene, vb, targets, &Lighting::pass(ambient, vec![(light, &term)], false), Blend::Add, receivers);
         stats.passes += 1;
+        pool.recycle(term);
     }
     add_reflection_map(scene, vb, targets);
     stats
 }
 
 /// The shadow term of `light`, timed into `stats`.
-fn build(scene: &Scene, light: &Light, bounds: (Vec3, Vec3), stats: &mut PassStats) -> ShadowTerm {
+fn build(scene: &Scene, light: &Light, bounds: (Vec3, Vec3), pool: &mut MapPool, stats: &mut PassStats) -> ShadowTerm {
     let t = Instant::now();
-    let term = ShadowTerm::build_within(scene, light, bounds);
+    let term = ShadowTerm::build_within(scene, light, bounds, pool);
     stats.shadow_ms += t.elapsed().as_secs_f64() * 1e3;
     term
 }

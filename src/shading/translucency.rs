@@ -23,7 +23,7 @@ use rayon::prelude::*;
 use super::phong::{self, Coefficients, Components};
 use super::{Component, ObjectFrames, SurfacePoint, Target};
 use crate::scene::{Light, Scene};
-use crate::shadows::ShadowTerm;
+use crate::shadows::{MapPool, ShadowTerm};
 use crate::visibility::Fragment;
 
 /// How translucent fragments are ordered in a pixel.
@@ -55,6 +55,7 @@ pub fn composite(
     order: TranslucencyOrder,
     lights: &[Light],
     targets: &mut [Target],
+    pool: &mut MapPool,
 ) -> usize {
     if fragments.is_empty() {
         return 0;
@@ -79,13 +80,14 @@ pub fn composite(
     let mut layers = prepare(scene, &fragments, &weights, w, h);
     let bounds = scene.bounds().unwrap_or_default();
     for light in lights {
-        let term = ShadowTerm::build_within(scene, light, bounds);
+        let term = ShadowTerm::build_within(scene, light, bounds, pool);
         layers.par_iter_mut().filter(|l| light.only.as_ref().is_none_or(|o| o.contains(&l.object))).for_each(|l| {
             let s = &l.surface;
             let cos = s.normal.dot(light.incident(s.position).to_light);
             let shadow = if cos > 0.0 { term.lit(s.position, cos) } else { 1.0 };
             phong::add_light(&mut l.lit, light, &l.k, s, shadow);
         });
+        pool.recycle(term);
     }
     for t in targets.iter_mut() {
         add_layers(scene, &layers, t);

@@ -36,10 +36,10 @@ pub struct DepthMap {
 
 impl DepthMap {
     /// Renders the depth of every object of `scene` seen by `camera` into a square
-    /// map of `resolution` texels.
+    /// map of `resolution` texels, held in `depth` (a depth-only buffer, resized).
     #[must_use]
-    pub fn render(scene: &Scene, camera: &Camera, resolution: u32) -> DepthMap {
-        let mut depth = VisibilityBuffer::depth_only(resolution, resolution);
+    pub fn render(scene: &Scene, camera: &Camera, resolution: u32, mut depth: VisibilityBuffer) -> DepthMap {
+        depth.resize(resolution, resolution);
         rasterize_from(scene, camera, Faces::All, &mut depth);
         let (ortho, texel) = match camera.projection {
             Projection::Perspective { fov_y_deg } => (false, 2.0 * (fov_y_deg.to_radians() * 0.5).tan()),
@@ -175,6 +175,12 @@ impl DepthMap {
             out[i] = lit as f32 * share;
         }
         f32x8::new(out)
+    }
+
+    /// Gives the map's buffer back (for the next map to reuse).
+    #[must_use]
+    pub fn into_buffer(self) -> VisibilityBuffer {
+        self.depth
     }
 
     /// Bytes held by the map.

@@ -16,6 +16,7 @@ use wide::f32x8;
 pub use map::DepthMap;
 
 use crate::scene::{Camera, Light, LightKind, Projection, Scene, ShadowMethod, ShadowSettings};
+use crate::visibility::VisibilityBuffer;
 
 /// Widest spot cone (half-angle, degrees) one perspective map covers; wider spots
 /// use a cube like point lights.
@@ -38,14 +39,15 @@ impl ShadowTerm {
     #[must_use]
     pub fn build(scene: &Scene, light: &Light) -> ShadowTerm {
         match scene.bounds() {
-            Some(bounds) => ShadowTerm::build_within(scene, light, bounds),
+            Some(bounds) => ShadowTerm::build_within(scene, light, bounds, &mut MapPool::default()),
             None => ShadowTerm::Unshadowed,
         }
     }
 
-    /// [`ShadowTerm::build`] with the scene's bounds already known.
+    /// [`ShadowTerm::build`] with the scene's bounds already known, its maps in
+    /// buffers taken from `pool` (give them back with [`MapPool::recycle`]).
     #[must_use]
-    pub fn build_within(scene: &Scene, light: &Light, bounds: (Vec3, Vec3)) -> ShadowTerm {
+    pub fn build_within(scene: &Scene, light: &Light, bounds: (Vec3, Vec3), pool: &mut MapPool) -> ShadowTerm {
         let settings = light.shadow;
         if settings.method == ShadowMethod::None {
             return ShadowTerm::Unshadowed;
@@ -55,21 +57,21 @@ impl ShadowTerm {
             LightKind::Spot { position, direction, outer, .. } if outer.to_degrees() <= MAX_SPOT_HALF_ANGLE_DEG => {
                 let fov = (2.0 * outer.to_degrees() + 2.0).min(170.0);
                 let cam = light_camera(position, direction, Projection::Perspective { fov_y_deg: fov }, bounds);
-                ShadowTerm::Map(DepthMap::render(scene, &cam, res), settings)
+                ShadowTerm::Map(DepthMap::render(scene, &cam, res, pool.take()), settings)
             }
             LightKind::Point { position } | LightKind::Spot { position, .. } => {
                 // Six faces at half the resolution: 1.5 single maps of memory.
                 let res = (res / 2).max(16);
                 let faces = [Vec3::X, Vec3::NEG_X, Vec3::Y, Vec3::NEG_Y, Vec3::Z, Vec3::NEG_Z].map(|axis| {
                     let cam = light_camera(position, axis, Projection::Perspective { fov_y_deg: 90.0 }, bounds);
-                    DepthMap::render(scene, &cam, res)
+                    DepthMap::render(scene, &cam, res, pool.take())
                 });
                 ShadowTerm::Cube(Box::new(faces), position, settings)
             }
             LightKind::Directional { direction } => {
                 let cam =
                     fitted_orthographic(&scene.camera, scene.width as f32 / scene.height as f32, direction, bounds);
-                ShadowTerm::Map(DepthMap::render(scene, &cam, res), settings)
+                ShadowTerm::Map(DepthMap::render(scene, &cam, res, pool.take()), settings)
             }
         }
     }
@@ -141,6 +143,36 @@ impl ShadowTerm {
             ShadowTerm::Map(m, _) => m.memory_bytes(),
             ShadowTerm::Cube(f, ..) => f.iter().map(DepthMap::memory_bytes).sum(),
         }
+    }
+}
+
+/// Depth buffers kept from one shadow map to the next and from frame to frame:
+/// a fresh 2048² map costs ~2 ms of page faults alone.
+#[derive(Debug, Default)]
+pub struct MapPool {
+    free: Vec<VisibilityBuffer>,
+}
+
+impl MapPool {
+    /// A buffer to render a map into.
+    #[must_use]
+    pub fn take(&mut self) -> VisibilityBuffer {
+        self.free.pop().unwrap_or_else(|| VisibilityBuffer::depth_only(0, 0))
+    }
+
+    /// Takes back the buffers of `term`'s maps.
+    pub fn recycle(&mut self, term: ShadowTerm) {
+        match term {
+            ShadowTerm::Unshadowed => {}
+            ShadowTerm::Map(map, _) => self.free.push(map.into_buffer()),
+            ShadowTerm::Cube(faces, ..) => self.free.extend(faces.into_iter().map(DepthMap::into_buffer)),
+        }
+    }
+
+    /// Bytes held by the buffers waiting in the pool.
+    #[must_use]
+    pub fn memory_bytes(&self) -> usize {
+        self.free.iter().map(VisibilityBuffer::memory_bytes).sum()
     }
 }
 
