@@ -12,9 +12,14 @@ use crate::scene::Ray;
 #[derive(Debug, Clone, Copy)]
 pub struct ShearedRay {
     origin: Vec3,
-    /// Axis permutation: kz is the dominant direction axis.
-    k: [usize; 3],
-    shear: Vec3,
+    /// The axis permutation and shear as three rows: sheared = (rx·a, ry·a, rz·a)
+    /// for a = vertex − origin, with rx = e_kx − Sx·e_kz, ry = e_ky − Sy·e_kz,
+    /// rz = e_kz (kz the dominant direction axis). The zero entries make each dot
+    /// product exactly `a[kx] − Sx·a[kz]`, as the paper computes it, without
+    /// indexing by a run-time axis.
+    rows: [Vec3; 3],
+    /// 1 / d[kz]: scales the interpolated z to the ray's t.
+    inv_dz: f32,
 }
 
 impl ShearedRay {
@@ -28,19 +33,21 @@ impl ShearedRay {
         if d[kz] < 0.0 {
             std::mem::swap(&mut kx, &mut ky);
         }
-        let shear = Vec3::new(d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]);
-        ShearedRay { origin: ray.origin, k: [kx, ky, kz], shear }
+        let unit = |k: usize| Vec3::AXES[k];
+        let (sx, sy) = (d[kx] / d[kz], d[ky] / d[kz]);
+        let rows = [unit(kx) - sx * unit(kz), unit(ky) - sy * unit(kz), unit(kz)];
+        ShearedRay { origin: ray.origin, rows, inv_dz: 1.0 / d[kz] }
     }
 
     /// Distance and barycentrics (b1, b2) of the hit with triangle `p` in
     /// `(t_min, t_max)`, from either side.
     #[must_use]
     pub fn intersect(&self, p: &[Vec3; 3], t_min: f32, t_max: f32) -> Option<(f32, Vec2)> {
-        let [kx, ky, kz] = self.k;
-        let s = self.shear;
-        let rel = p.map(|v| v - self.origin);
-        let sheared = rel.map(|a| Vec3::new(a[kx] - s.x * a[kz], a[ky] - s.y * a[kz], a[kz]));
-        let [a, b, c] = sheared;
+        let [rx, ry, rz] = self.rows;
+        let [a, b, c] = p.map(|v| {
+            let a = v - self.origin;
+            Vec3::new(rx.dot(a), ry.dot(a), rz.dot(a))
+        });
         let mut u = c.x * b.y - c.y * b.x;
         let mut v = a.x * c.y - a.y * c.x;
         let mut w = b.x * a.y - b.y * a.x;
@@ -56,7 +63,7 @@ impl ShearedRay {
         if det == 0.0 {
             return None;
         }
-        let t_scaled = s.z * (u * a.z + v * b.z + w * c.z);
+        let t_scaled = self.inv_dz * (u * a.z + v * b.z + w * c.z);
         let t = t_scaled / det;
         if !(t > t_min && t < t_max) {
             return None;
