@@ -44,10 +44,12 @@ impl ShearedRay {
     #[must_use]
     pub fn intersect(&self, p: &[Vec3; 3], t_min: f32, t_max: f32) -> Option<(f32, Vec2)> {
         let [rx, ry, rz] = self.rows;
-        let [a, b, c] = p.map(|v| {
+        // Not `p.map(..)`: array map is not inlined here and costs a call per vertex.
+        let shear = |v: Vec3| {
             let a = v - self.origin;
             Vec3::new(rx.dot(a), ry.dot(a), rz.dot(a))
-        });
+        };
+        let (a, b, c) = (shear(p[0]), shear(p[1]), shear(p[2]));
         let mut u = c.x * b.y - c.y * b.x;
         let mut v = a.x * c.y - a.y * c.x;
         let mut w = b.x * a.y - b.y * a.x;
