@@ -18,6 +18,7 @@ use crate::resolve::LinearImage;
 use crate::sampling::{concentric_disc, hash3, stratified};
 use crate::scene::{Light, LightKind, Ray, Scene};
 use crate::shading::phong::{self, Coefficients, Components};
+use crate::shading::reflection_map::reflection_map;
 use crate::shading::{ObjectFrames, SurfacePoint};
 
 /// How the reference is computed.
@@ -116,18 +117,7 @@ impl<'a> Tracer<'a> {
             let shadow = if self.opts.shadows { self.visibility(light, &s, i as u32) } else { 1.0 };
             phong::add_light(&mut acc, light, &k, &s, shadow);
         }
-        acc.total() + self.reflection_map(&s) + self.bounces(ray, &s, depth)
-    }
-
-    /// Ie of eq. 4: Km times the environment in the mirror direction at `s`.
-    fn reflection_map(&self, s: &SurfacePoint) -> Vec3 {
-        let km = self.scene.materials[s.material].km;
-        match &self.scene.environment {
-            Some(env) if km.max_element() > 0.0 => {
-                km * env.radiance(2.0 * s.normal.dot(s.to_eye) * s.normal - s.to_eye)
-            }
-            _ => Vec3::ZERO,
-        }
+        acc.total() + reflection_map(self.scene, &s) + self.bounces(ray, &s, depth)
     }
 
     /// IrayTracing of seed 002 eq. 5 at `s`, seen along `ray`: Kr times the light of

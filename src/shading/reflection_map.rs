@@ -7,7 +7,7 @@
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
-use super::{Component, ObjectFrames, Target};
+use super::{Component, ObjectFrames, SurfacePoint, Target};
 use crate::scene::Scene;
 use crate::visibility::VisibilityBuffer;
 
@@ -40,12 +40,21 @@ pub fn add_reflection_map(scene: &Scene, vb: &VisibilityBuffer, targets: &mut [T
                 }
                 let material = scene.objects[item.object as usize].material;
                 if reflection && reflecting[material] {
-                    let s = frames.surface(scene, item, &ray());
-                    let r = 2.0 * s.normal.dot(s.to_eye) * s.normal - s.to_eye;
-                    *px += scene.materials[material].km * env.radiance(r);
+                    *px += reflection_map(scene, &frames.surface(scene, item, &ray()));
                 }
             }
         });
+    }
+}
+
+/// Ie at one surface point: Km times the environment in the view's mirror
+/// direction R = 2(N·V)N − V (zero without an environment or a Km).
+#[must_use]
+pub fn reflection_map(scene: &Scene, s: &SurfacePoint) -> Vec3 {
+    let km = scene.materials[s.material].km;
+    match &scene.environment {
+        Some(env) if km.max_element() > 0.0 => km * env.radiance(2.0 * s.normal.dot(s.to_eye) * s.normal - s.to_eye),
+        _ => Vec3::ZERO,
     }
 }
 

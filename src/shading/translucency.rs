@@ -21,6 +21,7 @@ use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
 use super::phong::{self, Coefficients, Components};
+use super::reflection_map::reflection_map;
 use super::{Component, ObjectFrames, SurfacePoint, Target};
 use crate::scene::{Light, Scene};
 use crate::shadows::{MapPool, ShadowTerm};
@@ -143,14 +144,5 @@ fn add_layers(scene: &Scene, layers: &[Layer], t: &mut Target) {
             colour += reflection_map(scene, &l.surface);
         }
         pixels[l.pixel] += l.weight * (colour * (1.0 - l.fog) + fog_colour * l.fog);
-    }
-}
-
-/// Km · Mape(R) at `s` (zero without an environment).
-fn reflection_map(scene: &Scene, s: &SurfacePoint) -> Vec3 {
-    let km = scene.materials[s.material].km;
-    match &scene.environment {
-        Some(env) if km.max_element() > 0.0 => km * env.radiance(2.0 * s.normal.dot(s.to_eye) * s.normal - s.to_eye),
-        _ => Vec3::ZERO,
     }
 }
