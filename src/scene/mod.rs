@@ -167,6 +167,8 @@ pub fn framing(bounds: (Vec3, Vec3), aspect: f32) -> (Camera, Vec<Light>) {
         ambient: 0.12,
         size: 0.05 * r,
         falloff: Falloff::None,
+        // Four jittered maps: soft enough for so small a light, quick to preview.
+        shadow: ShadowSettings { samples: 4, ..ShadowSettings::default() },
         ..Light::default()
     };
     let fill = Light {

@@ -69,7 +69,7 @@ pub fn shade_lit(scene: &Scene, vb: &VisibilityBuffer, targets: &mut [Target], p
     let lights = frame_lights(scene);
     let (mut fused, mut own) = (Vec::new(), Vec::new());
     for light in &lights {
-        let bytes = ShadowTerm::bytes_needed(light);
+        let bytes = ShadowTerm::bytes_needed(light, bounds);
         if light.only.is_none() && bytes <= budget {
             budget -= bytes;
             fused.push((light, build(scene, light, bounds, pool, &mut stats)));

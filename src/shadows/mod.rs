@@ -49,48 +49,38 @@ impl ShadowTerm {
     #[must_use]
     pub fn build_within(scene: &Scene, light: &Light, bounds: (Vec3, Vec3), pool: &mut MapPool) -> ShadowTerm {
         let settings = light.shadow;
-        if settings.method == ShadowMethod::None {
-            return ShadowTerm::Unshadowed;
-        }
         let res = settings.resolution.max(1);
-        match light.kind {
-            LightKind::Spot { position, direction, outer, .. } if outer.to_degrees() <= MAX_SPOT_HALF_ANGLE_DEG => {
-                let fov = (2.0 * outer.to_degrees() + 2.0).min(170.0);
-                let cam = light_camera(position, direction, Projection::Perspective { fov_y_deg: fov }, bounds);
-                ShadowTerm::Map(DepthMap::render(scene, &cam, res, pool.take()), settings)
+        let mut map = |cam: Camera, res: u32| DepthMap::render(scene, &cam, res, pool.take());
+        match placement(light, bounds) {
+            Placement::None => ShadowTerm::Unshadowed,
+            Placement::Cone { eye, axis, fov_y_deg } => {
+                let cam = light_camera(eye, axis, Projection::Perspective { fov_y_deg }, bounds);
+                ShadowTerm::Map(map(cam, res), settings)
             }
-            LightKind::Point { position } | LightKind::Spot { position, .. } => {
+            Placement::Cube { eye } => {
                 // Six faces at half the resolution: 1.5 single maps of memory.
                 let res = (res / 2).max(16);
-                let faces = [Vec3::X, Vec3::NEG_X, Vec3::Y, Vec3::NEG_Y, Vec3::Z, Vec3::NEG_Z].map(|axis| {
-                    let cam = light_camera(position, axis, Projection::Perspective { fov_y_deg: 90.0 }, bounds);
-                    DepthMap::render(scene, &cam, res, pool.take())
-                });
-                ShadowTerm::Cube(Box::new(faces), position, settings)
+                let faces = [Vec3::X, Vec3::NEG_X, Vec3::Y, Vec3::NEG_Y, Vec3::Z, Vec3::NEG_Z]
+                    .map(|axis| map(light_camera(eye, axis, Projection::Perspective { fov_y_deg: 90.0 }, bounds), res));
+                ShadowTerm::Cube(Box::new(faces), eye, settings)
             }
-            LightKind::Directional { direction } => {
-                let cam =
-                    fitted_orthographic(&scene.camera, scene.width as f32 / scene.height as f32, direction, bounds);
-                ShadowTerm::Map(DepthMap::render(scene, &cam, res, pool.take()), settings)
+            Placement::Parallel { direction } => {
+                let aspect = scene.width as f32 / scene.height as f32;
+                ShadowTerm::Map(map(fitted_orthographic(&scene.camera, aspect, direction, bounds), res), settings)
             }
         }
     }
 
-    /// Bytes the maps of `light` will hold (before they are rendered).
+    /// Bytes the maps of `light` will hold (before they are rendered) in a scene
+    /// with these bounds.
     #[must_use]
-    pub fn bytes_needed(light: &Light) -> usize {
-        if light.shadow.method == ShadowMethod::None {
-            return 0;
-        }
+    pub fn bytes_needed(light: &Light, bounds: (Vec3, Vec3)) -> usize {
         let res = light.shadow.resolution.max(1) as usize;
-        let single = res * res * std::mem::size_of::<f32>();
-        match light.kind {
-            LightKind::Spot { outer, .. } if outer.to_degrees() <= MAX_SPOT_HALF_ANGLE_DEG => single,
-            LightKind::Directional { .. } => single,
-            LightKind::Point { .. } | LightKind::Spot { .. } => {
-                let face = (res / 2).max(16);
-                6 * face * face * std::mem::size_of::<f32>()
-            }
+        let texel = std::mem::size_of::<f32>();
+        match placement(light, bounds) {
+            Placement::None => 0,
+            Placement::Cone { .. } | Placement::Parallel { .. } => res * res * texel,
+            Placement::Cube { .. } => 6 * (res / 2).max(16).pow(2) * texel,
         }
     }
 
@@ -143,6 +133,44 @@ impl ShadowTerm {
             ShadowTerm::Map(m, _) => m.memory_bytes(),
             ShadowTerm::Cube(f, ..) => f.iter().map(DepthMap::memory_bytes).sum(),
         }
+    }
+}
+
+/// How a light's shadow maps are placed.
+enum Placement {
+    /// No shadows.
+    None,
+    /// One perspective map from `eye` along `axis`.
+    Cone { eye: Vec3, axis: Vec3, fov_y_deg: f32 },
+    /// Six 90° maps around `eye`.
+    Cube { eye: Vec3 },
+    /// One orthographic map fitted to the view.
+    Parallel { direction: Vec3 },
+}
+
+/// A spot light sees through its own cone; a point light (or a spot wider than
+/// one map can hold) outside the scene's bounding sphere sees the whole scene
+/// through one cone just holding that sphere (the peers' placement), and needs a
+/// cube only when it is among the objects.
+fn placement(light: &Light, bounds: (Vec3, Vec3)) -> Placement {
+    if light.shadow.method == ShadowMethod::None {
+        return Placement::None;
+    }
+    let (centre, radius) = ((bounds.0 + bounds.1) * 0.5, (bounds.1 - bounds.0).length() * 0.5);
+    match light.kind {
+        LightKind::Spot { position, direction, outer, .. } if outer.to_degrees() <= MAX_SPOT_HALF_ANGLE_DEG => {
+            Placement::Cone { eye: position, axis: direction, fov_y_deg: (2.0 * outer.to_degrees() + 2.0).min(170.0) }
+        }
+        LightKind::Point { position } | LightKind::Spot { position, .. } => {
+            let to_centre = centre - position;
+            let half = (radius / to_centre.length().max(f32::MIN_POSITIVE)).min(1.0).asin().to_degrees();
+            if half + 1.0 <= MAX_SPOT_HALF_ANGLE_DEG {
+                Placement::Cone { eye: position, axis: to_centre.normalize(), fov_y_deg: 2.0 * half + 2.0 }
+            } else {
+                Placement::Cube { eye: position }
+            }
+        }
+        LightKind::Directional { direction } => Placement::Parallel { direction },
     }
 }
 
