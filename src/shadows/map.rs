@@ -154,9 +154,22 @@ impl DepthMap {
             let near = f32x8::splat(self.near);
             limit.simd_gt(near).select(near / limit, f32x8::splat(f32::INFINITY))
         };
-        let (inside, u, v, z_limit) = (inside.to_array(), u.to_array(), v.to_array(), z_limit.to_array());
-        let (last, res) = (self.resolution as i32 - 1, self.resolution as usize);
         let depth = self.depth.depths();
+        let res = self.resolution as usize;
+        if k == 1 {
+            // One tap: all eight texel reads issued before any compare, so their
+            // cache misses overlap; lanes outside the map read texel 0 and count lit.
+            let (u0, v0) = (u.floor().round_int().to_array(), v.floor().round_int().to_array());
+            let inside_lanes = inside.to_array();
+            let texel: [f32; 8] = std::array::from_fn(|i| {
+                let index = if inside_lanes[i] != 0.0 { v0[i] as usize * res + u0[i] as usize } else { 0 };
+                depth.get(index).copied().unwrap_or(0.0)
+            });
+            let lit = f32x8::new(texel).simd_le(z_limit).select(f32x8::ONE, zero);
+            return inside.select(lit, f32x8::ONE);
+        }
+        let (inside, u, v, z_limit) = (inside.to_array(), u.to_array(), v.to_array(), z_limit.to_array());
+        let last = self.resolution as i32 - 1;
         let share = 1.0 / (k * k) as f32;
         let mut out = [1.0f32; 8];
         for i in 0..8 {
