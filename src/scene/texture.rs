@@ -115,12 +115,6 @@ impl Texture {
         Texture { levels, wrap: Wrap::Repeat }
     }
 
-    /// Width and height of the finest level.
-    #[must_use]
-    pub fn size(&self) -> (u32, u32) {
-        (self.levels[0].width, self.levels[0].height)
-    }
-
     /// Bilinear sample of the finest level at `uv` (origin top-left, texel centres
     /// at +0.5).
     #[must_use]

@@ -363,13 +363,6 @@ pub struct Lighting<'a> {
 }
 
 impl<'a> Lighting<'a> {
-    /// Every light's ambient, diffuse and specular, unshadowed, plus emission.
-    #[must_use]
-    pub fn new(lights: &'a [Light]) -> Self {
-        let direct = lights.iter().map(|l| (l, &ShadowTerm::Unshadowed)).collect();
-        Lighting::pass(lights, direct, true)
-    }
-
     /// The ambient terms of `ambient`, the diffuse and specular terms of `direct`
     /// (each multiplied by its shadow term) and, if `emission`, Ke.
     #[must_use]

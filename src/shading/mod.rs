@@ -1,6 +1,12 @@
-//! Shading passes over the visibility buffer (seed 002 §3): once per visible pixel,
-//! the surface is reconstructed from the item id and lit by eq. 1 into a linear
-//! float accumulation buffer. Pixels that see nothing get the background colour.
+//! Shading passes over the visibility buffer (seed 002 §3): in each pass every
+//! visible pixel's surface is reconstructed from its item id and lit by eq. 1, and
+//! the passes are summed in a linear float accumulation buffer (eq. 4).
+//!
+//! [`passes`] decides which lights share a pass ([`shade_lit`] runs a frame's);
+//! [`shade_pass`] runs one, eight pixels at a time ([`lanes`]); [`phong`] is the
+//! scalar statement of eq. 1 the lanes are tested against; [`reflection_map`],
+//! [`fog`] and [`translucency`] are the once-per-frame passes of §3.4, §3.5 and
+//! eq. 4's Ie.
 
 pub mod fog;
 pub mod lanes;
@@ -47,18 +53,6 @@ impl ShadingPass<'_> {
     fn receives(&self, item: ItemId) -> bool {
         !item.is_none() && self.receivers.as_ref().is_none_or(|r| r[item.object as usize])
     }
-}
-
-/// Shades every pixel of `vb` into `image` (same size) with every light,
-/// unshadowed: one pass replacing the image.
-pub fn shade_into(scene: &Scene, vb: &VisibilityBuffer, image: &mut LinearImage) {
-    let pass = ShadingPass {
-        lighting: lanes::Lighting::new(&scene.lights),
-        blend: Blend::Replace,
-        background: scene.background,
-        receivers: None,
-    };
-    shade_pass(scene, vb, image, &pass);
 }
 
 /// Runs one pass over `vb` into `image` (same size), rows in parallel, eight pixels
