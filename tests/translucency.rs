@@ -104,3 +104,26 @@ fn lit_translucent_layers_keep_the_component_sum() {
     }
     assert!(frame.aovs.iter().any(|(c, a)| *c == Component::Diffuse && a.pixels().iter().any(|p| p.z > 0.05)));
 }
+
+/// The reference renderer blends translucent surfaces the same way (α · surface +
+/// (1 − α) · what the ray meets behind it), so without shadows the two agree on
+/// nearly every pixel of the glass example.
+#[test]
+fn the_reference_blends_translucent_layers_as_the_raster_does() {
+    use kage::raytrace::reference::{render_reference, ReferenceOptions};
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenes/glass.toml");
+    let mut scene = kage::scene::file::load_scene(&path).unwrap();
+    (scene.width, scene.height) = (240, 135);
+    scene.lights.iter_mut().for_each(|l| l.shadow = kage::scene::ShadowSettings::NONE);
+    let frame = render(&scene, &RenderOptions::default()).unwrap();
+    let opts = ReferenceOptions { pixel_samples: 1, light_samples: 1, shadows: false, max_depth: 0 };
+    let truth = render_reference(&scene, &opts, &|_| {});
+    let c = kage::compare::compare(&frame.image, &truth, 2e-3).unwrap();
+    assert!(frame.stats.translucent_fragments > 5000);
+    assert!(
+        c.share_over < 0.01,
+        "{:.3}% of pixels differ by more than 2e-3 (rmse {:.5})",
+        100.0 * c.share_over,
+        c.rmse
+    );
+}

@@ -21,6 +21,9 @@ use crate::shading::phong::{self, Coefficients, Components};
 use crate::shading::reflection_map::reflection_map;
 use crate::shading::{ObjectFrames, SurfacePoint};
 
+/// Most translucent surfaces one ray passes through before it stops looking.
+const MAX_LAYERS: u32 = 64;
+
 /// How the reference is computed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct ReferenceOptions {
@@ -103,11 +106,28 @@ impl<'a> Tracer<'a> {
     }
 
     /// Light arriving along `ray` (unit direction), following `depth` bounces.
+    /// Translucent surfaces (opacity α < 1, seed 002 §3.4) are blended over what
+    /// the ray meets behind them: α · their colour + (1 − α) · the rest.
     #[must_use]
     pub fn radiance(&self, ray: &Ray, depth: u32) -> Vec3 {
+        self.through_layers(ray, depth, MAX_LAYERS)
+    }
+
+    fn through_layers(&self, ray: &Ray, depth: u32, layers: u32) -> Vec3 {
         let Some(hit) = self.trace.intersect(ray, f32::INFINITY) else { return self.scene.background_along(ray.dir) };
         let s = self.frames.prepare(self.scene, hit.item).surface(ray);
         let material = &self.scene.materials[s.material];
+        let behind = || {
+            let next = Ray { origin: s.position + ray.dir * self.epsilon, dir: ray.dir };
+            if layers > 0 {
+                self.through_layers(&next, depth, layers - 1)
+            } else {
+                self.scene.background_along(ray.dir)
+            }
+        };
+        if material.translucent() && !material.two_sided && !s.front {
+            return behind(); // a culled back face, as the polygon pass draws it
+        }
         let k = Coefficients::at(material, &s);
         let mut acc = Components { emission: k.parts().3, ..Default::default() };
         for (i, light) in self.scene.lights.iter().enumerate() {
@@ -117,7 +137,12 @@ impl<'a> Tracer<'a> {
             let shadow = if self.opts.shadows { self.visibility(light, &s, i as u32) } else { 1.0 };
             phong::add_light(&mut acc, light, &k, &s, shadow);
         }
-        acc.total() + reflection_map(self.scene, &s) + self.bounces(ray, &s, depth)
+        let own = acc.total() + reflection_map(self.scene, &s) + self.bounces(ray, &s, depth);
+        if material.translucent() {
+            material.opacity * own + (1.0 - material.opacity) * behind()
+        } else {
+            own
+        }
     }
 
     /// IrayTracing of seed 002 eq. 5 at `s`, seen along `ray`: Kr times the light of
