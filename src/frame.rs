@@ -157,7 +157,13 @@ fn render_into(scene: &Scene, frame: &mut Frame, scratch: &mut Scratch, options:
     let offsets = scene.antialias.offsets();
     frame.stats = FrameStats::default();
     let (w, h) = (scene.width, scene.height);
-    frame.aovs = options.aovs.iter().map(|c| (c, LinearImage::new(w, h))).collect();
+    // The component images are kept from frame to frame, like every other buffer.
+    let components: Vec<Component> = options.aovs.iter().collect();
+    frame.aovs.resize_with(components.len(), || (Component::Ambient, LinearImage::default()));
+    for ((slot, image), &c) in frame.aovs.iter_mut().zip(&components) {
+        *slot = c;
+        image.resize(w, h);
+    }
     scratch.aovs.resize_with(frame.aovs.len(), LinearImage::default);
     scratch.aovs.iter_mut().for_each(|a| a.resize(w, h));
     if offsets.len() == 1 && offsets[0] == Vec2::ZERO {
@@ -168,6 +174,7 @@ fn render_into(scene: &Scene, frame: &mut Frame, scratch: &mut Scratch, options:
         // item buffer samples another point of every pixel; the passes are averaged.
         scratch.accum.resize(w, h);
         scratch.accum.pixels_mut().fill(Vec3::ZERO);
+        frame.aovs.iter_mut().for_each(|(_, a)| a.pixels_mut().fill(Vec3::ZERO));
         let mut pass = scene.clone();
         let pixel = 2.0 / Vec2::new(w as f32, h as f32);
         let k = 1.0 / offsets.len() as f32;
