@@ -10,7 +10,7 @@ use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
 use crate::error::{Error, Result};
-use crate::raytrace::item_buffer;
+use crate::raytrace::{item_buffer, TraceCache};
 use crate::resolve::LinearImage;
 use crate::scene::Scene;
 use crate::shading::{self, fog, translucency, Component, ComponentSet, Target};
@@ -55,6 +55,9 @@ pub struct FrameStats {
     pub traced_ms: f64,
     /// Pixels that spawned secondary rays, summed over passes.
     pub traced_pixels: usize,
+    /// Whether this frame built a BVH for its traced term (false when it had none
+    /// or reused the last frame's: same meshes, same transforms).
+    pub bvh_built: bool,
     /// Translucent fragments blended (summed over passes).
     pub translucent_fragments: usize,
     /// Visibility passes rendered (more than one when antialiased by jitter).
@@ -98,6 +101,8 @@ struct Scratch {
     aovs: Vec<LinearImage>,
     /// Shadow-map buffers, reused from light to light and frame to frame.
     maps: MapPool,
+    /// The BVH of the traced term, rebuilt only when the geometry changes.
+    trace: TraceCache,
 }
 
 impl Renderer {
@@ -167,7 +172,7 @@ fn render_into(scene: &Scene, frame: &mut Frame, scratch: &mut Scratch, options:
     scratch.aovs.resize_with(frame.aovs.len(), LinearImage::default);
     scratch.aovs.iter_mut().for_each(|a| a.resize(w, h));
     if offsets.len() == 1 && offsets[0] == Vec2::ZERO {
-        render_pass(scene, frame, &mut scratch.aovs, &mut scratch.maps, options.ray_depth);
+        render_pass(scene, frame, scratch, options.ray_depth);
         frame.aovs.iter_mut().zip(&mut scratch.aovs).for_each(|((_, a), s)| std::mem::swap(a, s));
     } else {
         // Seed 002 §4: each pass shifts the image by a fraction of a pixel, so its
@@ -181,7 +186,7 @@ fn render_into(scene: &Scene, frame: &mut Frame, scratch: &mut Scratch, options:
         for &o in &offsets {
             // Pixel offsets (y down) to NDC (y up).
             pass.camera.shift = scene.camera.shift + Vec2::new(o.x, -o.y) * pixel;
-            render_pass(&pass, frame, &mut scratch.aovs, &mut scratch.maps, options.ray_depth);
+            render_pass(&pass, frame, scratch, options.ray_depth);
             add_scaled(&mut scratch.accum, &frame.image, k);
             frame.aovs.iter_mut().zip(&scratch.aovs).for_each(|((_, a), s)| add_scaled(a, s, k));
         }
@@ -200,9 +205,10 @@ fn add_scaled(acc: &mut LinearImage, img: &LinearImage, k: f32) {
 }
 
 /// One visibility pass, its shading and its traced term into `frame.image`, and
-/// the components `frame.aovs` names into `aovs` (same order); adds its timings to
-/// the frame's statistics.
-fn render_pass(scene: &Scene, frame: &mut Frame, aovs: &mut [LinearImage], maps: &mut MapPool, ray_depth: u32) {
+/// the components `frame.aovs` names into `scratch.aovs` (same order); adds its
+/// timings to the frame's statistics.
+fn render_pass(scene: &Scene, frame: &mut Frame, scratch: &mut Scratch, ray_depth: u32) {
+    let Scratch { aovs, maps, trace, .. } = scratch;
     let t0 = Instant::now();
     frame.visibility.resize(scene.width, scene.height);
     frame.stats.raster = visibility::rasterize(scene, &mut frame.visibility);
@@ -220,16 +226,18 @@ fn render_pass(scene: &Scene, frame: &mut Frame, aovs: &mut [LinearImage], maps:
     let vb = &frame.visibility;
     let lit = shading::shade_lit(scene, vb, &mut targets, maps);
     let t2 = Instant::now();
+    let builds = trace.builds();
     frame.stats.traced_pixels += match &mut traced_aov {
-        None => item_buffer::add_traced(scene, vb, targets[0].image, ray_depth),
+        None => item_buffer::add_traced(scene, vb, targets[0].image, ray_depth, trace),
         Some(t) => {
             t.pixels_mut().fill(Vec3::ZERO);
-            let n = item_buffer::add_traced(scene, vb, t, ray_depth);
+            let n = item_buffer::add_traced(scene, vb, t, ray_depth, trace);
             add_scaled(targets[0].image, t, 1.0);
             n
         }
     };
     let t3 = Instant::now();
+    frame.stats.bvh_built |= trace.builds() > builds;
     targets.extend(traced_aov.map(|image| Target { parts: ComponentSet::only(Component::Traced), image }));
     if let Some(fog) = &scene.fog {
         let amounts = fog::fog_amounts(scene, fog, vb);

@@ -105,6 +105,27 @@ fn a_plane_mirror_shows_the_sphere_at_its_mirror_image() {
     assert!(flat.image.get(seen.0, seen.1).max_element() < 0.01);
 }
 
+/// A renderer keeps its BVH while only the view changes, and a moved object is
+/// seen in the mirror where a fresh renderer sees it (a stale BVH would show it at
+/// its old place).
+#[test]
+fn the_bvh_is_kept_between_frames_until_the_geometry_moves() {
+    let mut scene = mirror_scene();
+    let mut renderer = kage::Renderer::new(&RenderOptions::default()).unwrap();
+    assert!(renderer.render(&scene).unwrap().stats.bvh_built, "the first frame builds it");
+    scene.camera.eye.x += 0.2;
+    assert!(!renderer.render(&scene).unwrap().stats.bvh_built, "a new viewpoint keeps it");
+    scene.objects[1].transform = Affine3A::from_translation(Vec3::new(-2.0, 0.0, 0.0)) * scene.objects[1].transform;
+    let kept = renderer.render(&scene).unwrap();
+    assert!(kept.stats.bvh_built, "a moved object rebuilds it");
+    let fresh = render(&scene, &RenderOptions::default()).unwrap();
+    assert_eq!(kept.image.pixels(), fresh.image.pixels(), "the reused renderer sees the moved ball");
+    // Mirror image of the moved ball (−1, 0, 2) is where the eye ray crosses the
+    // mirror at x = (−1 − 0.2)·5/7 + 0.2 (the eye is at x = 0.2).
+    let seen = pixel_of(&scene, Vec3::new(-1.2 * 5.0 / 7.0 + 0.2, 0.0, 0.0));
+    assert!(kept.image.get(seen.0, seen.1).x > 0.99, "moved ball's mirror image at {seen:?}");
+}
+
 /// A thin emissive vertical line at x = 0 behind (−z) a glass slab of thickness
 /// `t` turned `deg` degrees about y, seen by an orthographic camera looking down −z.
 fn slab_scene(deg: f32, t: f32) -> Scene {

@@ -11,22 +11,29 @@ use glam::Vec2;
 use rayon::prelude::*;
 
 use super::reference::{ReferenceOptions, Tracer};
-use super::TraceScene;
+use super::TraceCache;
 use crate::resolve::LinearImage;
 use crate::scene::Scene;
 use crate::shading::ObjectFrames;
 use crate::visibility::VisibilityBuffer;
 
 /// Adds traced reflection and refraction to `image`; returns how many pixels were
-/// traced (0, without building a BVH, when no material reflects or refracts).
-pub fn add_traced(scene: &Scene, vb: &VisibilityBuffer, image: &mut LinearImage, depth: u32) -> usize {
+/// traced (0, without building a BVH, when no material reflects or refracts). The
+/// BVH comes from `cache` (built there when the geometry changed).
+pub fn add_traced(
+    scene: &Scene,
+    vb: &VisibilityBuffer,
+    image: &mut LinearImage,
+    depth: u32,
+    cache: &mut TraceCache,
+) -> usize {
     if depth == 0 || !scene.materials.iter().any(|m| m.traces()) {
         return 0;
     }
-    let trace = TraceScene::new(scene);
+    let trace = cache.get(scene);
     let frames = ObjectFrames::new(scene);
     let opts = ReferenceOptions { pixel_samples: 1, light_samples: 1, shadows: true, max_depth: depth };
-    let tracer = Tracer::new(scene, &trace, &frames, opts);
+    let tracer = Tracer::new(scene, trace, &frames, opts);
     let w = vb.width() as usize;
     let rays = scene.camera.pixel_rays(Vec2::new(w as f32, vb.height() as f32));
     let rows = image.pixels_mut().par_chunks_mut(w).zip(vb.items().par_chunks(w));

@@ -8,6 +8,7 @@
 //! `occluded` (anything before a distance?).
 
 pub mod bvh;
+pub mod cache;
 pub mod item_buffer;
 pub mod reference;
 pub mod triangle;
@@ -19,6 +20,8 @@ use crate::scene::{Ray, Scene};
 use crate::visibility::ItemId;
 use bvh::{Aabb, Bvh};
 use triangle::ShearedRay;
+
+pub use cache::TraceCache;
 
 /// The nearest surface along a ray.
 #[derive(Debug, Clone, Copy, PartialEq)]
