@@ -261,7 +261,6 @@ impl Block {
     }
 }
 
-/// Shades eight pixels that all show `tri` with the map-free coefficients `k`:
 /// Shades a run of whole blocks (`out.len()` a multiple of eight) whose pixels all
 /// show `tri` with the map-free coefficients `k`, on the row `rays` describes,
 /// starting at column `x0`: the inputs are broadcast into vector registers once for

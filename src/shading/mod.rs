@@ -71,16 +71,27 @@ pub fn shade_pass(scene: &Scene, vb: &VisibilityBuffer, image: &mut LinearImage,
         let row = lanes::RowRays::new(&rays, y);
         let mut x = 0;
         while x < w {
-            let end = (x + lanes::LANES).min(w);
             let first = items[x];
-            let uniform = end - x == lanes::LANES && pass.receives(first) && items[x..end].iter().all(|&i| i == first);
-            let tri = if uniform { Some(cache.get(scene, &frames, first)) } else { None };
-            if let Some((tri, k)) = tri.and_then(|t| Some((t, constants[t.material].as_ref()?))) {
-                let run = uniform_run(items, x, first);
-                lanes::shade_run(tri, k, &row, x, lighting, blend, &mut out[x..run]);
+            let run = run_end(items, x);
+            if !pass.receives(first) {
+                // Background, or objects this pass does not light: written once by a
+                // replacing pass, left alone by an adding one.
+                if blend == Blend::Replace {
+                    out[x..run].fill(if first.is_none() { pass.background } else { Vec3::ZERO });
+                }
                 x = run;
                 continue;
             }
+            let whole = x + (run - x) / lanes::LANES * lanes::LANES;
+            if whole > x {
+                let tri = cache.get(scene, &frames, first);
+                if let Some(k) = constants[tri.material].as_ref() {
+                    lanes::shade_run(tri, k, &row, x, lighting, blend, &mut out[x..whole]);
+                    x = whole;
+                    continue;
+                }
+            }
+            let end = (x + lanes::LANES).min(w);
             block.clear();
             for (i, (&item, px)) in items[x..end].iter().zip(out[x..end].iter_mut()).enumerate() {
                 if !pass.receives(item) {
@@ -100,13 +111,10 @@ pub fn shade_pass(scene: &Scene, vb: &VisibilityBuffer, image: &mut LinearImage,
     });
 }
 
-/// End of the run of whole blocks from `x` (a full block of `item`) that all show `item`.
-fn uniform_run(items: &[ItemId], x: usize, item: ItemId) -> usize {
-    let mut end = x + lanes::LANES;
-    while end + lanes::LANES <= items.len() && items[end..end + lanes::LANES].iter().all(|&i| i == item) {
-        end += lanes::LANES;
-    }
-    end
+/// End of the run of pixels from `x` that show the same item as pixel `x`.
+fn run_end(items: &[ItemId], x: usize) -> usize {
+    let key = items[x].key();
+    items[x..].iter().position(|i| i.key() != key).map_or(items.len(), |n| x + n)
 }
 
 /// A small direct-mapped cache of prepared triangles, one per worker: the rows a

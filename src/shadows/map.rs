@@ -156,38 +156,24 @@ impl DepthMap {
         };
         let depth = self.depth.depths();
         let res = self.resolution as usize;
-        if k == 1 {
-            // One tap: all eight texel reads issued before any compare, so their
-            // cache misses overlap; lanes outside the map read texel 0 and count lit.
-            let (u0, v0) = (u.floor().round_int().to_array(), v.floor().round_int().to_array());
-            let inside_lanes = inside.to_array();
-            let texel: [f32; 8] = std::array::from_fn(|i| {
-                let index = if inside_lanes[i] != 0.0 { v0[i] as usize * res + u0[i] as usize } else { 0 };
-                depth.get(index).copied().unwrap_or(0.0)
-            });
-            let lit = f32x8::new(texel).simd_le(z_limit).select(f32x8::ONE, zero);
-            return inside.select(lit, f32x8::ONE);
-        }
-        let (inside, u, v, z_limit) = (inside.to_array(), u.to_array(), v.to_array(), z_limit.to_array());
+        // k × k taps; each tap's eight texel reads are issued before any compare, so
+        // their cache misses overlap. Lanes outside the map read texel 0 and count lit.
+        let (u0, v0) = (u.floor().round_int().to_array(), v.floor().round_int().to_array());
+        let inside_lanes = inside.to_array();
         let last = self.resolution as i32 - 1;
-        let share = 1.0 / (k * k) as f32;
-        let mut out = [1.0f32; 8];
-        for i in 0..8 {
-            if inside[i] == 0.0 {
-                continue;
+        let mut lit = zero;
+        for dy in 0..k {
+            for dx in 0..k {
+                let texel: [f32; 8] = std::array::from_fn(|i| {
+                    let x = u0[i].saturating_add(dx - k / 2).clamp(0, last) as usize;
+                    let y = v0[i].saturating_add(dy - k / 2).clamp(0, last) as usize;
+                    let index = if inside_lanes[i] != 0.0 { y * res + x } else { 0 };
+                    depth.get(index).copied().unwrap_or(0.0)
+                });
+                lit += f32x8::new(texel).simd_le(z_limit).select(f32x8::ONE, zero);
             }
-            let (cu, cv) = (u[i] as i32, v[i] as i32);
-            let mut lit = 0u32;
-            for dy in 0..k {
-                let y = (cv + dy - k / 2).clamp(0, last) as usize * res;
-                for dx in 0..k {
-                    let x = (cu + dx - k / 2).clamp(0, last) as usize;
-                    lit += u32::from(depth[y + x] <= z_limit[i]);
-                }
-            }
-            out[i] = lit as f32 * share;
         }
-        f32x8::new(out)
+        inside.select(lit * f32x8::splat(1.0 / (k * k) as f32), f32x8::ONE)
     }
 
     /// Gives the map's buffer back (for the next map to reuse).

@@ -290,3 +290,45 @@ fn fitted_orthographic(eye: &Camera, aspect: f32, dir: Vec3, bounds: (Vec3, Vec3
         shift: Vec2::ZERO,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sampling::radical_inverse;
+
+    /// The eight-lane lookup gives the scalar lookup's answer, lane by lane, for
+    /// one tap and for 2 × 2 and 3 × 3 PCF, on the demo's lights.
+    #[test]
+    fn lanes_equal_scalar_lookups_for_every_pcf_size() {
+        let scene = crate::scene::demo::demo_scene().expect("the demo loads");
+        // Around the teapot, the cow and the ball, where their shadows fall.
+        let (lo, hi) = (Vec3::new(-4.0, 0.0, -3.0), Vec3::new(4.0, 1.5, 3.0));
+        for pcf in 1..=3 {
+            for light in &scene.lights {
+                let mut light = light.clone();
+                (light.shadow.pcf, light.shadow.resolution) = (pcf, 512);
+                let term = ShadowTerm::build(&scene, &light);
+                assert!(term.casts());
+                let (mut differ, mut shadowed, mut total) = (0, 0, 0);
+                for block in 0..2000u32 {
+                    let point = |i: u32| {
+                        let k = block * 8 + i + 1;
+                        let t = Vec3::new(radical_inverse(k, 2), radical_inverse(k, 3), radical_inverse(k, 5));
+                        (lo + (hi - lo) * t, radical_inverse(k, 7))
+                    };
+                    let lanes: [(Vec3, f32); 8] = std::array::from_fn(|i| point(i as u32));
+                    let p = [0, 1, 2].map(|a| f32x8::new(lanes.map(|(p, _)| p[a])));
+                    let got = term.lit_lanes(p, f32x8::new(lanes.map(|(_, c)| c))).to_array();
+                    for (&(p, c), g) in lanes.iter().zip(got) {
+                        let want = term.lit(p, c);
+                        differ += usize::from((want - g).abs() > 1e-6);
+                        shadowed += usize::from(want < 1.0);
+                        total += 1;
+                    }
+                }
+                assert!(shadowed * 50 > total && shadowed < total, "pcf {pcf}: {shadowed} of {total} shadowed");
+                assert!(differ * 500 < total, "pcf {pcf}: {differ} of {total} lanes differ from the scalar lookup");
+            }
+        }
+    }
+}

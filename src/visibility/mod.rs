@@ -26,6 +26,14 @@ impl ItemId {
     /// The id of pixels that see nothing.
     pub const NONE: ItemId = ItemId { object: u32::MAX, triangle: u32::MAX };
 
+    /// Both fields in one integer (one comparison instead of two, for the
+    /// hot loops that look for runs of equal ids).
+    #[inline]
+    #[must_use]
+    pub fn key(self) -> u64 {
+        (u64::from(self.object) << 32) | u64::from(self.triangle)
+    }
+
     /// Whether this pixel sees nothing.
     #[must_use]
     pub fn is_none(self) -> bool {
