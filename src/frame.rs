@@ -11,7 +11,8 @@ use rayon::prelude::*;
 
 use crate::error::{Error, Result};
 use crate::raytrace::{item_buffer, TraceCache};
-use crate::resolve::LinearImage;
+use crate::resolve::edges::{self, EdgeCache, EdgeOptions};
+use crate::resolve::{Antialias, LinearImage};
 use crate::scene::Scene;
 use crate::shading::{self, fog, translucency, Component, ComponentSet, Target};
 use crate::shadows::MapPool;
@@ -58,6 +59,10 @@ pub struct FrameStats {
     /// Whether this frame built a BVH for its traced term (false when it had none
     /// or reused the last frame's: same meshes, same transforms).
     pub bvh_built: bool,
+    /// Milliseconds in the edge pass (seed 004; 0 unless antialiased by edges).
+    pub edge_ms: f64,
+    /// Pixels the edge pass blended.
+    pub edge_blends: usize,
     /// Translucent fragments blended (summed over passes).
     pub translucent_fragments: usize,
     /// Visibility passes rendered (more than one when antialiased by jitter).
@@ -103,6 +108,8 @@ struct Scratch {
     maps: MapPool,
     /// The BVH of the traced term, rebuilt only when the geometry changes.
     trace: TraceCache,
+    /// The meshes' edges for the edge pass (seed 004), kept while the meshes live.
+    edges: EdgeCache,
 }
 
 impl Renderer {
@@ -173,6 +180,15 @@ fn render_into(scene: &Scene, frame: &mut Frame, scratch: &mut Scratch, options:
     scratch.aovs.iter_mut().for_each(|a| a.resize(w, h));
     if offsets.len() == 1 && offsets[0] == Vec2::ZERO {
         render_pass(scene, frame, scratch, options.ray_depth);
+        if let Antialias::Edge(selection) = scene.antialias {
+            let t = Instant::now();
+            let mut images: Vec<&mut LinearImage> =
+                std::iter::once(&mut frame.image).chain(&mut scratch.aovs).collect();
+            let options = EdgeOptions { selection, ..EdgeOptions::default() };
+            let stats = edges::antialias_edges(scene, &frame.visibility, &mut images, &options, &mut scratch.edges);
+            frame.stats.edge_blends = stats.blends;
+            frame.stats.edge_ms = t.elapsed().as_secs_f64() * 1e3;
+        }
         frame.aovs.iter_mut().zip(&mut scratch.aovs).for_each(|((_, a), s)| std::mem::swap(a, s));
     } else {
         // Seed 002 §4: each pass shifts the image by a fraction of a pixel, so its

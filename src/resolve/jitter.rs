@@ -19,6 +19,8 @@ pub enum Antialias {
     None,
     /// `n` frames with sub-pixel jitter, averaged (n = 1 is one centred frame).
     Jitter(u32),
+    /// One frame, then seed 004's edge pass ([`super::edges`]) over these edges.
+    Edge(super::edges::EdgeSelection),
 }
 
 /// Most jittered passes one frame may take.
@@ -31,7 +33,7 @@ impl Antialias {
     #[must_use]
     pub fn offsets(self) -> Vec<Vec2> {
         match self {
-            Antialias::None | Antialias::Jitter(0 | 1) => vec![Vec2::ZERO],
+            Antialias::None | Antialias::Edge(_) | Antialias::Jitter(0 | 1) => vec![Vec2::ZERO],
             Antialias::Jitter(n) => (1..=n.min(MAX_JITTER_SAMPLES))
                 .map(|i| Vec2::new(radical_inverse(i, 2), radical_inverse(i, 3)) - 0.5)
                 .collect(),

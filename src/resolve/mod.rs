@@ -2,6 +2,7 @@
 //! (exposure, clamp to [0, 1], then the sRGB transfer curve). Float outputs skip
 //! this stage and keep the buffer's values.
 
+pub mod edges;
 pub mod jitter;
 
 use glam::Vec3;

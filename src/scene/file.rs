@@ -21,6 +21,7 @@ use super::{
     ShadowSettings, Texture,
 };
 use crate::error::{Error, Result, SourceLocation};
+use crate::resolve::edges::EdgeSelection;
 use crate::resolve::jitter::MAX_JITTER_SAMPLES;
 use crate::resolve::{Antialias, Exposure};
 use crate::scene::material::Filter;
@@ -112,12 +113,14 @@ enum FogModeRec {
     Exp2,
 }
 
-/// `antialias = { method = "jitter", samples = 8 }` (or `method = "none"`).
+/// `antialias = { method = "jitter", samples = 8 }`, `{ method = "edge" }` (with
+/// `edges = "outline"` or `"all"`) or `{ method = "none" }`.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct AntialiasRec {
     method: Spanned<String>,
     samples: Option<Spanned<i64>>,
+    edges: Option<Spanned<String>>,
 }
 
 #[derive(Debug, Deserialize, Clone, Copy, PartialEq)]
@@ -468,9 +471,26 @@ impl SceneFile {
     fn antialias(&self) -> Result<Antialias> {
         let Some(rec) = &self.image.antialias else { return Ok(Antialias::None) };
         let rec = rec.get_ref();
-        match (rec.method.get_ref().as_str(), &rec.samples) {
+        let method = rec.method.get_ref().as_str();
+        match (&rec.edges, method) {
+            (None, _) => {}
+            (Some(e), "edge") => {
+                return match e.get_ref().as_str() {
+                    "outline" => Ok(Antialias::Edge(EdgeSelection::Outline)),
+                    "all" => Ok(Antialias::Edge(EdgeSelection::All)),
+                    other => {
+                        Err(self
+                            .invalid(e.span(), format!("unknown edges '{other}' (expected \"outline\" or \"all\")")))
+                    }
+                };
+            }
+            (Some(e), _) => return Err(self.invalid(e.span(), "`edges` belongs to method \"edge\"")),
+        }
+        match (method, &rec.samples) {
             ("none", None) => Ok(Antialias::None),
             ("none", Some(n)) => Err(self.invalid(n.span(), "method \"none\" takes no samples")),
+            ("edge", None) => Ok(Antialias::Edge(EdgeSelection::Outline)),
+            ("edge", Some(n)) => Err(self.invalid(n.span(), "method \"edge\" takes no samples")),
             ("jitter", None) => Err(self.invalid(rec.method.span(), "method \"jitter\" needs `samples = n`")),
             ("jitter", Some(n)) => match u32::try_from(*n.get_ref()) {
                 Ok(k @ 1..=MAX_JITTER_SAMPLES) => Ok(Antialias::Jitter(k)),
@@ -478,7 +498,7 @@ impl SceneFile {
             },
             (other, _) => Err(self.invalid(
                 rec.method.span(),
-                format!("unknown antialiasing method '{other}' (expected \"none\" or \"jitter\")"),
+                format!("unknown antialiasing method '{other}' (expected \"none\", \"edge\" or \"jitter\")"),
             )),
         }
     }

@@ -9,6 +9,7 @@ mod report;
 use std::path::{Path, PathBuf};
 
 use clap::{Parser, Subcommand};
+use kage::resolve::edges::EdgeSelection;
 use kage::resolve::{Antialias, Exposure};
 use kage::scene::{demo::demo_scene, file, Scene};
 use kage::shading::{Component, ComponentSet};
@@ -86,8 +87,10 @@ struct RenderArgs {
     /// tracing in the raster pipeline, recursion in the reference).
     #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(0..=16))]
     ray_depth: u32,
-    /// Antialiasing: `none`, or `jitter:N` (N sub-pixel-jittered passes averaged,
-    /// seed 002 §4); overrides the scene. The reference uses --spp instead.
+    /// Antialiasing: `none`; `edge` (seed 004's edge pass over silhouettes, boundaries
+    /// and creases) or `edge:all` (every triangle edge, as the paper); or `jitter:N`
+    /// (N sub-pixel-jittered passes averaged, seed 002 §4). Overrides the scene. The
+    /// reference uses --spp instead.
     #[arg(long, value_parser = parse_antialias)]
     antialias: Option<Antialias>,
     /// Also write these components, each on its own (seed 002 Fig. 4), next to the
@@ -127,11 +130,16 @@ fn parse_antialias(s: &str) -> Result<Antialias, String> {
     let max = kage::resolve::jitter::MAX_JITTER_SAMPLES;
     match s.split_once(':') {
         None if s == "none" => Ok(Antialias::None),
+        None if s == "edge" => Ok(Antialias::Edge(EdgeSelection::Outline)),
+        Some(("edge", "outline")) => Ok(Antialias::Edge(EdgeSelection::Outline)),
+        Some(("edge", "all")) => Ok(Antialias::Edge(EdgeSelection::All)),
         Some(("jitter", n)) => match n.parse::<u32>() {
             Ok(k @ 1..) if k <= max => Ok(Antialias::Jitter(k)),
             _ => Err(format!("'{n}' is not a number of passes between 1 and {max}")),
         },
-        _ => Err(format!("'{s}' is not an antialiasing method (expected 'none' or 'jitter:N', e.g. jitter:8)")),
+        _ => Err(format!(
+            "'{s}' is not an antialiasing method (expected 'none', 'edge' (or 'edge:all') or 'jitter:N', e.g. jitter:8)"
+        )),
     }
 }
 
@@ -210,6 +218,9 @@ fn render_command(args: &RenderArgs) -> kage::error::Result<()> {
         s.traced_ms,
         s.traced_pixels
     );
+    if let Antialias::Edge(_) = scene.antialias {
+        eprintln!("edge pass (seed 004): {:.1} ms, {} pixels blended", s.edge_ms, s.edge_blends);
+    }
     Ok(())
 }
 
