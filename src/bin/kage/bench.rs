@@ -23,13 +23,13 @@ pub struct BenchArgs {
     meshes: PathBuf,
     /// The peers folder (for gen_scene.py).
     #[arg(long, default_value = "../shared/peers")]
-    peers: PathBuf,
+    pub(crate) peers: PathBuf,
     /// The llvmpipe peer program (`scripts/build-peers.sh` builds it); skipped if absent.
     #[arg(long, default_value = "target/peers/llvmpipe_bench_egl")]
     llvmpipe: PathBuf,
     /// Timed frames per row (the median is reported).
     #[arg(long, default_value_t = 10)]
-    frames: usize,
+    pub(crate) frames: usize,
     /// Alternating rounds of kage and llvmpipe; the best round of each is reported.
     #[arg(long, default_value_t = 3)]
     rounds: usize,
@@ -49,6 +49,13 @@ pub struct BenchArgs {
     /// matte floor.
     #[arg(long)]
     hybrid: bool,
+    /// Antialiasing: aliased, seed 004's edge pass and jittered passes against a
+    /// 256-pass supersampled truth on the example scenes and two real models.
+    #[arg(long)]
+    aa: bool,
+    /// With --aa: write side-by-side crops (aliased | edge pass | truth) here.
+    #[arg(long)]
+    pub(crate) crops: Option<PathBuf>,
     /// Time frames as lights grow (1, 4, 16, 100 spot lights round the first
     /// scene), with and without shadow maps.
     #[arg(long)]
@@ -58,10 +65,10 @@ pub struct BenchArgs {
     embree: PathBuf,
     /// Image width.
     #[arg(long, default_value_t = 1920)]
-    width: u32,
+    pub(crate) width: u32,
     /// Image height.
     #[arg(long, default_value_t = 1080)]
-    height: u32,
+    pub(crate) height: u32,
 }
 
 struct Row {
@@ -84,6 +91,9 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     }
     if args.lights {
         return run_lights(args);
+    }
+    if args.aa {
+        return crate::bench_aa::run(args);
     }
     let lp = &args.llvmpipe;
     let mut rows = Vec::new();

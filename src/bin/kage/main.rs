@@ -4,6 +4,7 @@
 //! the offending line of a scene file.
 
 mod bench;
+mod bench_aa;
 mod report;
 
 use std::path::{Path, PathBuf};

@@ -1,0 +1,166 @@
+//! `kage bench --aa`: seed 004's edge pass and jittered passes against a 16 × 16
+//! supersampled truth (256 jittered passes), on the example scenes and two real
+//! models: RMSE on silhouette pixels and over the image, and ms per frame.
+
+use std::path::Path;
+
+use kage::resolve::edges::EdgeSelection;
+use kage::resolve::{Antialias, LinearImage};
+use kage::visibility::VisibilityBuffer;
+use kage::{RenderOptions, Renderer, Scene};
+use miette::{miette, Result};
+
+use crate::bench::BenchArgs;
+
+/// Passes of the truth: 16 × 16 samples per pixel.
+const TRUTH_PASSES: u32 = 256;
+
+/// The scenes measured: every example scene that has silhouettes to speak of, and
+/// two models from `../shared/assets` when that folder is there.
+fn scenes(args: &BenchArgs) -> Result<Vec<(String, Scene)>> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenes");
+    let mut out = Vec::new();
+    for name in ["demo", "spotlights", "cad-ortho", "showroom", "reflections"] {
+        let scene = kage::scene::file::load_scene(&dir.join(format!("{name}.toml"))).map_err(|e| miette!("{e}"))?;
+        out.push((format!("{name}.toml"), scene));
+    }
+    let assets = args.peers.join("../assets");
+    for model in ["meshes/stanford-bunny/stanford-bunny.obj", "gltf/CesiumMilkTruck/CesiumMilkTruck.glb"] {
+        let path = assets.join(model);
+        if path.exists() {
+            let scene =
+                kage::scene::file::scene_for_model(&path, args.width, args.height).map_err(|e| miette!("{e}"))?;
+            out.push((model.rsplit('/').next().unwrap_or(model).to_string(), scene));
+        } else {
+            eprintln!("skipped {} (not found)", path.display());
+        }
+    }
+    for (_, s) in &mut out {
+        (s.width, s.height) = (args.width, args.height);
+    }
+    Ok(out)
+}
+
+/// Runs the table.
+pub fn run(args: &BenchArgs) -> Result<()> {
+    println!(
+        "| scene | method | ms/frame | x aliased | silhouette-pixel RMSE | share of aliased removed | image RMSE |"
+    );
+    println!("|---|---|---:|---:|---:|---:|---:|");
+    for (label, scene) in scenes(args)? {
+        let truth = frame(&scene, Antialias::Jitter(TRUTH_PASSES), 1)?.0;
+        let (aliased, aliased_ms, vb) = frame(&scene, Antialias::None, args.frames)?;
+        let mask = silhouettes(&vb);
+        let base = rmse(&aliased, &truth, Some(&mask));
+        let methods = [
+            ("aliased", Antialias::None),
+            ("edge pass (outline)", Antialias::Edge(EdgeSelection::Outline)),
+            ("edge pass (all edges)", Antialias::Edge(EdgeSelection::All)),
+            ("jitter 4", Antialias::Jitter(4)),
+            ("jitter 16", Antialias::Jitter(16)),
+        ];
+        let mut edged = None;
+        for (name, aa) in methods {
+            let (image, ms, _) = if aa == Antialias::None {
+                (aliased.clone(), aliased_ms, vb.clone())
+            } else {
+                frame(&scene, aa, args.frames.min(if matches!(aa, Antialias::Jitter(_)) { 3 } else { args.frames }))?
+            };
+            let e = rmse(&image, &truth, Some(&mask));
+            println!(
+                "| {label} | {name} | {ms:.1} | {:.2} | {e:.4} | {:.0}% | {:.4} |",
+                ms / aliased_ms,
+                100.0 * (1.0 - e / base),
+                rmse(&image, &truth, None)
+            );
+            if aa == Antialias::Edge(EdgeSelection::Outline) {
+                edged = Some(image);
+            }
+        }
+        if let (Some(dir), Some(edged)) = (&args.crops, edged) {
+            write_crop(dir, &label, [&aliased, &edged, &truth], &mask, scene.width)?;
+        }
+    }
+    println!(
+        "\n{}x{}, truth = {TRUTH_PASSES} jittered passes (16 x 16 per pixel); silhouette pixels = pixels whose 3 x 3 \
+         neighbourhood in the aliased visibility buffer holds more than one object (or object and background); \
+         median of {} frames (jittered rows: 3); 2 threads.",
+        args.width, args.height, args.frames
+    );
+    Ok(())
+}
+
+/// The frame of `scene` antialiased by `aa`: image, median ms over `frames`
+/// renders (after one warm-up, which builds the meshes' edge lists), and the
+/// visibility buffer.
+fn frame(scene: &Scene, aa: Antialias, frames: usize) -> Result<(LinearImage, f64, VisibilityBuffer)> {
+    let scene = Scene { antialias: aa, ..scene.clone() };
+    let mut renderer = Renderer::new(&RenderOptions::default()).map_err(|e| miette!("{e}"))?;
+    renderer.render(&scene).map_err(|e| miette!("{e}"))?;
+    let mut times = Vec::new();
+    for _ in 0..frames.max(1) {
+        let t = std::time::Instant::now();
+        renderer.render(&scene).map_err(|e| miette!("{e}"))?;
+        times.push(t.elapsed().as_secs_f64() * 1e3);
+    }
+    times.sort_by(f64::total_cmp);
+    let f = renderer.into_frame();
+    Ok((f.image, times[times.len() / 2], f.visibility))
+}
+
+/// Pixels whose 3 × 3 neighbourhood sees more than one object (or the background).
+fn silhouettes(vb: &VisibilityBuffer) -> Vec<bool> {
+    let (w, h) = (vb.width() as i64, vb.height() as i64);
+    let object = |x: i64, y: i64| vb.item(x.clamp(0, w - 1) as u32, y.clamp(0, h - 1) as u32).object;
+    (0..h)
+        .flat_map(|y| (0..w).map(move |x| (x, y)))
+        .map(|(x, y)| {
+            let o = object(x, y);
+            !(-1..=1).all(|dy| (-1..=1).all(|dx| object(x + dx, y + dy) == o))
+        })
+        .collect()
+}
+
+/// RMSE between `a` and `b` (linear RGB), over the pixels `mask` keeps (all if none).
+fn rmse(a: &LinearImage, b: &LinearImage, mask: Option<&[bool]>) -> f64 {
+    let (mut sum, mut n) = (0.0f64, 0usize);
+    for (i, (p, q)) in a.pixels().iter().zip(b.pixels()).enumerate() {
+        if mask.is_none_or(|m| m[i]) {
+            sum += f64::from((*p - *q).length_squared()) / 3.0;
+            n += 1;
+        }
+    }
+    (sum / n.max(1) as f64).sqrt()
+}
+
+/// Writes `dir/<label>.png`: the same window of the aliased frame, the edge pass
+/// and the truth side by side, four times enlarged, around the middle of the
+/// silhouettes.
+fn write_crop(dir: &Path, label: &str, images: [&LinearImage; 3], mask: &[bool], width: u32) -> Result<()> {
+    const W: u32 = 80;
+    const H: u32 = 60;
+    const ZOOM: u32 = 4;
+    let (w, h) = (images[0].width(), images[0].height());
+    let on: Vec<(u32, u32)> =
+        mask.iter().enumerate().filter(|(_, &m)| m).map(|(i, _)| (i as u32 % width, i as u32 / width)).collect();
+    let Some(&(cx, cy)) = on.get(on.len() / 2) else { return Ok(()) };
+    let (x0, y0) =
+        (cx.saturating_sub(W / 2).min(w.saturating_sub(W)), cy.saturating_sub(H / 2).min(h.saturating_sub(H)));
+    let gap = 4;
+    let mut out = image::RgbImage::from_pixel(3 * W * ZOOM + 2 * gap, H * ZOOM, image::Rgb([255, 255, 255]));
+    for (k, img) in images.iter().enumerate() {
+        let srgb = img.to_srgb8(1.0);
+        for y in 0..(H * ZOOM).min(h * ZOOM) {
+            for x in 0..(W * ZOOM).min(w * ZOOM) {
+                let (sx, sy) = (x0 + x / ZOOM, y0 + y / ZOOM);
+                let i = 3 * (sy * w + sx) as usize;
+                out.put_pixel(k as u32 * (W * ZOOM + gap) + x, y, image::Rgb([srgb[i], srgb[i + 1], srgb[i + 2]]));
+            }
+        }
+    }
+    std::fs::create_dir_all(dir).map_err(|e| miette!("{}: {e}", dir.display()))?;
+    let path = dir.join(format!("aa-{}.png", label.trim_end_matches(".toml").replace(['.', ' '], "-")));
+    out.save(&path).map_err(|e| miette!("{}: {e}", path.display()))?;
+    eprintln!("wrote {} (aliased | edge pass | {TRUTH_PASSES}-pass truth)", path.display());
+    Ok(())
+}
