@@ -65,6 +65,14 @@ fn semantic_errors_point_at_the_value() {
     assert!(e.starts_with("bad.toml:2:24") && e.contains("unknown antialiasing method 'blur'"), "{e}");
     let e = parse_err(&format!("[image]\nantialias = {{ method = \"jitter\", samples = 0 }}\n{OK_OBJECT}"));
     assert!(e.starts_with("bad.toml:2:44") && e.contains("between 1 and 1024"), "{e}");
+    let e = parse_err(&format!("[image]\nantialias = {{ method = \"edge\", edges = \"some\" }}\n{OK_OBJECT}"));
+    assert!(e.starts_with("bad.toml:2:40") && e.contains("unknown edges 'some'"), "{e}");
+    let e = parse_err(&format!(
+        "[image]\nantialias = {{ method = \"jitter\", samples = 4, edges = \"all\" }}\n{OK_OBJECT}"
+    ));
+    assert!(e.starts_with("bad.toml:2:55") && e.contains("`edges` belongs to method \"edge\""), "{e}");
+    let e = parse_err(&format!("[image]\nantialias = {{ method = \"edge\", samples = 4 }}\n{OK_OBJECT}"));
+    assert!(e.starts_with("bad.toml:2:42") && e.contains("takes no samples"), "{e}");
 }
 
 #[test]
@@ -141,6 +149,20 @@ fn the_cli_exits_non_zero_with_a_located_report() {
     assert!(!ok && err.contains("invalid image size 100000x100000"), "{err}");
     let (ok, err) = kage(&["render", "-o", dir.join("z.bmp").to_str().unwrap()]);
     assert!(!ok && err.contains("unknown image format '.bmp'"), "{err}");
+    let (ok, err) = kage(&["render", "--antialias", "edge:most", "-o", dir.join("e.png").to_str().unwrap()]);
+    assert!(!ok && err.contains("'edge:most' is not an antialiasing method"), "{err}");
+    let (ok, err) = kage(&[
+        "render",
+        "--width",
+        "96",
+        "--height",
+        "54",
+        "--antialias",
+        "edge",
+        "-o",
+        dir.join("e.png").to_str().unwrap(),
+    ]);
+    assert!(ok && err.contains("edge pass (seed 004)"), "{err}");
 }
 
 #[test]
