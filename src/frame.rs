@@ -180,11 +180,11 @@ fn render_into(scene: &Scene, frame: &mut Frame, scratch: &mut Scratch, options:
     scratch.aovs.iter_mut().for_each(|a| a.resize(w, h));
     if offsets.len() == 1 && offsets[0] == Vec2::ZERO {
         render_pass(scene, frame, scratch, options.ray_depth);
-        if let Antialias::Edge(selection) = scene.antialias {
+        if let Antialias::Edge(mode) = scene.antialias {
             let t = Instant::now();
             let mut images: Vec<&mut LinearImage> =
                 std::iter::once(&mut frame.image).chain(&mut scratch.aovs).collect();
-            let options = EdgeOptions { selection, ..EdgeOptions::default() };
+            let options = EdgeOptions { mode, ..EdgeOptions::default() };
             let stats = edges::antialias_edges(scene, &frame.visibility, &mut images, &options, &mut scratch.edges);
             frame.stats.edge_blends = stats.blends;
             frame.stats.edge_ms = t.elapsed().as_secs_f64() * 1e3;

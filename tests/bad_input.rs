@@ -70,9 +70,11 @@ fn semantic_errors_point_at_the_value() {
     let e = parse_err(&format!(
         "[image]\nantialias = {{ method = \"jitter\", samples = 4, edges = \"all\" }}\n{OK_OBJECT}"
     ));
-    assert!(e.starts_with("bad.toml:2:55") && e.contains("`edges` belongs to method \"edge\""), "{e}");
+    assert!(e.starts_with("bad.toml:2:55") && e.contains("`edges` and `filter` belong to method \"edge\""), "{e}");
     let e = parse_err(&format!("[image]\nantialias = {{ method = \"edge\", samples = 4 }}\n{OK_OBJECT}"));
     assert!(e.starts_with("bad.toml:2:42") && e.contains("takes no samples"), "{e}");
+    let e = parse_err(&format!("[image]\nantialias = {{ method = \"edge\", filter = \"box\" }}\n{OK_OBJECT}"));
+    assert!(e.starts_with("bad.toml:2:41") && e.contains("unknown filter 'box'"), "{e}");
 }
 
 #[test]

@@ -8,7 +8,7 @@ mod common;
 use std::sync::Arc;
 
 use glam::{Affine3A, Vec2, Vec3};
-use kage::resolve::edges::EdgeSelection;
+use kage::resolve::edges::{EdgeFilter, EdgeMode, EdgeSelection};
 use kage::resolve::{Antialias, LinearImage};
 use kage::scene::mesh::{shapes, NormalMode};
 use kage::scene::{Camera, Material, Mesh, Object, Projection, Scene};
@@ -64,7 +64,7 @@ fn flat_scene(shapes: &[FlatShape], background: Vec3) -> Scene {
 }
 
 fn with_edges(scene: &Scene, selection: EdgeSelection) -> Scene {
-    Scene { antialias: Antialias::Edge(selection), ..scene.clone() }
+    Scene { antialias: Antialias::Edge(EdgeMode { selection, ..EdgeMode::default() }), ..scene.clone() }
 }
 
 /// Area of the triangle `t` (screen space) inside pixel (x, y), by clipping the
@@ -135,6 +135,37 @@ fn edge_pixels_take_their_exact_covered_area() {
         assert!(mean < 0.005, "mean coverage error {mean} (aliased {mean_a})");
         assert!(worst < 0.02, "worst coverage error {worst}");
     }
+}
+
+/// The paper's own weights (§3 (2)): along an x-major edge, the pixel P whose
+/// centre lies above the edge point at distance D_P gets the edge's colour with
+/// alpha Filter(D_Q) = 1 − D_P. For a black triangle below a gentle edge on white,
+/// P's value is therefore D_P; and the paper's rule leaves the polygon about half a
+/// pixel too fat, which the coverage filter does not.
+#[test]
+fn the_papers_filter_blends_the_edge_colour_by_distance_and_coverage_does_better() {
+    let t = [Vec2::new(3.3, 20.4), Vec2::new(60.2, 31.8), Vec2::new(30.5, 61.1)];
+    let scene = flat_scene(&[(t.to_vec(), vec![[0, 1, 2]], 0.0, Vec3::ZERO)], Vec3::ONE);
+    let paper = EdgeMode { selection: EdgeSelection::All, filter: EdgeFilter::Paper };
+    let frame =
+        render(&Scene { antialias: Antialias::Edge(paper), ..scene.clone() }, &RenderOptions::default()).unwrap();
+    let mut checked = 0;
+    for x in 8..56u32 {
+        // The top edge from t[0] to t[1] at this column centre (y down).
+        let cx = x as f32 + 0.5;
+        let y = t[0].y + (cx - t[0].x) * (t[1].y - t[0].y) / (t[1].x - t[0].x);
+        let p = (y - 0.5).floor();
+        let d_p = (y - 0.5) - p;
+        let got = frame.image.get(x, p as u32).x;
+        assert!((got - d_p).abs() < 1e-4, "column {x}: P = row {p}: {got} vs D_P = {d_p}");
+        checked += 1;
+    }
+    assert!(checked > 40);
+    let coverage = render(&with_edges(&scene, EdgeSelection::All), &RenderOptions::default()).unwrap();
+    let (paper_err, _, _) = coverage_errors(&t, &frame.image);
+    let (coverage_err, _, _) = coverage_errors(&t, &coverage.image);
+    eprintln!("mean coverage error: paper's filter {paper_err:.3}, coverage filter {coverage_err:.4}");
+    assert!(coverage_err < 0.2 * paper_err, "{coverage_err} vs {paper_err}");
 }
 
 #[test]

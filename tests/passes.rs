@@ -21,7 +21,7 @@ fn component_images_sum_to_the_final_image() {
         ("reflections.toml", Antialias::None),
         ("spotlights.toml", Antialias::None),
         ("demo.toml", Antialias::Jitter(4)),
-        ("showroom.toml", Antialias::Edge(kage::resolve::edges::EdgeSelection::Outline)),
+        ("showroom.toml", Antialias::Edge(kage::resolve::edges::EdgeMode::default())),
         ("environment.toml", Antialias::None),
     ] {
         let mut scene = example(name);

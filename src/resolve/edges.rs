@@ -65,11 +65,33 @@ pub enum EdgeSelection {
     All,
 }
 
+/// How the edge pass weights its blends.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum EdgeFilter {
+    /// The pixel the edge crosses moves towards the pixel across by the share of its
+    /// area beyond the edge (exact for a straight edge).
+    #[default]
+    Coverage,
+    /// The paper's: the edge's colour is blended into the two pixels whose centres
+    /// straddle the edge, with alphas `Filter(D_Q)` and `Filter(D_P)`, D the
+    /// distance from each centre (a Wu line along the edge).
+    Paper,
+}
+
+/// Which edges the pass walks and how it blends: what a scene asks for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct EdgeMode {
+    /// Which edges.
+    pub selection: EdgeSelection,
+    /// How blends are weighted.
+    pub filter: EdgeFilter,
+}
+
 /// How the edge pass runs.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct EdgeOptions {
-    /// Which edges.
-    pub selection: EdgeSelection,
+    /// Which edges and how they blend.
+    pub mode: EdgeMode,
     /// Adjacent faces whose normals differ by more than this (degrees) meet at a
     /// crease, which is drawn like a silhouette.
     pub crease_deg: f32,
@@ -77,7 +99,7 @@ pub struct EdgeOptions {
 
 impl Default for EdgeOptions {
     fn default() -> Self {
-        EdgeOptions { selection: EdgeSelection::Outline, crease_deg: 30.0 }
+        EdgeOptions { mode: EdgeMode::default(), crease_deg: 30.0 }
     }
 }
 
@@ -266,8 +288,14 @@ pub fn antialias_edges(
     cache: &mut EdgeCache,
 ) -> EdgeStats {
     let edges = cache.edges_of(scene, options.crease_deg);
-    let (blends, walked) = find_blends(scene, vb, &edges, options.selection);
-    let blends = merge(blends);
+    let (blends, walked) = find_blends(scene, vb, &edges, options.mode);
+    // One straight edge moves a pixel by at most ½ under the coverage filter; the
+    // paper's Wu weights reach 1.
+    let cap = match options.mode.filter {
+        EdgeFilter::Coverage => 0.5,
+        EdgeFilter::Paper => 1.0,
+    };
+    let blends = merge(blends, cap);
     for image in images.iter_mut() {
         apply(image, &blends);
     }
@@ -279,7 +307,7 @@ fn find_blends(
     scene: &Scene,
     vb: &VisibilityBuffer,
     edges: &[Arc<MeshEdges>],
-    selection: EdgeSelection,
+    mode: EdgeMode,
 ) -> (Vec<EdgeBlend>, usize) {
     let camera = &scene.camera;
     let (w, h) = (vb.width(), vb.height());
@@ -299,7 +327,7 @@ fn find_blends(
             .edges
             .par_iter()
             .enumerate()
-            .filter(|(_, e)| selected(e, mesh_edges, &facing, material.two_sided, selection))
+            .filter(|(_, e)| selected(e, mesh_edges, &facing, material.two_sided, mode.selection))
             .filter_map(|(k, e)| {
                 let source = ((object as u64) << 32) | k as u64;
                 let [a, b] = e.v.map(|i| to_clip * o.mesh.positions[i as usize].as_dvec3().extend(1.0));
@@ -317,11 +345,11 @@ fn find_blends(
                                     .plane_depth(&to_clip, &o.mesh, item.triangle, point)
                                     .is_some_and(|z| depth.close(z, point.z)))
                     };
-                    if let Some(blend) = depth_tested(vb, &own, c, other, alpha, point.z as f32) {
+                    if let Some(blend) = depth_tested(vb, &own, c, other, alpha, point.z as f32, mode.filter) {
                         out.push(EdgeBlend { source, ..blend });
                     }
                 };
-                walk(a, b, visit, (w, h));
+                walk(a, b, visit, (w, h), mode.filter);
                 Some(out)
             })
             .collect();
@@ -341,11 +369,12 @@ fn find_blends(
 /// edge nearest the neighbour shows the neighbour's colour. Seen from inside (the
 /// pixel shows the edges' surface) that is the smallest share; seen from outside
 /// (the pixel shows what lies behind) the object covers the union, the largest
-/// share. Then a pixel keeps at least half its own colour: one straight edge never
-/// takes more (the half-plane holding the pixel centre holds the larger part), so
-/// where edges crowd (a vertex many edges leave, a spout's thin rim) the shares are
-/// scaled to sum to ½ instead of overshooting.
-fn merge(mut blends: Vec<EdgeBlend>) -> Vec<EdgeBlend> {
+/// share. Then a pixel's shares are scaled to sum to at most `cap` where edges crowd
+/// (a vertex many edges leave, a spout's thin rim): ½ for the coverage filter —
+/// one straight edge never takes more (the half-plane holding the pixel centre holds
+/// the larger part), so a pixel keeps at least half its own colour — and 1 for the
+/// paper's weights, instead of overshooting.
+fn merge(mut blends: Vec<EdgeBlend>, cap: f32) -> Vec<EdgeBlend> {
     // A sliver: the pixel across is itself crossed by another edge, from outside,
     // towards this pixel — a thin surface lies between the two edges, so nothing of
     // this pixel shows the colour across.
@@ -365,8 +394,8 @@ fn merge(mut blends: Vec<EdgeBlend>) -> Vec<EdgeBlend> {
     }
     for pixel in merged.chunk_by_mut(|a, b| a.c == b.c) {
         let total: f32 = pixel.iter().map(|b| b.alpha).sum();
-        if total > 0.5 {
-            pixel.iter_mut().for_each(|b| b.alpha *= 0.5 / total);
+        if total > cap {
+            pixel.iter_mut().for_each(|b| b.alpha *= cap / total);
         }
     }
     merged
@@ -489,6 +518,7 @@ fn walk(
     b: glam::DVec3,
     mut visit: impl FnMut((u32, u32), (u32, u32), f32, glam::DVec3),
     size: (u32, u32),
+    filter: EdgeFilter,
 ) {
     let swap = (b.y - a.y).abs() > (b.x - a.x).abs();
     // (major, minor, depth) of each end, ordered along the major axis.
@@ -517,16 +547,35 @@ fn walk(
         let (x0, x1) = (i as f64, (i + 1) as f64);
         let ((y0, _), (y1, _)) = (at(x0), at(x1));
         let (yc, z) = at(i as f64 + 0.5);
-        for r in y0.min(y1).floor() as i64..=y0.max(y1).floor() as i64 {
-            // Share of pixel row r below the edge, over [x0, x1].
-            let below = (x1 - x0) * clamped_mean(r as f64 + 1.0 - y0, y0 - y1);
-            let above = (x1 - x0) - below;
-            let centre_below = r as f64 + 0.5 > yc;
-            let (alpha, o) = if centre_below { (above, r - 1) } else { (below, r + 1) };
+        let centre = i as f64 + 0.5;
+        let point = if swap { glam::DVec3::new(yc, centre, z) } else { glam::DVec3::new(centre, yc, z) };
+        let mut emit = |r: i64, o: i64, alpha: f64| {
             if alpha > 1e-6 && inside(r) && inside(o) {
-                let centre = i as f64 + 0.5;
-                let point = if swap { glam::DVec3::new(yc, centre, z) } else { glam::DVec3::new(centre, yc, z) };
                 visit(to_xy(i as u32, r), to_xy(i as u32, o), alpha as f32, point);
+            }
+        };
+        match filter {
+            EdgeFilter::Coverage => {
+                for r in y0.min(y1).floor() as i64..=y0.max(y1).floor() as i64 {
+                    // Share of pixel row r below the edge, over [x0, x1].
+                    let below = (x1 - x0) * clamped_mean(r as f64 + 1.0 - y0, y0 - y1);
+                    let above = (x1 - x0) - below;
+                    if r as f64 + 0.5 > yc {
+                        emit(r, r - 1, above);
+                    } else {
+                        emit(r, r + 1, below);
+                    }
+                }
+            }
+            EdgeFilter::Paper => {
+                // P above and Q below the edge point, D_P its distance from P's centre:
+                // I_P = Filter(D_Q) = 1 − D_P, I_Q = Filter(D_P) = D_P (linear light,
+                // so the filter is already gamma-correct).
+                let m = yc - 0.5;
+                let p = m.floor() as i64;
+                let d_p = m - m.floor();
+                emit(p, p + 1, 1.0 - d_p);
+                emit(p + 1, p, d_p);
             }
         }
     }
@@ -608,6 +657,7 @@ fn depth_tested(
     o: (u32, u32),
     alpha: f32,
     z: f32,
+    filter: EdgeFilter,
 ) -> Option<EdgeBlend> {
     let w = vb.width();
     let index = |(x, y): (u32, u32)| y * w + x;
@@ -623,7 +673,12 @@ fn depth_tested(
         }
     };
     let (sc, so) = (side(c), side(o));
-    let shows = sc != Side::Occluder && so != Side::Occluder && (sc == Side::Own || so == Side::Own);
+    // The paper blends the edge's own colour: the pixel across must show it.
+    let source = match filter {
+        EdgeFilter::Coverage => sc == Side::Own || so == Side::Own,
+        EdgeFilter::Paper => so == Side::Own && sc != Side::Own,
+    };
+    let shows = sc != Side::Occluder && so != Side::Occluder && source;
     shows.then(|| EdgeBlend { c: index(c), o: index(o), alpha, inside: sc == Side::Own, source: 0 })
 }
 
@@ -648,11 +703,11 @@ mod tests {
         let (a, b) = (glam::DVec3::new(0.4, 2.48, 0.5), glam::DVec3::new(10.3, 9.41, 0.5));
         let line = |x: f64| 0.7 * x + 2.2;
         let mut seen = Vec::new();
-        walk(a, b, |c, o, alpha, _| seen.push((c, o, alpha)), (20, 20));
+        walk(a, b, |c, o, alpha, _| seen.push((c, o, alpha)), (20, 20), EdgeFilter::Coverage);
         let swapped = {
             let mut v = Vec::new();
             let t = |p: glam::DVec3| glam::DVec3::new(p.y, p.x, p.z);
-            walk(t(b), t(a), |c, o, alpha, _| v.push(((c.1, c.0), (o.1, o.0), alpha)), (20, 20));
+            walk(t(b), t(a), |c, o, alpha, _| v.push(((c.1, c.0), (o.1, o.0), alpha)), (20, 20), EdgeFilter::Coverage);
             v
         };
         assert_eq!(seen, swapped, "y-major is x-major with the axes swapped");

@@ -19,8 +19,8 @@ pub enum Antialias {
     None,
     /// `n` frames with sub-pixel jitter, averaged (n = 1 is one centred frame).
     Jitter(u32),
-    /// One frame, then seed 004's edge pass ([`super::edges`]) over these edges.
-    Edge(super::edges::EdgeSelection),
+    /// One frame, then seed 004's edge pass ([`super::edges`]).
+    Edge(super::edges::EdgeMode),
 }
 
 /// Most jittered passes one frame may take.

@@ -21,7 +21,7 @@ use super::{
     ShadowSettings, Texture,
 };
 use crate::error::{Error, Result, SourceLocation};
-use crate::resolve::edges::EdgeSelection;
+use crate::resolve::edges::{EdgeFilter, EdgeMode, EdgeSelection};
 use crate::resolve::jitter::MAX_JITTER_SAMPLES;
 use crate::resolve::{Antialias, Exposure};
 use crate::scene::material::Filter;
@@ -114,13 +114,15 @@ enum FogModeRec {
 }
 
 /// `antialias = { method = "jitter", samples = 8 }`, `{ method = "edge" }` (with
-/// `edges = "outline"` or `"all"`) or `{ method = "none" }`.
+/// `edges = "outline"` or `"all"`, `filter = "coverage"` or `"paper"`) or
+/// `{ method = "none" }`.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct AntialiasRec {
     method: Spanned<String>,
     samples: Option<Spanned<i64>>,
     edges: Option<Spanned<String>>,
+    filter: Option<Spanned<String>>,
 }
 
 #[derive(Debug, Deserialize, Clone, Copy, PartialEq)]
@@ -472,24 +474,37 @@ impl SceneFile {
         let Some(rec) = &self.image.antialias else { return Ok(Antialias::None) };
         let rec = rec.get_ref();
         let method = rec.method.get_ref().as_str();
-        match (&rec.edges, method) {
-            (None, _) => {}
-            (Some(e), "edge") => {
-                return match e.get_ref().as_str() {
-                    "outline" => Ok(Antialias::Edge(EdgeSelection::Outline)),
-                    "all" => Ok(Antialias::Edge(EdgeSelection::All)),
-                    other => {
-                        Err(self
-                            .invalid(e.span(), format!("unknown edges '{other}' (expected \"outline\" or \"all\")")))
-                    }
-                };
+        if method != "edge" {
+            if let Some(key) = [&rec.edges, &rec.filter].into_iter().flatten().next() {
+                return Err(self.invalid(key.span(), "`edges` and `filter` belong to method \"edge\""));
             }
-            (Some(e), _) => return Err(self.invalid(e.span(), "`edges` belongs to method \"edge\"")),
+        }
+        let mut mode = EdgeMode::default();
+        if let Some(e) = &rec.edges {
+            mode.selection = match e.get_ref().as_str() {
+                "outline" => EdgeSelection::Outline,
+                "all" => EdgeSelection::All,
+                other => {
+                    return Err(
+                        self.invalid(e.span(), format!("unknown edges '{other}' (expected \"outline\" or \"all\")"))
+                    )
+                }
+            };
+        }
+        if let Some(f) = &rec.filter {
+            mode.filter = match f.get_ref().as_str() {
+                "coverage" => EdgeFilter::Coverage,
+                "paper" => EdgeFilter::Paper,
+                other => {
+                    return Err(self
+                        .invalid(f.span(), format!("unknown filter '{other}' (expected \"coverage\" or \"paper\")")))
+                }
+            };
         }
         match (method, &rec.samples) {
             ("none", None) => Ok(Antialias::None),
             ("none", Some(n)) => Err(self.invalid(n.span(), "method \"none\" takes no samples")),
-            ("edge", None) => Ok(Antialias::Edge(EdgeSelection::Outline)),
+            ("edge", None) => Ok(Antialias::Edge(mode)),
             ("edge", Some(n)) => Err(self.invalid(n.span(), "method \"edge\" takes no samples")),
             ("jitter", None) => Err(self.invalid(rec.method.span(), "method \"jitter\" needs `samples = n`")),
             ("jitter", Some(n)) => match u32::try_from(*n.get_ref()) {

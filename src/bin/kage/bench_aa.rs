@@ -4,13 +4,17 @@
 
 use std::path::Path;
 
-use kage::resolve::edges::EdgeSelection;
+use kage::resolve::edges::{EdgeFilter, EdgeMode, EdgeSelection};
 use kage::resolve::{Antialias, LinearImage};
 use kage::visibility::VisibilityBuffer;
 use kage::{RenderOptions, Renderer, Scene};
 use miette::{miette, Result};
 
 use crate::bench::BenchArgs;
+
+fn edge(selection: EdgeSelection, filter: EdgeFilter) -> Antialias {
+    Antialias::Edge(EdgeMode { selection, filter })
+}
 
 /// Passes of the truth: 16 × 16 samples per pixel.
 const TRUTH_PASSES: u32 = 256;
@@ -54,8 +58,9 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         let base = rmse(&aliased, &truth, Some(&mask));
         let methods = [
             ("aliased", Antialias::None),
-            ("edge pass (outline)", Antialias::Edge(EdgeSelection::Outline)),
-            ("edge pass (all edges)", Antialias::Edge(EdgeSelection::All)),
+            ("edge pass, the paper (all edges, Wu weights)", edge(EdgeSelection::All, EdgeFilter::Paper)),
+            ("edge pass, all edges, coverage", edge(EdgeSelection::All, EdgeFilter::Coverage)),
+            ("edge pass, outline, coverage (default)", edge(EdgeSelection::Outline, EdgeFilter::Coverage)),
             ("jitter 4", Antialias::Jitter(4)),
             ("jitter 16", Antialias::Jitter(16)),
         ];
@@ -73,7 +78,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                 100.0 * (1.0 - e / base),
                 rmse(&image, &truth, None)
             );
-            if aa == Antialias::Edge(EdgeSelection::Outline) {
+            if aa == Antialias::Edge(EdgeMode::default()) {
                 edged = Some(image);
             }
         }

@@ -10,7 +10,7 @@ mod report;
 use std::path::{Path, PathBuf};
 
 use clap::{Parser, Subcommand};
-use kage::resolve::edges::EdgeSelection;
+use kage::resolve::edges::{EdgeFilter, EdgeMode, EdgeSelection};
 use kage::resolve::{Antialias, Exposure};
 use kage::scene::{demo::demo_scene, file, Scene};
 use kage::shading::{Component, ComponentSet};
@@ -89,7 +89,8 @@ struct RenderArgs {
     #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(0..=16))]
     ray_depth: u32,
     /// Antialiasing: `none`; `edge` (seed 004's edge pass over silhouettes, boundaries
-    /// and creases) or `edge:all` (every triangle edge, as the paper); or `jitter:N`
+    /// and creases), with `:all` for every triangle edge and `:paper` for the paper's
+    /// Wu-line weights (e.g. `edge:all:paper`, the paper as written); or `jitter:N`
     /// (N sub-pixel-jittered passes averaged, seed 002 §4). Overrides the scene. The
     /// reference uses --spp instead.
     #[arg(long, value_parser = parse_antialias)]
@@ -129,18 +130,33 @@ fn parse_components(s: &str) -> Result<ComponentSet, String> {
 
 fn parse_antialias(s: &str) -> Result<Antialias, String> {
     let max = kage::resolve::jitter::MAX_JITTER_SAMPLES;
-    match s.split_once(':') {
-        None if s == "none" => Ok(Antialias::None),
-        None if s == "edge" => Ok(Antialias::Edge(EdgeSelection::Outline)),
-        Some(("edge", "outline")) => Ok(Antialias::Edge(EdgeSelection::Outline)),
-        Some(("edge", "all")) => Ok(Antialias::Edge(EdgeSelection::All)),
-        Some(("jitter", n)) => match n.parse::<u32>() {
-            Ok(k @ 1..) if k <= max => Ok(Antialias::Jitter(k)),
-            _ => Err(format!("'{n}' is not a number of passes between 1 and {max}")),
+    let bad = || {
+        format!(
+            "'{s}' is not an antialiasing method (expected 'none', 'edge' with optional ':all' or ':outline' and \
+             ':paper' or ':coverage' (e.g. edge:all:paper), or 'jitter:N', e.g. jitter:8)"
+        )
+    };
+    let mut parts = s.split(':');
+    match parts.next() {
+        Some("none") if s == "none" => Ok(Antialias::None),
+        Some("edge") => {
+            let mut mode = EdgeMode::default();
+            for p in parts {
+                match p {
+                    "outline" => mode.selection = EdgeSelection::Outline,
+                    "all" => mode.selection = EdgeSelection::All,
+                    "coverage" => mode.filter = EdgeFilter::Coverage,
+                    "paper" => mode.filter = EdgeFilter::Paper,
+                    _ => return Err(bad()),
+                }
+            }
+            Ok(Antialias::Edge(mode))
+        }
+        Some("jitter") => match s.split_once(':').map(|(_, n)| n.parse::<u32>()) {
+            Some(Ok(k @ 1..)) if k <= max => Ok(Antialias::Jitter(k)),
+            _ => Err(format!("'{s}' is not jitter:N with N a number of passes between 1 and {max}")),
         },
-        _ => Err(format!(
-            "'{s}' is not an antialiasing method (expected 'none', 'edge' (or 'edge:all') or 'jitter:N', e.g. jitter:8)"
-        )),
+        _ => Err(bad()),
     }
 }
 
