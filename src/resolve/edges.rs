@@ -21,8 +21,10 @@
 //!   paper's blend of the edge colour (the colour of the surface next to the edge);
 //!   when `C` lies inside, it brings back the background the fill covered, which
 //!   blending the edge colour alone cannot — without it a straight edge is drawn half
-//!   a pixel too fat on every other column. For a straight edge the result is the
-//!   pixel's exact covered area along the major axis.
+//!   a pixel too fat on every other column. Where the edge's line crosses two rows
+//!   of a column, both crossed pixels are blended, each by its own share, so for a
+//!   straight edge every pixel ends at its exact covered area. The paper's weights
+//!   are kept as [`EdgeFilter::Paper`], to measure against.
 //! - Gamma. The frame is linear light, so blending there is the gamma-corrected
 //!   filter the paper asks for; the sRGB curve is applied at output.
 //! - Which edges. By default the outline: silhouette edges (one adjacent face towards
@@ -260,7 +262,8 @@ pub struct EdgeBlend {
     pub c: u32,
     /// The pixel across the edge.
     pub o: u32,
-    /// The share of `c`'s area on `o`'s side of the edge (≤ ½).
+    /// How far `c` moves: under the coverage filter the share of `c`'s area on
+    /// `o`'s side of the edge (≤ ½); under the paper's, its Wu weight (≤ 1).
     pub alpha: f32,
     /// Whether `c` shows the edge's own surface (else what lies behind the edge).
     pub inside: bool,
@@ -312,6 +315,8 @@ fn find_blends(
     let camera = &scene.camera;
     let (w, h) = (vb.width(), vb.height());
     let view_proj = camera.view_projection(w as f32 / h as f32);
+    let depth = DepthScale::of(camera, h);
+    let screen = Screen { width: w as f64, height: h as f64, far: f64::from(camera.far_plane_factor()) };
     let mut blends = Vec::new();
     let mut walked = 0;
     for (object, (o, mesh_edges)) in scene.objects.iter().zip(edges).enumerate() {
@@ -321,8 +326,6 @@ fn find_blends(
         }
         let facing = Facing::new(camera, o.transform.inverse());
         let to_clip = (view_proj * Mat4::from(o.transform)).as_dmat4();
-        let depth = DepthScale::of(camera, h);
-        let screen = Screen { width: w as f64, height: h as f64, far: f64::from(camera.far_plane_factor()) };
         let per_edge: Vec<Vec<EdgeBlend>> = mesh_edges
             .edges
             .par_iter()
