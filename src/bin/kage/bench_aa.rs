@@ -48,12 +48,12 @@ fn scenes(args: &BenchArgs) -> Result<Vec<(String, Scene)>> {
 /// Runs the table.
 pub fn run(args: &BenchArgs) -> Result<()> {
     println!(
-        "| scene | method | ms/frame | x aliased | silhouette-pixel RMSE | share of aliased removed | image RMSE |"
+        "| scene | method | ms/frame | of which edge pass | x aliased | silhouette-pixel RMSE | share of aliased removed | image RMSE |"
     );
-    println!("|---|---|---:|---:|---:|---:|---:|");
+    println!("|---|---|---:|---:|---:|---:|---:|---:|");
     for (label, scene) in scenes(args)? {
         let truth = frame(&scene, Antialias::Jitter(TRUTH_PASSES), 1)?.0;
-        let (aliased, aliased_ms, vb) = frame(&scene, Antialias::None, args.frames)?;
+        let (aliased, (aliased_ms, _), vb) = frame(&scene, Antialias::None, args.frames)?;
         let mask = silhouettes(&vb);
         let base = rmse(&aliased, &truth, Some(&mask));
         let methods = [
@@ -66,14 +66,14 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         ];
         let mut edged = None;
         for (name, aa) in methods {
-            let (image, ms, _) = if aa == Antialias::None {
-                (aliased.clone(), aliased_ms, vb.clone())
+            let (image, (ms, edge_ms), _) = if aa == Antialias::None {
+                (aliased.clone(), (aliased_ms, 0.0), vb.clone())
             } else {
                 frame(&scene, aa, args.frames.min(if matches!(aa, Antialias::Jitter(_)) { 3 } else { args.frames }))?
             };
             let e = rmse(&image, &truth, Some(&mask));
             println!(
-                "| {label} | {name} | {ms:.1} | {:.2} | {e:.4} | {:.0}% | {:.4} |",
+                "| {label} | {name} | {ms:.1} | {edge_ms:.1} | {:.2} | {e:.4} | {:.0}% | {:.4} |",
                 ms / aliased_ms,
                 100.0 * (1.0 - e / base),
                 rmse(&image, &truth, None)
@@ -95,22 +95,25 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     Ok(())
 }
 
-/// The frame of `scene` antialiased by `aa`: image, median ms over `frames`
-/// renders (after one warm-up, which builds the meshes' edge lists), and the
-/// visibility buffer.
-fn frame(scene: &Scene, aa: Antialias, frames: usize) -> Result<(LinearImage, f64, VisibilityBuffer)> {
+/// The frame of `scene` antialiased by `aa`: image, median ms per frame and of its
+/// edge pass over `frames` renders (after one warm-up, which builds the meshes'
+/// edge lists), and the visibility buffer.
+fn frame(scene: &Scene, aa: Antialias, frames: usize) -> Result<(LinearImage, (f64, f64), VisibilityBuffer)> {
     let scene = Scene { antialias: aa, ..scene.clone() };
     let mut renderer = Renderer::new(&RenderOptions::default()).map_err(|e| miette!("{e}"))?;
     renderer.render(&scene).map_err(|e| miette!("{e}"))?;
-    let mut times = Vec::new();
+    let (mut times, mut edge) = (Vec::new(), Vec::new());
     for _ in 0..frames.max(1) {
         let t = std::time::Instant::now();
-        renderer.render(&scene).map_err(|e| miette!("{e}"))?;
+        edge.push(renderer.render(&scene).map_err(|e| miette!("{e}"))?.stats.edge_ms);
         times.push(t.elapsed().as_secs_f64() * 1e3);
     }
-    times.sort_by(f64::total_cmp);
+    let median = |mut v: Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
     let f = renderer.into_frame();
-    Ok((f.image, times[times.len() / 2], f.visibility))
+    Ok((f.image, (median(times), median(edge)), f.visibility))
 }
 
 /// Pixels whose 3 × 3 neighbourhood sees more than one object (or the background).
