@@ -185,8 +185,8 @@ fn render_into(scene: &Scene, frame: &mut Frame, scratch: &mut Scratch, options:
             let mut images: Vec<&mut LinearImage> =
                 std::iter::once(&mut frame.image).chain(&mut scratch.aovs).collect();
             let options = EdgeOptions { mode, ..EdgeOptions::default() };
-            let stats = edges::antialias_edges(scene, &frame.visibility, &mut images, &options, &mut scratch.edges);
-            frame.stats.edge_blends = stats.blends;
+            frame.stats.edge_blends =
+                edges::antialias_edges(scene, &frame.visibility, &mut images, &options, &mut scratch.edges);
             frame.stats.edge_ms = t.elapsed().as_secs_f64() * 1e3;
         }
         frame.aovs.iter_mut().zip(&mut scratch.aovs).for_each(|((_, a), s)| std::mem::swap(a, s));

@@ -188,18 +188,6 @@ impl MeshEdges {
     fn touches(&self, mesh: &Mesh, t: u32, near: &[u32; 6]) -> bool {
         mesh.triangles.get(t as usize).is_some_and(|tri| tri.iter().any(|&v| near.contains(&self.weld[v as usize])))
     }
-
-    /// Number of edges.
-    #[must_use]
-    pub fn len(&self) -> usize {
-        self.edges.len()
-    }
-
-    /// Whether the mesh has no edges.
-    #[must_use]
-    pub fn is_empty(&self) -> bool {
-        self.edges.is_empty()
-    }
 }
 
 /// Per vertex, the index of the first vertex at the same position, to a millionth
@@ -271,27 +259,19 @@ pub struct EdgeBlend {
     pub source: u64,
 }
 
-/// What the edge pass did.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct EdgeStats {
-    /// Edges walked (after selection and clipping).
-    pub edges: usize,
-    /// Pixel blends applied.
-    pub blends: usize,
-}
-
 /// Runs seed 004's edge pass over the frame: finds the blends from `vb` and the
 /// frame `images[0]` as pass 1 left it, then applies them to every image in
-/// `images` (the frame and its component images, same size as `vb`).
+/// `images` (the frame and its component images, same size as `vb`). Returns the
+/// number of pixel blends applied.
 pub fn antialias_edges(
     scene: &Scene,
     vb: &VisibilityBuffer,
     images: &mut [&mut LinearImage],
     options: &EdgeOptions,
     cache: &mut EdgeCache,
-) -> EdgeStats {
+) -> usize {
     let edges = cache.edges_of(scene, options.crease_deg);
-    let (blends, walked) = find_blends(scene, vb, &edges, options.mode);
+    let blends = find_blends(scene, vb, &edges, options.mode);
     // One straight edge moves a pixel by at most ½ under the coverage filter; the
     // paper's Wu weights reach 1.
     let cap = match options.mode.filter {
@@ -302,23 +282,17 @@ pub fn antialias_edges(
     for image in images.iter_mut() {
         apply(image, &blends);
     }
-    EdgeStats { edges: walked, blends: blends.len() }
+    blends.len()
 }
 
-/// Every blend, in scene order (object, then edge), and the number of edges walked.
-fn find_blends(
-    scene: &Scene,
-    vb: &VisibilityBuffer,
-    edges: &[Arc<MeshEdges>],
-    mode: EdgeMode,
-) -> (Vec<EdgeBlend>, usize) {
+/// Every blend, in scene order (object, then edge).
+fn find_blends(scene: &Scene, vb: &VisibilityBuffer, edges: &[Arc<MeshEdges>], mode: EdgeMode) -> Vec<EdgeBlend> {
     let camera = &scene.camera;
     let (w, h) = (vb.width(), vb.height());
     let view_proj = camera.view_projection(w as f32 / h as f32);
     let depth = DepthScale::of(camera, h);
     let screen = Screen { width: w as f64, height: h as f64, far: f64::from(camera.far_plane_factor()) };
     let mut blends = Vec::new();
-    let mut walked = 0;
     for (object, (o, mesh_edges)) in scene.objects.iter().zip(edges).enumerate() {
         let material = &scene.materials[o.material];
         if material.translucent() {
@@ -356,10 +330,9 @@ fn find_blends(
                 Some(out)
             })
             .collect();
-        walked += per_edge.len();
         blends.extend(per_edge.into_iter().flatten());
     }
-    (blends, walked)
+    blends
 }
 
 /// One blend per pixel and neighbour, from all the edges that cross the pixel
