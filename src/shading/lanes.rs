@@ -12,7 +12,7 @@ use glam::{Vec2, Vec3};
 use wide::f32x8;
 
 use super::phong::{Coefficients, Component, ComponentSet};
-use super::surface::{PreparedTriangle, SurfacePoint};
+use super::surface::{PreparedTriangle, SurfacePoint, TriangleGeometry};
 use crate::scene::camera::PixelRays;
 use crate::scene::{Falloff, Light, LightKind};
 use crate::shadows::ShadowTerm;
@@ -289,8 +289,9 @@ pub fn shade_run(
         shininess: F::splat(n),
         whole: whole_exponent(n),
     };
+    let row = TriangleRow::new(&g, &rays.line(x0));
     for (b, out) in out.chunks_exact_mut(LANES).enumerate() {
-        let rgb = lighting.shade(&inputs, &surface(&inputs, rays, x0 + b * LANES));
+        let rgb = lighting.shade(&inputs, &row.surface(&inputs, b * LANES));
         let (r, g, b) = (rgb.x.to_array(), rgb.y.to_array(), rgb.z.to_array());
         for (i, px) in out.iter_mut().enumerate() {
             blend.apply(px, Vec3::new(r[i], g[i], b[i]));
@@ -343,11 +344,88 @@ fn surface(inp: &LaneInputs, rays: &RowRays, x0: usize) -> LaneSurface {
     let qvec = tvec.cross(inp.e1);
     let (b1, b2, t) = (tvec.dot(pvec) * inv, dir.dot(qvec) * inv, inp.e2.dot(qvec) * inv);
     let b0 = F::ONE - b1 - b2;
-    let n = inp.n[0].scale(b0).add(inp.n[1].scale(b1)).add(inp.n[2].scale(b2)).normalize_or(inp.geometric);
     let v = V3 { x: -dir.x, y: -dir.y, z: -dir.z };
-    let facing = n.dot(v).simd_lt(F::ZERO);
-    let n = V3::select(facing, V3 { x: -n.x, y: -n.y, z: -n.z }, n);
-    LaneSurface { p: origin.add(dir.scale(t)), n, v, weights: [b0, b1, b2] }
+    LaneSurface { p: origin.add(dir.scale(t)), n: facing_normal(inp, [b0, b1, b2], &v), v, weights: [b0, b1, b2] }
+}
+
+/// A polynomial `c + k·(b + k·q)` in the pixel offset `k` along a row.
+#[derive(Debug, Clone, Copy)]
+struct RowPolynomial {
+    c: f32,
+    b: f32,
+    q: f32,
+}
+
+impl RowPolynomial {
+    /// The product of two affine functions `(u + k·du)·(v + k·dv)`, each a dot
+    /// product of vectors affine in `k`.
+    fn dot(u: Vec3, du: Vec3, v: Vec3, dv: Vec3) -> Self {
+        RowPolynomial { c: u.dot(v), b: du.dot(v) + u.dot(dv), q: du.dot(dv) }
+    }
+    #[inline(always)]
+    fn at(&self, k: F) -> F {
+        k.mul_add(k.mul_add(F::splat(self.q), F::splat(self.b)), F::splat(self.c))
+    }
+}
+
+/// One triangle seen along a run of one row, with the ray/plane intersection
+/// done once for the whole run.
+///
+/// Along a row the rays are `o(k) + s·d(k)` with `o` and `d` affine in the pixel
+/// offset `k` (a perspective camera moves `d`, an orthographic one `o`). In
+/// Möller–Trumbore's solution every term is then a product of two affine
+/// functions: with `p = d × e2`, `t = o − a`, `q = t × e1`, the barycentric
+/// weights are `b1 = (t·p) / (e1·p)` and `b2 = (d·q) / (e1·p)`, ratios of
+/// polynomials in `k` of degree ≤ 2 (the quadratic terms vanish for both
+/// cameras; they are kept so the statement is exact for any affine rays). So a
+/// pixel costs three polynomial evaluations and one division, and the point is
+/// `a + b1·e1 + b2·e2`; this is perspective-correct interpolation.
+#[derive(Debug, Clone, Copy)]
+struct TriangleRow {
+    /// `t·p`, `d·q` and `e1·p` along the row.
+    weights: [RowPolynomial; 3],
+    /// The unnormalised ray direction at the run's start and per pixel.
+    dir: (Vec3, Vec3),
+}
+
+impl TriangleRow {
+    fn new(g: &TriangleGeometry, line: &RayLine) -> Self {
+        let (a, e1, e2) = (g.a, g.e1, g.e2);
+        let (p, dp) = (line.dir.cross(e2), line.dir_step.cross(e2));
+        let (t, dt) = (line.origin - a, line.origin_step);
+        let (q, dq) = (t.cross(e1), dt.cross(e1));
+        let weights = [
+            RowPolynomial::dot(t, dt, p, dp),
+            RowPolynomial::dot(line.dir, line.dir_step, q, dq),
+            RowPolynomial::dot(e1, Vec3::ZERO, p, dp),
+        ];
+        TriangleRow { weights, dir: (line.dir, line.dir_step) }
+    }
+
+    /// The surface seen by the eight pixels from offset `k0` of the run.
+    #[inline(always)]
+    fn surface(&self, inp: &LaneInputs, k0: usize) -> LaneSurface {
+        const STEPS: F = F::new([0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0]);
+        let k = F::splat(k0 as f32) + STEPS;
+        let det = self.weights[2].at(k);
+        let det = det.abs().simd_lt(F::splat(f32::MIN_POSITIVE)).select(F::splat(f32::MIN_POSITIVE), det);
+        let inv = F::ONE / det;
+        let (b1, b2) = (self.weights[0].at(k) * inv, self.weights[1].at(k) * inv);
+        let b0 = F::ONE - b1 - b2;
+        let (d, dd) = (V3::splat(self.dir.0), V3::splat(self.dir.1));
+        let dir = d.add(dd.scale(k));
+        let v = V3 { x: -dir.x, y: -dir.y, z: -dir.z }.normalize_or(V3::splat(-self.dir.0));
+        let p = inp.a.add(inp.e1.scale(b1)).add(inp.e2.scale(b2));
+        LaneSurface { p, n: facing_normal(inp, [b0, b1, b2], &v), v, weights: [b0, b1, b2] }
+    }
+}
+
+/// The interpolated unit normal at barycentric weights `w`, turned towards `v`.
+#[inline(always)]
+fn facing_normal(inp: &LaneInputs, w: [F; 3], v: &V3) -> V3 {
+    let n = inp.n[0].scale(w[0]).add(inp.n[1].scale(w[1])).add(inp.n[2].scale(w[2])).normalize_or(inp.geometric);
+    let facing = n.dot(*v).simd_lt(F::ZERO);
+    V3::select(facing, V3 { x: -n.x, y: -n.y, z: -n.z }, n)
 }
 
 /// What one shading pass adds (seed 002 eq. 4): the ambient of some lights, the
@@ -491,18 +569,29 @@ fn incident(light: &Light, p: &V3) -> (V3, V3) {
 #[derive(Debug, Clone, Copy)]
 pub struct RowRays {
     /// Ray origin at the row's centre line (orthographic) or the eye.
-    origin: V3,
+    origin: Vec3,
     /// Direction (perspective) or origin offset (orthographic) at ndc x = 0.
-    base: V3,
+    base: Vec3,
     /// Change per unit of ndc x.
-    right: V3,
+    right: Vec3,
     /// Unit view direction (orthographic rays).
-    forward: V3,
-    ndc_scale: F,
+    forward: Vec3,
+    ndc_scale: f32,
     ortho: bool,
     /// From this row's rays to the next row's: added to the origin
     /// (orthographic) or the direction base (perspective).
-    down: V3,
+    down: Vec3,
+}
+
+/// The rays of a row from one column on, as affine functions of the pixel
+/// offset `k`: origin `origin + k·origin_step`, unnormalised direction
+/// `dir + k·dir_step`.
+#[derive(Debug, Clone, Copy)]
+struct RayLine {
+    origin: Vec3,
+    origin_step: Vec3,
+    dir: Vec3,
+    dir_step: Vec3,
 }
 
 impl RowRays {
@@ -513,13 +602,13 @@ impl RowRays {
         let up = rays.up * ndc_y;
         let (origin, base) = if rays.ortho { (rays.origin + up, Vec3::ZERO) } else { (rays.origin, rays.forward + up) };
         RowRays {
-            origin: V3::splat(origin),
-            base: V3::splat(base),
-            right: V3::splat(rays.right),
-            forward: V3::splat(rays.forward.normalize()),
-            ndc_scale: F::splat(2.0 / rays.size.x),
+            origin,
+            base,
+            right: rays.right,
+            forward: rays.forward.normalize(),
+            ndc_scale: 2.0 / rays.size.x,
             ortho: rays.ortho,
-            down: V3::splat(rays.up * (-2.0 / rays.size.y)),
+            down: rays.up * (-2.0 / rays.size.y),
         }
     }
 
@@ -528,23 +617,36 @@ impl RowRays {
     pub fn below(&self) -> RowRays {
         let mut r = *self;
         if self.ortho {
-            r.origin = r.origin.add(self.down);
+            r.origin += self.down;
         } else {
-            r.base = r.base.add(self.down);
+            r.base += self.down;
         }
         r
+    }
+
+    /// The rays from column `x0` on.
+    fn line(&self, x0: usize) -> RayLine {
+        let ndc_x = (x0 as f32 + 0.5) * self.ndc_scale - 1.0;
+        let offset = self.base + self.right * ndc_x;
+        let step = self.right * self.ndc_scale;
+        if self.ortho {
+            RayLine { origin: self.origin + offset, origin_step: step, dir: self.forward, dir_step: Vec3::ZERO }
+        } else {
+            RayLine { origin: self.origin, origin_step: Vec3::ZERO, dir: offset, dir_step: step }
+        }
     }
 
     /// Origins and unit directions of the rays through pixels `x0 .. x0 + 8`.
     #[inline(always)]
     fn at(&self, x0: usize) -> (V3, V3) {
         const STEPS: F = F::new([0.5, 1.5, 2.5, 3.5, 4.5, 5.5, 6.5, 7.5]);
-        let ndc_x = (F::splat(x0 as f32) + STEPS) * self.ndc_scale - F::ONE;
-        let offset = self.base.add(self.right.scale(ndc_x));
+        let ndc_x = (F::splat(x0 as f32) + STEPS) * F::splat(self.ndc_scale) - F::ONE;
+        let offset = V3::splat(self.base).add(V3::splat(self.right).scale(ndc_x));
+        let forward = V3::splat(self.forward);
         if self.ortho {
-            (self.origin.add(offset), self.forward)
+            (V3::splat(self.origin).add(offset), forward)
         } else {
-            (self.origin, offset.normalize_or(self.forward))
+            (V3::splat(self.origin), offset.normalize_or(forward))
         }
     }
 }
