@@ -157,19 +157,18 @@ impl DepthMap {
         let depth = self.depth.depths();
         let res = self.resolution as usize;
         // k × k taps; each tap's eight texel reads are issued before any compare, so
-        // their cache misses overlap. Lanes outside the map read texel 0 and count lit.
-        let (u0, v0) = (u.floor().round_int().to_array(), v.floor().round_int().to_array());
-        let inside_lanes = inside.to_array();
-        let last = self.resolution as i32 - 1;
+        // their cache misses overlap. Texel coordinates are clamped to the map as
+        // vectors (lanes outside it read texel 0 and count lit), leaving one load
+        // per lane.
+        let last = f32x8::splat((self.resolution - 1) as f32);
+        let (u0, v0) = (inside.select(u, zero).floor(), inside.select(v, zero).floor());
+        let texels = |base: f32x8, d: i32| (base + f32x8::splat(d as f32)).max(zero).min(last).round_int().to_array();
         let mut lit = zero;
         for dy in 0..k {
+            let y = texels(v0, dy - k / 2);
             for dx in 0..k {
-                let texel: [f32; 8] = std::array::from_fn(|i| {
-                    let x = u0[i].saturating_add(dx - k / 2).clamp(0, last) as usize;
-                    let y = v0[i].saturating_add(dy - k / 2).clamp(0, last) as usize;
-                    let index = if inside_lanes[i] != 0.0 { y * res + x } else { 0 };
-                    depth.get(index).copied().unwrap_or(0.0)
-                });
+                let x = texels(u0, dx - k / 2);
+                let texel: [f32; 8] = std::array::from_fn(|i| depth[y[i] as usize * res + x[i] as usize]);
                 lit += f32x8::new(texel).simd_le(z_limit).select(f32x8::ONE, zero);
             }
         }
