@@ -31,7 +31,7 @@ pub struct BenchArgs {
     #[arg(long, default_value_t = 10)]
     pub(crate) frames: usize,
     /// Alternating rounds of kage and llvmpipe; the best round of each is reported.
-    #[arg(long, default_value_t = 3)]
+    #[arg(long, default_value_t = 5)]
     rounds: usize,
     /// Only these scenes (comma-separated names).
     #[arg(long, default_value = "sphere10k,sphere100k,sphere1m")]
