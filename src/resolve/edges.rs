@@ -28,9 +28,12 @@
 //! - Gamma. The frame is linear light, so blending there is the gamma-corrected
 //!   filter the paper asks for; the sRGB curve is applied at output.
 //! - Which edges. By default the outline: silhouette edges (one adjacent face towards
-//!   the eye, one away), mesh boundaries and creases (adjacent face normals more than
-//!   [`EdgeOptions::crease_deg`] apart), with vertices welded by position so the UV
-//!   seam of a smooth sphere is not an edge. [`EdgeSelection::All`] walks every
+//!   the eye, one away), mesh boundaries and creases, with vertices welded by
+//!   position so the UV seam of a smooth sphere is not an edge. A crease is where
+//!   the shading breaks: the two faces' vertex normals at an end of the edge differ
+//!   by more than [`EdgeOptions::crease_deg`] (a flat-shaded mesh breaks at every
+//!   fold; a smooth-shaded one, however sharply folded, has no crease to smooth —
+//!   blending across its folds only blurred a scanned model's detail). [`EdgeSelection::All`] walks every
 //!   triangle edge, as the paper does.
 //! - Depth test. Each pixel is classed against the edge: the edge's own surface (it
 //!   shows a triangle that touches a face beside the edge), else by depth against
@@ -94,8 +97,8 @@ pub struct EdgeMode {
 pub struct EdgeOptions {
     /// Which edges and how they blend.
     pub mode: EdgeMode,
-    /// Adjacent faces whose normals differ by more than this (degrees) meet at a
-    /// crease, which is drawn like a silhouette.
+    /// Adjacent faces whose vertex normals at a shared end differ by more than
+    /// this (degrees) meet at a crease, which is drawn like a silhouette.
     pub crease_deg: f32,
 }
 
@@ -164,8 +167,13 @@ impl MeshEdges {
             let (key, f0, v) = keyed[i];
             let second = keyed.get(i + 1).filter(|e| e.0 == key).map(|e| e.1);
             let faces = [f0, second.unwrap_or(NO_FACE)];
-            let crease = second
-                .is_some_and(|f1| planes[f0 as usize].truncate().dot(planes[f1 as usize].truncate()) < cos_crease);
+            let crease = keyed.get(i + 1).filter(|_| second.is_some()).is_some_and(|e| {
+                let [a, b] = v;
+                // The other face's copies of this edge's two ends, matched by position.
+                let [c, d] = if weld[e.2[0] as usize] == weld[a as usize] { e.2 } else { [e.2[1], e.2[0]] };
+                let n = |i: u32| mesh.normals[i as usize];
+                n(a).dot(n(c)) < cos_crease || n(b).dot(n(d)) < cos_crease
+            });
             edges.push(MeshEdge { v, faces, crease });
             i += if second.is_some() { 2 } else { 1 };
         }
@@ -670,6 +678,19 @@ mod tests {
         let cube = MeshEdges::new(&shapes::cube(), 30.0);
         assert_eq!(cube.edges.iter().filter(|e| e.crease).count(), 12);
         assert!(cube.edges.iter().all(|e| e.faces[1] != NO_FACE));
+    }
+
+    #[test]
+    fn a_crease_is_where_the_shading_normals_break_not_where_the_surface_folds() {
+        // Two triangles folded 90° along the edge (0,0,0)-(1,0,0).
+        let positions = vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z];
+        let triangles = vec![[0, 1, 2], [1, 0, 3]];
+        let fold = |mode| crate::scene::Mesh::new(positions.clone(), Vec::new(), Vec::new(), triangles.clone(), mode);
+        let creases = |mesh: &crate::scene::Mesh| MeshEdges::new(mesh, 30.0).edges.iter().filter(|e| e.crease).count();
+        let (smooth, _) = fold(crate::scene::mesh::NormalMode::Smooth).unwrap();
+        let (flat, _) = fold(crate::scene::mesh::NormalMode::Flat).unwrap();
+        assert_eq!(creases(&smooth), 0, "shared normals: the shading is continuous across the fold");
+        assert_eq!(creases(&flat), 1, "face normals: the shading breaks at the fold");
     }
 
     #[test]
