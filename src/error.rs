@@ -61,6 +61,14 @@ pub enum Error {
         /// What was expected there.
         message: String,
     },
+    /// An OpenSCAD `.csg` file does not follow the grammar OpenSCAD writes.
+    #[error("{location}: {message}")]
+    CsgSyntax {
+        /// Where the parser stopped.
+        location: Box<SourceLocation>,
+        /// What was expected there.
+        message: String,
+    },
     /// The scene file parses but says something impossible (unknown material, bad value).
     #[error("{location}: {message}")]
     SceneInvalid {

@@ -1,4 +1,4 @@
-//! Library errors → miette reports: scene-file errors show the offending line with
+//! Library errors → miette reports: scene-file and `.csg` errors show the offending line with
 //! the value underlined; every other error keeps its message.
 
 use kage::Error;
@@ -7,19 +7,19 @@ use miette::{LabeledSpan, MietteDiagnostic, NamedSource, Report};
 /// Turns a library error into a report for the terminal.
 pub fn to_report(e: Error) -> Report {
     let located = match &e {
-        Error::SceneSyntax { location, message } | Error::SceneInvalid { location, message } => {
-            Some((location.clone(), message.clone()))
-        }
+        Error::SceneSyntax { location, message }
+        | Error::SceneInvalid { location, message }
+        | Error::CsgSyntax { location, message } => Some((location.clone(), message.clone())),
         _ => None,
     };
     match located {
         Some((loc, message)) => {
             let len = loc.span.len().max(1);
             let diag = MietteDiagnostic::new(format!("{}: {}", loc, message))
-                .with_code(if matches!(e, Error::SceneSyntax { .. }) {
-                    "kage::scene::syntax"
-                } else {
-                    "kage::scene::invalid"
+                .with_code(match e {
+                    Error::SceneSyntax { .. } => "kage::scene::syntax",
+                    Error::CsgSyntax { .. } => "kage::csg::syntax",
+                    _ => "kage::scene::invalid",
                 })
                 .with_label(LabeledSpan::at(loc.span.start..loc.span.start + len, "here"));
             let source = NamedSource::new(loc.path.display().to_string(), loc.text.to_string());

@@ -1,4 +1,5 @@
-//! Mesh and texture files: Wavefront OBJ + MTL, STL (binary and ASCII), glTF 2.0.
+//! Mesh and texture files: Wavefront OBJ + MTL, STL (binary and ASCII), glTF 2.0;
+//! and OpenSCAD `.csg` files, read into a syntax tree ([`openscad`]).
 //!
 //! Each loader turns a file into a [`LoadedModel`]: parts (a mesh with an optional
 //! material of its own and a placement), and for glTF the file's camera and lights.
@@ -7,6 +8,7 @@
 
 mod gltf;
 mod obj;
+pub mod openscad;
 mod stl;
 
 use std::io;
