@@ -69,6 +69,15 @@ pub enum Error {
         /// What was expected there.
         message: String,
     },
+    /// An OpenSCAD `.csg` file parses but holds what kage cannot render (a
+    /// non-convex polyhedron, a node out of scope, a malformed argument).
+    #[error("{location}: {message}")]
+    CsgInvalid {
+        /// The offending node or argument.
+        location: Box<SourceLocation>,
+        /// What is wrong with it.
+        message: String,
+    },
     /// The scene file parses but says something impossible (unknown material, bad value).
     #[error("{location}: {message}")]
     SceneInvalid {

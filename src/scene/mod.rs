@@ -3,6 +3,7 @@
 //! ([`mod@file`]), then meshes and textures are loaded ([`load`]) into this form.
 
 pub mod camera;
+pub mod csg;
 pub mod demo;
 pub mod environment;
 pub mod file;

@@ -19,6 +19,7 @@ pub fn to_report(e: Error) -> Report {
                 .with_code(match e {
                     Error::SceneSyntax { .. } => "kage::scene::syntax",
                     Error::CsgSyntax { .. } => "kage::csg::syntax",
+                    Error::CsgInvalid { .. } => "kage::csg::invalid",
                     _ => "kage::scene::invalid",
                 })
                 .with_label(LabeledSpan::at(loc.span.start..loc.span.start + len, "here"));

@@ -1,4 +1,4 @@
-//! OpenSCAD's flattened `.csg` files, read into a syntax tree (issue 6: CSG solids
+//! The syntax of OpenSCAD's flattened `.csg` files (issue 6: CSG solids
 //! by scanline, seed 003, read from the models OpenSCAD users already have).
 //!
 //! OpenSCAD 2021.01 writes a `.csg` file as a tree of built-in nodes with literal

@@ -1,0 +1,147 @@
+//! CSG solids made of convex primitives (seed 003 §5–6; issue 6).
+//!
+//! A [`CsgSolid`] is a tree of booleans ([`CsgTree`]) over convex primitives
+//! ([`Primitive`]): spheres and ellipsoids, cylinders, cones and frustums (exact
+//! quadrics), and convex polyhedra given by their planes (boxes, prisms, any convex
+//! point set). Each primitive carries an affine transform from its unit shape into
+//! the solid's space, so one unit sphere and one unit frustum describe every
+//! ellipsoid and elliptic cylinder. Differences are kept as written (`A − B − C`);
+//! seed 003 turns them into intersections with negative primitives when it forms
+//! its sum of products, which the renderer does, not the model.
+//!
+//! [`CsgSolid::contains`] is the point-membership oracle the renderers are tested
+//! against.
+
+use std::ops::Range;
+
+use glam::{Affine3A, Vec3, Vec4};
+
+/// A unit shape, before its primitive's transform.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Shape {
+    /// The sphere of radius 1 about the origin.
+    Sphere,
+    /// A frustum about the z axis from z = 0 (radius `bottom`) to z = 1 (radius
+    /// `top`); a cylinder when they are equal, a cone when one is 0. The larger
+    /// radius is 1.
+    Frustum {
+        /// Radius at z = 0.
+        bottom: f32,
+        /// Radius at z = 1.
+        top: f32,
+    },
+    /// A convex polyhedron.
+    Polyhedron(ConvexPolyhedron),
+}
+
+/// A convex polyhedron: the points `p` with `n·p ≤ d` for every plane `(n, d)`
+/// (n a unit outward normal), and its corners.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ConvexPolyhedron {
+    /// Outward unit normal and offset of each face plane.
+    pub planes: Vec<Vec4>,
+    /// The corners (for bounds and hulls).
+    pub vertices: Vec<Vec3>,
+}
+
+impl ConvexPolyhedron {
+    /// The box `[0, 1]³`.
+    #[must_use]
+    pub fn unit_cube() -> Self {
+        let planes = [Vec3::X, Vec3::Y, Vec3::Z].into_iter().flat_map(|n| [n.extend(1.0), (-n).extend(0.0)]).collect();
+        let vertices =
+            (0..8).map(|i| Vec3::new((i & 1) as f32, ((i >> 1) & 1) as f32, ((i >> 2) & 1) as f32)).collect();
+        ConvexPolyhedron { planes, vertices }
+    }
+
+    /// Whether `p` lies inside or on the surface (within `eps` of a plane).
+    #[must_use]
+    pub fn contains(&self, p: Vec3, eps: f32) -> bool {
+        self.planes.iter().all(|pl| pl.truncate().dot(p) <= pl.w + eps)
+    }
+}
+
+/// One convex primitive of a solid.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Primitive {
+    /// The unit shape.
+    pub shape: Shape,
+    /// From the unit shape's space to the solid's.
+    pub transform: Affine3A,
+    /// RGBA colour from the file, if one applies (OpenSCAD: the outermost wins).
+    pub color: Option<Vec4>,
+    /// Bytes of the source node that made it (for messages).
+    pub source: Range<usize>,
+}
+
+impl Primitive {
+    /// Whether the point `p` (solid space) lies inside the primitive or on its
+    /// surface.
+    #[must_use]
+    pub fn contains(&self, p: Vec3) -> bool {
+        const EPS: f32 = 1e-5;
+        let q = self.transform.inverse().transform_point3(p);
+        match &self.shape {
+            Shape::Sphere => q.length_squared() <= 1.0 + EPS,
+            Shape::Frustum { bottom, top } => {
+                let r = bottom + (top - bottom) * q.z;
+                (-EPS..=1.0 + EPS).contains(&q.z) && q.truncate().length() <= r + EPS
+            }
+            Shape::Polyhedron(poly) => poly.contains(q, EPS),
+        }
+    }
+}
+
+/// Booleans over primitives (indices into [`CsgSolid::primitives`]).
+#[derive(Debug, Clone, PartialEq)]
+pub enum CsgTree {
+    /// One primitive.
+    Leaf(usize),
+    /// Inside any child.
+    Union(Vec<CsgTree>),
+    /// Inside every child.
+    Intersection(Vec<CsgTree>),
+    /// Inside the first, outside all the others.
+    Difference(Box<CsgTree>, Vec<CsgTree>),
+}
+
+impl CsgTree {
+    /// Whether `p` is inside, given which primitives contain it.
+    #[must_use]
+    pub fn contains(&self, inside: &impl Fn(usize) -> bool) -> bool {
+        match self {
+            CsgTree::Leaf(i) => inside(*i),
+            CsgTree::Union(c) => c.iter().any(|t| t.contains(inside)),
+            CsgTree::Intersection(c) => c.iter().all(|t| t.contains(inside)),
+            CsgTree::Difference(a, b) => a.contains(inside) && !b.iter().any(|t| t.contains(inside)),
+        }
+    }
+
+    /// The primitives the tree uses, in order.
+    #[must_use]
+    pub fn leaves(&self) -> Vec<usize> {
+        match self {
+            CsgTree::Leaf(i) => vec![*i],
+            CsgTree::Union(c) | CsgTree::Intersection(c) => c.iter().flat_map(CsgTree::leaves).collect(),
+            CsgTree::Difference(a, b) => a.leaves().into_iter().chain(b.iter().flat_map(CsgTree::leaves)).collect(),
+        }
+    }
+}
+
+/// A solid: primitives and the booleans that combine them.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct CsgSolid {
+    /// Every primitive, in file order.
+    pub primitives: Vec<Primitive>,
+    /// The booleans; `None` for a solid with no volume.
+    pub tree: Option<CsgTree>,
+}
+
+impl CsgSolid {
+    /// Whether the point `p` (solid space) lies inside the solid (brute force:
+    /// every primitive is asked).
+    #[must_use]
+    pub fn contains(&self, p: Vec3) -> bool {
+        self.tree.as_ref().is_some_and(|t| t.contains(&|i| self.primitives[i].contains(p)))
+    }
+}
