@@ -13,8 +13,10 @@
 //!   ≤ 0 and zero-radius cylinders make nothing, as in OpenSCAD); a polyhedron is
 //!   checked for convexity and planar faces;
 //! - `%` subtrees are not part of the model and are skipped; `#` is plain;
-//! - every other node (`linear_extrude`, `text`, `import`, `minkowski`, `hull`
-//!   for now, ...) is an error naming the node, file, line and column, or, with
+//! - `hull()` of primitives (under groups, transforms, colours) is one convex
+//!   polyhedron around their corners, spheres and cylinders by their facets;
+//! - every other node (`linear_extrude`, `text`, `import`, `minkowski`, ...) is
+//!   an error naming the node, file, line and column, or, with
 //!   [`CsgOptions::skip_unsupported`], skipped with a warning.
 //!
 //! Spheres and cylinders are exact quadrics ([`Geometry::Exact`], seed 003's
@@ -30,7 +32,7 @@ use std::ops::Range;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use glam::{Affine3A, Mat4, Vec3, Vec4};
+use glam::{Affine3A, DVec3, Mat4, Vec3, Vec4};
 
 use crate::error::{Error, Result, SourceLocation};
 use crate::scene::csg::{ConvexPolyhedron, CsgSolid, CsgTree, Primitive, Shape};
@@ -147,6 +149,7 @@ impl Builder {
                 let own = (rgba[..3] != [-1.0; 3]).then(|| Vec4::from_slice(&rgba));
                 self.union(kids, m, color.or(own))
             }
+            "hull" => self.hull(node, m, color),
             "cube" | "sphere" | "cylinder" | "polyhedron" => {
                 Ok(self.primitive(node, m, color)?.map_or(Built::Empty, |p| {
                     self.solid.primitives.push(p);
@@ -211,6 +214,39 @@ impl Builder {
         };
         let cutters = self.children(rest.as_slice(), m, color, false)?.unwrap_or_default();
         Ok(Built::Tree(if cutters.is_empty() { positive } else { CsgTree::Difference(Box::new(positive), cutters) }))
+    }
+
+    /// `hull()`: one convex polyhedron around every point of the children's
+    /// primitives (spheres and cylinders by their facets, as OpenSCAD does).
+    fn hull(&mut self, node: &CsgNode, m: Affine3A, color: Option<Vec4>) -> Result<Built> {
+        let mut points = Vec::new();
+        self.hull_points(&node.children, Affine3A::IDENTITY, &mut points)?;
+        let Some(poly) = convex_hull(&points) else { return Ok(Built::Empty) };
+        let shape = Shape::Polyhedron(poly);
+        self.solid.primitives.push(Primitive { shape, transform: m, color, source: node.span.clone() });
+        Ok(Built::Tree(CsgTree::Leaf(self.solid.primitives.len() - 1)))
+    }
+
+    /// The corners of every primitive below `nodes` (placed by `m`) into `out`.
+    fn hull_points(&mut self, nodes: &[CsgNode], m: Affine3A, out: &mut Vec<Vec3>) -> Result<()> {
+        for node in nodes.iter().filter(|n| !n.background) {
+            match node.name.as_str() {
+                "group" | "union" | "render" | "color" | "hull" => self.hull_points(&node.children, m, out)?,
+                "multmatrix" => self.hull_points(&node.children, m * Affine3A::from_mat4(self.matrix(node)?), out)?,
+                "cube" | "sphere" | "cylinder" | "polyhedron" => {
+                    let faceted = std::mem::replace(&mut self.options.geometry, Geometry::Faceted);
+                    let made = self.primitive(node, m, None);
+                    self.options.geometry = faceted;
+                    if let Some(Primitive { shape: Shape::Polyhedron(p), transform, .. }) = made? {
+                        out.extend(p.vertices.iter().map(|v| transform.transform_point3(*v)));
+                    }
+                }
+                name => {
+                    return Err(self.invalid(&node.span, format!("`{name}()` inside `hull()` is not supported (only primitives, groups, transforms and colours)")));
+                }
+            }
+        }
+        Ok(())
     }
 
     /// A primitive node as a primitive, or `None` if it has no volume.
@@ -447,6 +483,44 @@ fn circle(n: usize, r: f32, z: f32) -> Vec<Vec3> {
         .collect()
 }
 
+/// The convex hull of `points` (quickhull, the `chull` crate) as planes: the
+/// hull's triangles in f64, largest first, each merged into a plane already found
+/// when its three corners lie on it (a flat face of many thin triangles is one
+/// plane); `None` if the points span no volume.
+fn convex_hull(points: &[Vec3]) -> Option<ConvexPolyhedron> {
+    let size = f64::from(bounds_size(points));
+    if points.len() < 4 || !(size > 0.0) {
+        return None;
+    }
+    let coords: Vec<Vec<f64>> = points.iter().map(|p| p.to_array().map(f64::from).to_vec()).collect();
+    let hull = chull::ConvexHull::try_new(&coords, size * 1e-9, None).ok()?;
+    let (corners, indices) = hull.vertices_indices();
+    let corners: Vec<DVec3> = corners.iter().map(|c| DVec3::new(c[0], c[1], c[2])).collect();
+    let centroid = corners.iter().copied().sum::<DVec3>() / corners.len() as f64;
+    let mut triangles: Vec<(f64, DVec3, [DVec3; 3])> = indices
+        .chunks_exact(3)
+        .filter_map(|t| {
+            let [a, b, c] = [t[0], t[1], t[2]].map(|i| corners[i]);
+            let cross = (b - a).cross(c - a);
+            let n = cross.try_normalize()?;
+            Some((cross.length(), if n.dot(a - centroid) < 0.0 { -n } else { n }, [a, b, c]))
+        })
+        .collect();
+    triangles.sort_by(|x, y| y.0.total_cmp(&x.0));
+    let eps = 1e-6 * size;
+    let mut planes: Vec<(DVec3, f64)> = Vec::new();
+    for (_, n, tri) in triangles {
+        let on = |(m, d): &(DVec3, f64)| m.dot(n) > 0.99 && tri.iter().all(|v| (m.dot(*v) - d).abs() < eps);
+        if !planes.iter().any(on) {
+            planes.push((n, n.dot(tri[0])));
+        }
+    }
+    Some(ConvexPolyhedron {
+        planes: planes.iter().map(|(n, d)| n.as_vec3().extend(*d as f32)).collect(),
+        vertices: corners.iter().map(|c| c.as_vec3()).collect(),
+    })
+}
+
 /// The largest side of the points' bounding box.
 fn bounds_size(points: &[Vec3]) -> f32 {
     let (lo, hi) = points.iter().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(a, b), &p| (a.min(p), b.max(p)));
@@ -565,6 +639,20 @@ mod tests {
         let loaded = load_csg(Path::new("t.csg"), Arc::from(text), &options).unwrap();
         assert_eq!(loaded.solid.primitives.len(), 1);
         assert!(loaded.warnings[0].starts_with("t.csg:2:2: skipped"), "{:?}", loaded.warnings);
+    }
+
+    #[test]
+    fn a_hull_of_two_balls_is_a_capsule_around_their_facets() {
+        let ball = |x: i32| {
+            format!("\tmultmatrix([[1, 0, 0, {x}], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]) {{\n\t\tsphere($fn = 0, $fa = 12, $fs = 2, r = 10);\n\t}}\n")
+        };
+        let s = solid(&format!("hull() {{\n{}{}}}\n", ball(0), ball(40)));
+        assert_eq!(s.primitives.len(), 1);
+        assert!(s.contains(Vec3::new(20.0, 9.0, 0.0)) && !s.contains(Vec3::new(20.0, 10.5, 0.0)));
+        assert!(s.contains(Vec3::new(49.0, 0.0, 0.0)) && !s.contains(Vec3::new(51.0, 0.0, 0.0)));
+        let Shape::Polyhedron(p) = &s.primitives[0].shape else { panic!("a polyhedron") };
+        // Coplanar triangles merged: the two flat caps are one plane each.
+        assert_eq!(p.planes.iter().filter(|q| q.z.abs() > 0.999).count(), 2);
     }
 
     #[test]
