@@ -489,7 +489,7 @@ fn circle(n: usize, r: f32, z: f32) -> Vec<Vec3> {
 /// plane); `None` if the points span no volume.
 fn convex_hull(points: &[Vec3]) -> Option<ConvexPolyhedron> {
     let size = f64::from(bounds_size(points));
-    if points.len() < 4 || !(size > 0.0) {
+    if points.len() < 4 || size.is_nan() || size <= 0.0 {
         return None;
     }
     let coords: Vec<Vec<f64>> = points.iter().map(|p| p.to_array().map(f64::from).to_vec()).collect();
