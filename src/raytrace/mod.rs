@@ -5,10 +5,11 @@
 //! [`bvh`] is the acceleration structure (binned SAH), [`triangle`] the watertight
 //! ray/triangle test; [`TraceScene`] puts a scene's triangles, in world space and
 //! with their item ids, behind one BVH and answers `intersect` (nearest hit) and
-//! `occluded` (anything before a distance?).
+//! `occluded` (anything before a distance?). [`csg`] casts rays at CSG solids.
 
 pub mod bvh;
 pub mod cache;
+pub mod csg;
 pub mod item_buffer;
 pub mod reference;
 pub mod triangle;
