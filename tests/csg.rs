@@ -147,3 +147,55 @@ fn normals_point_out_of_the_solid_and_hole_walls_are_marked_cut() {
     let hit = first_hit(&solid, &down, 0.0, f32::INFINITY).unwrap();
     assert!(near(hit.t, 4.0) && hit.cut && hit.normal.abs_diff_eq(Vec3::Z, 1e-5), "the pocket's floor: {hit:?}");
 }
+
+#[test]
+fn the_scanline_walk_finds_what_a_ray_per_pixel_finds() {
+    use kage::scene::{Camera, Projection};
+    use kage::visibility::csg::scan_solid;
+    let mut rng = StdRng::seed_from_u64(3);
+    let (w, h) = (96u32, 64u32);
+    let (mut pixels, mut covered) = (0, 0);
+    for round in 0..40 {
+        let mut prims = Vec::new();
+        let tree = random_tree(&mut rng, &mut prims, 3);
+        let solid = CsgSolid { primitives: prims, tree: Some(tree) };
+        let dir = Vec3::new(rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0))
+            .normalize_or(Vec3::Z);
+        let projection = if round % 4 == 3 {
+            Projection::Orthographic { height: 6.0 }
+        } else {
+            Projection::Perspective { fov_y_deg: rng.gen_range(30.0..70.0) }
+        };
+        // Some eyes sit inside the solid's reach, so primitives straddle the eye.
+        let distance = if round % 5 == 4 { 1.0 } else { rng.gen_range(5.0..9.0) };
+        let camera = Camera {
+            eye: dir * distance,
+            target: Vec3::ZERO,
+            up: if dir.y.abs() > 0.9 { Vec3::X } else { Vec3::Y },
+            near: 0.05,
+            far: 100.0,
+            projection,
+            shift: glam::Vec2::ZERO,
+        };
+        let scanned = scan_solid(&solid, &camera, w, h);
+        let rays = camera.pixel_rays(glam::Vec2::new(w as f32, h as f32));
+        for y in 0..h {
+            for x in 0..w {
+                let ray = rays.ray(glam::Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
+                let cast = first_hit(&solid, &ray, 0.0, f32::INFINITY);
+                let got = scanned[(y * w + x) as usize];
+                pixels += 1;
+                covered += usize::from(cast.is_some());
+                match (got, cast) {
+                    (None, None) => {}
+                    (Some(a), Some(b)) => {
+                        assert_eq!(a.primitive, b.primitive, "({x}, {y}) round {round}");
+                        assert!((a.t - b.t).abs() <= 1e-4 * b.t.abs().max(1.0), "({x}, {y}): {a:?} vs {b:?}");
+                    }
+                    _ => panic!("({x}, {y}) round {round}: scanline {got:?}, ray {cast:?}"),
+                }
+            }
+        }
+    }
+    assert!(covered * 20 > pixels, "only {covered} of {pixels} pixels show a solid");
+}

@@ -63,7 +63,7 @@ pub fn first_hit(solid: &CsgSolid, ray: &Ray, t_min: f32, t_max: f32) -> Option<
 }
 
 /// The spans of the subtree `tree`, given each leaf's.
-fn combine(tree: &CsgTree, leaf: &impl Fn(usize) -> Vec<Span>) -> Vec<Span> {
+pub fn combine(tree: &CsgTree, leaf: &impl Fn(usize) -> Vec<Span>) -> Vec<Span> {
     match tree {
         CsgTree::Leaf(i) => leaf(*i),
         CsgTree::Union(kids) => kids.iter().map(|k| combine(k, leaf)).reduce(|a, b| union(&a, &b)).unwrap_or_default(),

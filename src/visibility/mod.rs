@@ -5,9 +5,11 @@
 //!
 //! Stages, one file each: [`clip`] (homogeneous clipping), [`scan`] (exact
 //! fixed-point DDA scan conversion, top-left rule) and [`raster`] (projection,
-//! binning into bands and the band-parallel z-buffer).
+//! binning into bands and the band-parallel z-buffer). [`csg`] finds the visible
+//! surfaces of CSG solids by seed 003's scanline walk.
 
 pub mod clip;
+pub mod csg;
 pub mod raster;
 pub mod scan;
 
