@@ -168,3 +168,66 @@ fn faceted_solids_agree_with_openscads_own_mesh_point_by_point() {
         assert!(differ * 1000 <= n as usize, "{name}: {differ} of {n} points differ from OpenSCAD's mesh");
     }
 }
+
+/// The corpus camera of `name` (eye, centre, up, vertical field of view, image
+/// size), from its `.camera.txt` sidecar.
+fn sidecar_camera(dir: &Path, name: &str) -> Option<(kage::scene::Camera, u32, u32)> {
+    let text = std::fs::read_to_string(dir.join(format!("{name}.camera.txt"))).ok()?;
+    let field = |key: &str| -> Option<Vec<f32>> {
+        let line = text.lines().find(|l| l.starts_with(&format!("{key}=")))?;
+        Some(line[key.len() + 1..].split(',').filter_map(|v| v.trim().parse().ok()).collect())
+    };
+    let v3 = |key: &str| field(key).map(|v| Vec3::new(v[0], v[1], v[2]));
+    let size = field("imgsize")?;
+    let camera = kage::scene::Camera {
+        eye: v3("eye")?,
+        target: v3("center")?,
+        up: v3("up")?,
+        near: field("near")?[0],
+        far: field("far")?[0],
+        projection: kage::scene::Projection::Perspective { fov_y_deg: field("fovy_deg")?[0] },
+        shift: glam::Vec2::ZERO,
+    };
+    Some((camera, size[0] as u32, size[1] as u32))
+}
+
+#[test]
+fn scanned_coverage_matches_openscads_mesh_rasterized_by_kage() {
+    // The two models kept in the repository always run; the corpus adds the rest.
+    let local = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/csg");
+    let mut files: Vec<PathBuf> =
+        ["ex001_sphere_minus_cylinders", "ex004_cube_minus_sphere"].map(|n| local.join(format!("{n}.csg"))).to_vec();
+    if let Some((_, corpus_files)) = corpus() {
+        let kept: Vec<_> = files.iter().filter_map(|f| f.file_name().map(ToOwned::to_owned)).collect();
+        files.extend(corpus_files.into_iter().filter(|p| p.file_name().is_none_or(|n| !kept.iter().any(|k| k == n))));
+    }
+    let options = CsgOptions { geometry: Geometry::Faceted, skip_unsupported: false };
+    let mut worst = 1.0f64;
+    for path in files.iter().filter(|p| p.with_extension("stl").exists()) {
+        let dir = path.parent().unwrap_or(Path::new("."));
+        let name = path.file_stem().and_then(|s| s.to_str()).unwrap_or_default();
+        let Some((camera, w, h)) = sidecar_camera(dir, name) else { continue };
+        let solid = load_csg(path, read(path), &options).unwrap().solid;
+        let scanned = kage::visibility::csg::scan_solid(&solid, &camera, w, h);
+        let mut scene = kage::scene::file::scene_for_model(&path.with_extension("stl"), w, h).unwrap();
+        scene.camera = camera;
+        let mut vb = kage::visibility::VisibilityBuffer::new(w, h);
+        kage::visibility::rasterize(&scene, &mut vb);
+        let (mut agree, mut either) = (0usize, 0usize);
+        for (s, item) in scanned.iter().zip(vb.items()) {
+            let (a, b) = (s.is_some(), !item.is_none());
+            agree += usize::from(a == b);
+            either += usize::from(a || b);
+        }
+        let share = agree as f64 / scanned.len() as f64;
+        let of_covered = 1.0 - (scanned.len() - agree) as f64 / either.max(1) as f64;
+        eprintln!(
+            "{name}: coverage agrees on {:.3}% of pixels ({:.2}% of the {either} covered)",
+            share * 100.0,
+            of_covered * 100.0
+        );
+        worst = worst.min(share);
+        assert!(share >= 0.995, "{name}: coverage agrees on only {:.3}% of pixels", share * 100.0);
+    }
+    eprintln!("worst: {:.3}%", worst * 100.0);
+}
