@@ -51,15 +51,59 @@ pub struct Span {
 /// The spans of `ray` inside `solid`, sorted and disjoint (empty if it misses).
 #[must_use]
 pub fn spans(solid: &CsgSolid, ray: &Ray) -> Vec<Span> {
-    let Some(tree) = &solid.tree else { return Vec::new() };
-    let leaf = |i: usize| primitive_span(&solid.primitives[i], i, ray).into_iter().collect();
-    combine(tree, &leaf)
+    CsgCaster::new(solid).spans(ray)
 }
 
 /// The first surface of `solid` along `ray` at `t` in `(t_min, t_max)`.
 #[must_use]
 pub fn first_hit(solid: &CsgSolid, ray: &Ray, t_min: f32, t_max: f32) -> Option<Crossing> {
-    spans(solid, ray).into_iter().flat_map(|s| [s.enter, s.exit]).find(|c| c.t > t_min && c.t < t_max)
+    CsgCaster::new(solid).first_hit(ray, t_min, t_max)
+}
+
+/// A solid ready for many rays: each primitive's inverse transform and normal
+/// matrix computed once.
+#[derive(Debug, Clone)]
+pub struct CsgCaster<'s> {
+    solid: &'s CsgSolid,
+    /// Per primitive: solid space → unit shape, and the normal matrix back.
+    frames: Vec<(Affine3A, Mat3A)>,
+}
+
+impl<'s> CsgCaster<'s> {
+    /// Prepares `solid`.
+    #[must_use]
+    pub fn new(solid: &'s CsgSolid) -> Self {
+        let frames = solid.primitives.iter().map(|p| (p.transform.inverse(), normal_matrix(&p.transform))).collect();
+        CsgCaster { solid, frames }
+    }
+
+    /// The span of `ray` inside primitive `i`, if it meets it.
+    #[must_use]
+    pub fn span(&self, i: usize, ray: &Ray) -> Option<Span> {
+        let (to_unit, to_solid) = &self.frames[i];
+        let (o, d) = (to_unit.transform_point3(ray.origin), to_unit.transform_vector3(ray.dir));
+        let ((t0, n0), (t1, n1)) = unit_span(&self.solid.primitives[i].shape, o, d)?;
+        let crossing = |t: f32, n: Vec3| Crossing { t, normal: (*to_solid * n).normalize_or_zero(), primitive: i, cut: false };
+        Some(Span { enter: crossing(t0, n0), exit: crossing(t1, n1) })
+    }
+
+    /// The spans of `ray` inside the part of the solid `tree` describes.
+    #[must_use]
+    pub fn spans_of(&self, tree: &CsgTree, ray: &Ray) -> Vec<Span> {
+        combine(tree, &|i| self.span(i, ray).into_iter().collect())
+    }
+
+    /// The spans of `ray` inside the solid.
+    #[must_use]
+    pub fn spans(&self, ray: &Ray) -> Vec<Span> {
+        self.solid.tree.as_ref().map_or_else(Vec::new, |t| self.spans_of(t, ray))
+    }
+
+    /// The first surface along `ray` at `t` in `(t_min, t_max)`.
+    #[must_use]
+    pub fn first_hit(&self, ray: &Ray, t_min: f32, t_max: f32) -> Option<Crossing> {
+        self.spans(ray).into_iter().flat_map(|s| [s.enter, s.exit]).find(|c| c.t > t_min && c.t < t_max)
+    }
 }
 
 /// The spans of the subtree `tree`, given each leaf's.
@@ -148,17 +192,19 @@ fn wall(c: Crossing) -> Crossing {
 /// The span of `ray` inside primitive `p` (index `index`), if it meets it.
 #[must_use]
 pub fn primitive_span(p: &Primitive, index: usize, ray: &Ray) -> Option<Span> {
-    let inverse = p.transform.inverse();
-    let (o, d) = (inverse.transform_point3(ray.origin), inverse.transform_vector3(ray.dir));
-    let ((t0, n0), (t1, n1)) = match &p.shape {
-        Shape::Sphere => sphere(o, d)?,
-        Shape::Frustum { bottom, top } => frustum(*bottom, *top, o, d)?,
-        Shape::Polyhedron(poly) => polyhedron(poly, o, d)?,
-    };
-    let to_solid = normal_matrix(&p.transform);
-    let crossing =
-        |t: f32, n: Vec3| Crossing { t, normal: (to_solid * n).normalize_or_zero(), primitive: index, cut: false };
-    Some(Span { enter: crossing(t0, n0), exit: crossing(t1, n1) })
+    let solid = CsgSolid { primitives: vec![p.clone()], tree: None };
+    let mut span = CsgCaster::new(&solid).span(0, ray)?;
+    (span.enter.primitive, span.exit.primitive) = (index, index);
+    Some(span)
+}
+
+/// The span of the ray `o + t·d` inside a unit shape.
+fn unit_span(shape: &Shape, o: Vec3, d: Vec3) -> Option<UnitSpan> {
+    match shape {
+        Shape::Sphere => sphere(o, d),
+        Shape::Frustum { bottom, top } => frustum(*bottom, *top, o, d),
+        Shape::Polyhedron(poly) => polyhedron(poly, o, d),
+    }
 }
 
 /// The inverse transpose of the transform's linear part: carries normals.

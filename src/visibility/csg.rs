@@ -27,7 +27,7 @@
 use glam::{Mat4, Vec2, Vec3, Vec4};
 use rayon::prelude::*;
 
-use crate::raytrace::csg::{combine, primitive_span, Crossing};
+use crate::raytrace::csg::{CsgCaster, Crossing};
 use crate::scene::csg::{CsgSolid, CsgTree, Shape};
 use crate::scene::Camera;
 
@@ -58,6 +58,7 @@ pub fn scan_solid(solid: &CsgSolid, camera: &Camera, width: u32, height: u32) ->
     let mut entry: Vec<usize> = (0..extents.len()).filter(|&i| extents[i].is_some()).collect();
     entry.sort_by_key(|&i| extents[i].map_or(0, |e| e.y0));
     let rays = camera.pixel_rays(Vec2::new(width as f32, height as f32));
+    let caster = CsgCaster::new(solid);
     let band_len = w * BAND_ROWS;
     out.par_chunks_mut(band_len).enumerate().for_each(|(band, rows)| {
         let first = band * BAND_ROWS;
@@ -73,7 +74,7 @@ pub fn scan_solid(solid: &CsgSolid, camera: &Camera, width: u32, height: u32) ->
                 next += 1;
             }
             occupied.retain(|&i| extents[i].is_some_and(|e| e.y1 >= y));
-            scan_row(solid, tree, &extents, &occupied, |x| rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5)), row);
+            scan_row(&caster, tree, &extents, &occupied, |x| rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5)), row);
         }
     });
     out
@@ -82,7 +83,7 @@ pub fn scan_solid(solid: &CsgSolid, camera: &Camera, width: u32, height: u32) ->
 /// One scanline: the x-entry table of the occupants, the x-occupancy list, and
 /// each occupied pixel's surface from the tree cut down to the occupants.
 fn scan_row(
-    solid: &CsgSolid,
+    caster: &CsgCaster,
     tree: &CsgTree,
     extents: &[Option<Extent>],
     occupied: &[usize],
@@ -94,7 +95,7 @@ fn scan_row(
     entry.sort_by_key(|&i| x0(i));
     let (mut next, mut inside): (usize, Vec<usize>) = (0, Vec::new());
     let mut cut: Option<CsgTree> = None;
-    let mut active = vec![false; solid.primitives.len()];
+    let mut active = vec![false; extents.len()];
     for (x, px) in row.iter_mut().enumerate() {
         let mut changed = false;
         while next < entry.len() && x0(entry[next]) <= x as i64 {
@@ -108,8 +109,7 @@ fn scan_row(
         }
         if let Some(tree) = &cut {
             let ray = ray_at(x);
-            let spans = combine(tree, &|i| primitive_span(&solid.primitives[i], i, &ray).into_iter().collect());
-            *px = spans.into_iter().flat_map(|s| [s.enter, s.exit]).find(|c| c.t > 0.0);
+            *px = caster.spans_of(tree, &ray).into_iter().flat_map(|s| [s.enter, s.exit]).find(|c| c.t > 0.0);
         }
         // Primitives whose right end is this pixel leave the x-occupancy list.
         let before = inside.len();

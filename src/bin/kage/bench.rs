@@ -53,6 +53,10 @@ pub struct BenchArgs {
     /// 256-pass supersampled truth on the example scenes and two real models.
     #[arg(long)]
     aa: bool,
+    /// CSG solids: seed 003's scanline visibility against a ray per pixel cast at
+    /// every primitive, on the OpenSCAD corpus (`../shared/assets/csg`).
+    #[arg(long)]
+    csg: bool,
     /// With --aa: write side-by-side crops (aliased | edge pass | truth) here.
     #[arg(long)]
     pub(crate) crops: Option<PathBuf>,
@@ -94,6 +98,9 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     }
     if args.aa {
         return crate::bench_aa::run(args);
+    }
+    if args.csg {
+        return crate::bench_csg::run(args);
     }
     let lp = &args.llvmpipe;
     let mut rows = Vec::new();

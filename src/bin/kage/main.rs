@@ -5,6 +5,7 @@
 
 mod bench;
 mod bench_aa;
+mod bench_csg;
 mod report;
 
 use std::path::{Path, PathBuf};
