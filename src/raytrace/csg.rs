@@ -83,14 +83,26 @@ impl<'s> CsgCaster<'s> {
         let (to_unit, to_solid) = &self.frames[i];
         let (o, d) = (to_unit.transform_point3(ray.origin), to_unit.transform_vector3(ray.dir));
         let ((t0, n0), (t1, n1)) = unit_span(&self.solid.primitives[i].shape, o, d)?;
-        let crossing = |t: f32, n: Vec3| Crossing { t, normal: (*to_solid * n).normalize_or_zero(), primitive: i, cut: false };
+        let crossing =
+            |t: f32, n: Vec3| Crossing { t, normal: (*to_solid * n).normalize_or_zero(), primitive: i, cut: false };
         Some(Span { enter: crossing(t0, n0), exit: crossing(t1, n1) })
     }
 
     /// The spans of `ray` inside the part of the solid `tree` describes.
     #[must_use]
     pub fn spans_of(&self, tree: &CsgTree, ray: &Ray) -> Vec<Span> {
-        combine(tree, &|i| self.span(i, ray).into_iter().collect())
+        let mut scratch = SpanScratch::default();
+        combine(tree, &|i| self.span(i, ray), &mut scratch);
+        scratch.stack
+    }
+
+    /// The first surface of the part `tree` along `ray` at `t > t_min`, with
+    /// buffers reused from pixel to pixel.
+    #[must_use]
+    pub fn first_hit_with(&self, tree: &CsgTree, ray: &Ray, t_min: f32, scratch: &mut SpanScratch) -> Option<Crossing> {
+        scratch.stack.clear();
+        combine(tree, &|i| self.span(i, ray), scratch);
+        scratch.stack.iter().flat_map(|s| [s.enter, s.exit]).find(|c| c.t > t_min)
     }
 
     /// The spans of `ray` inside the solid.
@@ -106,41 +118,80 @@ impl<'s> CsgCaster<'s> {
     }
 }
 
-/// The spans of the subtree `tree`, given each leaf's.
-pub fn combine(tree: &CsgTree, leaf: &impl Fn(usize) -> Vec<Span>) -> Vec<Span> {
+/// Reusable buffers for combining spans along a tree, so a pixel allocates
+/// nothing: each node leaves its spans on top of `stack`.
+#[derive(Debug, Clone, Default)]
+pub struct SpanScratch {
+    stack: Vec<Span>,
+    out: Vec<Span>,
+}
+
+/// The spans of the subtree `tree`, given each leaf's span (at most one: a
+/// primitive is convex), left on top of `scratch.stack`; returns where they start.
+pub fn combine(tree: &CsgTree, leaf: &impl Fn(usize) -> Option<Span>, scratch: &mut SpanScratch) -> usize {
+    let base = scratch.stack.len();
     match tree {
-        CsgTree::Leaf(i) => leaf(*i),
-        CsgTree::Union(kids) => kids.iter().map(|k| combine(k, leaf)).reduce(|a, b| union(&a, &b)).unwrap_or_default(),
-        CsgTree::Intersection(kids) => {
-            kids.iter().map(|k| combine(k, leaf)).reduce(|a, b| intersection(&a, &b)).unwrap_or_default()
-        }
-        CsgTree::Difference(a, cutters) => {
-            cutters.iter().fold(combine(a, leaf), |acc, c| difference(&acc, &combine(c, leaf)))
-        }
-    }
-}
-
-/// Sorted disjoint spans covering `a ∪ b`.
-fn union(a: &[Span], b: &[Span]) -> Vec<Span> {
-    let mut all: Vec<Span> = a.iter().chain(b).copied().collect();
-    all.sort_by(|x, y| x.enter.t.total_cmp(&y.enter.t));
-    let mut out: Vec<Span> = Vec::with_capacity(all.len());
-    for s in all {
-        match out.last_mut() {
-            Some(last) if s.enter.t <= last.exit.t => {
-                if s.exit.t > last.exit.t {
-                    last.exit = s.exit;
-                }
+        CsgTree::Leaf(i) => scratch.stack.extend(leaf(*i)),
+        CsgTree::Union(kids) => {
+            for k in kids {
+                combine(k, leaf, scratch);
             }
-            _ => out.push(s),
+            union(&mut scratch.stack, base);
+        }
+        CsgTree::Intersection(kids) | CsgTree::Difference(_, kids) => {
+            let (first, rest) = match tree {
+                CsgTree::Difference(a, _) => (&**a, &kids[..]),
+                _ => match kids.split_first() {
+                    Some((f, r)) => (f, r),
+                    None => return base,
+                },
+            };
+            combine(first, leaf, scratch);
+            let cut = matches!(tree, CsgTree::Difference(..));
+            for k in rest {
+                if scratch.stack.len() == base {
+                    break; // nothing left to intersect with or cut from
+                }
+                let mid = combine(k, leaf, scratch);
+                let SpanScratch { stack, out } = scratch;
+                out.clear();
+                let (a, b) = stack[base..].split_at(mid - base);
+                if cut {
+                    difference(a, b, out);
+                } else {
+                    intersection(a, b, out);
+                }
+                stack.truncate(base);
+                stack.extend_from_slice(out);
+            }
         }
     }
-    out
+    base
 }
 
-/// Sorted disjoint spans covering `a ∩ b`.
-fn intersection(a: &[Span], b: &[Span]) -> Vec<Span> {
-    let mut out = Vec::new();
+/// Merges the spans on `stack` from `base` into sorted disjoint spans covering
+/// their union.
+fn union(stack: &mut Vec<Span>, base: usize) {
+    stack[base..].sort_unstable_by(|x, y| x.enter.t.total_cmp(&y.enter.t));
+    let mut last = base;
+    for k in base..stack.len() {
+        let s = stack[k];
+        if k > base && s.enter.t <= stack[last].exit.t {
+            if s.exit.t > stack[last].exit.t {
+                stack[last].exit = s.exit;
+            }
+        } else {
+            if k > base {
+                last += 1;
+            }
+            stack[last] = s;
+        }
+    }
+    stack.truncate(last + 1);
+}
+
+/// Sorted disjoint spans covering `a ∩ b`, into `out`.
+fn intersection(a: &[Span], b: &[Span], out: &mut Vec<Span>) {
     for x in a {
         for y in b {
             let enter = if x.enter.t >= y.enter.t { x.enter } else { y.enter };
@@ -150,38 +201,32 @@ fn intersection(a: &[Span], b: &[Span]) -> Vec<Span> {
             }
         }
     }
-    out.sort_by(|p, q| p.enter.t.total_cmp(&q.enter.t));
-    out
+    out.sort_unstable_by(|p, q| p.enter.t.total_cmp(&q.enter.t));
 }
 
-/// Sorted disjoint spans covering `a` minus `b`, `b` widened by [`TIE`]: where
-/// the ray leaves a cutter it enters the remaining solid through the cutter's
-/// wall, whose outward normal (for the solid) is the cutter's, reversed.
-fn difference(a: &[Span], b: &[Span]) -> Vec<Span> {
-    let mut out = Vec::new();
+/// Sorted disjoint spans covering `a` minus `b`, `b` widened by [`TIE`], into
+/// `out`: where the ray leaves a cutter it enters the remaining solid through the
+/// cutter's wall, whose outward normal (for the solid) is the cutter's, reversed.
+fn difference(a: &[Span], b: &[Span], out: &mut Vec<Span>) {
     for x in a {
-        let mut pieces = vec![*x];
+        // `b` is sorted and disjoint: walk it once, cutting `x` from the left.
+        let mut rest = Some(*x);
         for y in b {
+            let Some(p) = rest else { break };
             let (lo, hi) = (y.enter.t - TIE * y.enter.t.abs().max(1.0), y.exit.t + TIE * y.exit.t.abs().max(1.0));
-            pieces = pieces
-                .into_iter()
-                .flat_map(|p| {
-                    let mut keep = Vec::with_capacity(2);
-                    if p.enter.t < lo {
-                        let exit = if p.exit.t <= lo { p.exit } else { wall(y.enter) };
-                        keep.push(Span { enter: p.enter, exit });
-                    }
-                    if p.exit.t > hi {
-                        let enter = if p.enter.t >= hi { p.enter } else { wall(y.exit) };
-                        keep.push(Span { enter, exit: p.exit });
-                    }
-                    keep
-                })
-                .collect();
+            if hi <= p.enter.t {
+                continue;
+            }
+            if lo >= p.exit.t {
+                break;
+            }
+            if p.enter.t < lo {
+                out.push(Span { enter: p.enter, exit: wall(y.enter) });
+            }
+            rest = (p.exit.t > hi).then(|| Span { enter: wall(y.exit), exit: p.exit });
         }
-        out.extend(pieces);
+        out.extend(rest);
     }
-    out
 }
 
 /// A cutter's crossing seen as the wall of the hole it makes.

@@ -27,7 +27,7 @@
 use glam::{Mat4, Vec2, Vec3, Vec4};
 use rayon::prelude::*;
 
-use crate::raytrace::csg::{CsgCaster, Crossing};
+use crate::raytrace::csg::{Crossing, CsgCaster, SpanScratch};
 use crate::scene::csg::{CsgSolid, CsgTree, Shape};
 use crate::scene::Camera;
 
@@ -96,6 +96,7 @@ fn scan_row(
     let (mut next, mut inside): (usize, Vec<usize>) = (0, Vec::new());
     let mut cut: Option<CsgTree> = None;
     let mut active = vec![false; extents.len()];
+    let mut scratch = SpanScratch::default();
     for (x, px) in row.iter_mut().enumerate() {
         let mut changed = false;
         while next < entry.len() && x0(entry[next]) <= x as i64 {
@@ -109,7 +110,7 @@ fn scan_row(
         }
         if let Some(tree) = &cut {
             let ray = ray_at(x);
-            *px = caster.spans_of(tree, &ray).into_iter().flat_map(|s| [s.enter, s.exit]).find(|c| c.t > 0.0);
+            *px = caster.first_hit_with(tree, &ray, 0.0, &mut scratch);
         }
         // Primitives whose right end is this pixel leave the x-occupancy list.
         let before = inside.len();
