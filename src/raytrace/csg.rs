@@ -77,6 +77,12 @@ impl<'s> CsgCaster<'s> {
         CsgCaster { solid, frames }
     }
 
+    /// How many primitives the solid has.
+    #[must_use]
+    pub fn primitives(&self) -> usize {
+        self.frames.len()
+    }
+
     /// The span of `ray` inside primitive `i`, if it meets it.
     #[must_use]
     pub fn span(&self, i: usize, ray: &Ray) -> Option<Span> {

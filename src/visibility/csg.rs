@@ -28,7 +28,8 @@ use glam::{Mat4, Vec2, Vec3, Vec4};
 use rayon::prelude::*;
 
 use crate::raytrace::csg::{Crossing, CsgCaster, SpanScratch};
-use crate::scene::csg::{CsgSolid, CsgTree, Shape};
+use crate::scene::camera::PixelRays;
+use crate::scene::csg::{CsgSolid, CsgTree, Primitive, Shape};
 use crate::scene::Camera;
 
 /// Rows scanned by one worker in turn.
@@ -52,12 +53,12 @@ pub fn scan_solid(solid: &CsgSolid, camera: &Camera, width: u32, height: u32) ->
     let mut out = vec![None; w * h];
     let Some(tree) = &solid.tree else { return out };
     let vp = camera.view_projection(width as f32 / height as f32);
-    let extents: Vec<Option<Extent>> =
-        solid.primitives.iter().map(|p| extent(&corners(&p.shape, &p.transform), vp, width, height)).collect();
+    let rays = camera.pixel_rays(Vec2::new(width as f32, height as f32));
+    let outlines: Vec<Option<Outline>> = solid.primitives.iter().map(|p| Outline::new(p, vp, &rays)).collect();
+    let extents: Vec<Option<Extent>> = outlines.iter().map(|o| o.as_ref().map(|o| o.rows)).collect();
     // The y-entry table: primitives by top scanline.
     let mut entry: Vec<usize> = (0..extents.len()).filter(|&i| extents[i].is_some()).collect();
     entry.sort_by_key(|&i| extents[i].map_or(0, |e| e.y0));
-    let rays = camera.pixel_rays(Vec2::new(width as f32, height as f32));
     let caster = CsgCaster::new(solid);
     let band_len = w * BAND_ROWS;
     out.par_chunks_mut(band_len).enumerate().for_each(|(band, rows)| {
@@ -74,7 +75,10 @@ pub fn scan_solid(solid: &CsgSolid, camera: &Camera, width: u32, height: u32) ->
                 next += 1;
             }
             occupied.retain(|&i| extents[i].is_some_and(|e| e.y1 >= y));
-            scan_row(&caster, tree, &extents, &occupied, |x| rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5)), row);
+            // Procedure 2: each occupant's left and right ends on this scanline.
+            let ends: Vec<(usize, i64, i64)> =
+                occupied.iter().filter_map(|&i| outlines[i].as_ref()?.columns(y).map(|(a, b)| (i, a, b))).collect();
+            scan_row(&caster, tree, &ends, |x| rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5)), row);
         }
     });
     out
@@ -85,23 +89,22 @@ pub fn scan_solid(solid: &CsgSolid, camera: &Camera, width: u32, height: u32) ->
 fn scan_row(
     caster: &CsgCaster,
     tree: &CsgTree,
-    extents: &[Option<Extent>],
-    occupied: &[usize],
+    ends: &[(usize, i64, i64)],
     ray_at: impl Fn(usize) -> crate::scene::Ray,
     row: &mut [Option<Crossing>],
 ) {
-    let x0 = |i: usize| extents[i].map_or(0, |e| e.x0);
-    let mut entry: Vec<usize> = occupied.to_vec();
-    entry.sort_by_key(|&i| x0(i));
-    let (mut next, mut inside): (usize, Vec<usize>) = (0, Vec::new());
+    // The x-entry table: occupants by left end.
+    let mut entry: Vec<(usize, i64, i64)> = ends.to_vec();
+    entry.sort_by_key(|e| e.1);
+    let (mut next, mut inside): (usize, Vec<(usize, i64, i64)>) = (0, Vec::new());
     let mut cut: Option<CsgTree> = None;
-    let mut active = vec![false; extents.len()];
+    let mut active = vec![false; caster.primitives()];
     let mut scratch = SpanScratch::default();
     for (x, px) in row.iter_mut().enumerate() {
         let mut changed = false;
-        while next < entry.len() && x0(entry[next]) <= x as i64 {
+        while next < entry.len() && entry[next].1 <= x as i64 {
             inside.push(entry[next]);
-            active[entry[next]] = true;
+            active[entry[next].0] = true;
             next += 1;
             changed = true;
         }
@@ -114,8 +117,8 @@ fn scan_row(
         }
         // Primitives whose right end is this pixel leave the x-occupancy list.
         let before = inside.len();
-        inside.retain(|&i| {
-            let stays = extents[i].is_some_and(|e| e.x1 > x as i64);
+        inside.retain(|&(i, _, right)| {
+            let stays = right > x as i64;
             active[i] = stays;
             stays
         });
@@ -123,6 +126,115 @@ fn scan_row(
             cut = tree.restricted(&|i| active[i]);
         }
     }
+}
+
+/// Where a primitive shows on the screen: its scanlines (the y-entry table's
+/// key; procedure 1) and, per scanline, its left and right ends (procedure 2).
+#[derive(Debug, Clone, Copy)]
+struct Outline {
+    /// Rows, and the columns of its bounding box.
+    rows: Extent,
+    /// An ellipsoid under a perspective camera, its ends exact.
+    ellipsoid: Option<EllipsoidView>,
+}
+
+/// An ellipsoid `{M·q + c : |q| ≤ 1}` seen from an eye outside it, in the unit
+/// sphere's space: the eye `o`, `k = |o|² − 1 > 0`, and the camera's ray
+/// vectors carried there by `M⁻¹` (a pixel's ray direction is
+/// `forward + u·right + v·up`, u and v its NDC coordinates).
+#[derive(Debug, Clone, Copy)]
+struct EllipsoidView {
+    o: Vec3,
+    k: f32,
+    forward: Vec3,
+    right: Vec3,
+    up: Vec3,
+    width: f32,
+    height: f32,
+}
+
+impl Outline {
+    fn new(p: &Primitive, vp: Mat4, rays: &PixelRays) -> Option<Outline> {
+        let (width, height) = (rays.size.x as u32, rays.size.y as u32);
+        let mut rows = extent(&corners(&p.shape, &p.transform), vp, width, height)?;
+        let ellipsoid = (p.shape == Shape::Sphere && !rays.ortho)
+            .then(|| {
+                let to_unit = p.transform.inverse();
+                let o = to_unit.transform_point3(rays.origin);
+                let carry = |v: Vec3| to_unit.transform_vector3(v);
+                let (k, size) = (o.length_squared() - 1.0, rays.size);
+                (k > 1e-4).then_some(EllipsoidView {
+                    o,
+                    k,
+                    forward: carry(rays.forward),
+                    right: carry(rays.right),
+                    up: carry(rays.up),
+                    width: size.x,
+                    height: size.y,
+                })
+            })
+            .flatten();
+        if let Some(e) = &ellipsoid {
+            // Procedure 1: the scanline planes through the eye tangent to the
+            // ellipsoid bound its rows.
+            let (v0, v1) = e.rows()?;
+            let row = |v: f64| (1.0 - v) * f64::from(e.height) * 0.5 - 0.5;
+            rows.y0 = rows.y0.max((row(v1) - 1e-3).ceil() as i64);
+            rows.y1 = rows.y1.min((row(v0) + 1e-3).floor() as i64);
+            if rows.y0 > rows.y1 {
+                return None;
+            }
+        }
+        Some(Outline { rows, ellipsoid })
+    }
+
+    /// The columns the primitive may cover on row `y`.
+    fn columns(&self, y: i64) -> Option<(i64, i64)> {
+        let (x0, x1) = (self.rows.x0, self.rows.x1);
+        let Some(e) = &self.ellipsoid else { return Some((x0, x1)) };
+        let (u0, u1) = e.columns(1.0 - 2.0 * (y as f32 + 0.5) / e.height)?;
+        let column = |u: f64| (u + 1.0) * f64::from(e.width) * 0.5 - 0.5;
+        let (a, b) = (x0.max((column(u0) - 1e-3).ceil() as i64), x1.min((column(u1) + 1e-3).floor() as i64));
+        (a <= b).then_some((a, b))
+    }
+}
+
+impl EllipsoidView {
+    /// Procedure 1: the `v` for which the scanline plane through the eye, spanned
+    /// by `right` and `forward + v·up`, meets the unit sphere: with normal
+    /// `n(v) = n0 + v·n1`, where `|n|² − (n·o)² ≥ 0`.
+    fn rows(&self) -> Option<(f64, f64)> {
+        let (o, right) = (self.o.as_dvec3(), self.right.as_dvec3());
+        let (n0, n1) = (right.cross(self.forward.as_dvec3()), right.cross(self.up.as_dvec3()));
+        let (p, q) = (n0.dot(o), n1.dot(o));
+        inside_quadratic(n1.dot(n1) - q * q, n0.dot(n1) - p * q, n0.dot(n0) - p * p)
+    }
+
+    /// Procedure 2 on the scanline at NDC height `v`: the `u` for which the line
+    /// through the eye along `d(u) = d0 + u·right` meets the unit sphere, where
+    /// `(o·d)² − k·|d|² ≥ 0`.
+    fn columns(&self, v: f32) -> Option<(f64, f64)> {
+        let (o, k) = (self.o.as_dvec3(), f64::from(self.k));
+        let (d0, d1) = ((self.forward + self.up * v).as_dvec3(), self.right.as_dvec3());
+        let (p, q) = (o.dot(d0), o.dot(d1));
+        inside_quadratic(q * q - k * d1.dot(d1), p * q - k * d0.dot(d1), p * p - k * d0.dot(d0))
+    }
+}
+
+/// Where `a·s² + 2·b·s + c ≥ 0`: the interval between the roots when `a < 0`;
+/// `(−∞, ∞)` (no narrowing) when the set is not one bounded interval; `None`
+/// when it is empty.
+fn inside_quadratic(a: f64, b: f64, c: f64) -> Option<(f64, f64)> {
+    if a >= 0.0 {
+        return Some((f64::NEG_INFINITY, f64::INFINITY));
+    }
+    let disc = b * b - a * c;
+    if disc < 0.0 {
+        return None;
+    }
+    let r = disc.sqrt();
+    let (s0, s1) = ((-b + r) / a, (-b - r) / a);
+    Some((s0.min(s1), s0.max(s1)))
 }
 
 /// Corners of a box around the primitive's unit shape, in solid space.
