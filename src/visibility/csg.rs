@@ -17,12 +17,14 @@
 //! instead of the visible-segment list. Intervals are combined along the cut-down
 //! tree, so a difference costs no more than an intersection.
 //!
-//! What is not the paper's yet: a primitive's extent on the screen is the
-//! projection of its bounding corners (exact for polyhedra, conservative for
-//! spheres and frustums, and the whole screen when a corner lies behind the eye),
-//! the same on every scanline it spans, rather than the paper's tangent-plane
-//! procedures 1 and 2. A too-wide extent only costs time: where a primitive does
-//! not reach, its interval is empty.
+//! Extents (procedures 1 and 2): an ellipsoid seen in perspective from outside
+//! gets the paper's exact rows (scanline planes through the eye tangent to it)
+//! and, per scanline, exact left and right ends (lines through the eye tangent to
+//! it), both closed-form quadratics ([`EllipsoidView`]). Every other primitive —
+//! frustums and polyhedra for now, and everything under an orthographic camera —
+//! uses the projection of its bounding corners, the same columns on every row it
+//! spans (the whole screen when a corner lies behind the eye). A too-wide extent
+//! only costs time: where a primitive does not reach, its interval is empty.
 
 use glam::{Mat4, Vec2, Vec3, Vec4};
 use rayon::prelude::*;
@@ -34,6 +36,10 @@ use crate::scene::Camera;
 
 /// Rows scanned by one worker in turn.
 const BAND_ROWS: usize = 16;
+
+/// How far (in pixels) an exact extent is widened, so that rounding never drops
+/// a pixel whose ray grazes the primitive.
+const ROUNDING_PX: f64 = 1e-3;
 
 /// Pixels a primitive may cover: rows `y0..=y1`, columns `x0..=x1`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -179,8 +185,8 @@ impl Outline {
             // ellipsoid bound its rows.
             let (v0, v1) = e.rows()?;
             let row = |v: f64| (1.0 - v) * f64::from(e.height) * 0.5 - 0.5;
-            rows.y0 = rows.y0.max((row(v1) - 1e-3).ceil() as i64);
-            rows.y1 = rows.y1.min((row(v0) + 1e-3).floor() as i64);
+            rows.y0 = rows.y0.max((row(v1) - ROUNDING_PX).ceil() as i64);
+            rows.y1 = rows.y1.min((row(v0) + ROUNDING_PX).floor() as i64);
             if rows.y0 > rows.y1 {
                 return None;
             }
@@ -194,7 +200,8 @@ impl Outline {
         let Some(e) = &self.ellipsoid else { return Some((x0, x1)) };
         let (u0, u1) = e.columns(1.0 - 2.0 * (y as f32 + 0.5) / e.height)?;
         let column = |u: f64| (u + 1.0) * f64::from(e.width) * 0.5 - 0.5;
-        let (a, b) = (x0.max((column(u0) - 1e-3).ceil() as i64), x1.min((column(u1) + 1e-3).floor() as i64));
+        let (a, b) =
+            (x0.max((column(u0) - ROUNDING_PX).ceil() as i64), x1.min((column(u1) + ROUNDING_PX).floor() as i64));
         (a <= b).then_some((a, b))
     }
 }
@@ -272,10 +279,9 @@ fn extent(points: &[Vec3], vp: Mat4, width: u32, height: u32) -> Option<Extent> 
         let px = glam::DVec2::new((ndc.x * 0.5 + 0.5) * w, (0.5 - ndc.y * 0.5) * h);
         (lo, hi) = (lo.min(px), hi.max(px));
     }
-    // Pixel x is covered when its centre x + ½ lies in [lo, hi]; a hair wider so
-    // rounding never drops a pixel the primitive reaches.
-    let first = |v: f64| (v - 0.5 - 1e-3).ceil() as i64;
-    let last = |v: f64| (v - 0.5 + 1e-3).floor() as i64;
+    // Pixel x is covered when its centre x + ½ lies in [lo, hi].
+    let first = |v: f64| (v - 0.5 - ROUNDING_PX).ceil() as i64;
+    let last = |v: f64| (v - 0.5 + ROUNDING_PX).floor() as i64;
     let e = Extent {
         x0: first(lo.x).max(0),
         x1: last(hi.x).min(i64::from(width) - 1),
