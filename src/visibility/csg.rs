@@ -20,7 +20,7 @@
 //! Extents (procedures 1 and 2): an ellipsoid seen in perspective from outside
 //! gets the paper's exact rows (scanline planes through the eye tangent to it)
 //! and, per scanline, exact left and right ends (lines through the eye tangent to
-//! it), both closed-form quadratics ([`EllipsoidView`]). Every other primitive —
+//! it), both closed-form quadratics. Every other primitive —
 //! frustums and polyhedra for now, and everything under an orthographic camera —
 //! uses the projection of its bounding corners, the same columns on every row it
 //! spans (the whole screen when a corner lies behind the eye). A too-wide extent
