@@ -169,26 +169,9 @@ fn faceted_solids_agree_with_openscads_own_mesh_point_by_point() {
     }
 }
 
-/// The corpus camera of `name` (eye, centre, up, vertical field of view, image
-/// size), from its `.camera.txt` sidecar.
+/// The corpus camera of `name` and its image size, from its `.camera.txt` sidecar.
 fn sidecar_camera(dir: &Path, name: &str) -> Option<(kage::scene::Camera, u32, u32)> {
-    let text = std::fs::read_to_string(dir.join(format!("{name}.camera.txt"))).ok()?;
-    let field = |key: &str| -> Option<Vec<f32>> {
-        let line = text.lines().find(|l| l.starts_with(&format!("{key}=")))?;
-        Some(line[key.len() + 1..].split(',').filter_map(|v| v.trim().parse().ok()).collect())
-    };
-    let v3 = |key: &str| field(key).map(|v| Vec3::new(v[0], v[1], v[2]));
-    let size = field("imgsize")?;
-    let camera = kage::scene::Camera {
-        eye: v3("eye")?,
-        target: v3("center")?,
-        up: v3("up")?,
-        near: field("near")?[0],
-        far: field("far")?[0],
-        projection: kage::scene::Projection::Perspective { fov_y_deg: field("fovy_deg")?[0] },
-        shift: glam::Vec2::ZERO,
-    };
-    Some((camera, size[0] as u32, size[1] as u32))
+    kage::scene::load::openscad::sidecar_camera(&std::fs::read_to_string(dir.join(format!("{name}.camera.txt"))).ok()?)
 }
 
 #[test]
@@ -206,7 +189,7 @@ fn scanned_coverage_matches_openscads_mesh_rasterized_by_kage() {
     for path in files.iter().filter(|p| p.with_extension("stl").exists()) {
         let dir = path.parent().unwrap_or(Path::new("."));
         let name = path.file_stem().and_then(|s| s.to_str()).unwrap_or_default();
-        let Some((camera, w, h)) = sidecar_camera(dir, name) else { continue };
+        let (camera, w, h) = sidecar_camera(dir, name).unwrap_or_else(|| panic!("{name}: no camera sidecar"));
         let solid = load_csg(path, read(path), &options).unwrap().solid;
         let scanned = kage::visibility::csg::scan_solid(&solid, &camera, w, h);
         let mut scene = kage::scene::file::scene_for_model(&path.with_extension("stl"), w, h).unwrap();

@@ -92,20 +92,7 @@ fn naive(solid: &CsgSolid, camera: &Camera, w: u32, h: u32) -> usize {
 /// The camera of the corpus sidecar `NAME.camera.txt`.
 fn corpus_camera(dir: &Path, name: &str) -> Option<Camera> {
     let text = std::fs::read_to_string(dir.join(format!("{name}.camera.txt"))).ok()?;
-    let field = |key: &str| -> Option<Vec<f32>> {
-        let line = text.lines().find(|l| l.starts_with(&format!("{key}=")))?;
-        Some(line[key.len() + 1..].split(',').filter_map(|v| v.trim().parse().ok()).collect())
-    };
-    let v3 = |key: &str| field(key).filter(|v| v.len() == 3).map(|v| Vec3::new(v[0], v[1], v[2]));
-    Some(Camera {
-        eye: v3("eye")?,
-        target: v3("center")?,
-        up: v3("up")?,
-        near: *field("near")?.first()?,
-        far: *field("far")?.first()?,
-        projection: Projection::Perspective { fov_y_deg: *field("fovy_deg")?.first()? },
-        shift: Vec2::ZERO,
-    })
+    kage::scene::load::openscad::sidecar_camera(&text).map(|(camera, _, _)| camera)
 }
 
 /// A camera 35° above the model, as OpenSCAD's default view, when no sidecar exists.

@@ -36,6 +36,7 @@ use glam::{Affine3A, DVec3, Mat4, Vec3, Vec4};
 
 use crate::error::{Error, Result, SourceLocation};
 use crate::scene::csg::{ConvexPolyhedron, CsgSolid, CsgTree, Primitive, Shape};
+use crate::scene::{Camera, Projection};
 use syntax::{parse_csg, CsgNode, CsgValue};
 
 /// How spheres and cylinders become primitives.
@@ -64,6 +65,31 @@ pub struct LoadedCsg {
     pub solid: CsgSolid,
     /// What was skipped or changed, one line each, with its location.
     pub warnings: Vec<String>,
+}
+
+/// The camera of an OpenSCAD camera sidecar (the corpus's `NAME.camera.txt`:
+/// `key=value` lines with `eye`, `center`, `up`, `fovy_deg`, `near`, `far` and
+/// `imgsize`), with the image size it was made for; `None` if a field is
+/// missing or malformed.
+#[must_use]
+pub fn sidecar_camera(text: &str) -> Option<(Camera, u32, u32)> {
+    let field = |key: &str| -> Option<Vec<f32>> {
+        let line = text.lines().find_map(|l| l.strip_prefix(key)?.strip_prefix('='))?;
+        line.split(',').map(|v| v.trim().parse().ok()).collect()
+    };
+    let v3 = |key: &str| field(key).filter(|v| v.len() == 3).map(|v| Vec3::new(v[0], v[1], v[2]));
+    let scalar = |key: &str| field(key).and_then(|v| v.first().copied());
+    let size = field("imgsize").filter(|v| v.len() == 2)?;
+    let camera = Camera {
+        eye: v3("eye")?,
+        target: v3("center")?,
+        up: v3("up")?,
+        near: scalar("near")?,
+        far: scalar("far")?,
+        projection: Projection::Perspective { fov_y_deg: scalar("fovy_deg")? },
+        shift: glam::Vec2::ZERO,
+    };
+    Some((camera, size[0] as u32, size[1] as u32))
 }
 
 /// `$fn` at or below which spheres and cylinders stay faceted in exact mode.
