@@ -87,11 +87,7 @@ impl<'s> CsgCaster<'s> {
     #[must_use]
     pub fn span(&self, i: usize, ray: &Ray) -> Option<Span> {
         let (to_unit, to_solid) = &self.frames[i];
-        let (o, d) = (to_unit.transform_point3(ray.origin), to_unit.transform_vector3(ray.dir));
-        let ((t0, n0), (t1, n1)) = unit_span(&self.solid.primitives[i].shape, o, d)?;
-        let crossing =
-            |t: f32, n: Vec3| Crossing { t, normal: (*to_solid * n).normalize_or_zero(), primitive: i, cut: false };
-        Some(Span { enter: crossing(t0, n0), exit: crossing(t1, n1) })
+        span_in(&self.solid.primitives[i].shape, to_unit, to_solid, i, ray)
     }
 
     /// The spans of `ray` inside the part of the solid `tree` describes.
@@ -243,10 +239,17 @@ fn wall(c: Crossing) -> Crossing {
 /// The span of `ray` inside primitive `p` (index `index`), if it meets it.
 #[must_use]
 pub fn primitive_span(p: &Primitive, index: usize, ray: &Ray) -> Option<Span> {
-    let solid = CsgSolid { primitives: vec![p.clone()], tree: None };
-    let mut span = CsgCaster::new(&solid).span(0, ray)?;
-    (span.enter.primitive, span.exit.primitive) = (index, index);
-    Some(span)
+    span_in(&p.shape, &p.transform.inverse(), &normal_matrix(&p.transform), index, ray)
+}
+
+/// The span of `ray` inside primitive `index`, whose unit `shape` the ray reaches
+/// through `to_unit`; normals go back through `to_solid`.
+fn span_in(shape: &Shape, to_unit: &Affine3A, to_solid: &Mat3A, index: usize, ray: &Ray) -> Option<Span> {
+    let (o, d) = (to_unit.transform_point3(ray.origin), to_unit.transform_vector3(ray.dir));
+    let ((t0, n0), (t1, n1)) = unit_span(shape, o, d)?;
+    let crossing =
+        |t: f32, n: Vec3| Crossing { t, normal: (*to_solid * n).normalize_or_zero(), primitive: index, cut: false };
+    Some(Span { enter: crossing(t0, n0), exit: crossing(t1, n1) })
 }
 
 /// The span of the ray `o + t·d` inside a unit shape.
