@@ -61,29 +61,30 @@ pub fn scan_solid(solid: &CsgSolid, camera: &Camera, width: u32, height: u32) ->
     let vp = camera.view_projection(width as f32 / height as f32);
     let rays = camera.pixel_rays(Vec2::new(width as f32, height as f32));
     let outlines: Vec<Option<Outline>> = solid.primitives.iter().map(|p| Outline::new(p, vp, &rays)).collect();
-    let extents: Vec<Option<Extent>> = outlines.iter().map(|o| o.as_ref().map(|o| o.rows)).collect();
-    // The y-entry table: primitives by top scanline.
-    let mut entry: Vec<usize> = (0..extents.len()).filter(|&i| extents[i].is_some()).collect();
-    entry.sort_by_key(|&i| extents[i].map_or(0, |e| e.y0));
+    // The y-entry table: the primitives that show at all, by top scanline.
+    let mut entry: Vec<(usize, Extent)> =
+        outlines.iter().enumerate().filter_map(|(i, o)| o.as_ref().map(|o| (i, o.rows))).collect();
+    entry.sort_by_key(|(_, e)| e.y0);
     let caster = CsgCaster::new(solid);
     let band_len = w * BAND_ROWS;
     out.par_chunks_mut(band_len).enumerate().for_each(|(band, rows)| {
-        let first = band * BAND_ROWS;
+        let first = (band * BAND_ROWS) as i64;
         // The y-occupancy list as the band's first scanline finds it, then kept
         // row by row.
-        let mut next = entry.partition_point(|&i| extents[i].map_or(0, |e| e.y0) <= first as i64);
-        let mut occupied: Vec<usize> =
-            entry[..next].iter().copied().filter(|&i| extents[i].is_some_and(|e| e.y1 >= first as i64)).collect();
+        let mut next = entry.partition_point(|(_, e)| e.y0 <= first);
+        let mut occupied: Vec<(usize, Extent)> = entry[..next].iter().copied().filter(|(_, e)| e.y1 >= first).collect();
         for (dy, row) in rows.chunks_mut(w).enumerate() {
-            let y = (first + dy) as i64;
-            while next < entry.len() && extents[entry[next]].is_some_and(|e| e.y0 <= y) {
+            let y = first + dy as i64;
+            while next < entry.len() && entry[next].1.y0 <= y {
                 occupied.push(entry[next]);
                 next += 1;
             }
-            occupied.retain(|&i| extents[i].is_some_and(|e| e.y1 >= y));
+            occupied.retain(|(_, e)| e.y1 >= y);
             // Procedure 2: each occupant's left and right ends on this scanline.
-            let ends: Vec<(usize, i64, i64)> =
-                occupied.iter().filter_map(|&i| outlines[i].as_ref()?.columns(y).map(|(a, b)| (i, a, b))).collect();
+            let ends: Vec<(usize, i64, i64)> = occupied
+                .iter()
+                .filter_map(|&(i, _)| outlines[i].as_ref()?.columns(y).map(|(a, b)| (i, a, b)))
+                .collect();
             scan_row(&caster, tree, &ends, |x| rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5)), row);
         }
     });

@@ -6,11 +6,11 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Instant;
 
-use glam::{Vec2, Vec3};
+use glam::Vec2;
 use kage::raytrace::csg::CsgCaster;
 use kage::scene::csg::CsgSolid;
 use kage::scene::load::openscad::{load_csg, CsgOptions, Geometry};
-use kage::scene::{Camera, Projection};
+use kage::scene::Camera;
 use kage::visibility::csg::scan_solid;
 use miette::{miette, Result};
 use rayon::prelude::*;
@@ -36,7 +36,10 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         let text: Arc<str> = Arc::from(std::fs::read_to_string(path).map_err(|e| miette!("{e}"))?);
         let options = CsgOptions { geometry: Geometry::Exact, skip_unsupported: true };
         let solid = load_csg(path, text, &options).map_err(|e| miette!("{e}"))?.solid;
-        let camera = corpus_camera(&dir, name).unwrap_or_else(|| default_camera(&solid));
+        let Some(camera) = corpus_camera(&dir, name) else {
+            eprintln!("skipped {name}: no camera sidecar");
+            continue;
+        };
         let mut times = Vec::new();
         let mut covered = 0;
         for _ in 0..args.frames.max(1) {
@@ -93,17 +96,4 @@ fn naive(solid: &CsgSolid, camera: &Camera, w: u32, h: u32) -> usize {
 fn corpus_camera(dir: &Path, name: &str) -> Option<Camera> {
     let text = std::fs::read_to_string(dir.join(format!("{name}.camera.txt"))).ok()?;
     kage::scene::load::openscad::sidecar_camera(&text).map(|(camera, _, _)| camera)
-}
-
-/// A camera 35° above the model, as OpenSCAD's default view, when no sidecar exists.
-fn default_camera(_solid: &CsgSolid) -> Camera {
-    Camera {
-        eye: Vec3::new(60.0, -120.0, 90.0),
-        target: Vec3::ZERO,
-        up: Vec3::Z,
-        near: 1.0,
-        far: 10_000.0,
-        projection: Projection::Perspective { fov_y_deg: 22.5 },
-        shift: Vec2::ZERO,
-    }
 }
