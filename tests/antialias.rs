@@ -70,13 +70,8 @@ fn mirror_scene() -> Scene {
     let floor = Affine3A::from_scale_rotation_translation(Vec3::splat(10.0), Quat::IDENTITY, Vec3::new(0.0, -0.6, 0.0));
     let ball = Affine3A::from_scale_rotation_translation(Vec3::splat(0.4), Quat::IDENTITY, Vec3::new(1.1, 0.0, 0.5));
     scene.objects[0].transform = Affine3A::from_scale(Vec3::splat(0.6));
-    scene.objects.push(Object { name: "floor".into(), mesh: Arc::new(shapes::plane()), transform: floor, material: 1 });
-    scene.objects.push(Object {
-        name: "glow".into(),
-        mesh: Arc::new(shapes::sphere(24)),
-        transform: ball,
-        material: 2,
-    });
+    scene.objects.push(Object::mesh("floor", Arc::new(shapes::plane()), floor, 1));
+    scene.objects.push(Object::mesh("glow", Arc::new(shapes::sphere(24)), ball, 2));
     scene
 }
 

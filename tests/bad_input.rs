@@ -116,7 +116,7 @@ fn bad_meshes_are_errors_or_warned_repairs() {
     assert!(e.contains("garbage.glb"), "{e}");
     let unknown = write(&dir, "model.ply", "ply");
     let e = scene_for_model(&unknown, 64, 64).unwrap_err().to_string();
-    assert!(e.contains("unknown mesh format '.ply'"), "{e}");
+    assert!(e.contains("unknown model format '.ply'"), "{e}");
 }
 
 #[test]

@@ -182,7 +182,9 @@ fn the_scanline_walk_finds_what_a_ray_per_pixel_finds() {
         for y in 0..h {
             for x in 0..w {
                 let ray = rays.ray(glam::Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
-                let cast = first_hit(&solid, &ray, 0.0, f32::INFINITY);
+                // The walk clips at the near plane, as the polygon pass does.
+                let near = camera.distance_at_depth(&ray, 1.0);
+                let cast = first_hit(&solid, &ray, near, f32::INFINITY);
                 let got = scanned[(y * w + x) as usize];
                 pixels += 1;
                 covered += usize::from(cast.is_some());

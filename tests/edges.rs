@@ -53,12 +53,7 @@ fn flat_scene(shapes: &[FlatShape], background: Vec3) -> Scene {
     for (i, (points, tris, z, rgb)) in shapes.iter().enumerate() {
         let positions = points.iter().map(|p| Vec3::new(p.x, SIZE as f32 - p.y, *z)).collect();
         scene.materials.push(flat(*rgb));
-        scene.objects.push(Object {
-            name: format!("shape {i}"),
-            mesh: mesh(positions, tris.clone()),
-            transform: Affine3A::IDENTITY,
-            material: i,
-        });
+        scene.objects.push(Object::mesh(format!("shape {i}"), mesh(positions, tris.clone()), Affine3A::IDENTITY, i));
     }
     scene
 }

@@ -90,7 +90,7 @@ fn roofed(ambient: f32) -> Scene {
     scene.materials[0].ke = Vec3::new(0.01, 0.02, 0.03);
     let roof = Affine3A::from_scale_rotation_translation(Vec3::splat(1.0), glam::Quat::IDENTITY, Vec3::Y);
     scene.materials.push(Material { two_sided: true, ..Material::default() });
-    scene.objects.push(Object { name: "roof".into(), mesh: Arc::new(shapes::plane()), transform: roof, material: 1 });
+    scene.objects.push(Object::mesh("roof", Arc::new(shapes::plane()), roof, 1));
     scene.lights = vec![Light {
         kind: LightKind::Directional { direction: Vec3::new(0.8, -1.0, 0.05).normalize() },
         ambient,

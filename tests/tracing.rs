@@ -64,8 +64,8 @@ fn mirror_scene() -> Scene {
         lights: Vec::new(),
         materials: vec![mirror, red],
         objects: vec![
-            Object { name: "mirror".into(), mesh: Arc::new(shapes::plane()), transform: plane, material: 0 },
-            Object { name: "ball".into(), mesh: Arc::new(shapes::sphere(32)), transform: ball, material: 1 },
+            Object::mesh("mirror", Arc::new(shapes::plane()), plane, 0),
+            Object::mesh("ball", Arc::new(shapes::sphere(32)), ball, 1),
         ],
         warnings: Vec::new(),
     }
@@ -155,8 +155,8 @@ fn slab_scene(deg: f32, t: f32) -> Scene {
     };
     scene.materials = vec![glass, line];
     scene.objects = vec![
-        Object { name: "slab".into(), mesh: Arc::new(shapes::cube()), transform: slab, material: 0 },
-        Object { name: "line".into(), mesh: Arc::new(shapes::cube()), transform: bar, material: 1 },
+        Object::mesh("slab", Arc::new(shapes::cube()), slab, 0),
+        Object::mesh("line", Arc::new(shapes::cube()), bar, 1),
     ];
     scene
 }

@@ -21,7 +21,7 @@ fn glow(e: Vec3, alpha: f32) -> Material {
 fn quad(name: &str, z: f32, size: f32, tilt: f32, material: usize) -> Object {
     let turn = Quat::from_rotation_y(tilt.to_radians()) * Quat::from_rotation_x(90f32.to_radians());
     let transform = Affine3A::from_scale_rotation_translation(Vec3::splat(size), turn, Vec3::new(0.0, 0.0, z));
-    Object { name: name.into(), mesh: Arc::new(shapes::plane()), transform, material }
+    Object::mesh(name, Arc::new(shapes::plane()), transform, material)
 }
 
 /// An orthographic view down −z of a red opaque wall at z = −2 and the given quads.

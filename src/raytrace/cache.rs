@@ -3,21 +3,19 @@
 //! of geometry (a mesh or an object's transform) needs a new BVH. Jittered passes of
 //! one frame (seed 002 §4) share it too.
 //!
-//! The key holds a clone of every object's `Arc<Mesh>`: while the cache holds it, no
-//! one can change that mesh in place (`Arc::get_mut` fails and `Arc::make_mut`
+//! The key holds a clone of every object's body (its `Arc<Mesh>` or
+//! `Arc<CsgSolid>`): while the cache holds it, no one can change that geometry in place (`Arc::get_mut` fails and `Arc::make_mut`
 //! copies), so pointer equality is a sound test of "the same geometry".
-
-use std::sync::Arc;
 
 use glam::Affine3A;
 
 use super::TraceScene;
-use crate::scene::{Mesh, Scene};
+use crate::scene::{Body, Scene};
 
 /// The BVH of the last scene traced, and what it was built from.
 #[derive(Debug, Default)]
 pub struct TraceCache {
-    key: Vec<(Arc<Mesh>, Affine3A)>,
+    key: Vec<(Body, Affine3A)>,
     trace: Option<TraceScene>,
     builds: usize,
 }
@@ -27,9 +25,9 @@ impl TraceCache {
     /// from the last call's.
     pub fn get(&mut self, scene: &Scene) -> &TraceScene {
         let same = self.key.len() == scene.objects.len()
-            && self.key.iter().zip(&scene.objects).all(|((m, t), o)| Arc::ptr_eq(m, &o.mesh) && *t == o.transform);
+            && self.key.iter().zip(&scene.objects).all(|((b, t), o)| b.same(&o.body) && *t == o.transform);
         if !same || self.trace.is_none() {
-            self.key = scene.objects.iter().map(|o| (Arc::clone(&o.mesh), o.transform)).collect();
+            self.key = scene.objects.iter().map(|o| (o.body.clone(), o.transform)).collect();
             self.builds += 1;
             self.trace = None;
         }
@@ -61,7 +59,10 @@ mod tests {
         scene.objects[0].transform = Affine3A::from_translation(glam::Vec3::X) * scene.objects[0].transform;
         cache.get(&scene);
         assert_eq!(cache.builds(), 2, "a moved object needs a new BVH");
-        let mesh = Arc::make_mut(&mut scene.objects[0].mesh);
+        let crate::scene::Body::Mesh(mesh) = &mut scene.objects[0].body else {
+            panic!("the demo's objects are meshes")
+        };
+        let mesh = std::sync::Arc::make_mut(mesh);
         mesh.triangles.truncate(1);
         let m = cache.get(&scene).len();
         assert_eq!(cache.builds(), 3, "an edited mesh needs a new BVH");

@@ -63,18 +63,30 @@ pub fn first_hit(solid: &CsgSolid, ray: &Ray, t_min: f32, t_max: f32) -> Option<
 /// A solid ready for many rays: each primitive's inverse transform and normal
 /// matrix computed once.
 #[derive(Debug, Clone)]
-pub struct CsgCaster<'s> {
-    solid: &'s CsgSolid,
+pub struct CsgCaster {
+    solid: CsgSolid,
     /// Per primitive: solid space → unit shape, and the normal matrix back.
     frames: Vec<(Affine3A, Mat3A)>,
 }
 
-impl<'s> CsgCaster<'s> {
+impl CsgCaster {
+    /// Prepares a copy of `solid`.
+    #[must_use]
+    pub fn new(solid: &CsgSolid) -> Self {
+        Self::from_solid(solid.clone())
+    }
+
     /// Prepares `solid`.
     #[must_use]
-    pub fn new(solid: &'s CsgSolid) -> Self {
+    pub fn from_solid(solid: CsgSolid) -> Self {
         let frames = solid.primitives.iter().map(|p| (p.transform.inverse(), normal_matrix(&p.transform))).collect();
         CsgCaster { solid, frames }
+    }
+
+    /// The solid.
+    #[must_use]
+    pub fn solid(&self) -> &CsgSolid {
+        &self.solid
     }
 
     /// How many primitives the solid has.

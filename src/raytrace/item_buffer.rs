@@ -41,11 +41,11 @@ pub fn add_traced(
         .map(|(y, (out, items))| {
             let mut traced = 0;
             for (x, (px, &item)) in out.iter_mut().zip(items).enumerate() {
-                if item.is_none() || !scene.materials[scene.objects[item.object as usize].material].traces() {
+                if item.is_none() || !scene.materials[scene.item_material(item)].traces() {
                     continue;
                 }
                 let ray = rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
-                let s = frames.prepare(scene, item).surface(&ray);
+                let s = frames.surface_at(scene, vb, x as u32, y as u32, &ray);
                 *px += tracer.bounces(&ray, &s, depth);
                 traced += 1;
             }

@@ -17,9 +17,10 @@ pub mod triangle;
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
-use crate::scene::{Ray, Scene};
+use crate::scene::{CsgSolid, Ray, Scene};
 use crate::visibility::ItemId;
 use bvh::{Aabb, Bvh};
+use csg::CsgCaster;
 use triangle::ShearedRay;
 
 pub use cache::TraceCache;
@@ -29,37 +30,85 @@ pub use cache::TraceCache;
 pub struct Hit {
     /// Distance along the ray, in units of its direction's length.
     pub t: f32,
-    /// What was hit.
+    /// What was hit: a triangle, or a solid's primitive.
     pub item: ItemId,
-    /// Barycentric weights of the triangle's second and third vertices.
+    /// Barycentric weights of the triangle's second and third vertices (zero
+    /// for a solid).
     pub barycentrics: Vec2,
+    /// A solid's unit outward normal there (world space; zero for a triangle).
+    pub normal: Vec3,
 }
 
-/// A scene's triangles in world space behind a BVH.
+/// A scene's triangles and CSG solids in world space behind one BVH: a
+/// triangle is a leaf, and so is a whole solid, by its bounds (its rays are
+/// cast by [`csg::CsgCaster`]).
 #[derive(Debug, Clone)]
 pub struct TraceScene {
+    /// Per leaf, in leaf order; a solid's leaf holds a triangle that no ray hits.
     triangles: Vec<[Vec3; 3]>,
     items: Vec<ItemId>,
+    /// The solids' leaves, sorted, with their object and caster.
+    solids: Vec<(u32, u32, CsgCaster)>,
     bvh: Bvh,
 }
 
 impl TraceScene {
-    /// Transforms every object's triangles to world space and builds the BVH.
+    /// Transforms every object's triangles and solids to world space and builds
+    /// the BVH.
     #[must_use]
     pub fn new(scene: &Scene) -> TraceScene {
+        let (triangles, items) = Self::mesh_triangles(scene);
+        let solids: Vec<(u32, CsgSolid, Aabb)> = scene
+            .objects
+            .iter()
+            .enumerate()
+            .filter_map(|(o, obj)| {
+                let solid = obj.solid()?.transformed(&obj.transform);
+                let (lo, hi) = solid.bounds()?;
+                Some((o as u32, solid, Aabb::around(&[lo, hi])))
+            })
+            .collect();
+        if solids.is_empty() {
+            return TraceScene::from_triangles(triangles, items);
+        }
+        // Leaves past the triangles are solids.
+        let n = triangles.len();
+        let mut bounds: Vec<Aabb> = triangles.par_iter().map(|t| Aabb::around(t)).collect();
+        bounds.extend(solids.iter().map(|s| s.2));
+        let mut bvh = Bvh::build(&bounds);
+        let order = bvh.renumber();
+        let mut solids: Vec<Option<(u32, CsgSolid)>> = solids.into_iter().map(|(o, s, _)| Some((o, s))).collect();
+        let mut trace = TraceScene { triangles: Vec::new(), items: Vec::new(), solids: Vec::new(), bvh };
+        for (leaf, &i) in order.iter().enumerate() {
+            let i = i as usize;
+            if i < n {
+                trace.triangles.push(triangles[i]);
+                trace.items.push(items[i]);
+            } else {
+                let (object, solid) = solids[i - n].take().expect("each leaf once");
+                trace.triangles.push([Vec3::ZERO; 3]);
+                trace.items.push(ItemId::primitive_of(object, 0));
+                trace.solids.push((leaf as u32, object, CsgCaster::from_solid(solid)));
+            }
+        }
+        trace
+    }
+
+    /// The mesh objects' triangles in world space, with their ids.
+    fn mesh_triangles(scene: &Scene) -> (Vec<[Vec3; 3]>, Vec<ItemId>) {
         let (triangles, items): (Vec<[Vec3; 3]>, Vec<ItemId>) = scene
             .objects
             .par_iter()
             .enumerate()
-            .flat_map_iter(|(o, obj)| {
-                let m = obj.transform;
-                obj.mesh.triangles.iter().enumerate().map(move |(t, tri)| {
-                    let p = tri.map(|i| m.transform_point3(obj.mesh.positions[i as usize]));
+            .filter_map(|(o, obj)| Some((o, obj.triangles()?, obj.transform)))
+            .flat_map_iter(|(o, mesh, m)| {
+                mesh.triangles.iter().enumerate().map(move |(t, tri)| {
+                    let p = tri.map(|i| m.transform_point3(mesh.positions[i as usize]));
                     (p, ItemId { object: o as u32, triangle: t as u32 })
                 })
             })
             .unzip();
-        TraceScene::from_triangles(triangles, items)
+        (triangles, items)
     }
 
     /// A trace scene over explicit world-space triangles and their ids.
@@ -70,36 +119,54 @@ impl TraceScene {
         let order = bvh.renumber();
         let triangles = order.iter().map(|&i| triangles[i as usize]).collect();
         let items = order.iter().map(|&i| items[i as usize]).collect();
-        TraceScene { triangles, items, bvh }
+        TraceScene { triangles, items, solids: Vec::new(), bvh }
+    }
+
+    /// The solid at leaf `i`, if that leaf is one.
+    fn solid_at(&self, i: u32) -> Option<&(u32, u32, CsgCaster)> {
+        if self.solids.is_empty() {
+            return None;
+        }
+        self.solids.binary_search_by_key(&i, |s| s.0).ok().map(|k| &self.solids[k])
     }
 
     /// The nearest hit along `ray` in `(0, t_max)`.
     #[must_use]
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
         let sr = ShearedRay::new(ray);
-        let mut bary = Vec2::ZERO;
+        let mut hit = Hit { t: 0.0, item: ItemId::NONE, barycentrics: Vec2::ZERO, normal: Vec3::ZERO };
         let (i, t) = self.bvh.intersect(ray, t_max, |i, t_max| {
+            if let Some((_, object, caster)) = self.solid_at(i) {
+                let c = caster.first_hit(ray, 0.0, t_max)?;
+                hit.item = ItemId::primitive_of(*object, c.primitive as u32);
+                hit.normal = c.normal;
+                return Some(c.t);
+            }
             let (t, b) = sr.intersect(&self.triangles[i as usize], 0.0, t_max)?;
-            bary = b;
+            (hit.item, hit.barycentrics, hit.normal) = (self.items[i as usize], b, Vec3::ZERO);
             Some(t)
         })?;
-        Some(Hit { t, item: self.items[i as usize], barycentrics: bary })
+        debug_assert_eq!(hit.item.object, self.items[i as usize].object);
+        Some(Hit { t, ..hit })
     }
 
     /// Whether anything lies along `ray` in `(0, t_max)` (shadow rays).
     #[must_use]
     pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
         let sr = ShearedRay::new(ray);
-        self.bvh.occluded(ray, t_max, |i, t_max| sr.intersect(&self.triangles[i as usize], 0.0, t_max).map(|h| h.0))
+        self.bvh.occluded(ray, t_max, |i, t_max| match self.solid_at(i) {
+            Some((_, _, caster)) => caster.first_hit(ray, 0.0, t_max).map(|c| c.t),
+            None => sr.intersect(&self.triangles[i as usize], 0.0, t_max).map(|h| h.0),
+        })
     }
 
-    /// Number of triangles.
+    /// Number of leaves (triangles and solids).
     #[must_use]
     pub fn len(&self) -> usize {
         self.triangles.len()
     }
 
-    /// Whether there are no triangles.
+    /// Whether there are no leaves.
     #[must_use]
     pub fn is_empty(&self) -> bool {
         self.triangles.is_empty()

@@ -115,7 +115,11 @@ impl<'a> Tracer<'a> {
 
     fn through_layers(&self, ray: &Ray, depth: u32, layers: u32) -> Vec3 {
         let Some(hit) = self.trace.intersect(ray, f32::INFINITY) else { return self.scene.background_along(ray.dir) };
-        let s = self.frames.prepare(self.scene, hit.item).surface(ray);
+        let s = match hit.item.primitive() {
+            // A solid: its tangent plane at the hit, which the ray meets there.
+            Some(_) => ObjectFrames::tangent(self.scene, hit.item, ray.at(hit.t), hit.normal).surface(ray),
+            None => self.frames.prepare(self.scene, hit.item).surface(ray),
+        };
         let material = &self.scene.materials[s.material];
         let behind = || {
             let next = Ray { origin: s.position + ray.dir * self.epsilon, dir: ray.dir };

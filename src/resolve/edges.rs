@@ -227,7 +227,7 @@ pub struct EdgeCache {
 impl EdgeCache {
     /// The edges of every object's mesh (index = object), found for the meshes not
     /// seen last frame; entries of meshes no longer drawn are dropped.
-    fn edges_of(&mut self, scene: &Scene, crease_deg: f32) -> Vec<Arc<MeshEdges>> {
+    fn edges_of(&mut self, scene: &Scene, crease_deg: f32) -> Vec<Option<Arc<MeshEdges>>> {
         if self.crease_deg != crease_deg {
             self.meshes.clear();
             self.crease_deg = crease_deg;
@@ -237,13 +237,14 @@ impl EdgeCache {
             .objects
             .iter()
             .map(|o| {
-                let key = Arc::as_ptr(&o.mesh) as usize;
+                let mesh = o.triangles()?;
+                let key = Arc::as_ptr(mesh) as usize;
                 let entry = kept.entry(key).or_insert_with(|| {
                     self.meshes
                         .remove(&key)
-                        .unwrap_or_else(|| (Arc::clone(&o.mesh), Arc::new(MeshEdges::new(&o.mesh, crease_deg))))
+                        .unwrap_or_else(|| (Arc::clone(mesh), Arc::new(MeshEdges::new(mesh, crease_deg))))
                 });
-                Arc::clone(&entry.1)
+                Some(Arc::clone(&entry.1))
             })
             .collect();
         self.meshes = kept;
@@ -294,7 +295,12 @@ pub fn antialias_edges(
 }
 
 /// Every blend, in scene order (object, then edge).
-fn find_blends(scene: &Scene, vb: &VisibilityBuffer, edges: &[Arc<MeshEdges>], mode: EdgeMode) -> Vec<EdgeBlend> {
+fn find_blends(
+    scene: &Scene,
+    vb: &VisibilityBuffer,
+    edges: &[Option<Arc<MeshEdges>>],
+    mode: EdgeMode,
+) -> Vec<EdgeBlend> {
     let camera = &scene.camera;
     let (w, h) = (vb.width(), vb.height());
     let view_proj = camera.view_projection(w as f32 / h as f32);
@@ -302,6 +308,8 @@ fn find_blends(scene: &Scene, vb: &VisibilityBuffer, edges: &[Arc<MeshEdges>], m
     let screen = Screen { width: w as f64, height: h as f64, far: f64::from(camera.far_plane_factor()) };
     let mut blends = Vec::new();
     for (object, (o, mesh_edges)) in scene.objects.iter().zip(edges).enumerate() {
+        // Solids' outlines are not mesh edges: they keep their aliased edges.
+        let (Some(mesh), Some(mesh_edges)) = (o.triangles(), mesh_edges.as_ref()) else { continue };
         let material = &scene.materials[o.material];
         if material.translucent() {
             continue; // blended over the opaque frame later; its edges are not walked
@@ -315,19 +323,19 @@ fn find_blends(scene: &Scene, vb: &VisibilityBuffer, edges: &[Arc<MeshEdges>], m
             .filter(|(_, e)| selected(e, mesh_edges, &facing, material.two_sided, mode.selection))
             .filter_map(|(k, e)| {
                 let source = ((object as u64) << 32) | k as u64;
-                let [a, b] = e.v.map(|i| to_clip * o.mesh.positions[i as usize].as_dvec3().extend(1.0));
+                let [a, b] = e.v.map(|i| to_clip * mesh.positions[i as usize].as_dvec3().extend(1.0));
                 let (a, b) = screen.clip_and_project(a, b)?;
                 let mut out = Vec::new();
-                let near = mesh_edges.neighbourhood(&o.mesh, e);
+                let near = mesh_edges.neighbourhood(mesh, e);
                 let visit = |c: (u32, u32), other: (u32, u32), alpha, point: glam::DVec3| {
                     // A pixel shows the edge's own surface if its triangle touches the
                     // faces beside the edge, or if its plane passes near the edge point
                     // (a fine mesh: the triangle at the pixel is a few rings away).
                     let own = |item: ItemId| {
                         item.object == object as u32
-                            && (mesh_edges.touches(&o.mesh, item.triangle, &near)
+                            && (mesh_edges.touches(mesh, item.triangle, &near)
                                 || screen
-                                    .plane_depth(&to_clip, &o.mesh, item.triangle, point)
+                                    .plane_depth(&to_clip, mesh, item.triangle, point)
                                     .is_some_and(|z| depth.close(z, point.z)))
                     };
                     if let Some(blend) = depth_tested(vb, &own, c, other, alpha, point.z as f32, mode.filter) {

@@ -143,6 +143,17 @@ impl Camera {
         PixelRays { origin, right, up, forward, size, ortho }
     }
 
+    /// How far along `ray` (a ray of this camera, unit direction) the point of
+    /// reversed depth `depth` lies (see [`crate::visibility::VisibilityBuffer`]).
+    #[must_use]
+    pub fn distance_at_depth(&self, ray: &Ray, depth: f32) -> f32 {
+        let along_view = match self.projection {
+            Projection::Perspective { .. } => self.near / depth,
+            Projection::Orthographic { .. } => self.far - depth * (self.far - self.near),
+        };
+        along_view / ray.dir.dot((self.target - self.eye).normalize()).max(1e-6)
+    }
+
     /// Checks the camera can form an image; returns what is wrong otherwise.
     pub fn validate(&self) -> Result<(), String> {
         let finite = self.eye.is_finite() && self.target.is_finite() && self.up.is_finite();
@@ -168,6 +179,14 @@ impl Camera {
             }
             _ => Ok(()),
         }
+    }
+}
+
+impl Ray {
+    /// The point at distance `t` along the ray.
+    #[must_use]
+    pub fn at(&self, t: f32) -> Vec3 {
+        self.origin + self.dir * t
     }
 }
 
@@ -235,6 +254,8 @@ mod tests {
                 let back = Vec2::new((ndc.x + 1.0) * 0.5 * size.x, (1.0 - ndc.y) * 0.5 * size.y);
                 assert!((back - pix).length() < 1e-3, "{p:?} {pix} -> {back}");
                 assert!(ndc.z > 0.0 && ndc.z <= 1.0, "depth {}", ndc.z);
+                let t = c.distance_at_depth(&r, ndc.z);
+                assert!((t - 3.0).abs() < 1e-3, "{p:?} {pix}: depth {} back to distance {t}, not 3", ndc.z);
             }
         }
     }

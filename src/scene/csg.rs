@@ -75,6 +75,32 @@ pub struct Primitive {
 }
 
 impl Primitive {
+    /// Corners of a box around the primitive (its unit shape's box, or a
+    /// polyhedron's own corners), in solid space.
+    #[must_use]
+    pub fn corners(&self) -> Vec<Vec3> {
+        let unit_box = |z0: f32| -> Vec<Vec3> {
+            (0..8)
+                .map(|i| {
+                    let pick = |bit: usize, lo: f32| if i >> bit & 1 == 0 { lo } else { 1.0 };
+                    Vec3::new(pick(0, -1.0), pick(1, -1.0), pick(2, z0))
+                })
+                .collect()
+        };
+        let local = match &self.shape {
+            Shape::Sphere => unit_box(-1.0),
+            Shape::Frustum { .. } => unit_box(0.0),
+            Shape::Polyhedron(p) => p.vertices.clone(),
+        };
+        local.into_iter().map(|c| self.transform.transform_point3(c)).collect()
+    }
+
+    /// Axis-aligned bounds `(min, max)` in solid space.
+    #[must_use]
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        self.corners().into_iter().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), c| (lo.min(c), hi.max(c)))
+    }
+
     /// Whether the point `p` (solid space) lies inside the primitive or on its
     /// surface.
     #[must_use]
@@ -145,6 +171,24 @@ impl CsgTree {
         }
     }
 
+    /// Axis-aligned bounds of the tree given each primitive's: unions join
+    /// them, intersections overlap them, a difference keeps its first part's.
+    /// `None` when the bounds show the tree empty.
+    #[must_use]
+    pub fn bounds(&self, leaf: &impl Fn(usize) -> (Vec3, Vec3)) -> Option<(Vec3, Vec3)> {
+        let join = |a: (Vec3, Vec3), b: (Vec3, Vec3)| (a.0.min(b.0), a.1.max(b.1));
+        let meet = |a: (Vec3, Vec3), b: (Vec3, Vec3)| (a.0.max(b.0), a.1.min(b.1));
+        let b = match self {
+            CsgTree::Leaf(i) => leaf(*i),
+            CsgTree::Union(kids) => kids.iter().filter_map(|k| k.bounds(leaf)).reduce(join)?,
+            CsgTree::Intersection(kids) => {
+                kids.iter().map(|k| k.bounds(leaf)).collect::<Option<Vec<_>>>()?.into_iter().reduce(meet)?
+            }
+            CsgTree::Difference(a, _) => a.bounds(leaf)?,
+        };
+        (b.0.cmple(b.1).all()).then_some(b)
+    }
+
     /// The primitives the tree uses, in order.
     #[must_use]
     pub fn leaves(&self) -> Vec<usize> {
@@ -171,5 +215,20 @@ impl CsgSolid {
     #[must_use]
     pub fn contains(&self, p: Vec3) -> bool {
         self.tree.as_ref().is_some_and(|t| t.contains(&|i| self.primitives[i].contains(p)))
+    }
+
+    /// The solid moved by `m` (each primitive's transform composed after it).
+    #[must_use]
+    pub fn transformed(&self, m: &Affine3A) -> CsgSolid {
+        let mut out = self.clone();
+        out.primitives.iter_mut().for_each(|p| p.transform = *m * p.transform);
+        out
+    }
+
+    /// Axis-aligned bounds `(min, max)` of the solid (`None` if it is empty).
+    #[must_use]
+    pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
+        let boxes: Vec<(Vec3, Vec3)> = self.primitives.iter().map(Primitive::bounds).collect();
+        self.tree.as_ref()?.bounds(&|i| boxes[i])
     }
 }

@@ -14,10 +14,11 @@ use glam::{Affine3A, EulerRot, Quat, Vec3};
 use serde::Deserialize;
 use toml::Spanned;
 
+use super::load::openscad::CsgOptions;
 use super::load::{self, AssetSource, LoadedModel};
 use super::mesh::shapes;
 use super::{
-    framing, Camera, Environment, Falloff, Light, LightKind, Material, Object, Projection, Scene, ShadowMethod,
+    framing, Body, Camera, Environment, Falloff, Light, LightKind, Material, Object, Projection, Scene, ShadowMethod,
     ShadowSettings, Texture,
 };
 use crate::error::{Error, Result, SourceLocation};
@@ -826,8 +827,51 @@ pub fn add_model(scene: &mut Scene, model: &LoadedModel, label: &str, transform:
             scene.materials.len() - 1
         });
         let name = if model.parts.len() > 1 { format!("{label}/{}", part.name) } else { label.to_string() };
-        scene.objects.push(Object { name, mesh: part.mesh.clone(), transform: transform * part.transform, material });
+        scene.objects.push(Object::mesh(name, part.mesh.clone(), transform * part.transform, material));
     }
+    for part in &model.solids {
+        let materials: Arc<[usize]> = match material {
+            Some(m) => vec![m; part.materials.len()].into(),
+            None => {
+                let base = scene.materials.len();
+                scene.materials.extend(part.palette.iter().cloned());
+                part.materials.iter().map(|m| base + m).collect()
+            }
+        };
+        // Objects need a material of their own even when no primitive shows one.
+        let own = material.or(materials.first().copied()).unwrap_or_else(|| {
+            scene.materials.push(Material::default());
+            scene.materials.len() - 1
+        });
+        let name = if model.parts.len() + model.solids.len() > 1 {
+            format!("{label}/{}", part.name)
+        } else {
+            label.to_string()
+        };
+        let body = Body::Solid { solid: Arc::clone(&part.solid), materials };
+        scene.objects.push(Object { name, body, transform, material: own });
+    }
+}
+
+/// A matte ground under `bounds` (z up), four times their size, unless the
+/// camera looks at it from below.
+fn add_ground(scene: &mut Scene, (lo, hi): (Vec3, Vec3)) {
+    if scene.camera.eye.z <= lo.z {
+        return;
+    }
+    let size = 4.0 * (hi - lo).max_element().max(1e-3);
+    let centre = Vec3::new((lo.x + hi.x) * 0.5, (lo.y + hi.y) * 0.5, lo.z);
+    let placed = Affine3A::from_translation(centre)
+        * Affine3A::from_rotation_x(std::f32::consts::FRAC_PI_2)
+        * Affine3A::from_scale(Vec3::splat(size));
+    scene.materials.push(Material {
+        name: "ground".into(),
+        ka: Vec3::splat(0.6),
+        kd: Vec3::splat(0.6),
+        ks: Vec3::ZERO,
+        ..Material::default()
+    });
+    scene.objects.push(Object::mesh("ground", Arc::new(shapes::plane()), placed, scene.materials.len() - 1));
 }
 
 /// Reads and builds a scene file from disk.
@@ -839,10 +883,19 @@ pub fn load_scene(path: &Path) -> Result<Scene> {
 
 /// A scene showing one model file, framed automatically.
 pub fn scene_for_model(path: &Path, width: u32, height: u32) -> Result<Scene> {
+    scene_for_model_with(path, width, height, &CsgOptions::default())
+}
+
+/// A scene showing one model file, framed automatically, reading `.csg` files
+/// with `csg`. An OpenSCAD model (z up) is seen from its camera sidecar or
+/// OpenSCAD's default view, lit from above by the same rig as other models
+/// turned z-up, and stands on a ground that catches its shadows (left out
+/// when the camera looks from below it).
+pub fn scene_for_model_with(path: &Path, width: u32, height: u32, csg: &CsgOptions) -> Result<Scene> {
     let base = path.parent().unwrap_or(Path::new(".")).to_path_buf();
     let fs = load::FileSystem { base };
     let name = Path::new(path.file_name().unwrap_or(path.as_os_str()));
-    let model = load::model(name, &fs)?;
+    let model = load::model_with(name, &fs, csg)?;
     let mut scene = Scene {
         width,
         height,
@@ -859,8 +912,18 @@ pub fn scene_for_model(path: &Path, width: u32, height: u32) -> Result<Scene> {
         translucency: Default::default(),
     };
     add_model(&mut scene, &model, &path.display().to_string(), Affine3A::IDENTITY, None);
-    let (camera, lights) = framing(scene.bounds().expect("a model has parts"), width as f32 / height as f32);
+    let bounds = scene.bounds().ok_or_else(|| Error::Scene(format!("{}: the model is empty", path.display())))?;
+    let (camera, mut lights) = framing(bounds, width as f32 / height as f32);
     scene.camera = model.camera.unwrap_or(camera);
+    if !model.solids.is_empty() {
+        // OpenSCAD models stand on the xy-plane, z up: turn the y-up rig.
+        let centre = (bounds.0 + bounds.1) * 0.5;
+        let z_up = Affine3A::from_translation(centre)
+            * Affine3A::from_rotation_x(std::f32::consts::FRAC_PI_2)
+            * Affine3A::from_translation(-centre);
+        lights.iter_mut().for_each(|l| l.kind = l.kind.transformed(&z_up));
+        add_ground(&mut scene, bounds);
+    }
     scene.lights = if model.lights.is_empty() { lights } else { model.lights.clone() };
     if !model.lights.is_empty() {
         // The file's lights are in physical units (candela, lux): expose for them.

@@ -29,6 +29,21 @@ pub enum LightKind {
     },
 }
 
+impl LightKind {
+    /// The same light moved by the rigid motion `m`.
+    #[must_use]
+    pub fn transformed(&self, m: &glam::Affine3A) -> LightKind {
+        let dir = |d: Vec3| m.transform_vector3(d).normalize_or(d);
+        match *self {
+            LightKind::Point { position } => LightKind::Point { position: m.transform_point3(position) },
+            LightKind::Spot { position, direction, inner, outer } => {
+                LightKind::Spot { position: m.transform_point3(position), direction: dir(direction), inner, outer }
+            }
+            LightKind::Directional { direction } => LightKind::Directional { direction: dir(direction) },
+        }
+    }
+}
+
 /// How a positional light dims with distance.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Falloff {

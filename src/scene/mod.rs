@@ -18,6 +18,7 @@ use std::sync::Arc;
 use glam::{Affine3A, Vec3};
 
 pub use camera::{Camera, Projection, Ray};
+pub use csg::CsgSolid;
 pub use environment::Environment;
 pub use light::{Falloff, Light, LightKind, ShadowMethod, ShadowSettings};
 pub use material::{ComponentMaps, Material};
@@ -31,17 +32,82 @@ pub const MAX_IMAGE_SIDE: u32 = 16_384;
 /// Largest image kage accepts, in pixels (a 16k × 8k frame).
 pub const MAX_IMAGE_PIXELS: u64 = 16_384 * 8_192;
 
-/// A mesh placed in the world with a material.
+/// What an object is made of.
+#[derive(Debug, Clone)]
+pub enum Body {
+    /// A triangle mesh, drawn by the polygon pass.
+    Mesh(Arc<Mesh>),
+    /// A CSG solid (seed 003), drawn by the scanline walk of
+    /// [`crate::visibility::csg`]; its pixels' item ids name the primitive.
+    Solid {
+        /// The solid, in object space.
+        solid: Arc<CsgSolid>,
+        /// Per primitive: index into [`Scene::materials`].
+        materials: Arc<[usize]>,
+    },
+}
+
+impl Body {
+    /// Whether both are the same shared geometry (the same `Arc`; a solid's
+    /// materials too).
+    #[must_use]
+    pub fn same(&self, other: &Body) -> bool {
+        match (self, other) {
+            (Body::Mesh(a), Body::Mesh(b)) => Arc::ptr_eq(a, b),
+            (Body::Solid { solid: a, materials: m }, Body::Solid { solid: b, materials: n }) => {
+                Arc::ptr_eq(a, b) && Arc::ptr_eq(m, n)
+            }
+            _ => false,
+        }
+    }
+}
+
+/// A mesh or a CSG solid placed in the world with a material.
 #[derive(Debug, Clone)]
 pub struct Object {
     /// Name, for messages and statistics.
     pub name: String,
     /// Shared geometry in object space.
-    pub mesh: Arc<Mesh>,
+    pub body: Body,
     /// Object → world transform.
     pub transform: Affine3A,
-    /// Index into [`Scene::materials`].
+    /// Index into [`Scene::materials`] (a solid's primitives name their own).
     pub material: usize,
+}
+
+impl Object {
+    /// A mesh object.
+    #[must_use]
+    pub fn mesh(name: impl Into<String>, mesh: Arc<Mesh>, transform: Affine3A, material: usize) -> Object {
+        Object { name: name.into(), body: Body::Mesh(mesh), transform, material }
+    }
+
+    /// The triangles, if the object is a mesh.
+    #[must_use]
+    pub fn triangles(&self) -> Option<&Arc<Mesh>> {
+        match &self.body {
+            Body::Mesh(m) => Some(m),
+            Body::Solid { .. } => None,
+        }
+    }
+
+    /// The solid, if the object is one.
+    #[must_use]
+    pub fn solid(&self) -> Option<&Arc<CsgSolid>> {
+        match &self.body {
+            Body::Solid { solid, .. } => Some(solid),
+            Body::Mesh(_) => None,
+        }
+    }
+
+    /// Bounds `(min, max)` in object space (`None` for an empty body).
+    #[must_use]
+    pub fn local_bounds(&self) -> Option<(Vec3, Vec3)> {
+        match &self.body {
+            Body::Mesh(m) => Some(m.bounds()),
+            Body::Solid { solid, .. } => solid.bounds(),
+        }
+    }
 }
 
 /// A complete scene.
@@ -108,7 +174,7 @@ impl Scene {
     #[must_use]
     pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
         self.objects.iter().fold(None, |acc, o| {
-            let (lo, hi) = o.mesh.bounds();
+            let Some((lo, hi)) = o.local_bounds() else { return acc };
             let corners = (0..8).map(|k| {
                 let pick = |bit: usize, a: f32, b: f32| if k >> bit & 1 == 0 { a } else { b };
                 o.transform.transform_point3(Vec3::new(pick(0, lo.x, hi.x), pick(1, lo.y, hi.y), pick(2, lo.z, hi.z)))
@@ -132,10 +198,21 @@ impl Scene {
         }
     }
 
-    /// Number of triangles over all objects.
+    /// The material of what item `item` shows (a mesh object's, or a solid's
+    /// primitive's).
+    #[must_use]
+    pub fn item_material(&self, item: crate::visibility::ItemId) -> usize {
+        let o = &self.objects[item.object as usize];
+        match (&o.body, item.primitive()) {
+            (Body::Solid { materials, .. }, Some(p)) => materials.get(p as usize).copied().unwrap_or(o.material),
+            _ => o.material,
+        }
+    }
+
+    /// Number of triangles over all mesh objects.
     #[must_use]
     pub fn triangle_count(&self) -> usize {
-        self.objects.iter().map(|o| o.mesh.triangles.len()).sum()
+        self.objects.iter().filter_map(Object::triangles).map(|m| m.triangles.len()).sum()
     }
 }
 

@@ -80,13 +80,12 @@ impl Fog {
 pub fn fog_amounts(scene: &Scene, fog: &Fog, vb: &VisibilityBuffer) -> Vec<f32> {
     let w = vb.width() as usize;
     let rays = scene.camera.pixel_rays(Vec2::new(w as f32, vb.height() as f32));
-    let forward = (scene.camera.target - scene.camera.eye).normalize();
     let mut out = vec![0.0; vb.depths().len()];
     out.par_chunks_mut(w).zip(vb.depths().par_chunks(w)).enumerate().for_each(|(y, (row, depth))| {
         for (x, (f, &z)) in row.iter_mut().zip(depth).enumerate() {
             if z > 0.0 {
                 let ray = rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
-                *f = fog.amount(distance(&scene.camera, z) / ray.dir.dot(forward).max(1e-6));
+                *f = fog.amount(scene.camera.distance_at_depth(&ray, z));
             }
         }
     });
@@ -97,14 +96,6 @@ pub fn fog_amounts(scene: &Scene, fog: &Fog, vb: &VisibilityBuffer) -> Vec<f32> 
 /// fog component (black for an image that does not hold it).
 pub fn apply(image: &mut LinearImage, amounts: &[f32], color: Vec3) {
     image.pixels_mut().par_iter_mut().zip(amounts.par_iter()).for_each(|(p, &f)| *p = *p * (1.0 - f) + color * f);
-}
-
-/// Distance along the view axis of reversed depth `z` (> 0).
-fn distance(camera: &Camera, z: f32) -> f32 {
-    match camera.projection {
-        Projection::Perspective { .. } => camera.near / z,
-        Projection::Orthographic { .. } => camera.far - z * (camera.far - camera.near),
-    }
 }
 
 #[cfg(test)]

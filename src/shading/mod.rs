@@ -87,7 +87,9 @@ pub fn shade_pass(scene: &Scene, vb: &VisibilityBuffer, image: &mut LinearImage,
                 continue;
             }
             let whole = x + (run - x) / lanes::LANES * lanes::LANES;
-            if whole > x {
+            // A run of one triangle shares its plane; a solid's pixels each have
+            // their own tangent plane.
+            if whole > x && first.primitive().is_none() {
                 let tri = cache.get(scene, &frames, first);
                 if let Some(k) = constants[tri.material].as_ref() {
                     lanes::shade_run(tri, k, &row, x, lighting, blend, &mut out[x..whole]);
@@ -104,7 +106,14 @@ pub fn shade_pass(scene: &Scene, vb: &VisibilityBuffer, image: &mut LinearImage,
                     }
                     continue;
                 }
-                let tri = cache.get(scene, &frames, item);
+                let tangent;
+                let tri = if item.primitive().is_some() {
+                    let ray = rays.ray(Vec2::new((x + i) as f32 + 0.5, y as f32 + 0.5));
+                    tangent = frames.prepare_at(scene, vb, (x + i) as u32, y as u32, &ray);
+                    &tangent
+                } else {
+                    cache.get(scene, &frames, item)
+                };
                 block.set(i, tri, constants[tri.material].as_ref());
             }
             if block.live.iter().any(|&l| l) {
@@ -168,7 +177,8 @@ pub fn shade_into_scalar(scene: &Scene, vb: &VisibilityBuffer, image: &mut Linea
                 continue;
             }
             let at = |dx: f32, dy: f32| {
-                frames.surface(scene, item, &rays.ray(Vec2::new(x as f32 + 0.5 + dx, y as f32 + 0.5 + dy)))
+                let ray = rays.ray(Vec2::new(x as f32 + 0.5 + dx, y as f32 + 0.5 + dy));
+                frames.surface_at(scene, vb, x as u32, y as u32, &ray)
             };
             let mut s = at(0.0, 0.0);
             // Ray differentials: the same triangle met one pixel right and one below.

@@ -38,9 +38,8 @@ pub fn add_reflection_map(scene: &Scene, vb: &VisibilityBuffer, targets: &mut [T
                     }
                     continue;
                 }
-                let material = scene.objects[item.object as usize].material;
-                if reflection && reflecting[material] {
-                    *px += reflection_map(scene, &frames.surface(scene, item, &ray()));
+                if reflection && reflecting[scene.item_material(item)] {
+                    *px += reflection_map(scene, &frames.surface_at(scene, vb, x as u32, y as u32, &ray()));
                 }
             }
         });

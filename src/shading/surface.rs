@@ -2,11 +2,16 @@
 //! ray is intersected exactly with the ONE triangle whose id the pixel holds — no
 //! search — giving perspective-correct barycentrics, the position, the interpolated
 //! normal and texture coordinates.
+//!
+//! A pixel that shows a CSG solid (seed 003) holds its primitive, depth and normal
+//! instead: its point is where the pixel's ray reaches that depth, and it is shaded
+//! as the plane tangent to the solid there ([`ObjectFrames::tangent`]), so every
+//! shading path built for triangles shades solids unchanged.
 
 use glam::{Affine3A, Mat3A, Vec2, Vec3};
 
 use crate::scene::{Ray, Scene};
-use crate::visibility::ItemId;
+use crate::visibility::{ItemId, VisibilityBuffer};
 
 /// What shading needs to know about the visible point of a pixel.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -42,11 +47,12 @@ impl ObjectFrames {
         ObjectFrames { frames }
     }
 
-    /// The world-space vertices of an item's triangle.
+    /// The world-space vertices of an item's triangle (`item` must name a
+    /// triangle of a mesh object).
     #[must_use]
     pub fn triangle(&self, scene: &Scene, item: ItemId) -> [Vec3; 3] {
         let (m, _) = self.frames[item.object as usize];
-        let mesh = &scene.objects[item.object as usize].mesh;
+        let mesh = scene.objects[item.object as usize].triangles().expect("a triangle's item names a mesh");
         mesh.triangles[item.triangle as usize].map(|i| m.transform_point3(mesh.positions[i as usize]))
     }
 
@@ -56,12 +62,54 @@ impl ObjectFrames {
         self.prepare(scene, item).surface(ray)
     }
 
-    /// Gathers everything about `item`'s triangle that does not depend on the ray,
-    /// so neighbouring pixels showing the same triangle share the work.
+    /// The surface that pixel (`x`, `y`) of `vb` shows, seen along `ray` (the
+    /// pixel's ray, or a ray through another point of the pixel: a triangle is
+    /// met again, a solid's tangent plane stands in for its surface).
+    #[must_use]
+    pub fn surface_at(&self, scene: &Scene, vb: &VisibilityBuffer, x: u32, y: u32, ray: &Ray) -> SurfacePoint {
+        self.prepare_at(scene, vb, x, y, ray).surface(ray)
+    }
+
+    /// [`ObjectFrames::prepare`] for the item at pixel (`x`, `y`) of `vb`, whose
+    /// ray is `ray`: a solid's primitive gives its tangent plane at the pixel's
+    /// point.
+    #[must_use]
+    pub fn prepare_at(&self, scene: &Scene, vb: &VisibilityBuffer, x: u32, y: u32, ray: &Ray) -> PreparedTriangle {
+        let item = vb.item(x, y);
+        if item.primitive().is_none() {
+            return self.prepare(scene, item);
+        }
+        let t = scene.camera.distance_at_depth(ray, vb.depth(x, y));
+        Self::tangent(scene, item, ray.origin + ray.dir * t, vb.normal(x, y))
+    }
+
+    /// The plane tangent to a solid's primitive `item` at `point` with the
+    /// solid's outward `normal` (world space), as a triangle with that normal at
+    /// every vertex: shading it along a ray through `point` gives the solid's
+    /// surface point.
+    #[must_use]
+    pub fn tangent(scene: &Scene, item: ItemId, point: Vec3, normal: Vec3) -> PreparedTriangle {
+        let normal = normal.normalize_or(Vec3::Y);
+        let (e1, e2) = normal.any_orthonormal_pair();
+        PreparedTriangle {
+            item,
+            a: point,
+            e1,
+            e2,
+            geometric: normal,
+            normals: [normal; 3],
+            uvs: None,
+            material: scene.item_material(item),
+        }
+    }
+
+    /// Gathers everything about `item`'s triangle (a mesh's) that does not
+    /// depend on the ray, so neighbouring pixels showing the same triangle share
+    /// the work.
     #[must_use]
     pub fn prepare(&self, scene: &Scene, item: ItemId) -> PreparedTriangle {
         let object = &scene.objects[item.object as usize];
-        let mesh = &object.mesh;
+        let mesh = object.triangles().expect("a triangle's item names a mesh");
         let idx = mesh.triangles[item.triangle as usize].map(|i| i as usize);
         let [a, b, c] = self.triangle(scene, item);
         let (_, nm) = self.frames[item.object as usize];

@@ -27,12 +27,14 @@
 //! only costs time: where a primitive does not reach, its interval is empty.
 
 use glam::{Mat4, Vec2, Vec3, Vec4};
+use rayon::iter::IndexedParallelIterator;
 use rayon::prelude::*;
 
 use crate::raytrace::csg::{Crossing, CsgCaster, SpanScratch};
 use crate::scene::camera::PixelRays;
 use crate::scene::csg::{CsgSolid, CsgTree, Primitive, Shape};
-use crate::scene::Camera;
+use crate::scene::{Camera, Ray, Scene};
+use crate::visibility::{ItemId, VisibilityBuffer};
 
 /// Rows scanned by one worker in turn.
 const BAND_ROWS: usize = 16;
@@ -52,12 +54,75 @@ struct Extent {
 
 /// The visible surface of `solid` (in world space) at each pixel centre of a
 /// `width` x `height` image seen by `camera`, rows top to bottom: the first
-/// crossing in front of the eye, or `None`.
+/// crossing beyond the near plane, or `None`.
 #[must_use]
 pub fn scan_solid(solid: &CsgSolid, camera: &Camera, width: u32, height: u32) -> Vec<Option<Crossing>> {
     let (w, h) = (width as usize, height as usize);
     let mut out = vec![None; w * h];
-    let Some(tree) = &solid.tree else { return out };
+    let bands = out.par_chunks_mut(w * BAND_ROWS);
+    scan_bands(solid, camera, (width, height), bands, |band, dy, row| {
+        band[dy * w..(dy + 1) * w].copy_from_slice(row);
+    });
+    out
+}
+
+/// Draws every solid of `scene` seen by `camera` into `vb` (after its
+/// polygons): where a solid's visible surface lies nearer than what the pixel
+/// holds and between the near and far planes, the pixel takes its depth, its
+/// item (object + primitive) and its outward normal. A depth-only buffer (a
+/// shadow map) takes the depth alone. Returns the number of solids drawn.
+pub fn draw_solids(scene: &Scene, camera: &Camera, vb: &mut VisibilityBuffer) -> usize {
+    let (width, height) = (vb.width(), vb.height());
+    let w = width as usize;
+    let vp = camera.view_projection(width as f32 / height as f32);
+    let far = camera.far_plane_factor();
+    let rays = camera.pixel_rays(Vec2::new(width as f32, height as f32));
+    let mut drawn = 0;
+    for (object, o) in scene.objects.iter().enumerate() {
+        let Some(solid) = o.solid() else { continue };
+        let world = solid.transformed(&o.transform);
+        let (depth, items, normals) = vb.solid_parts_mut();
+        let n = w * BAND_ROWS;
+        let (mut items, mut normals) = (items.chunks_mut(n), normals.chunks_mut(n));
+        // Depth-only buffers have no items or normals: their bands get empty slices.
+        let bands: Vec<(&mut [f32], &mut [ItemId], &mut [Vec3])> = depth
+            .chunks_mut(n)
+            .map(|d| (d, items.next().unwrap_or(&mut []), normals.next().unwrap_or(&mut [])))
+            .collect();
+        let bands = bands.into_par_iter().enumerate();
+        scan_bands(&world, camera, (width, height), bands, |(band, (depth, items, normals)), dy, row| {
+            let y = *band * BAND_ROWS + dy;
+            for (x, c) in row.iter().enumerate().filter_map(|(x, c)| Some((x, c.as_ref()?))) {
+                let point = rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5)).at(c.t);
+                let clip = vp * point.extend(1.0);
+                let z = clip.z / clip.w;
+                let i = dy * w + x;
+                if z > depth[i] && z >= far && z <= 1.0 {
+                    depth[i] = z;
+                    if !items.is_empty() {
+                        items[i] = ItemId::primitive_of(object as u32, c.primitive as u32);
+                        normals[i] = c.normal;
+                    }
+                }
+            }
+        });
+        drawn += 1;
+    }
+    drawn
+}
+
+/// The walk itself: for each band of [`BAND_ROWS`] rows (in parallel, `bands`
+/// gives each its output), `visit(band, row_in_band, crossings)` with the row's
+/// visible crossings.
+fn scan_bands<B: Send>(
+    solid: &CsgSolid,
+    camera: &Camera,
+    (width, height): (u32, u32),
+    bands: impl IndexedParallelIterator<Item = B>,
+    visit: impl Fn(&mut B, usize, &[Option<Crossing>]) + Sync,
+) {
+    let (w, h) = (width as usize, height as usize);
+    let Some(tree) = &solid.tree else { return };
     let vp = camera.view_projection(width as f32 / height as f32);
     let rays = camera.pixel_rays(Vec2::new(width as f32, height as f32));
     let outlines: Vec<Option<Outline>> = solid.primitives.iter().map(|p| Outline::new(p, vp, &rays)).collect();
@@ -66,29 +131,35 @@ pub fn scan_solid(solid: &CsgSolid, camera: &Camera, width: u32, height: u32) ->
         outlines.iter().enumerate().filter_map(|(i, o)| o.as_ref().map(|o| (i, o.rows))).collect();
     entry.sort_by_key(|(_, e)| e.y0);
     let caster = CsgCaster::new(solid);
-    let band_len = w * BAND_ROWS;
-    out.par_chunks_mut(band_len).enumerate().for_each(|(band, rows)| {
-        let first = (band * BAND_ROWS) as i64;
-        // The y-occupancy list as the band's first scanline finds it, then kept
-        // row by row.
-        let mut next = entry.partition_point(|(_, e)| e.y0 <= first);
-        let mut occupied: Vec<(usize, Extent)> = entry[..next].iter().copied().filter(|(_, e)| e.y1 >= first).collect();
-        for (dy, row) in rows.chunks_mut(w).enumerate() {
-            let y = first + dy as i64;
-            while next < entry.len() && entry[next].1.y0 <= y {
-                occupied.push(entry[next]);
-                next += 1;
+    // Depth 1 is the near plane, under either projection.
+    let near = |ray: &Ray| camera.distance_at_depth(ray, 1.0);
+    bands.enumerate().for_each_init(
+        || vec![None; w],
+        |row, (band, mut out)| {
+            let first = (band * BAND_ROWS) as i64;
+            // The y-occupancy list as the band's first scanline finds it, then kept
+            // row by row.
+            let mut next = entry.partition_point(|(_, e)| e.y0 <= first);
+            let mut occupied: Vec<(usize, Extent)> =
+                entry[..next].iter().copied().filter(|(_, e)| e.y1 >= first).collect();
+            for dy in 0..BAND_ROWS.min(h - band * BAND_ROWS) {
+                let y = first + dy as i64;
+                while next < entry.len() && entry[next].1.y0 <= y {
+                    occupied.push(entry[next]);
+                    next += 1;
+                }
+                occupied.retain(|(_, e)| e.y1 >= y);
+                // Procedure 2: each occupant's left and right ends on this scanline.
+                let ends: Vec<(usize, i64, i64)> = occupied
+                    .iter()
+                    .filter_map(|&(i, _)| outlines[i].as_ref()?.columns(y).map(|(a, b)| (i, a, b)))
+                    .collect();
+                row.fill(None);
+                scan_row(&caster, tree, &ends, |x| rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5)), &near, row);
+                visit(&mut out, dy, row);
             }
-            occupied.retain(|(_, e)| e.y1 >= y);
-            // Procedure 2: each occupant's left and right ends on this scanline.
-            let ends: Vec<(usize, i64, i64)> = occupied
-                .iter()
-                .filter_map(|&(i, _)| outlines[i].as_ref()?.columns(y).map(|(a, b)| (i, a, b)))
-                .collect();
-            scan_row(&caster, tree, &ends, |x| rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5)), row);
-        }
-    });
-    out
+        },
+    );
 }
 
 /// One scanline: the x-entry table of the occupants, the x-occupancy list, and
@@ -97,7 +168,8 @@ fn scan_row(
     caster: &CsgCaster,
     tree: &CsgTree,
     ends: &[(usize, i64, i64)],
-    ray_at: impl Fn(usize) -> crate::scene::Ray,
+    ray_at: impl Fn(usize) -> Ray,
+    near: &impl Fn(&Ray) -> f32,
     row: &mut [Option<Crossing>],
 ) {
     // The x-entry table: occupants by left end.
@@ -120,7 +192,7 @@ fn scan_row(
         }
         if let Some(tree) = &cut {
             let ray = ray_at(x);
-            *px = caster.first_hit_with(tree, &ray, 0.0, &mut scratch);
+            *px = caster.first_hit_with(tree, &ray, near(&ray), &mut scratch);
         }
         // Primitives whose right end is this pixel leave the x-occupancy list.
         let before = inside.len();
@@ -163,7 +235,7 @@ struct EllipsoidView {
 impl Outline {
     fn new(p: &Primitive, vp: Mat4, rays: &PixelRays) -> Option<Outline> {
         let (width, height) = (rays.size.x as u32, rays.size.y as u32);
-        let mut rows = extent(&corners(&p.shape, &p.transform), vp, width, height)?;
+        let mut rows = extent(&p.corners(), vp, width, height)?;
         let ellipsoid = (p.shape == Shape::Sphere && !rays.ortho)
             .then(|| {
                 let to_unit = p.transform.inverse();
@@ -243,27 +315,6 @@ fn inside_quadratic(a: f64, b: f64, c: f64) -> Option<(f64, f64)> {
     let r = disc.sqrt();
     let (s0, s1) = ((-b + r) / a, (-b - r) / a);
     Some((s0.min(s1), s0.max(s1)))
-}
-
-/// Corners of a box around the primitive's unit shape, in solid space.
-fn corners(shape: &Shape, m: &glam::Affine3A) -> Vec<Vec3> {
-    let unit_box = |z0: f32| -> Vec<Vec3> {
-        (0..8)
-            .map(|i| {
-                Vec3::new(
-                    if i & 1 == 0 { -1.0 } else { 1.0 },
-                    if i & 2 == 0 { -1.0 } else { 1.0 },
-                    if i & 4 == 0 { z0 } else { 1.0 },
-                )
-            })
-            .collect()
-    };
-    let local = match shape {
-        Shape::Sphere => unit_box(-1.0),
-        Shape::Frustum { .. } => unit_box(0.0),
-        Shape::Polyhedron(p) => p.vertices.clone(),
-    };
-    local.into_iter().map(|c| m.transform_point3(c)).collect()
 }
 
 /// The pixels whose centres the projection of `points` can cover; the whole

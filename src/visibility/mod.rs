@@ -13,20 +13,41 @@ pub mod csg;
 pub mod raster;
 pub mod scan;
 
+use glam::Vec3;
+
 pub use raster::{fragments, rasterize, rasterize_from, Faces, Fragment, RasterStats};
 
-/// What a pixel sees: an object and one of its triangles.
+/// What a pixel sees: an object and one of its triangles, or one primitive of a
+/// CSG solid (seed 003: item id = object + primitive).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct ItemId {
     /// Index into `Scene::objects`.
     pub object: u32,
-    /// Triangle index within the object's mesh.
+    /// Triangle index within the object's mesh, or [`ItemId::PRIMITIVE`] plus
+    /// the index of a solid's primitive.
     pub triangle: u32,
 }
 
 impl ItemId {
     /// The id of pixels that see nothing.
     pub const NONE: ItemId = ItemId { object: u32::MAX, triangle: u32::MAX };
+
+    /// The bit that marks a CSG primitive rather than a triangle.
+    pub const PRIMITIVE: u32 = 1 << 31;
+
+    /// The id of primitive `primitive` of the solid `object`.
+    #[must_use]
+    pub fn primitive_of(object: u32, primitive: u32) -> ItemId {
+        ItemId { object, triangle: Self::PRIMITIVE | primitive }
+    }
+
+    /// The CSG primitive this id names, if it names one (not a triangle, not
+    /// nothing).
+    #[inline]
+    #[must_use]
+    pub fn primitive(self) -> Option<u32> {
+        (self.triangle & Self::PRIMITIVE != 0 && !self.is_none()).then_some(self.triangle & !Self::PRIMITIVE)
+    }
 
     /// Both fields in one integer (one comparison instead of two, for the
     /// hot loops that look for runs of equal ids).
@@ -54,6 +75,9 @@ pub struct VisibilityBuffer {
     height: u32,
     depth: Vec<f32>,
     items: Vec<ItemId>,
+    /// World-space outward normals of the pixels that show a CSG solid (held
+    /// only once a solid has been drawn; other pixels' entries mean nothing).
+    normals: Vec<Vec3>,
     /// False for a depth-only buffer (shadow maps), whose `items` stay empty.
     with_items: bool,
 }
@@ -64,7 +88,14 @@ impl VisibilityBuffer {
     #[must_use]
     pub fn new(width: u32, height: u32) -> Self {
         let n = width as usize * height as usize;
-        VisibilityBuffer { width, height, depth: vec![0.0; n], items: vec![ItemId::NONE; n], with_items: true }
+        VisibilityBuffer {
+            width,
+            height,
+            depth: vec![0.0; n],
+            items: vec![ItemId::NONE; n],
+            normals: Vec::new(),
+            with_items: true,
+        }
     }
 
     /// A buffer that keeps depth only ([`VisibilityBuffer::items`] is empty): a
@@ -73,7 +104,14 @@ impl VisibilityBuffer {
     #[must_use]
     pub fn depth_only(width: u32, height: u32) -> Self {
         let n = width as usize * height as usize;
-        VisibilityBuffer { width, height, depth: vec![0.0; n], items: Vec::new(), with_items: false }
+        VisibilityBuffer {
+            width,
+            height,
+            depth: vec![0.0; n],
+            items: Vec::new(),
+            normals: Vec::new(),
+            with_items: false,
+        }
     }
 
     /// Width in pixels.
@@ -106,6 +144,14 @@ impl VisibilityBuffer {
         self.items[y as usize * self.width as usize + x as usize]
     }
 
+    /// The solid's outward normal (world space) at pixel (x, y), meaningful
+    /// where the pixel's item is a CSG primitive ([`ItemId::primitive`]); zero
+    /// when no solid was drawn.
+    #[must_use]
+    pub fn normal(&self, x: u32, y: u32) -> Vec3 {
+        self.normals.get(y as usize * self.width as usize + x as usize).copied().unwrap_or(Vec3::ZERO)
+    }
+
     /// Depth at pixel (x, y).
     #[must_use]
     pub fn depth(&self, x: u32, y: u32) -> f32 {
@@ -122,6 +168,9 @@ impl VisibilityBuffer {
         if self.with_items {
             self.items.resize(n, ItemId::NONE);
         }
+        if !self.normals.is_empty() {
+            self.normals.resize(n, Vec3::ZERO);
+        }
     }
 
     /// Forgets everything drawn.
@@ -134,9 +183,20 @@ impl VisibilityBuffer {
         (&mut self.depth, &mut self.items)
     }
 
+    /// Depth, items (empty for a depth-only buffer) and normals (allocated here
+    /// when the buffer keeps items), for drawing solids.
+    fn solid_parts_mut(&mut self) -> (&mut [f32], &mut [ItemId], &mut [Vec3]) {
+        if self.with_items && self.normals.len() != self.depth.len() {
+            self.normals.resize(self.depth.len(), Vec3::ZERO);
+        }
+        (&mut self.depth, &mut self.items, &mut self.normals)
+    }
+
     /// Bytes held by the buffer.
     #[must_use]
     pub fn memory_bytes(&self) -> usize {
-        self.depth.len() * std::mem::size_of::<f32>() + self.items.len() * std::mem::size_of::<ItemId>()
+        self.depth.len() * std::mem::size_of::<f32>()
+            + self.items.len() * std::mem::size_of::<ItemId>()
+            + self.normals.len() * std::mem::size_of::<Vec3>()
     }
 }

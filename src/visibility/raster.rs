@@ -36,6 +36,8 @@ pub struct RasterStats {
     pub binned: usize,
     /// Triangles that needed clipping.
     pub clipped: usize,
+    /// CSG solids drawn by the scanline walk (seed 003).
+    pub solids: usize,
 }
 
 /// A projected vertex: fixed-point screen position and reversed depth.
@@ -114,17 +116,21 @@ pub enum Faces {
 
 /// Draws every opaque object of `scene` seen by the scene's camera into `vb`,
 /// which is cleared first (each band clears its own rows, in parallel, just before
-/// drawing them). Translucent objects are left to [`fragments`].
+/// drawing them): meshes by the polygon pass, then solids by the scanline walk
+/// ([`super::csg::draw_solids`]; solids are drawn opaque whatever their
+/// material). Translucent meshes are left to [`fragments`].
 pub fn rasterize(scene: &Scene, vb: &mut VisibilityBuffer) -> RasterStats {
     let pass = PolygonPass::new(scene, &scene.camera, Faces::AsMaterials, vb.width(), vb.height());
-    pass.draw(&chunks(scene, |m| !m.translucent()), vb)
+    let stats = pass.draw(&chunks(scene, |m| !m.translucent()), vb);
+    RasterStats { solids: super::csg::draw_solids(scene, &scene.camera, vb), ..stats }
 }
 
 /// Draws every object of `scene`, opaque or not, seen by `camera` (a light's, for
 /// a shadow map), drawing `faces`, into `vb`.
 pub fn rasterize_from(scene: &Scene, camera: &Camera, faces: Faces, vb: &mut VisibilityBuffer) -> RasterStats {
     let pass = PolygonPass::new(scene, camera, faces, vb.width(), vb.height());
-    pass.draw(&chunks(scene, |_| true), vb)
+    let stats = pass.draw(&chunks(scene, |_| true), vb);
+    RasterStats { solids: super::csg::draw_solids(scene, camera, vb), ..stats }
 }
 
 /// A sample of a translucent surface at a pixel centre.
@@ -218,6 +224,7 @@ impl<'a> PolygonPass<'a> {
             triangles: drawn,
             binned: bins.iter().map(|b| b.binned).sum(),
             clipped: bins.iter().map(|b| b.clipped_count).sum(),
+            solids: 0,
         }
     }
 }
@@ -231,9 +238,8 @@ fn project(
     faces: Faces,
 ) -> Projected {
     let m = view_proj * Mat4::from(object.transform);
-    let (outcode, screen) = object
-        .mesh
-        .positions
+    let positions = object.triangles().map_or(&[][..], |m| &m.positions[..]);
+    let (outcode, screen) = positions
         .par_iter()
         .map(|p| {
             let c: Vec4 = m * p.extend(1.0);
@@ -253,7 +259,8 @@ fn project(
 fn chunks(scene: &Scene, include: impl Fn(&Material) -> bool) -> Vec<Chunk> {
     let mut out = Vec::new();
     for (object, o) in scene.objects.iter().enumerate().filter(|(_, o)| include(&scene.materials[o.material])) {
-        let n = o.mesh.triangles.len() as u32;
+        let Some(mesh) = o.triangles() else { continue };
+        let n = mesh.triangles.len() as u32;
         out.extend(
             (0..n)
                 .step_by(CHUNK_TRIANGLES as usize)
@@ -267,7 +274,7 @@ impl PolygonPass<'_> {
     fn bin(&self, chunk: &Chunk) -> ChunkBins {
         let mut bins = ChunkBins { bands: vec![Vec::new(); self.bands], ..Default::default() };
         let p = &self.projected[chunk.object];
-        let tris = &self.scene.objects[chunk.object].mesh.triangles;
+        let tris = &self.scene.objects[chunk.object].triangles().expect("chunks hold meshes").triangles;
         for t in chunk.triangles.clone() {
             let [a, b, c] = tris[t as usize].map(|i| i as usize);
             let codes = [p.outcode[a], p.outcode[b], p.outcode[c]];
@@ -275,7 +282,7 @@ impl PolygonPass<'_> {
                 self.bin_triangle(&mut bins, [p.screen[a], p.screen[b], p.screen[c]], p.cull_back, t);
             } else if codes[0] & codes[1] & codes[2] == 0 {
                 bins.clipped_count += 1;
-                let positions = &self.scene.objects[chunk.object].mesh.positions;
+                let positions = &self.scene.objects[chunk.object].triangles().expect("chunks hold meshes").positions;
                 self.bin_clipped(
                     &mut bins,
                     [a, b, c].map(|i| p.to_clip * positions[i].as_dvec3().extend(1.0)),
@@ -331,7 +338,7 @@ impl PolygonPass<'_> {
         let rows = row0..(row0 + BAND_ROWS as i64).min(self.height);
         for (chunk, bin) in chunks.iter().zip(bins) {
             let p = &self.projected[chunk.object];
-            let tris = &self.scene.objects[chunk.object].mesh.triangles;
+            let tris = &self.scene.objects[chunk.object].triangles().expect("chunks hold meshes").triangles;
             for &entry in &bin.bands[band] {
                 let (v, t) = if entry & CLIPPED != 0 {
                     bin.clipped[(entry & !CLIPPED) as usize]

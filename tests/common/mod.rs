@@ -29,7 +29,7 @@ pub fn scene_with(mesh: Mesh, camera: Camera, width: u32, height: u32, two_sided
             ..Light::default()
         }],
         materials: vec![Material { two_sided, ..Material::default() }],
-        objects: vec![Object { name: "soup".into(), mesh: Arc::new(mesh), transform: Affine3A::IDENTITY, material: 0 }],
+        objects: vec![Object::mesh("soup", Arc::new(mesh), Affine3A::IDENTITY, 0)],
         warnings: Vec::new(),
         exposure: Default::default(),
         antialias: Default::default(),
@@ -92,7 +92,7 @@ pub struct Hit {
 /// scene's single object (world = object space), honouring near/far and culling.
 pub fn cast(scene: &Scene, x: u32, y: u32) -> Option<Hit> {
     let cam = &scene.camera;
-    let mesh = &scene.objects[0].mesh;
+    let mesh = scene.objects[0].triangles().expect("a mesh");
     let cull = !scene.materials[0].two_sided;
     let fwd = (cam.target - cam.eye).normalize();
     let right = fwd.cross(cam.up).normalize();

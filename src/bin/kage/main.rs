@@ -13,6 +13,7 @@ use std::path::{Path, PathBuf};
 use clap::{Parser, Subcommand};
 use kage::resolve::edges::{EdgeFilter, EdgeMode, EdgeSelection};
 use kage::resolve::{Antialias, Exposure};
+use kage::scene::load::openscad::{CsgOptions, Geometry};
 use kage::scene::{demo::demo_scene, file, Scene};
 use kage::shading::{Component, ComponentSet};
 use kage::{render, RenderOptions};
@@ -27,8 +28,8 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Render a scene file (.toml) or a model (.obj, .stl, .gltf, .glb); with no
-    /// input, the built-in demo scene.
+    /// Render a scene file (.toml) or a model (.obj, .stl, .gltf, .glb, or an
+    /// OpenSCAD .csg); with no input, the built-in demo scene.
     Render(RenderArgs),
     /// Time frames at 1920x1080 on the peers' procedural scenes and print a table.
     Bench(bench::BenchArgs),
@@ -104,6 +105,24 @@ struct RenderArgs {
     /// Brightness of PNG output: stops (e.g. 1.5, -1) or `auto`; overrides the scene.
     #[arg(long, value_parser = parse_exposure, allow_hyphen_values = true)]
     exposure: Option<Exposure>,
+    /// An OpenSCAD .csg model's spheres and cylinders: `exact` quadrics (seed
+    /// 003) or `faceted` as OpenSCAD's own mesh ($fn/$fa/$fs), to compare with
+    /// OpenSCAD pixel for pixel.
+    #[arg(long, value_enum, default_value_t = GeometryArg::Exact)]
+    geometry: GeometryArg,
+    /// An OpenSCAD .csg model: skip nodes kage cannot render (linear_extrude,
+    /// text, import, ...) with a warning instead of failing.
+    #[arg(long)]
+    skip_unsupported: bool,
+}
+
+/// `--geometry`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum GeometryArg {
+    /// True spheres, cylinders and cones.
+    Exact,
+    /// OpenSCAD's facets.
+    Faceted,
 }
 
 /// `out.png` → `out.diffuse.png`.
@@ -184,14 +203,20 @@ fn main() -> miette::Result<()> {
     }
 }
 
-fn load(input: Option<&Path>, width: Option<u32>, height: Option<u32>) -> kage::error::Result<Scene> {
+fn load(args: &RenderArgs) -> kage::error::Result<Scene> {
     let is_model = |p: &Path| {
         let ext = p.extension().and_then(|e| e.to_str()).unwrap_or_default().to_ascii_lowercase();
-        matches!(ext.as_str(), "obj" | "stl" | "gltf" | "glb")
+        matches!(ext.as_str(), "obj" | "stl" | "gltf" | "glb" | "csg")
     };
-    let mut scene = match input {
+    let geometry = match args.geometry {
+        GeometryArg::Exact => Geometry::Exact,
+        GeometryArg::Faceted => Geometry::Faceted,
+    };
+    let csg = CsgOptions { geometry, skip_unsupported: args.skip_unsupported };
+    let (width, height) = (args.width, args.height);
+    let mut scene = match args.input.as_deref() {
         None => demo_scene()?,
-        Some(p) if is_model(p) => file::scene_for_model(p, width.unwrap_or(960), height.unwrap_or(540))?,
+        Some(p) if is_model(p) => file::scene_for_model_with(p, width.unwrap_or(960), height.unwrap_or(540), &csg)?,
         Some(p) => file::load_scene(p)?,
     };
     scene.width = width.unwrap_or(scene.width);
@@ -200,7 +225,7 @@ fn load(input: Option<&Path>, width: Option<u32>, height: Option<u32>) -> kage::
 }
 
 fn render_command(args: &RenderArgs) -> kage::error::Result<()> {
-    let mut scene = load(args.input.as_deref(), args.width, args.height)?;
+    let mut scene = load(args)?;
     scene.antialias = args.antialias.unwrap_or(scene.antialias);
     for w in &scene.warnings {
         eprintln!("warning: {w}");
@@ -223,11 +248,12 @@ fn render_command(args: &RenderArgs) -> kage::error::Result<()> {
     }
     let s = frame.stats;
     eprintln!(
-        "wrote {} ({}x{}, {} triangles, {} pass{}): visibility {:.1} ms, shadow maps {:.1} ms, shading {:.1} ms, traced {:.1} ms ({} pixels)",
+        "wrote {} ({}x{}, {} triangles, {} solids, {} pass{}): visibility {:.1} ms, shadow maps {:.1} ms, shading {:.1} ms, traced {:.1} ms ({} pixels)",
         args.output.display(),
         scene.width,
         scene.height,
         s.raster.triangles,
+        s.raster.solids,
         s.passes,
         if s.passes == 1 { "" } else { "es" },
         s.visibility_ms,

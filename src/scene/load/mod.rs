@@ -2,7 +2,9 @@
 //! and OpenSCAD `.csg` files, read into a syntax tree ([`openscad`]).
 //!
 //! Each loader turns a file into a [`LoadedModel`]: parts (a mesh with an optional
-//! material of its own and a placement), and for glTF the file's camera and lights.
+//! material of its own and a placement), solids (an OpenSCAD file's CSG solid
+//! and its colours), and for glTF the file's camera and lights (for OpenSCAD its
+//! camera sidecar's, or OpenSCAD's default view).
 //! Files are read through an [`AssetSource`], so the built-in demo scene can be
 //! served from bytes compiled into the binary.
 
@@ -18,8 +20,9 @@ use std::sync::Arc;
 use glam::{Affine3A, Vec3};
 
 use super::mesh::{Mesh, MeshRepairs};
-use super::{Camera, Light, Material, Texture};
+use super::{Camera, CsgSolid, Light, Material, Texture};
 use crate::error::{Error, Result};
+use openscad::CsgOptions;
 
 /// Where scene files find the files they name.
 pub trait AssetSource: Sync {
@@ -81,11 +84,27 @@ pub struct Part {
     pub transform: Affine3A,
 }
 
+/// One CSG solid of a model (an OpenSCAD `.csg` file), with the materials its
+/// primitives' colours make.
+#[derive(Debug, Clone)]
+pub struct SolidPart {
+    /// Name (the file's).
+    pub name: String,
+    /// The solid.
+    pub solid: Arc<CsgSolid>,
+    /// The distinct materials of its primitives.
+    pub palette: Vec<Material>,
+    /// Per primitive: index into `palette`.
+    pub materials: Vec<usize>,
+}
+
 /// Everything a model file contributes to a scene.
 #[derive(Debug, Clone, Default)]
 pub struct LoadedModel {
     /// Meshes.
     pub parts: Vec<Part>,
+    /// CSG solids.
+    pub solids: Vec<SolidPart>,
     /// The file's first camera (glTF), already placed in the model's space.
     pub camera: Option<Camera>,
     /// The file's lights (glTF `KHR_lights_punctual`).
@@ -105,11 +124,13 @@ impl LoadedModel {
     /// Bounds of all parts in model space.
     #[must_use]
     pub fn bounds(&self) -> (Vec3, Vec3) {
-        self.parts.iter().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), p| {
+        let meshes = self.parts.iter().map(|p| {
             let (a, b) = p.mesh.bounds();
             let (a, b) = (p.transform.transform_point3(a), p.transform.transform_point3(b));
-            (lo.min(a.min(b)), hi.max(a.max(b)))
-        })
+            (a.min(b), a.max(b))
+        });
+        let solids = self.solids.iter().filter_map(|s| s.solid.bounds());
+        meshes.chain(solids).fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), (a, b)| (lo.min(a), hi.max(b)))
     }
 
     fn note_repairs(&mut self, path: &Path, repairs: MeshRepairs) {
@@ -123,8 +144,15 @@ impl LoadedModel {
     }
 }
 
-/// Loads a model file, choosing the loader by extension.
+/// Loads a model file, choosing the loader by extension (`.csg` files with
+/// the default [`CsgOptions`]).
 pub fn model(path: &Path, assets: &dyn AssetSource) -> Result<LoadedModel> {
+    model_with(path, assets, &CsgOptions::default())
+}
+
+/// Loads a model file, choosing the loader by extension; `.csg` files are read
+/// with `csg`.
+pub fn model_with(path: &Path, assets: &dyn AssetSource, csg: &CsgOptions) -> Result<LoadedModel> {
     let shown = assets.display_path(path);
     let ext = path.extension().and_then(|e| e.to_str()).unwrap_or_default().to_ascii_lowercase();
     let bytes = read(path, assets)?;
@@ -133,7 +161,12 @@ pub fn model(path: &Path, assets: &dyn AssetSource) -> Result<LoadedModel> {
         "obj" => obj::load(&bytes, path, assets).map_err(fail)?,
         "stl" => stl::load(&bytes).map_err(fail)?,
         "gltf" | "glb" => gltf::load(&bytes, path, assets).map_err(fail)?,
-        _ => return Err(fail(format!("unknown mesh format '.{ext}' (kage reads .obj, .stl, .gltf and .glb)"))),
+        "csg" => {
+            let text = String::from_utf8(bytes).map_err(|_| fail("the file is not UTF-8 text".into()))?;
+            let sidecar = assets.read(&path.with_extension("camera.txt")).ok();
+            openscad::model(&shown, text.into(), sidecar.as_deref(), csg)?
+        }
+        _ => return Err(fail(format!("unknown model format '.{ext}' (kage reads .obj, .stl, .gltf, .glb and .csg)"))),
     };
     Ok(model)
 }
