@@ -229,3 +229,21 @@ fn the_cli_renders_openscad_files() {
     assert!(o.status.success() && err.contains("warning") && err.contains("linear_extrude"), "{err}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// A scene file's `.csg` object reads exact quadrics by default and OpenSCAD's
+/// facets with `geometry = "faceted"`; a misspelt mode is a located error.
+#[test]
+fn scene_files_choose_the_geometry_of_csg_objects() {
+    let build = |geometry: &str| {
+        let text = format!("[[object]]\nmesh = \"ex004_cube_minus_sphere.csg\"\n{geometry}\n");
+        SceneFile::parse(&text, &data().join("scene.toml")).and_then(|f| f.build(&FileSystem { base: data() }))
+    };
+    let polyhedra = |scene: &Scene| {
+        let solid = scene.objects[0].solid().expect("a solid");
+        solid.primitives.iter().all(|p| matches!(p.shape, kage::scene::csg::Shape::Polyhedron(_)))
+    };
+    assert!(!polyhedra(&build("").unwrap()), "exact by default: the sphere is a quadric");
+    assert!(polyhedra(&build("geometry = \"faceted\"").unwrap()), "faceted: every primitive a polyhedron");
+    let e = build("geometry = \"facetted\"").unwrap_err().to_string();
+    assert!(e.contains("scene.toml:3:12") && e.contains("faceted"), "{e}");
+}

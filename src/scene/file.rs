@@ -14,7 +14,7 @@ use glam::{Affine3A, EulerRot, Quat, Vec3};
 use serde::Deserialize;
 use toml::Spanned;
 
-use super::load::openscad::CsgOptions;
+use super::load::openscad::{CsgOptions, Geometry};
 use super::load::{self, AssetSource, LoadedModel};
 use super::mesh::shapes;
 use super::{
@@ -394,6 +394,14 @@ enum ShapeRec {
     Sphere,
 }
 
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default)]
+#[serde(rename_all = "kebab-case")]
+enum GeometryRec {
+    #[default]
+    Exact,
+    Faceted,
+}
+
 #[derive(Debug, Deserialize)]
 #[serde(untagged)]
 enum ScaleRec {
@@ -414,6 +422,12 @@ struct ObjectRec {
     rotate: V3,
     scale: Option<ScaleRec>,
     fit: Option<Spanned<f32>>,
+    /// A `.csg` model's spheres and cylinders.
+    #[serde(default)]
+    geometry: GeometryRec,
+    /// A `.csg` model: skip nodes kage cannot render, with a warning.
+    #[serde(default)]
+    skip_unsupported: bool,
 }
 
 impl SceneFile {
@@ -763,7 +777,14 @@ impl SceneFile {
     ) -> Result<LoadedModel> {
         let r = o.get_ref();
         let model = match (&r.mesh, r.shape) {
-            (Some(path), None) => load::model(Path::new(path.get_ref()), assets)?,
+            (Some(path), None) => {
+                let geometry = match r.geometry {
+                    GeometryRec::Exact => Geometry::Exact,
+                    GeometryRec::Faceted => Geometry::Faceted,
+                };
+                let csg = CsgOptions { geometry, skip_unsupported: r.skip_unsupported };
+                load::model_with(Path::new(path.get_ref()), assets, &csg)?
+            }
             (None, Some(shape)) => LoadedModel::single(match shape {
                 ShapeRec::Plane => shapes::plane(),
                 ShapeRec::Cube => shapes::cube(),
