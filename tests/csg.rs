@@ -201,3 +201,37 @@ fn the_scanline_walk_finds_what_a_ray_per_pixel_finds() {
     }
     assert!(covered * 20 > pixels, "only {covered} of {pixels} pixels show a solid");
 }
+
+/// The BVH-culled ray caster (a primitive whose box the ray misses counts as
+/// missed) finds exactly what casting every primitive finds, on random solids
+/// large enough to get a BVH, for rays from inside and outside their reach.
+#[test]
+fn culling_primitives_by_their_boxes_changes_no_hit() {
+    use kage::raytrace::csg::CsgCaster;
+    let mut rng = StdRng::seed_from_u64(61);
+    let (mut hits, mut rays) = (0, 0);
+    for _ in 0..40 {
+        let mut prims = Vec::new();
+        let kids = (0..6).map(|_| random_tree(&mut rng, &mut prims, 3)).collect();
+        let mut solid = CsgSolid { primitives: prims, tree: Some(CsgTree::Union(kids)) };
+        // Spread the parts out, so boxes separate them.
+        for p in &mut solid.primitives {
+            p.transform = Affine3A::from_translation(Vec3::new(rng.gen_range(-3.0..3.0), 0.0, 0.0)) * p.transform;
+        }
+        if solid.primitives.len() < CsgCaster::BVH_PRIMITIVES {
+            continue;
+        }
+        let caster = CsgCaster::new(&solid);
+        for _ in 0..2000 {
+            let mut v = || Vec3::new(rng.gen_range(-5.0..5.0), rng.gen_range(-3.0..3.0), rng.gen_range(-3.0..3.0));
+            let (origin, to) = (v(), v());
+            let ray = kage::scene::Ray { origin, dir: (to - origin).normalize_or(Vec3::X) };
+            let culled = caster.first_hit(&ray, 0.0, f32::INFINITY);
+            let every = caster.first_hit_every_primitive(&ray, 0.0);
+            assert_eq!(culled.map(|c| (c.primitive, c.t)), every.map(|c| (c.primitive, c.t)), "{ray:?}");
+            rays += 1;
+            hits += usize::from(every.is_some());
+        }
+    }
+    assert!(rays >= 20_000 && hits * 4 > rays, "{hits} hits of {rays} rays");
+}

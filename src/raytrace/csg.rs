@@ -19,6 +19,7 @@
 
 use glam::{Affine3A, Mat3A, Vec3};
 
+use super::bvh::{Aabb, Bvh};
 use crate::scene::csg::{ConvexPolyhedron, CsgSolid, CsgTree, Primitive, Shape};
 use crate::scene::Ray;
 
@@ -61,12 +62,15 @@ pub fn first_hit(solid: &CsgSolid, ray: &Ray, t_min: f32, t_max: f32) -> Option<
 }
 
 /// A solid ready for many rays: each primitive's inverse transform and normal
-/// matrix computed once.
+/// matrix computed once, and for solids of many primitives a BVH over their
+/// bounds, so a ray meets only the primitives whose boxes it crosses.
 #[derive(Debug, Clone)]
 pub struct CsgCaster {
     solid: CsgSolid,
     /// Per primitive: solid space → unit shape, and the normal matrix back.
     frames: Vec<(Affine3A, Mat3A)>,
+    /// Over the primitives' boxes, from [`CsgCaster::BVH_PRIMITIVES`] up.
+    bvh: Option<Bvh>,
 }
 
 impl CsgCaster {
@@ -80,8 +84,15 @@ impl CsgCaster {
     #[must_use]
     pub fn from_solid(solid: CsgSolid) -> Self {
         let frames = solid.primitives.iter().map(|p| (p.transform.inverse(), normal_matrix(&p.transform))).collect();
-        CsgCaster { solid, frames }
+        let bvh = (solid.primitives.len() >= Self::BVH_PRIMITIVES).then(|| {
+            let boxes: Vec<Aabb> = solid.primitives.iter().map(|p| Aabb::around(&p.corners())).collect();
+            Bvh::build(&boxes)
+        });
+        CsgCaster { solid, frames, bvh }
     }
+
+    /// Primitives from which [`CsgCaster::first_hit`] culls by a BVH.
+    pub const BVH_PRIMITIVES: usize = 8;
 
     /// The solid.
     #[must_use]
@@ -98,16 +109,31 @@ impl CsgCaster {
     /// The span of `ray` inside primitive `i`, if it meets it.
     #[must_use]
     pub fn span(&self, i: usize, ray: &Ray) -> Option<Span> {
-        let (to_unit, to_solid) = &self.frames[i];
-        span_in(&self.solid.primitives[i].shape, to_unit, to_solid, i, ray)
+        self.raw_span(i, ray).map(|s| Span { enter: self.finish(s.enter), exit: self.finish(s.exit) })
+    }
+
+    /// [`CsgCaster::span`] with its normals left in the unit shape's space
+    /// (unnormalised): combining spans needs only `t`, so only the crossing
+    /// finally seen pays for its normal ([`CsgCaster::finish`]).
+    fn raw_span(&self, i: usize, ray: &Ray) -> Option<Span> {
+        let (o, d) = (self.frames[i].0.transform_point3(ray.origin), self.frames[i].0.transform_vector3(ray.dir));
+        let ((t0, n0), (t1, n1)) = unit_span(&self.solid.primitives[i].shape, o, d)?;
+        let crossing = |t: f32, normal: Vec3| Crossing { t, normal, primitive: i, cut: false };
+        Some(Span { enter: crossing(t0, n0), exit: crossing(t1, n1) })
+    }
+
+    /// A crossing of [`CsgCaster::raw_span`] with its unit outward normal in
+    /// solid space.
+    fn finish(&self, c: Crossing) -> Crossing {
+        Crossing { normal: (self.frames[c.primitive].1 * c.normal).normalize_or_zero(), ..c }
     }
 
     /// The spans of `ray` inside the part of the solid `tree` describes.
     #[must_use]
     pub fn spans_of(&self, tree: &CsgTree, ray: &Ray) -> Vec<Span> {
         let mut scratch = SpanScratch::default();
-        combine(tree, &|i| self.span(i, ray), &mut scratch);
-        scratch.stack
+        combine(tree, &|i| self.raw_span(i, ray), &mut scratch);
+        scratch.stack.iter().map(|s| Span { enter: self.finish(s.enter), exit: self.finish(s.exit) }).collect()
     }
 
     /// The first surface of the part `tree` along `ray` at `t > t_min`, with
@@ -115,8 +141,8 @@ impl CsgCaster {
     #[must_use]
     pub fn first_hit_with(&self, tree: &CsgTree, ray: &Ray, t_min: f32, scratch: &mut SpanScratch) -> Option<Crossing> {
         scratch.stack.clear();
-        combine(tree, &|i| self.span(i, ray), scratch);
-        scratch.stack.iter().flat_map(|s| [s.enter, s.exit]).find(|c| c.t > t_min)
+        combine(tree, &|i| self.raw_span(i, ray), scratch);
+        scratch.stack.iter().flat_map(|s| [s.enter, s.exit]).find(|c| c.t > t_min).map(|c| self.finish(c))
     }
 
     /// The spans of `ray` inside the solid.
@@ -125,11 +151,52 @@ impl CsgCaster {
         self.solid.tree.as_ref().map_or_else(Vec::new, |t| self.spans_of(t, ray))
     }
 
-    /// The first surface along `ray` at `t` in `(t_min, t_max)`.
+    /// The first surface along `ray` at `t` in `(t_min, t_max)`: the primitives
+    /// whose boxes the ray crosses (all of them without a BVH) are cast, the
+    /// others count as missed.
     #[must_use]
     pub fn first_hit(&self, ray: &Ray, t_min: f32, t_max: f32) -> Option<Crossing> {
-        self.spans(ray).into_iter().flat_map(|s| [s.enter, s.exit]).find(|c| c.t > t_min && c.t < t_max)
+        let tree = self.solid.tree.as_ref()?;
+        let Some(bvh) = &self.bvh else {
+            return SCRATCH.with_borrow_mut(|s| self.first_hit_with(tree, ray, t_min, s)).filter(|c| c.t < t_max);
+        };
+        SCRATCH.with_borrow_mut(|s| {
+            let (mut crossed, mut met) = (std::mem::take(&mut s.crossed), std::mem::take(&mut s.met));
+            crossed.resize(self.frames.len(), false);
+            bvh.intersect(ray, t_max, |i, _| {
+                crossed[i as usize] = true;
+                met.push(i);
+                None
+            });
+            s.stack.clear();
+            combine(tree, &|i| if crossed[i] { self.raw_span(i, ray) } else { None }, s);
+            met.drain(..).for_each(|i| crossed[i as usize] = false);
+            (s.crossed, s.met) = (crossed, met);
+            s.stack
+                .iter()
+                .flat_map(|sp| [sp.enter, sp.exit])
+                .find(|c| c.t > t_min && c.t < t_max)
+                .map(|c| self.finish(c))
+        })
     }
+
+    /// The first surface along `ray` beyond `t_min` when every primitive's span
+    /// is computed first, whether or not the booleans need it: the paper's
+    /// baseline ray caster (every pixel, every primitive, no acceleration).
+    #[must_use]
+    pub fn first_hit_every_primitive(&self, ray: &Ray, t_min: f32) -> Option<Crossing> {
+        let tree = self.solid.tree.as_ref()?;
+        let all: Vec<Option<Span>> = (0..self.frames.len()).map(|i| self.raw_span(i, ray)).collect();
+        let mut scratch = SpanScratch::default();
+        combine(tree, &|i| all[i], &mut scratch);
+        scratch.stack.iter().flat_map(|s| [s.enter, s.exit]).find(|c| c.t > t_min).map(|c| self.finish(c))
+    }
+}
+
+thread_local! {
+    /// Span buffers for [`CsgCaster::first_hit`], one per thread, so traced rays
+    /// allocate nothing.
+    static SCRATCH: std::cell::RefCell<SpanScratch> = std::cell::RefCell::default();
 }
 
 /// Reusable buffers for combining spans along a tree, so a pixel allocates
@@ -138,6 +205,10 @@ impl CsgCaster {
 pub struct SpanScratch {
     stack: Vec<Span>,
     out: Vec<Span>,
+    /// Per primitive: whether the ray crosses its box (all false between rays).
+    crossed: Vec<bool>,
+    /// The primitives marked in `crossed`.
+    met: Vec<u32>,
 }
 
 /// The spans of the subtree `tree`, given each leaf's span (at most one: a
@@ -167,7 +238,7 @@ pub fn combine(tree: &CsgTree, leaf: &impl Fn(usize) -> Option<Span>, scratch: &
                     break; // nothing left to intersect with or cut from
                 }
                 let mid = combine(k, leaf, scratch);
-                let SpanScratch { stack, out } = scratch;
+                let SpanScratch { stack, out, .. } = scratch;
                 out.clear();
                 let (a, b) = stack[base..].split_at(mid - base);
                 if cut {
@@ -251,16 +322,11 @@ fn wall(c: Crossing) -> Crossing {
 /// The span of `ray` inside primitive `p` (index `index`), if it meets it.
 #[must_use]
 pub fn primitive_span(p: &Primitive, index: usize, ray: &Ray) -> Option<Span> {
-    span_in(&p.shape, &p.transform.inverse(), &normal_matrix(&p.transform), index, ray)
-}
-
-/// The span of `ray` inside primitive `index`, whose unit `shape` the ray reaches
-/// through `to_unit`; normals go back through `to_solid`.
-fn span_in(shape: &Shape, to_unit: &Affine3A, to_solid: &Mat3A, index: usize, ray: &Ray) -> Option<Span> {
+    let (to_unit, to_solid) = (p.transform.inverse(), normal_matrix(&p.transform));
     let (o, d) = (to_unit.transform_point3(ray.origin), to_unit.transform_vector3(ray.dir));
-    let ((t0, n0), (t1, n1)) = unit_span(shape, o, d)?;
+    let ((t0, n0), (t1, n1)) = unit_span(&p.shape, o, d)?;
     let crossing =
-        |t: f32, n: Vec3| Crossing { t, normal: (*to_solid * n).normalize_or_zero(), primitive: index, cut: false };
+        |t: f32, n: Vec3| Crossing { t, normal: (to_solid * n).normalize_or_zero(), primitive: index, cut: false };
     Some(Span { enter: crossing(t0, n0), exit: crossing(t1, n1) })
 }
 
@@ -316,18 +382,20 @@ fn frustum(bottom: f32, top: f32, o: Vec3, d: Vec3) -> Option<UnitSpan> {
         let p = o + d * t;
         Vec3::new(p.x, p.y, -k * (bottom + k * p.z))
     };
-    let inside: Vec<(f32, f32)> = match roots(a, b, c) {
+    const ALL: (f32, f32) = (f32::NEG_INFINITY, f32::INFINITY);
+    const NONE: (f32, f32) = (f32::INFINITY, f32::NEG_INFINITY);
+    let inside: [(f32, f32); 2] = match roots(a, b, c) {
         // The quadric's inside along the line is between the roots (a > 0) or
         // outside them (a < 0: the line runs steeper than the cone's side).
-        Some((r0, r1)) if a > 0.0 => vec![(r0, r1)],
-        Some((r0, r1)) => vec![(f32::NEG_INFINITY, r0), (r1, f32::INFINITY)],
+        Some((r0, r1)) if a > 0.0 => [(r0, r1), NONE],
+        Some((r0, r1)) => [(f32::NEG_INFINITY, r0), (r1, f32::INFINITY)],
         // Linear along a line parallel to the cone's side: a half-line.
         None if a == 0.0 && b != 0.0 => {
             let t = -c / (2.0 * b);
-            vec![if b > 0.0 { (f32::NEG_INFINITY, t) } else { (t, f32::INFINITY) }]
+            [if b > 0.0 { (f32::NEG_INFINITY, t) } else { (t, f32::INFINITY) }, NONE]
         }
         // No crossing: all inside or all outside, as at any one point.
-        None if c <= 0.0 => vec![(f32::NEG_INFINITY, f32::INFINITY)],
+        None if c <= 0.0 => [ALL, NONE],
         None => return None,
     };
     let ((s0, n0), (s1, n1)) = slab;

@@ -33,6 +33,9 @@ pub struct BenchArgs {
     /// Alternating rounds of kage and llvmpipe; the best round of each is reported.
     #[arg(long, default_value_t = 5)]
     rounds: usize,
+    /// `--csg`: only these corpus models (comma-separated names; default all).
+    #[arg(long)]
+    pub models: Option<String>,
     /// Only these scenes (comma-separated names).
     #[arg(long, default_value = "sphere10k,sphere100k,sphere1m")]
     scenes: String,
