@@ -145,6 +145,29 @@ impl CsgCaster {
         scratch.stack.iter().flat_map(|s| [s.enter, s.exit]).find(|c| c.t > t_min).map(|c| self.finish(c))
     }
 
+    /// The first surface along `ray` at `t > t_min` of the union of the parts
+    /// `trees` describe (seed 003's nearest surface over segments), with
+    /// buffers reused from pixel to pixel.
+    #[must_use]
+    pub fn first_hit_in<'t>(
+        &self,
+        trees: impl IntoIterator<Item = &'t CsgTree>,
+        ray: &Ray,
+        t_min: f32,
+        scratch: &mut SpanScratch,
+    ) -> Option<Crossing> {
+        scratch.stack.clear();
+        let mut parts = 0;
+        for tree in trees {
+            combine(tree, &|i| self.raw_span(i, ray), scratch);
+            parts += 1;
+        }
+        if parts > 1 {
+            union(&mut scratch.stack, 0);
+        }
+        scratch.stack.iter().flat_map(|s| [s.enter, s.exit]).find(|c| c.t > t_min).map(|c| self.finish(c))
+    }
+
     /// The spans of `ray` inside the solid.
     #[must_use]
     pub fn spans(&self, ray: &Ray) -> Vec<Span> {

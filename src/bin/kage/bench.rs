@@ -60,6 +60,16 @@ pub struct BenchArgs {
     /// every primitive, on the OpenSCAD corpus (`../shared/assets/csg`).
     #[arg(long)]
     csg: bool,
+    /// CSG: the paper's Tables 1 and 2 on random spheres (50-300 spheres; 120
+    /// spheres in 120/60/40/30 segments) at 160x100 and 1920x1080, scanline
+    /// against naive ray casting.
+    #[arg(long)]
+    csg_random: bool,
+    /// CSG: time to image of `kage render NAME.csg` at 640x480 (a fresh process,
+    /// as OpenSCAD's preview in ../shared/peers/openscad/TIMINGS.md), and frames
+    /// per second at --width x --height when only the camera moves.
+    #[arg(long)]
+    csg_preview: bool,
     /// With --aa: write side-by-side crops (aliased | edge pass | truth) here.
     #[arg(long)]
     pub(crate) crops: Option<PathBuf>,
@@ -104,6 +114,12 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     }
     if args.csg {
         return crate::bench_csg::run(args);
+    }
+    if args.csg_random {
+        return crate::bench_csg::run_random(args);
+    }
+    if args.csg_preview {
+        return crate::bench_csg::run_preview(args);
     }
     let lp = &args.llvmpipe;
     let mut rows = Vec::new();

@@ -1,6 +1,9 @@
 //! `kage bench --csg`: seed 003's scanline visibility of CSG solids against the
 //! paper's baseline, a ray per pixel cast at every primitive, on the OpenSCAD
-//! corpus (`../shared/assets/csg`, each model with its own camera).
+//! corpus (`../shared/assets/csg`, each model with its own camera);
+//! `--csg-random`: the paper's Tables 1 and 2 on random spheres;
+//! `--csg-preview`: time to image beside OpenSCAD's preview, and frames per
+//! second when only the camera moves.
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -9,7 +12,7 @@ use std::time::Instant;
 use glam::Vec2;
 use kage::raytrace::csg::CsgCaster;
 use kage::scene::load::openscad::{load_csg, CsgOptions, Geometry};
-use kage::scene::Camera;
+use kage::scene::{Camera, CsgSolid};
 use kage::visibility::csg::scan_solid;
 use miette::{miette, Result};
 use rayon::prelude::*;
@@ -19,17 +22,7 @@ use crate::bench::BenchArgs;
 /// Runs the table.
 pub fn run(args: &BenchArgs) -> Result<()> {
     let dir = args.peers.join("../assets/csg");
-    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .map_err(|e| miette!("cannot read {}: {e}", dir.display()))?
-        .flatten()
-        .map(|e| e.path())
-        .filter(|p| p.extension().is_some_and(|e| e == "csg"))
-        .filter(|p| {
-            let name = p.file_stem().and_then(|s| s.to_str()).unwrap_or_default();
-            args.models.as_ref().is_none_or(|m| m.split(',').any(|k| k.trim() == name))
-        })
-        .collect();
-    files.sort();
+    let files = corpus(&dir, args)?;
     let (w, h) = (args.width, args.height);
     println!("| model | primitives | scanline ms | covered pixels | naive rays ms | ratio | BVH rays ms | ratio |");
     println!("|---|---:|---:|---:|---:|---:|---:|---:|");
@@ -85,6 +78,22 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     Ok(())
 }
 
+/// The corpus's `.csg` files (those `--models` names, if given), sorted.
+fn corpus(dir: &Path, args: &BenchArgs) -> Result<Vec<PathBuf>> {
+    let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map_err(|e| miette!("cannot read {}: {e}", dir.display()))?
+        .flatten()
+        .map(|e| e.path())
+        .filter(|p| p.extension().is_some_and(|e| e == "csg"))
+        .filter(|p| {
+            let name = p.file_stem().and_then(|s| s.to_str()).unwrap_or_default();
+            args.models.as_ref().is_none_or(|m| m.split(',').any(|k| k.trim() == name))
+        })
+        .collect();
+    files.sort();
+    Ok(files)
+}
+
 /// The median of `v` (0 when empty).
 fn median(v: &mut [f64]) -> f64 {
     v.sort_by(f64::total_cmp);
@@ -111,4 +120,181 @@ fn cast(camera: &Camera, w: u32, h: u32, covers: impl Fn(&kage::scene::Ray) -> b
 fn corpus_camera(dir: &Path, name: &str) -> Option<Camera> {
     let text = std::fs::read_to_string(dir.join(format!("{name}.camera.txt"))).ok()?;
     kage::scene::load::openscad::sidecar_camera(&text).map(|(camera, _, _)| camera)
+}
+
+/// A union of `segments` intersections of `per` spheres each: spheres of radius
+/// 0.25–0.45 scattered in the cube [−2, 2]³, each segment's spheres within 0.2
+/// of a common centre so that their intersection is not empty.
+fn random_spheres(seed: u64, segments: usize, per: usize) -> CsgSolid {
+    use kage::scene::csg::{CsgTree, Primitive, Shape};
+    let mut state = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1;
+    let mut unit = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 40) as f32 / (1u64 << 24) as f32
+    };
+    let mut primitives = Vec::new();
+    let mut kids = Vec::new();
+    for _ in 0..segments {
+        let centre = glam::Vec3::new(unit(), unit(), unit()) * 4.0 - 2.0;
+        let members = (0..per)
+            .map(|_| {
+                let jitter = (glam::Vec3::new(unit(), unit(), unit()) - 0.5) * 0.4;
+                let r = 0.25 + 0.2 * unit();
+                let transform = glam::Affine3A::from_scale_rotation_translation(
+                    glam::Vec3::splat(r),
+                    glam::Quat::IDENTITY,
+                    centre + jitter,
+                );
+                primitives.push(Primitive { shape: Shape::Sphere, transform, color: None, source: 0..0 });
+                CsgTree::Leaf(primitives.len() - 1)
+            })
+            .collect::<Vec<_>>();
+        kids.push(if per == 1 { members.into_iter().next().expect("one") } else { CsgTree::Intersection(members) });
+    }
+    CsgSolid { primitives, tree: Some(CsgTree::Union(kids)) }
+}
+
+/// The paper's Tables 1 (random spheres) and 2 (120 spheres in fewer, larger
+/// segments): scanline and naive ray casting, at the paper's 160x100 and at
+/// 1920x1080.
+pub fn run_random(args: &BenchArgs) -> Result<()> {
+    let camera = Camera {
+        eye: glam::Vec3::new(0.0, 0.0, 9.0),
+        target: glam::Vec3::ZERO,
+        up: glam::Vec3::Y,
+        near: 0.1,
+        far: 100.0,
+        projection: kage::scene::Projection::Perspective { fov_y_deg: 40.0 },
+        shift: Vec2::ZERO,
+    };
+    let tables = [
+        ("Table 1: random spheres", vec![(50, 1), (100, 1), (200, 1), (300, 1)]),
+        ("Table 2: 120 spheres in segments", vec![(120, 1), (60, 2), (40, 3), (30, 4)]),
+    ];
+    for (title, rows) in tables {
+        println!("\n{title}\n");
+        println!("| spheres | segments | size | scanline ms | naive rays ms | ratio |");
+        println!("|---:|---:|---|---:|---:|---:|");
+        for (segments, per) in rows {
+            let solid = random_spheres(segments as u64 * 31 + per as u64, segments, per);
+            for (w, h) in [(160, 100), (1920, 1080)] {
+                let scan_ms = best_of(args.frames.max(1), || scan_solid(&solid, &camera, w, h));
+                let caster = CsgCaster::new(&solid);
+                let (naive_ms, _) =
+                    timed(|| cast(&camera, w, h, |ray| caster.first_hit_every_primitive(ray, 0.0).is_some()));
+                println!(
+                    "| {} | {segments} | {w}x{h} | {scan_ms:.1} | {naive_ms:.0} | {:.0} |",
+                    segments * per,
+                    naive_ms / scan_ms
+                );
+            }
+        }
+    }
+    println!(
+        "\nScanline: best of {} frames; naive rays: one frame, every sphere's interval at every pixel, then the \
+         booleans. {} threads. The paper (160x100, i80286): 50 spheres 73x, 300 spheres 108x; 120 spheres in 30 \
+         segments 225x.",
+        args.frames.max(1),
+        rayon::current_num_threads()
+    );
+    Ok(())
+}
+
+/// The fastest of `n` runs of `f`, in milliseconds.
+fn best_of<T>(n: usize, mut f: impl FnMut() -> T) -> f64 {
+    (0..n).map(|_| timed(&mut f).0).fold(f64::INFINITY, f64::min)
+}
+
+/// OpenSCAD's preview seconds per model, from the peers' TIMINGS.md table.
+fn openscad_preview_seconds(peers: &Path) -> std::collections::HashMap<String, f64> {
+    let text = std::fs::read_to_string(peers.join("openscad/TIMINGS.md")).unwrap_or_default();
+    text.lines()
+        .filter_map(|l| {
+            let cells: Vec<&str> = l.split('|').map(str::trim).collect();
+            // | model | set | prims | normalized | preview s | ...
+            Some((cells.get(1)?.to_string(), cells.get(5)?.parse().ok()?))
+        })
+        .collect()
+}
+
+/// Time to image of `kage render NAME.csg` (a fresh process, 640x480, median of
+/// three) beside OpenSCAD's preview, and frames per second of a viewer whose
+/// camera orbits the model, with and without shadows.
+pub fn run_preview(args: &BenchArgs) -> Result<()> {
+    let dir = args.peers.join("../assets/csg");
+    let openscad = openscad_preview_seconds(&args.peers);
+    let exe = std::env::current_exe().map_err(|e| miette!("{e}"))?;
+    let out = std::env::temp_dir().join(format!("kage-bench-{}.png", std::process::id()));
+    let (w, h) = (args.width, args.height);
+    println!(
+        "| model | kage s (640x480, process) | OpenSCAD preview s | OpenSCAD / kage | fps {w}x{h} | fps, no shadows |"
+    );
+    println!("|---|---:|---:|---:|---:|---:|");
+    let (mut ratios, mut fps_all) = (Vec::new(), Vec::new());
+    for path in corpus(&dir, args)? {
+        let name = path.file_stem().and_then(|s| s.to_str()).unwrap_or_default().to_string();
+        let mut runs: Vec<f64> = (0..3)
+            .map(|_| {
+                let t = Instant::now();
+                let status = std::process::Command::new(&exe)
+                    .args(["render", "--width", "640", "--height", "480", "-o"])
+                    .arg(&out)
+                    .arg(&path)
+                    .arg("--skip-unsupported")
+                    .stderr(std::process::Stdio::null())
+                    .status();
+                status.is_ok_and(|s| s.success()).then(|| t.elapsed().as_secs_f64())
+            })
+            .collect::<Option<_>>()
+            .ok_or_else(|| miette!("kage render {} failed", path.display()))?;
+        let kage_s = median(&mut runs);
+        let theirs = openscad.get(&name).copied();
+        let options = CsgOptions { geometry: Geometry::Exact, skip_unsupported: true };
+        let scene = kage::scene::file::scene_for_model_with(&path, w, h, &options).map_err(|e| miette!("{e}"))?;
+        let fps = orbit_fps(&scene, args.frames.max(3))?;
+        let mut plain = scene.clone();
+        plain.lights.iter_mut().for_each(|l| l.shadow = kage::scene::ShadowSettings::NONE);
+        let fps_plain = orbit_fps(&plain, args.frames.max(3))?;
+        fps_all.push(fps_plain);
+        let ratio = theirs.map(|t| t / kage_s);
+        ratios.extend(ratio);
+        println!(
+            "| {name} | {kage_s:.2} | {} | {} | {fps:.1} | {fps_plain:.1} |",
+            theirs.map_or("-".into(), |t| format!("{t:.2}")),
+            ratio.map_or("-".into(), |r| format!("{r:.1}"))
+        );
+    }
+    std::fs::remove_file(&out).ok();
+    println!(
+        "\nkage: `kage render NAME.csg --width 640 --height 480` (exact quadrics, lit, shadowed, on a ground), wall \
+         clock of the whole process, median of 3. OpenSCAD 2021.01: its preview PNG at 640x480 (no shadows), from \
+         ../shared/peers/openscad/TIMINGS.md (same machine type). Orbit: the camera turns 3° about the model per \
+         frame, median of {} frames of a reused renderer ({} threads). Medians: OpenSCAD / kage {:.1}, fps without \
+         shadows {:.1}.",
+        args.frames.max(3),
+        rayon::current_num_threads(),
+        median(&mut ratios),
+        median(&mut fps_all)
+    );
+    Ok(())
+}
+
+/// Frames per second of a renderer re-rendering `scene` as its camera orbits
+/// the target (3° per frame about the z axis): the median frame.
+fn orbit_fps(scene: &kage::scene::Scene, frames: usize) -> Result<f64> {
+    let mut renderer = kage::Renderer::new(&kage::RenderOptions::default()).map_err(|e| miette!("{e}"))?;
+    let mut scene = scene.clone();
+    let turn = glam::Affine3A::from_translation(scene.camera.target)
+        * glam::Affine3A::from_rotation_z(3f32.to_radians())
+        * glam::Affine3A::from_translation(-scene.camera.target);
+    let mut times = Vec::new();
+    for _ in 0..frames {
+        scene.camera.eye = turn.transform_point3(scene.camera.eye);
+        let t = Instant::now();
+        renderer.render(&scene).map_err(|e| miette!("{e}"))?;
+        times.push(t.elapsed().as_secs_f64());
+    }
+    Ok(1.0 / median(&mut times))
 }
