@@ -910,8 +910,8 @@ pub fn scene_for_model(path: &Path, width: u32, height: u32) -> Result<Scene> {
 /// A scene showing one model file, framed automatically, reading `.csg` files
 /// with `csg`. An OpenSCAD model (z up) is seen from its camera sidecar or
 /// OpenSCAD's default view, lit from above by the same rig as other models
-/// turned z-up, and stands on a ground that catches its shadows (left out
-/// when the camera looks from below it).
+/// turned z-up (only the key light casts shadows), and stands on a ground that
+/// catches its shadows (left out when the camera looks from below it).
 pub fn scene_for_model_with(path: &Path, width: u32, height: u32, csg: &CsgOptions) -> Result<Scene> {
     let base = path.parent().unwrap_or(Path::new(".")).to_path_buf();
     let fs = load::FileSystem { base };
@@ -943,6 +943,12 @@ pub fn scene_for_model_with(path: &Path, width: u32, height: u32, csg: &CsgOptio
             * Affine3A::from_rotation_x(std::f32::consts::FRAC_PI_2)
             * Affine3A::from_translation(-centre);
         lights.iter_mut().for_each(|l| l.kind = l.kind.transformed(&z_up));
+        // Shadow maps are drawn by the same scanline walk as the view, texel by
+        // texel: the key light's four jittered maps at 512² (their average hides
+        // the coarser texels) and none for the fill light, whose map fitted to
+        // the whole view would cost more than the rest of the frame.
+        lights[0].shadow.resolution = 1024;
+        lights.iter_mut().skip(1).for_each(|l| l.shadow = ShadowSettings::NONE);
         add_ground(&mut scene, bounds);
     }
     scene.lights = if model.lights.is_empty() { lights } else { model.lights.clone() };

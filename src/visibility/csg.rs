@@ -512,12 +512,16 @@ fn hull_row(hull: &[DVec2], y: f64) -> Option<(f64, f64)> {
 }
 
 /// The pixels whose centres the projection of `points` can cover; the whole
-/// image if a point lies at or behind the eye; `None` if off screen.
+/// image if some point lies at or behind the eye; `None` if off screen or all
+/// behind the eye (the points' hull then lies in the half-space behind it).
 fn extent(points: &[Vec3], vp: Mat4, width: u32, height: u32) -> Option<Extent> {
     let (w, h) = (f64::from(width), f64::from(height));
+    let clip: Vec<Vec4> = points.iter().map(|p| vp * p.extend(1.0)).collect();
+    if clip.iter().all(|c| c.w <= 0.0) {
+        return None; // wholly behind the eye (a cube-map face looking away)
+    }
     let (mut lo, mut hi) = (glam::DVec2::splat(f64::INFINITY), glam::DVec2::splat(f64::NEG_INFINITY));
-    for p in points {
-        let c: Vec4 = vp * p.extend(1.0);
+    for c in clip {
         if c.w <= 1e-6 {
             return Some(Extent { x0: 0, x1: i64::from(width) - 1, y0: 0, y1: i64::from(height) - 1 });
         }
