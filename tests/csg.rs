@@ -178,6 +178,9 @@ fn the_scanline_walk_finds_what_a_ray_per_pixel_finds() {
             shift: glam::Vec2::ZERO,
         };
         let scanned = scan_solid(&solid, &camera, w, h);
+        // The paper's pattern matrix finds the same surfaces.
+        let method = kage::visibility::csg::CsgMethod::PatternMatrix { limit: 100_000 };
+        let expanded = kage::visibility::csg::scan_solid_with(&solid, &camera, w, h, method).unwrap();
         let rays = camera.pixel_rays(glam::Vec2::new(w as f32, h as f32));
         for y in 0..h {
             for x in 0..w {
@@ -186,6 +189,15 @@ fn the_scanline_walk_finds_what_a_ray_per_pixel_finds() {
                 let near = camera.distance_at_depth(&ray, 1.0);
                 let cast = first_hit(&solid, &ray, near, f32::INFINITY);
                 let got = scanned[(y * w + x) as usize];
+                let paper = expanded[(y * w + x) as usize];
+                assert_eq!(
+                    got.map(|c| c.primitive),
+                    paper.map(|c| c.primitive),
+                    "({x}, {y}) round {round}: pattern matrix"
+                );
+                if let (Some(a), Some(b)) = (got, paper) {
+                    assert!((a.t - b.t).abs() <= 1e-5 * a.t.abs().max(1.0), "({x}, {y}): {a:?} vs {b:?}");
+                }
                 pixels += 1;
                 covered += usize::from(cast.is_some());
                 match (got, cast) {

@@ -168,6 +168,64 @@ impl CsgCaster {
         scratch.stack.iter().flat_map(|s| [s.enter, s.exit]).find(|c| c.t > t_min).map(|c| self.finish(c))
     }
 
+    /// [`CsgCaster::span`] with normals not yet carried to solid space: only
+    /// `t` matters for combining; [`CsgCaster::first_hit_of_segments`] finishes
+    /// the crossing it returns.
+    #[must_use]
+    pub fn raw_span_of(&self, i: usize, ray: &Ray) -> Option<Span> {
+        self.raw_span(i, ray)
+    }
+
+    /// The first surface beyond `t_min` of a union of pattern-matrix segments
+    /// (seed 003 §5.2.1): per segment, the intersection of its positive
+    /// primitives' intervals minus the intervals of its negative primitives
+    /// that `occupying` says cover the pixel; the nearest over the segments.
+    /// `span` gives a primitive's raw span ([`CsgCaster::raw_span_of`], cached
+    /// by the caller).
+    pub fn first_hit_of_segments<'s>(
+        &self,
+        segments: impl IntoIterator<Item = &'s crate::visibility::pattern::Segment>,
+        occupying: &impl Fn(usize) -> bool,
+        span: &mut impl FnMut(usize) -> Option<Span>,
+        t_min: f32,
+        scratch: &mut SpanScratch,
+    ) -> Option<Crossing> {
+        scratch.stack.clear();
+        let mut parts = 0;
+        'segments: for seg in segments {
+            let mut inside: Option<Span> = None;
+            for &i in &seg.positive {
+                let Some(s) = span(i) else { continue 'segments };
+                inside = Some(match inside {
+                    None => s,
+                    Some(a) => Span {
+                        enter: if a.enter.t >= s.enter.t { a.enter } else { s.enter },
+                        exit: if a.exit.t <= s.exit.t { a.exit } else { s.exit },
+                    },
+                });
+            }
+            let Some(inside) = inside.filter(|s| s.enter.t < s.exit.t) else { continue };
+            let base = scratch.stack.len();
+            scratch.stack.push(inside);
+            for &i in seg.negative.iter().filter(|&&i| occupying(i)) {
+                let Some(cut) = span(i) else { continue };
+                let SpanScratch { stack, out, .. } = scratch;
+                out.clear();
+                difference(&stack[base..], &[cut], out);
+                stack.truncate(base);
+                stack.extend_from_slice(out);
+                if stack.len() == base {
+                    break;
+                }
+            }
+            parts += 1;
+        }
+        if parts > 1 {
+            union(&mut scratch.stack, 0);
+        }
+        scratch.stack.iter().flat_map(|s| [s.enter, s.exit]).find(|c| c.t > t_min).map(|c| self.finish(c))
+    }
+
     /// The spans of `ray` inside the solid.
     #[must_use]
     pub fn spans(&self, ray: &Ray) -> Vec<Span> {

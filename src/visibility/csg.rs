@@ -43,6 +43,7 @@ use crate::raytrace::csg::{Crossing, CsgCaster, SpanScratch};
 use crate::scene::camera::PixelRays;
 use crate::scene::csg::{CsgSolid, CsgTree, Primitive, Shape};
 use crate::scene::{Camera, Ray, Scene};
+use crate::visibility::pattern::{PatternMatrix, TooManySegments};
 use crate::visibility::{ItemId, VisibilityBuffer};
 
 /// Rows scanned by one worker in turn.
@@ -66,13 +67,59 @@ struct Extent {
 /// crossing beyond the near plane, or `None`.
 #[must_use]
 pub fn scan_solid(solid: &CsgSolid, camera: &Camera, width: u32, height: u32) -> Vec<Option<Crossing>> {
+    scan_solid_with(solid, camera, width, height, CsgMethod::Segments).expect("segments need no expansion")
+}
+
+/// How a scanline's pixels find their surface.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CsgMethod {
+    /// The tree's own segments, cut down to the occupants (the default; no
+    /// expansion).
+    Segments,
+    /// The paper's pattern matrix ([`super::pattern`]), expanded up to `limit`
+    /// segments.
+    PatternMatrix {
+        /// Most segments the expansion may make.
+        limit: usize,
+    },
+}
+
+/// [`scan_solid`] by `method`; fails when the pattern matrix would pass its
+/// limit.
+pub fn scan_solid_with(
+    solid: &CsgSolid,
+    camera: &Camera,
+    width: u32,
+    height: u32,
+    method: CsgMethod,
+) -> Result<Vec<Option<Crossing>>, TooManySegments> {
     let (w, h) = (width as usize, height as usize);
     let mut out = vec![None; w * h];
+    let walker = RowWalker::new(solid, method)?;
     let bands = out.par_chunks_mut(w * BAND_ROWS);
-    scan_bands(solid, camera, (width, height), bands, |band, dy, row| {
+    scan_bands(solid, &walker, camera, (width, height), bands, |band, dy, row| {
         band[dy * w..(dy + 1) * w].copy_from_slice(row);
     });
-    out
+    Ok(out)
+}
+
+/// What walks a scanline's pixels.
+enum RowWalker {
+    Segments(Segments),
+    Pattern(PatternMatrix),
+    /// A solid with no volume.
+    Empty,
+}
+
+impl RowWalker {
+    fn new(solid: &CsgSolid, method: CsgMethod) -> Result<RowWalker, TooManySegments> {
+        let n = solid.primitives.len();
+        let Some(tree) = &solid.tree else { return Ok(RowWalker::Empty) };
+        Ok(match method {
+            CsgMethod::Segments => RowWalker::Segments(Segments::new(tree, n)),
+            CsgMethod::PatternMatrix { limit } => RowWalker::Pattern(PatternMatrix::expand(tree, n, limit)?),
+        })
+    }
 }
 
 /// Draws every solid of `scene` seen by `camera` into `vb` (after its
@@ -99,7 +146,8 @@ pub fn draw_solids(scene: &Scene, camera: &Camera, vb: &mut VisibilityBuffer) ->
             .map(|d| (d, items.next().unwrap_or(&mut []), normals.next().unwrap_or(&mut [])))
             .collect();
         let bands = bands.into_par_iter().enumerate();
-        scan_bands(&world, camera, (width, height), bands, |(band, (depth, items, normals)), dy, row| {
+        let walker = RowWalker::new(&world, CsgMethod::Segments).expect("segments need no expansion");
+        scan_bands(&world, &walker, camera, (width, height), bands, |(band, (depth, items, normals)), dy, row| {
             let y = *band * BAND_ROWS + dy;
             for (x, c) in row.iter().enumerate().filter_map(|(x, c)| Some((x, c.as_ref()?))) {
                 let point = rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5)).at(c.t);
@@ -125,13 +173,16 @@ pub fn draw_solids(scene: &Scene, camera: &Camera, vb: &mut VisibilityBuffer) ->
 /// visible crossings.
 fn scan_bands<B: Send>(
     solid: &CsgSolid,
+    walker: &RowWalker,
     camera: &Camera,
     (width, height): (u32, u32),
     bands: impl IndexedParallelIterator<Item = B>,
     visit: impl Fn(&mut B, usize, &[Option<Crossing>]) + Sync,
 ) {
     let (w, h) = (width as usize, height as usize);
-    let Some(tree) = &solid.tree else { return };
+    if matches!(walker, RowWalker::Empty) {
+        return;
+    }
     let vp = camera.view_projection(width as f32 / height as f32);
     let rays = camera.pixel_rays(Vec2::new(width as f32, height as f32));
     let outlines: Vec<Option<Outline>> = solid.primitives.iter().map(|p| Outline::new(p, vp, &rays)).collect();
@@ -140,7 +191,6 @@ fn scan_bands<B: Send>(
         outlines.iter().enumerate().filter_map(|(i, o)| o.as_ref().map(|o| (i, o.rows))).collect();
     entry.sort_by_key(|(_, e)| e.y0);
     let caster = CsgCaster::new(solid);
-    let segments = Segments::new(tree, solid.primitives.len());
     // Depth 1 is the near plane, under either projection.
     let near = |ray: &Ray| camera.distance_at_depth(ray, 1.0);
     bands.enumerate().for_each_init(
@@ -165,14 +215,12 @@ fn scan_bands<B: Send>(
                     .filter_map(|&(i, _)| outlines[i].as_ref()?.columns(y).map(|(a, b)| (i, a, b)))
                     .collect();
                 row.fill(None);
-                scan_row(
-                    &caster,
-                    &segments,
-                    &ends,
-                    |x| rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5)),
-                    &near,
-                    row,
-                );
+                let ray_at = |x: usize| rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
+                match walker {
+                    RowWalker::Segments(segments) => scan_row(&caster, segments, &ends, ray_at, &near, row),
+                    RowWalker::Pattern(matrix) => matrix.walk_row(&caster, &ends, ray_at, &near, row),
+                    RowWalker::Empty => {}
+                }
                 visit(&mut out, dy, row);
             }
         },

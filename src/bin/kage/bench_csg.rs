@@ -13,7 +13,8 @@ use glam::Vec2;
 use kage::raytrace::csg::CsgCaster;
 use kage::scene::load::openscad::{load_csg, CsgOptions, Geometry};
 use kage::scene::{Camera, CsgSolid};
-use kage::visibility::csg::scan_solid;
+use kage::visibility::csg::{scan_solid, scan_solid_with, CsgMethod};
+use kage::visibility::pattern::PatternMatrix;
 use miette::{miette, Result};
 use rayon::prelude::*;
 
@@ -24,8 +25,11 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     let dir = args.peers.join("../assets/csg");
     let files = corpus(&dir, args)?;
     let (w, h) = (args.width, args.height);
-    println!("| model | primitives | scanline ms | covered pixels | naive rays ms | ratio | BVH rays ms | ratio |");
-    println!("|---|---:|---:|---:|---:|---:|---:|---:|");
+    println!(
+        "| model | primitives | scanline ms | covered pixels | naive rays ms | ratio | BVH rays ms | ratio | \
+         pattern matrix: segments, ms |"
+    );
+    println!("|---|---:|---:|---:|---:|---:|---:|---:|---|");
     let (mut ratios, mut bvh_ratios) = (Vec::new(), Vec::new());
     for path in &files {
         let name = path.file_stem().and_then(|s| s.to_str()).unwrap_or_default();
@@ -46,6 +50,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         }
         times.sort_by(f64::total_cmp);
         let scan_ms = times[times.len() / 2];
+        let pattern = pattern_cell(&solid, &camera, w, h, args.frames.max(1));
         let caster = CsgCaster::new(&solid);
         let near = |ray: &kage::scene::Ray| camera.distance_at_depth(ray, 1.0);
         let (naive_ms, naive_covered) =
@@ -58,7 +63,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         ratios.push(naive_ms / scan_ms);
         bvh_ratios.push(bvh_ms / scan_ms);
         println!(
-            "| {name} | {} | {scan_ms:.1} | {covered} | {naive_ms:.0} | {:.1} | {bvh_ms:.0} | {:.1} |",
+            "| {name} | {} | {scan_ms:.1} | {covered} | {naive_ms:.0} | {:.1} | {bvh_ms:.0} | {:.1} | {pattern} |",
             solid.primitives.len(),
             naive_ms / scan_ms,
             bvh_ms / scan_ms
@@ -92,6 +97,22 @@ fn corpus(dir: &Path, args: &BenchArgs) -> Result<Vec<PathBuf>> {
         .collect();
     files.sort();
     Ok(files)
+}
+
+/// Most segments the pattern-matrix column expands (OpenSCAD's own limit).
+const PATTERN_LIMIT: usize = 100_000;
+
+/// The pattern-matrix walk's cell: its number of segments and median time, or
+/// where the expansion stopped.
+fn pattern_cell(solid: &CsgSolid, camera: &Camera, w: u32, h: u32, frames: usize) -> String {
+    let Some(tree) = &solid.tree else { return "empty".into() };
+    let matrix = match PatternMatrix::expand(tree, solid.primitives.len(), PATTERN_LIMIT) {
+        Ok(m) => m,
+        Err(e) => return format!("> {} segments", e.limit),
+    };
+    let method = CsgMethod::PatternMatrix { limit: PATTERN_LIMIT };
+    let mut times: Vec<f64> = (0..frames).map(|_| timed(|| scan_solid_with(solid, camera, w, h, method)).0).collect();
+    format!("{}, {:.1}", matrix.segments.len(), median(&mut times))
 }
 
 /// The median of `v` (0 when empty).
@@ -175,17 +196,19 @@ pub fn run_random(args: &BenchArgs) -> Result<()> {
     ];
     for (title, rows) in tables {
         println!("\n{title}\n");
-        println!("| spheres | segments | size | scanline ms | naive rays ms | ratio |");
-        println!("|---:|---:|---|---:|---:|---:|");
+        println!("| spheres | segments | size | scanline ms | naive rays ms | ratio | pattern matrix ms |");
+        println!("|---:|---:|---|---:|---:|---:|---:|");
         for (segments, per) in rows {
             let solid = random_spheres(segments as u64 * 31 + per as u64, segments, per);
             for (w, h) in [(160, 100), (1920, 1080)] {
                 let scan_ms = best_of(args.frames.max(1), || scan_solid(&solid, &camera, w, h));
+                let method = CsgMethod::PatternMatrix { limit: PATTERN_LIMIT };
+                let pattern_ms = best_of(args.frames.max(1), || scan_solid_with(&solid, &camera, w, h, method));
                 let caster = CsgCaster::new(&solid);
                 let (naive_ms, _) =
                     timed(|| cast(&camera, w, h, |ray| caster.first_hit_every_primitive(ray, 0.0).is_some()));
                 println!(
-                    "| {} | {segments} | {w}x{h} | {scan_ms:.1} | {naive_ms:.0} | {:.0} |",
+                    "| {} | {segments} | {w}x{h} | {scan_ms:.1} | {naive_ms:.0} | {:.0} | {pattern_ms:.1} |",
                     segments * per,
                     naive_ms / scan_ms
                 );
