@@ -190,6 +190,31 @@ impl Ray {
     }
 }
 
+/// The rays through the pixel centres of one image row as affine functions of
+/// the column `x`: origin `origin + x·origin_step`, direction `dir +
+/// x·dir_step`, the direction NOT normalised — its component along the view
+/// axis is 1, so a distance `t` along it is the view-axis distance from the
+/// eye (perspective) or the eye plane (orthographic).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct RowLine {
+    /// Origin of column 0's ray.
+    pub origin: Vec3,
+    /// Change of the origin per column (orthographic; zero in perspective).
+    pub origin_step: Vec3,
+    /// Direction of column 0's ray.
+    pub dir: Vec3,
+    /// Change of the direction per column (perspective; zero orthographic).
+    pub dir_step: Vec3,
+}
+
+impl RowLine {
+    /// Column `x`'s ray, direction not normalised.
+    #[must_use]
+    pub fn at(&self, x: f32) -> Ray {
+        Ray { origin: self.origin + self.origin_step * x, dir: self.dir + self.dir_step * x }
+    }
+}
+
 /// Rays through the pixels of one image (see [`Camera::pixel_rays`]).
 #[derive(Debug, Clone, Copy)]
 pub struct PixelRays {
@@ -209,6 +234,19 @@ pub struct PixelRays {
 }
 
 impl PixelRays {
+    /// Row `y`'s pixel-centre rays as a [`RowLine`].
+    #[must_use]
+    pub fn row_line(&self, y: usize) -> RowLine {
+        let v = 1.0 - 2.0 * (y as f32 + 0.5) / self.size.y;
+        let step = self.right * (2.0 / self.size.x);
+        let first = self.right * (1.0 / self.size.x - 1.0) + self.up * v;
+        if self.ortho {
+            RowLine { origin: self.origin + first, origin_step: step, dir: self.forward, dir_step: Vec3::ZERO }
+        } else {
+            RowLine { origin: self.origin, origin_step: Vec3::ZERO, dir: self.forward + first, dir_step: step }
+        }
+    }
+
     /// The ray through image point `pixel`; unit direction.
     #[must_use]
     pub fn ray(&self, pixel: Vec2) -> Ray {

@@ -39,10 +39,11 @@ use glam::{DVec2, Mat4, Vec2, Vec3, Vec4};
 use rayon::iter::IndexedParallelIterator;
 use rayon::prelude::*;
 
-use crate::raytrace::csg::{Crossing, CsgCaster, SpanScratch};
+use crate::raytrace::csg::{Crossing, CsgCaster, Span, SpanScratch};
 use crate::scene::camera::PixelRays;
+use crate::scene::camera::RowLine;
 use crate::scene::csg::{CsgSolid, CsgTree, Primitive, Shape};
-use crate::scene::{Camera, Ray, Scene};
+use crate::scene::{Camera, Scene};
 use crate::visibility::pattern::{PatternMatrix, TooManySegments};
 use crate::visibility::{ItemId, VisibilityBuffer};
 
@@ -191,11 +192,12 @@ fn scan_bands<B: Send>(
         outlines.iter().enumerate().filter_map(|(i, o)| o.as_ref().map(|o| (i, o.rows))).collect();
     entry.sort_by_key(|(_, e)| e.y0);
     let caster = CsgCaster::new(solid);
-    // Depth 1 is the near plane, under either projection.
-    let near = |ray: &Ray| camera.distance_at_depth(ray, 1.0);
+    // Along a row line's direction (unit component along the view axis), the
+    // near plane lies at t = near, under either projection.
+    let near = camera.near;
     bands.enumerate().for_each_init(
-        || vec![None; w],
-        |row, (band, mut out)| {
+        || (vec![None; w], vec![RowLine::default(); solid.primitives.len()]),
+        |(row, lines), (band, mut out)| {
             let first = (band * BAND_ROWS) as i64;
             // The y-occupancy list as the band's first scanline finds it, then kept
             // row by row.
@@ -215,11 +217,19 @@ fn scan_bands<B: Send>(
                     .filter_map(|&(i, _)| outlines[i].as_ref()?.columns(y).map(|(a, b)| (i, a, b)))
                     .collect();
                 row.fill(None);
-                let ray_at = |x: usize| rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
+                // The row's rays, carried into each occupant's unit space once.
+                let line = rays.row_line(y as usize);
+                ends.iter().for_each(|&(i, _, _)| lines[i] = caster.unit_line(i, &line));
+                let span = |i: usize, x: usize| caster.span_on(i, &lines[i], x as f32);
                 match walker {
-                    RowWalker::Segments(segments) => scan_row(&caster, segments, &ends, ray_at, &near, row),
-                    RowWalker::Pattern(matrix) => matrix.walk_row(&caster, &ends, ray_at, &near, row),
+                    RowWalker::Segments(segments) => scan_row(&caster, segments, &ends, &span, near, row),
+                    RowWalker::Pattern(matrix) => matrix.walk_row(&caster, &ends, &span, near, row),
                     RowWalker::Empty => {}
+                }
+                // Distances along the unnormalised row line become distances
+                // along the unit pixel ray.
+                for (x, c) in row.iter_mut().enumerate().filter_map(|(x, c)| Some((x, c.as_mut()?))) {
+                    c.t *= line.at(x as f32).dir.length();
                 }
                 visit(&mut out, dy, row);
             }
@@ -330,8 +340,8 @@ fn scan_row(
     caster: &CsgCaster,
     segments: &Segments,
     ends: &[(usize, i64, i64)],
-    ray_at: impl Fn(usize) -> Ray,
-    near: &impl Fn(&Ray) -> f32,
+    span: &impl Fn(usize, usize) -> Option<Span>,
+    near: f32,
     row: &mut [Option<Crossing>],
 ) {
     let mut entry: Vec<(usize, i64, i64)> = ends.to_vec();
@@ -349,8 +359,7 @@ fn scan_row(
         }
         cuts.update();
         if !cuts.visible.is_empty() {
-            let ray = ray_at(x);
-            *px = caster.first_hit_in(cuts.visible(), &ray, near(&ray), &mut scratch);
+            *px = caster.first_hit_in_by(cuts.visible(), &|i| span(i, x), near, &mut scratch);
         }
         // Primitives whose right end is this pixel leave the x-occupancy list.
         while next_out < exit.len() && exit[next_out].2 <= x as i64 {

@@ -23,9 +23,8 @@
 //! of its positive primitives' intervals minus its flagged negative ones', and the
 //! pixel's surface is the nearest over the visible segments.
 
-use crate::raytrace::csg::{Crossing, CsgCaster, SpanScratch};
+use crate::raytrace::csg::{Crossing, CsgCaster, Span, SpanScratch};
 use crate::scene::csg::CsgTree;
-use crate::scene::Ray;
 
 /// One segment: an intersection of positive primitives and complements of
 /// negative ones (indices into the solid's primitives, sorted).
@@ -77,8 +76,8 @@ impl PatternMatrix {
         &self,
         caster: &CsgCaster,
         ends: &[(usize, i64, i64)],
-        ray_at: impl Fn(usize) -> Ray,
-        near: &impl Fn(&Ray) -> f32,
+        span: &impl Fn(usize, usize) -> Option<Span>,
+        near: f32,
         row: &mut [Option<Crossing>],
     ) {
         let n = self.positive_in.len();
@@ -116,13 +115,12 @@ impl PatternMatrix {
                 next_in += 1;
             }
             if !visible.is_empty() {
-                let ray = ray_at(x);
                 spans.next_pixel();
                 *px = caster.first_hit_of_segments(
                     visible.iter().map(|&s| &self.segments[s]),
                     &|i| flagged[i],
-                    &mut |i| spans.get(caster, i, &ray),
-                    near(&ray),
+                    &mut |i| spans.get(i, || span(i, x)),
+                    near,
                     &mut scratch,
                 );
             }
@@ -154,7 +152,7 @@ impl PatternMatrix {
 /// paper's own named defect, paid for here by a per-pixel cache).
 struct PixelSpans {
     stamp: Vec<u32>,
-    spans: Vec<Option<crate::raytrace::csg::Span>>,
+    spans: Vec<Option<Span>>,
     pixel: u32,
 }
 
@@ -167,10 +165,10 @@ impl PixelSpans {
         self.pixel += 1;
     }
 
-    fn get(&mut self, caster: &CsgCaster, i: usize, ray: &Ray) -> Option<crate::raytrace::csg::Span> {
+    fn get(&mut self, i: usize, span: impl FnOnce() -> Option<Span>) -> Option<Span> {
         if self.stamp[i] != self.pixel {
             self.stamp[i] = self.pixel;
-            self.spans[i] = caster.raw_span_of(i, ray);
+            self.spans[i] = span();
         }
         self.spans[i]
     }
