@@ -48,6 +48,9 @@ pub struct FrameStats {
     pub shadow_ms: f64,
     /// Most bytes the shadow maps of one light held.
     pub shadow_bytes: usize,
+    /// Lights whose shadow maps came from the previous frame or pass (nothing
+    /// they depend on changed), summed over passes.
+    pub shadow_maps_reused: usize,
     /// Shading passes run (summed over jittered passes).
     pub shading_passes: u32,
     /// Milliseconds in the shading passes (shadow maps aside).
@@ -272,6 +275,7 @@ fn render_pass(scene: &Scene, frame: &mut Frame, scratch: &mut Scratch, ray_dept
     frame.stats.visibility_ms += (t1 - t0).as_secs_f64() * 1e3;
     frame.stats.shading_ms += ((t2 - t1) + t3.elapsed()).as_secs_f64() * 1e3 - lit.shadow_ms;
     frame.stats.shadow_ms += lit.shadow_ms;
+    frame.stats.shadow_maps_reused += lit.maps_reused;
     frame.stats.shadow_bytes = frame.stats.shadow_bytes.max(lit.shadow_bytes);
     frame.stats.shading_passes += lit.passes;
     frame.stats.traced_ms += (t3 - t2).as_secs_f64() * 1e3;

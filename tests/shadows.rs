@@ -239,3 +239,35 @@ fn jittered_area_lights_approach_the_reference_penumbra() {
         hard.share_over
     );
 }
+
+/// A renderer keeps last frame's shadow maps while only the camera moves (the
+/// viewer's case): the point light's jittered maps are reused, the directional
+/// light's map (fitted to the view) is not, and every frame equals a fresh
+/// render; moving an object drops them all.
+#[test]
+fn shadow_maps_are_reused_while_only_the_camera_moves() {
+    let mut scene = kage::scene::demo::demo_scene().unwrap();
+    (scene.width, scene.height) = (160, 90);
+    let point_maps = kage::shading::frame_lights(&scene)
+        .iter()
+        .filter(|l| matches!(l.kind, LightKind::Point { .. }) && l.shadow.method != kage::scene::ShadowMethod::None)
+        .count();
+    assert!(point_maps >= 2, "the demo's key light is a sized point light");
+    let mut renderer = kage::Renderer::new(&RenderOptions::default()).unwrap();
+    renderer.render(&scene).unwrap();
+    let orbit = Affine3A::from_rotation_y(0.1);
+    scene.camera.eye = orbit.transform_point3(scene.camera.eye);
+    let frame = renderer.render(&scene).unwrap().clone();
+    assert_eq!(frame.stats.shadow_maps_reused, point_maps, "only the point light's maps carry over");
+    assert!(frame.image.pixels() == render(&scene, &RenderOptions::default()).unwrap().image.pixels());
+    // An object moved within the scene's bounds: only the geometry says the
+    // maps are stale.
+    let bounds = scene.bounds();
+    let last = scene.objects.len() - 1;
+    scene.objects[last].transform =
+        Affine3A::from_translation(Vec3::new(0.1, 0.0, 0.0)) * scene.objects[last].transform;
+    assert_eq!(scene.bounds(), bounds, "the move keeps the scene's bounds");
+    let frame = renderer.render(&scene).unwrap().clone();
+    assert_eq!(frame.stats.shadow_maps_reused, 0, "a moved object needs new maps");
+    assert!(frame.image.pixels() == render(&scene, &RenderOptions::default()).unwrap().image.pixels());
+}

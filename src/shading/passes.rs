@@ -34,6 +34,9 @@ pub struct PassStats {
     pub shadow_ms: f64,
     /// Most bytes of shadow maps held at once.
     pub shadow_bytes: usize,
+    /// Lights whose shadow maps were reused from the last frame (only the
+    /// camera moved, or a jittered pass of the same frame).
+    pub maps_reused: usize,
 }
 
 /// An image a frame's passes write: the final image (every component) or one
@@ -63,6 +66,7 @@ pub fn frame_lights(scene: &Scene) -> Vec<Light> {
 /// from `pool` and go back to it.
 pub fn shade_lit(scene: &Scene, vb: &VisibilityBuffer, targets: &mut [Target], pool: &mut MapPool) -> PassStats {
     let mut stats = PassStats::default();
+    pool.begin_frame(scene);
     let mut budget = FUSED_SHADOW_BUDGET;
     let bounds = scene.bounds().unwrap_or_default();
     // Area lights become several jittered lights (§3.3), each with its own maps.
@@ -72,7 +76,9 @@ pub fn shade_lit(scene: &Scene, vb: &VisibilityBuffer, targets: &mut [Target], p
         let bytes = ShadowTerm::bytes_needed(light, bounds);
         if light.only.is_none() && bytes <= budget {
             budget -= bytes;
-            fused.push((light, build(scene, light, bounds, pool, &mut stats)));
+            let t = Instant::now();
+            fused.push((light, pool.term(scene, light, bounds)));
+            stats.shadow_ms += t.elapsed().as_secs_f64() * 1e3;
         } else {
             own.push(light);
         }
@@ -82,7 +88,8 @@ pub fn shade_lit(scene: &Scene, vb: &VisibilityBuffer, targets: &mut [Target], p
     let ambient = lights.iter().filter(|l| l.only.is_none());
     run(scene, vb, targets, &Lighting::pass(ambient, direct, true), Blend::Replace, None);
     stats.passes = 1;
-    fused.into_iter().for_each(|(_, term)| pool.recycle(term));
+    // The fused terms stay for the next frame (within the same budget).
+    fused.into_iter().for_each(|(light, term)| pool.keep(scene, light, bounds, term));
     for light in own {
         let term = build(scene, light, bounds, pool, &mut stats);
         stats.shadow_bytes = stats.shadow_bytes.max(term.memory_bytes());
@@ -94,6 +101,7 @@ pub fn shade_lit(scene: &Scene, vb: &VisibilityBuffer, targets: &mut [Target], p
         pool.recycle(term);
     }
     add_reflection_map(scene, vb, targets);
+    stats.maps_reused = pool.reused();
     stats
 }
 

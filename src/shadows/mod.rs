@@ -10,12 +10,12 @@
 
 pub mod map;
 
-use glam::{Vec2, Vec3};
+use glam::{Affine3A, Vec2, Vec3};
 use wide::f32x8;
 
 pub use map::DepthMap;
 
-use crate::scene::{Camera, Light, LightKind, Projection, Scene, ShadowMethod, ShadowSettings};
+use crate::scene::{Body, Camera, Light, LightKind, Projection, Scene, ShadowMethod, ShadowSettings};
 use crate::visibility::VisibilityBuffer;
 
 /// Widest spot cone (half-angle, degrees) one perspective map covers; wider spots
@@ -174,14 +174,79 @@ fn placement(light: &Light, bounds: (Vec3, Vec3)) -> Placement {
     }
 }
 
-/// Depth buffers kept from one shadow map to the next and from frame to frame:
-/// a fresh 2048² map costs ~2 ms of page faults alone.
+/// Depth buffers kept from one shadow map to the next and from frame to frame
+/// (a fresh 2048² map costs ~2 ms of page faults alone), and the shadow terms
+/// of the last frame, reused while nothing they depend on changes: an
+/// interactive viewer whose camera moves re-renders no spot or point light's
+/// maps (a directional light's map is fitted to the view, so it follows the
+/// camera).
 #[derive(Debug, Default)]
 pub struct MapPool {
     free: Vec<VisibilityBuffer>,
+    /// Terms of this frame, offered to the next.
+    kept: Vec<(MapKey, ShadowTerm)>,
+    /// Terms of the last frame not yet taken by this one.
+    previous: Vec<(MapKey, ShadowTerm)>,
+    /// The geometry the kept terms saw: every object's body and transform.
+    geometry: Vec<(Body, Affine3A)>,
+    /// Terms reused since [`MapPool::begin_frame`].
+    reused: usize,
+}
+
+/// What a light's shadow term depends on besides the geometry.
+#[derive(Debug, Clone, PartialEq)]
+struct MapKey {
+    light: Light,
+    bounds: (Vec3, Vec3),
+    /// The view, for a map fitted to it (directional lights).
+    view: Option<(Camera, u32, u32)>,
+}
+
+impl MapKey {
+    fn of(scene: &Scene, light: &Light, bounds: (Vec3, Vec3)) -> MapKey {
+        let fitted = matches!(placement(light, bounds), Placement::Parallel { .. });
+        MapKey { light: light.clone(), bounds, view: fitted.then_some((scene.camera, scene.width, scene.height)) }
+    }
 }
 
 impl MapPool {
+    /// Starts a frame of `scene`: last frame's terms become reusable, unless
+    /// an object's body or transform changed, which drops them all.
+    pub fn begin_frame(&mut self, scene: &Scene) {
+        let same = self.geometry.len() == scene.objects.len()
+            && self.geometry.iter().zip(&scene.objects).all(|((b, t), o)| b.same(&o.body) && *t == o.transform);
+        if !same {
+            self.geometry = scene.objects.iter().map(|o| (o.body.clone(), o.transform)).collect();
+            let stale: Vec<_> = self.kept.drain(..).chain(self.previous.drain(..)).collect();
+            stale.into_iter().for_each(|(_, term)| self.recycle(term));
+        }
+        let previous = std::mem::take(&mut self.kept);
+        let older = std::mem::replace(&mut self.previous, previous);
+        older.into_iter().for_each(|(_, term)| self.recycle(term));
+        self.reused = 0;
+    }
+
+    /// The shadow term of `light`: last frame's if it still holds, else newly
+    /// rendered. Give it back with [`MapPool::keep`] or [`MapPool::recycle`].
+    pub fn term(&mut self, scene: &Scene, light: &Light, bounds: (Vec3, Vec3)) -> ShadowTerm {
+        let key = MapKey::of(scene, light, bounds);
+        if let Some(k) = self.previous.iter().position(|(have, _)| *have == key) {
+            self.reused += 1;
+            return self.previous.swap_remove(k).1;
+        }
+        ShadowTerm::build_within(scene, light, bounds, self)
+    }
+
+    /// Keeps `light`'s term for the next frame.
+    pub fn keep(&mut self, scene: &Scene, light: &Light, bounds: (Vec3, Vec3), term: ShadowTerm) {
+        self.kept.push((MapKey::of(scene, light, bounds), term));
+    }
+
+    /// Terms reused from the last frame since this frame began.
+    #[must_use]
+    pub fn reused(&self) -> usize {
+        self.reused
+    }
     /// A buffer to render a map into.
     #[must_use]
     pub fn take(&mut self) -> VisibilityBuffer {
@@ -197,10 +262,11 @@ impl MapPool {
         }
     }
 
-    /// Bytes held by the buffers waiting in the pool.
+    /// Bytes held by the pool: free buffers and kept terms.
     #[must_use]
     pub fn memory_bytes(&self) -> usize {
-        self.free.iter().map(VisibilityBuffer::memory_bytes).sum()
+        let kept = self.kept.iter().chain(&self.previous).map(|(_, t)| t.memory_bytes()).sum::<usize>();
+        self.free.iter().map(VisibilityBuffer::memory_bytes).sum::<usize>() + kept
     }
 }
 
