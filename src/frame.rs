@@ -12,6 +12,7 @@ use rayon::prelude::*;
 use crate::error::{Error, Result};
 use crate::raytrace::{item_buffer, TraceCache};
 use crate::resolve::edges::{self, EdgeCache, EdgeOptions};
+use crate::resolve::solid_edges;
 use crate::resolve::{Antialias, LinearImage};
 use crate::scene::Scene;
 use crate::shading::{self, fog, translucency, Component, ComponentSet, Target};
@@ -190,6 +191,12 @@ fn render_into(scene: &Scene, frame: &mut Frame, scratch: &mut Scratch, options:
             let options = EdgeOptions { mode, ..EdgeOptions::default() };
             frame.stats.edge_blends =
                 edges::antialias_edges(scene, &frame.visibility, &mut images, &options, &mut scratch.edges);
+            if scene.objects.iter().any(|o| o.solid().is_some()) {
+                // Solids' outlines are curves no mesh edge bounds: measured by rays.
+                let blends = solid_edges::find_outline_blends(scene, &frame.visibility, scratch.trace.get(scene));
+                images.iter_mut().for_each(|image| solid_edges::apply_outline_blends(image, &blends));
+                frame.stats.edge_blends += blends.len();
+            }
             frame.stats.edge_ms = t.elapsed().as_secs_f64() * 1e3;
         }
         frame.aovs.iter_mut().zip(&mut scratch.aovs).for_each(|((_, a), s)| std::mem::swap(a, s));

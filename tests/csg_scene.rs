@@ -247,3 +247,39 @@ fn scene_files_choose_the_geometry_of_csg_objects() {
     let e = build("geometry = \"facetted\"").unwrap_err().to_string();
     assert!(e.contains("scene.toml:3:12") && e.contains("faceted"), "{e}");
 }
+
+/// Under `antialias = edge`, a solid's outline pixels come out close to a
+/// 64-pass supersampled truth, and pixels inside a solid's face are untouched.
+#[test]
+fn solid_outlines_are_antialiased_like_the_truth() {
+    use kage::resolve::Antialias;
+    let mut scene = without_shadows(scene(200, 130));
+    let opts = RenderOptions { ray_depth: 0, ..Default::default() };
+    let aliased = render(&scene, &opts).unwrap();
+    scene.antialias = Antialias::Edge(kage::resolve::edges::EdgeMode::default());
+    let edge = render(&scene, &opts).unwrap();
+    scene.antialias = Antialias::Jitter(64);
+    let truth = render(&scene, &opts).unwrap();
+    let vb = &aliased.visibility;
+    let (mut outline, mut err_aliased, mut err_edge, mut inside) = (0, 0.0, 0.0, 0);
+    for y in 1..129 {
+        for x in 1..199 {
+            let me = vb.item(x, y);
+            let around = [(x - 1, y), (x + 1, y), (x, y - 1), (x, y + 1)].map(|(a, b)| vb.item(a, b));
+            let on_solid_outline =
+                around.iter().any(|&n| n != me && (n.primitive().is_some() || me.primitive().is_some()));
+            let (a, e, t) = (aliased.image.get(x, y), edge.image.get(x, y), truth.image.get(x, y));
+            if on_solid_outline {
+                outline += 1;
+                err_aliased += (a - t).length_squared();
+                err_edge += (e - t).length_squared();
+            } else if me.primitive().is_some() && around.iter().all(|&n| n == me) {
+                inside += 1;
+                assert_eq!(a, e, "({x}, {y}) inside a solid's face changed");
+            }
+        }
+    }
+    assert!(outline > 300 && inside > 1000, "{outline} outline and {inside} inner pixels");
+    let (ra, re) = ((err_aliased / outline as f32).sqrt(), (err_edge / outline as f32).sqrt());
+    assert!(re < 0.5 * ra, "outline RMSE vs 64 passes: aliased {ra:.4}, edge pass {re:.4}");
+}

@@ -4,6 +4,7 @@
 
 pub mod edges;
 pub mod jitter;
+pub mod solid_edges;
 
 use glam::Vec3;
 

@@ -1,0 +1,122 @@
+//! Antialiased outlines of CSG solids: seed 004's idea — after the aliased frame,
+//! move each pixel an outline crosses towards the pixels across it by the share
+//! of its area on their side — for outlines that are not polygon edges.
+//!
+//! Seed 004 finds that share from the edge's line equation. A solid's outline is
+//! made of curves (a sphere's rim, a hole's wall seen edge-on) and of lines where
+//! primitives meet, none of them stored anywhere. So the share is measured: a
+//! pixel where a solid meets something else (another object, another primitive,
+//! the background) casts `SAMPLES` stratified rays through its area (the ray
+//! tracer sees solids by interval arithmetic, [`crate::raytrace::csg`]), and
+//! each ray that sees what a neighbouring pixel shows takes that neighbour's
+//! colour. Only outline pixels are touched, and the frame is never re-shaded:
+//! the colours come from the aliased frame, as in seed 004.
+
+use glam::{Vec2, Vec3};
+use rayon::prelude::*;
+
+use super::LinearImage;
+use crate::raytrace::TraceScene;
+use crate::sampling::{hash3, stratified};
+use crate::scene::Scene;
+use crate::visibility::{ItemId, VisibilityBuffer};
+
+/// Rays per outline pixel along each axis.
+const SAMPLES: u32 = 3;
+
+/// One outline pixel's new colour as weights of itself and its neighbours.
+#[derive(Debug, Clone, PartialEq)]
+pub struct OutlineBlend {
+    /// The pixel (row-major index).
+    pub pixel: u32,
+    /// Source pixels (row-major) and their weights, summing to 1.
+    pub weights: Vec<(u32, f32)>,
+}
+
+/// Whether two items meet at an outline a solid takes part in: at least one is
+/// a solid's primitive, and they differ in object or primitive.
+fn solid_outline(a: ItemId, b: ItemId) -> bool {
+    (a.primitive().is_some() || b.primitive().is_some()) && a != b
+}
+
+/// Finds the blends of every pixel on a solid's outline in `vb` (the frame of
+/// `scene` as the visibility pass left it), with `trace` the scene's rays.
+#[must_use]
+pub fn find_outline_blends(scene: &Scene, vb: &VisibilityBuffer, trace: &TraceScene) -> Vec<OutlineBlend> {
+    let (w, h) = (vb.width() as i64, vb.height() as i64);
+    let rays = scene.camera.pixel_rays(Vec2::new(w as f32, h as f32));
+    let item = |x: i64, y: i64| vb.item(x as u32, y as u32);
+    let rows: Vec<Vec<OutlineBlend>> = (0..h)
+        .into_par_iter()
+        .map(|y| {
+            let mut out = Vec::new();
+            for x in 0..w {
+                let me = item(x, y);
+                let near: Vec<(i64, i64)> = (-1..=1)
+                    .flat_map(|dy| (-1..=1).map(move |dx| (x + dx, y + dy)))
+                    .filter(|&(nx, ny)| (nx, ny) != (x, y) && (0..w).contains(&nx) && (0..h).contains(&ny))
+                    .collect();
+                let crossed = near.iter().any(|&(nx, ny)| (nx == x || ny == y) && solid_outline(me, item(nx, ny)));
+                if !crossed {
+                    continue;
+                }
+                // Each ray takes the colour of the nearest pixel (itself first)
+                // that shows what the ray sees; a ray that sees something no
+                // neighbour shows keeps the pixel's own colour.
+                let mut weights: Vec<(u32, f32)> = Vec::new();
+                let share = 1.0 / (SAMPLES * SAMPLES) as f32;
+                for k in 0..SAMPLES * SAMPLES {
+                    let offset = stratified(k, SAMPLES, hash3(x as u32, y as u32, k));
+                    let ray = rays.ray(Vec2::new(x as f32, y as f32) + offset);
+                    let seen = trace.intersect(&ray, f32::INFINITY).map_or(ItemId::NONE, |hit| hit.item);
+                    // The same item, else the same object (another triangle of
+                    // a mesh, another primitive of a solid), else itself.
+                    let around = || std::iter::once((x, y)).chain(near.iter().copied());
+                    let same_object =
+                        |i: ItemId| i.object == seen.object && i.primitive().is_some() == seen.primitive().is_some();
+                    let source = around()
+                        .find(|&(nx, ny)| item(nx, ny) == seen)
+                        .or_else(|| around().find(|&(nx, ny)| same_object(item(nx, ny))))
+                        .unwrap_or((x, y));
+                    let index = (source.1 * w + source.0) as u32;
+                    match weights.iter_mut().find(|(p, _)| *p == index) {
+                        Some((_, wgt)) => *wgt += share,
+                        None => weights.push((index, share)),
+                    }
+                }
+                out.push(OutlineBlend { pixel: (y * w + x) as u32, weights });
+            }
+            out
+        })
+        .collect();
+    rows.concat()
+}
+
+/// Applies `blends` to `image` (every blend reads the image as it was before
+/// any of them).
+pub fn apply_outline_blends(image: &mut LinearImage, blends: &[OutlineBlend]) {
+    let colours: Vec<Vec3> = {
+        let px = image.pixels();
+        blends.iter().map(|b| b.weights.iter().map(|&(p, wgt)| px[p as usize] * wgt).sum()).collect()
+    };
+    let px = image.pixels_mut();
+    for (b, c) in blends.iter().zip(colours) {
+        px[b.pixel as usize] = c;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn only_pairs_with_a_solid_make_outlines() {
+        let tri = |o, t| ItemId { object: o, triangle: t };
+        let prim = ItemId::primitive_of;
+        assert!(!solid_outline(tri(0, 1), tri(1, 2)), "mesh against mesh: seed 004's own edge pass");
+        assert!(solid_outline(prim(0, 1), ItemId::NONE), "a solid against the background");
+        assert!(solid_outline(prim(0, 1), prim(0, 2)), "two primitives of one solid");
+        assert!(!solid_outline(prim(0, 1), prim(0, 1)), "inside one primitive's face");
+        assert!(solid_outline(tri(1, 0), prim(0, 0)), "a mesh in front of a solid");
+    }
+}
