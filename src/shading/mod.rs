@@ -86,11 +86,27 @@ pub fn shade_pass(scene: &Scene, vb: &VisibilityBuffer, image: &mut LinearImage,
                 x = run;
                 continue;
             }
+            // A run of one triangle shares its plane. A solid's pixels share one
+            // where they show one flat face (the same primitive and normal: a
+            // polyhedron's face, a cylinder's cap); on a curved surface each
+            // pixel has its own tangent plane.
+            let run = match first.primitive() {
+                None => run,
+                Some(_) => {
+                    let n = vb.normal(x as u32, y as u32);
+                    x + (x..run).take_while(|&k| vb.normal(k as u32, y as u32) == n).count()
+                }
+            };
             let whole = x + (run - x) / lanes::LANES * lanes::LANES;
-            // A run of one triangle shares its plane; a solid's pixels each have
-            // their own tangent plane.
-            if whole > x && first.primitive().is_none() {
-                let tri = cache.get(scene, &frames, first);
+            if whole > x {
+                let tangent;
+                let tri = if first.primitive().is_some() {
+                    let ray = rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
+                    tangent = frames.prepare_at(scene, vb, x as u32, y as u32, &ray);
+                    &tangent
+                } else {
+                    cache.get(scene, &frames, first)
+                };
                 if let Some(k) = constants[tri.material].as_ref() {
                     lanes::shade_run(tri, k, &row, x, lighting, blend, &mut out[x..whole]);
                     x = whole;
