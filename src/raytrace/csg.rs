@@ -36,7 +36,7 @@ pub struct Crossing {
     /// Unit outward normal of the solid there (solid space).
     pub normal: Vec3,
     /// The primitive whose surface it is.
-    pub primitive: usize,
+    pub primitive: u32,
     /// Whether that surface belongs to a subtracted primitive (a hole's wall).
     pub cut: bool,
 }
@@ -124,7 +124,7 @@ impl CsgCaster {
     /// The raw span of primitive `i` along `o + t·d` in its unit shape's space.
     fn unit_span_of(&self, i: usize, o: Vec3, d: Vec3) -> Option<Span> {
         let ((t0, n0), (t1, n1)) = unit_span(&self.solid.primitives[i].shape, o, d)?;
-        let crossing = |t: f32, normal: Vec3| Crossing { t, normal, primitive: i, cut: false };
+        let crossing = |t: f32, normal: Vec3| Crossing { t, normal, primitive: i as u32, cut: false };
         Some(Span { enter: crossing(t0, n0), exit: crossing(t1, n1) })
     }
 
@@ -153,7 +153,7 @@ impl CsgCaster {
     /// A crossing of [`CsgCaster::raw_span`] with its unit outward normal in
     /// solid space.
     fn finish(&self, c: Crossing) -> Crossing {
-        Crossing { normal: (self.frames[c.primitive].1 * c.normal).normalize_or_zero(), ..c }
+        Crossing { normal: (self.frames[c.primitive as usize].1 * c.normal).normalize_or_zero(), ..c }
     }
 
     /// The spans of `ray` inside the part of the solid `tree` describes.
@@ -447,7 +447,7 @@ pub fn primitive_span(p: &Primitive, index: usize, ray: &Ray) -> Option<Span> {
     let (o, d) = (to_unit.transform_point3(ray.origin), to_unit.transform_vector3(ray.dir));
     let ((t0, n0), (t1, n1)) = unit_span(&p.shape, o, d)?;
     let crossing =
-        |t: f32, n: Vec3| Crossing { t, normal: (to_solid * n).normalize_or_zero(), primitive: index, cut: false };
+        |t: f32, n: Vec3| Crossing { t, normal: (to_solid * n).normalize_or_zero(), primitive: index as u32, cut: false };
     Some(Span { enter: crossing(t0, n0), exit: crossing(t1, n1) })
 }
 

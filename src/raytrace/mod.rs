@@ -138,7 +138,7 @@ impl TraceScene {
         let (i, t) = self.bvh.intersect(ray, t_max, |i, t_max| {
             if let Some((_, object, caster)) = self.solid_at(i) {
                 let c = caster.first_hit(ray, 0.0, t_max)?;
-                hit.item = ItemId::primitive_of(*object, c.primitive as u32);
+                hit.item = ItemId::primitive_of(*object, c.primitive);
                 hit.normal = c.normal;
                 return Some(c.t);
             }

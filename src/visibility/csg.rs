@@ -158,7 +158,7 @@ pub fn draw_solids(scene: &Scene, camera: &Camera, vb: &mut VisibilityBuffer) ->
                 if z > depth[i] && z >= far && z <= 1.0 {
                     depth[i] = z;
                     if !items.is_empty() {
-                        items[i] = ItemId::primitive_of(object as u32, c.primitive as u32);
+                        items[i] = ItemId::primitive_of(object as u32, c.primitive);
                         normals[i] = c.normal;
                     }
                 }
