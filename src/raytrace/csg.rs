@@ -446,8 +446,12 @@ pub fn primitive_span(p: &Primitive, index: usize, ray: &Ray) -> Option<Span> {
     let (to_unit, to_solid) = (p.transform.inverse(), normal_matrix(&p.transform));
     let (o, d) = (to_unit.transform_point3(ray.origin), to_unit.transform_vector3(ray.dir));
     let ((t0, n0), (t1, n1)) = unit_span(&p.shape, o, d)?;
-    let crossing =
-        |t: f32, n: Vec3| Crossing { t, normal: (to_solid * n).normalize_or_zero(), primitive: index as u32, cut: false };
+    let crossing = |t: f32, n: Vec3| Crossing {
+        t,
+        normal: (to_solid * n).normalize_or_zero(),
+        primitive: index as u32,
+        cut: false,
+    };
     Some(Span { enter: crossing(t0, n0), exit: crossing(t1, n1) })
 }
 
