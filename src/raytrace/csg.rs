@@ -168,27 +168,13 @@ impl CsgCaster {
     /// buffers reused from pixel to pixel.
     #[must_use]
     pub fn first_hit_with(&self, tree: &CsgTree, ray: &Ray, t_min: f32, scratch: &mut SpanScratch) -> Option<Crossing> {
-        scratch.stack.clear();
-        combine(tree, &|i| self.raw_span(i, ray), scratch);
-        scratch.stack.iter().flat_map(|s| [s.enter, s.exit]).find(|c| c.t > t_min).map(|c| self.finish(c))
+        self.first_hit_in_by([tree], &|i| self.raw_span(i, ray), t_min, scratch)
     }
 
-    /// The first surface along `ray` at `t > t_min` of the union of the parts
-    /// `trees` describe (seed 003's nearest surface over segments), with
-    /// buffers reused from pixel to pixel.
-    #[must_use]
-    pub fn first_hit_in<'t>(
-        &self,
-        trees: impl IntoIterator<Item = &'t CsgTree>,
-        ray: &Ray,
-        t_min: f32,
-        scratch: &mut SpanScratch,
-    ) -> Option<Crossing> {
-        self.first_hit_in_by(trees, &|i| self.raw_span(i, ray), t_min, scratch)
-    }
-
-    /// [`CsgCaster::first_hit_in`] with each primitive's raw span from `leaf`
-    /// ([`CsgCaster::span_on`], or [`CsgCaster::raw_span_of`]).
+    /// The first surface at `t > t_min` of the union of the parts `trees`
+    /// describe (seed 003's nearest surface over segments), each primitive's
+    /// span (normals not yet carried to solid space) from `leaf` — e.g.
+    /// [`CsgCaster::span_on`] — with buffers reused from pixel to pixel.
     pub fn first_hit_in_by<'t>(
         &self,
         trees: impl IntoIterator<Item = &'t CsgTree>,
@@ -208,20 +194,12 @@ impl CsgCaster {
         scratch.stack.iter().flat_map(|s| [s.enter, s.exit]).find(|c| c.t > t_min).map(|c| self.finish(c))
     }
 
-    /// [`CsgCaster::span`] with normals not yet carried to solid space: only
-    /// `t` matters for combining; [`CsgCaster::first_hit_of_segments`] finishes
-    /// the crossing it returns.
-    #[must_use]
-    pub fn raw_span_of(&self, i: usize, ray: &Ray) -> Option<Span> {
-        self.raw_span(i, ray)
-    }
-
     /// The first surface beyond `t_min` of a union of pattern-matrix segments
     /// (seed 003 §5.2.1): per segment, the intersection of its positive
     /// primitives' intervals minus the intervals of its negative primitives
     /// that `occupying` says cover the pixel; the nearest over the segments.
-    /// `span` gives a primitive's raw span ([`CsgCaster::raw_span_of`], cached
-    /// by the caller).
+    /// `span` gives a primitive's span, normals not yet carried to solid space
+    /// ([`CsgCaster::span_on`], cached by the caller).
     pub fn first_hit_of_segments<'s>(
         &self,
         segments: impl IntoIterator<Item = &'s crate::visibility::pattern::Segment>,
@@ -289,15 +267,11 @@ impl CsgCaster {
                 met.push(i);
                 None
             });
-            s.stack.clear();
-            combine(tree, &|i| if crossed[i] { self.raw_span(i, ray) } else { None }, s);
+            let hit =
+                self.first_hit_in_by([tree], &|i| if crossed[i] { self.raw_span(i, ray) } else { None }, t_min, s);
             met.drain(..).for_each(|i| crossed[i as usize] = false);
             (s.crossed, s.met) = (crossed, met);
-            s.stack
-                .iter()
-                .flat_map(|sp| [sp.enter, sp.exit])
-                .find(|c| c.t > t_min && c.t < t_max)
-                .map(|c| self.finish(c))
+            hit.filter(|c| c.t < t_max)
         })
     }
 
@@ -308,9 +282,7 @@ impl CsgCaster {
     pub fn first_hit_every_primitive(&self, ray: &Ray, t_min: f32) -> Option<Crossing> {
         let tree = self.solid.tree.as_ref()?;
         let all: Vec<Option<Span>> = (0..self.frames.len()).map(|i| self.raw_span(i, ray)).collect();
-        let mut scratch = SpanScratch::default();
-        combine(tree, &|i| all[i], &mut scratch);
-        scratch.stack.iter().flat_map(|s| [s.enter, s.exit]).find(|c| c.t > t_min).map(|c| self.finish(c))
+        self.first_hit_in_by([tree], &|i| all[i], t_min, &mut SpanScratch::default())
     }
 }
 

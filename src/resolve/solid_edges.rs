@@ -52,14 +52,15 @@ pub fn find_outline_blends(scene: &Scene, vb: &VisibilityBuffer, trace: &TraceSc
             let mut out = Vec::new();
             for x in 0..w {
                 let me = item(x, y);
-                let near: Vec<(i64, i64)> = (-1..=1)
-                    .flat_map(|dy| (-1..=1).map(move |dx| (x + dx, y + dy)))
-                    .filter(|&(nx, ny)| (nx, ny) != (x, y) && (0..w).contains(&nx) && (0..h).contains(&ny))
-                    .collect();
-                let crossed = near.iter().any(|&(nx, ny)| (nx == x || ny == y) && solid_outline(me, item(nx, ny)));
-                if !crossed {
+                let inside = |(nx, ny): (i64, i64)| (0..w).contains(&nx) && (0..h).contains(&ny);
+                let sides = [(x - 1, y), (x + 1, y), (x, y - 1), (x, y + 1)];
+                if !sides.into_iter().any(|n| inside(n) && solid_outline(me, item(n.0, n.1))) {
                     continue;
                 }
+                let near: Vec<(i64, i64)> = (-1..=1)
+                    .flat_map(|dy| (-1..=1).map(move |dx| (x + dx, y + dy)))
+                    .filter(|&n| n != (x, y) && inside(n))
+                    .collect();
                 // Each ray takes the colour of the nearest pixel (itself first)
                 // that shows what the ray sees; a ray that sees something no
                 // neighbour shows keeps the pixel's own colour.
