@@ -94,14 +94,29 @@ pub fn scan_solid_with(
     height: u32,
     method: CsgMethod,
 ) -> Result<Vec<Option<Crossing>>, TooManySegments> {
-    let (w, h) = (width as usize, height as usize);
-    let mut out = vec![None; w * h];
+    let mut out = Vec::new();
+    scan_solid_into(solid, camera, (width, height), method, &mut out)?;
+    Ok(out)
+}
+
+/// [`scan_solid_with`] into `out` (resized to the image), so a viewer
+/// re-scanning frame after frame reuses one buffer, as the frame's
+/// visibility buffer is reused.
+pub fn scan_solid_into(
+    solid: &CsgSolid,
+    camera: &Camera,
+    (width, height): (u32, u32),
+    method: CsgMethod,
+    out: &mut Vec<Option<Crossing>>,
+) -> Result<(), TooManySegments> {
+    let w = width as usize;
     let walker = RowWalker::new(solid, method)?;
+    out.resize(w * height as usize, None);
     let bands = out.par_chunks_mut(w * BAND_ROWS);
     scan_bands(solid, &walker, camera, (width, height), bands, |band, dy, row| {
         band[dy * w..(dy + 1) * w].copy_from_slice(row);
     });
-    Ok(out)
+    Ok(())
 }
 
 /// What walks a scanline's pixels.

@@ -13,7 +13,7 @@ use glam::Vec2;
 use kage::raytrace::csg::CsgCaster;
 use kage::scene::load::openscad::{load_csg, CsgOptions, Geometry};
 use kage::scene::{Camera, CsgSolid};
-use kage::visibility::csg::{scan_solid, scan_solid_with, CsgMethod};
+use kage::visibility::csg::{scan_solid_into, CsgMethod};
 use kage::visibility::pattern::PatternMatrix;
 use miette::{miette, Result};
 use rayon::prelude::*;
@@ -40,16 +40,8 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             eprintln!("skipped {name}: no camera sidecar");
             continue;
         };
-        let mut times = Vec::new();
-        let mut covered = 0;
-        for _ in 0..args.frames.max(1) {
-            let t = Instant::now();
-            let pixels = scan_solid(&solid, &camera, w, h);
-            times.push(t.elapsed().as_secs_f64() * 1e3);
-            covered = pixels.iter().filter(|p| p.is_some()).count();
-        }
-        times.sort_by(f64::total_cmp);
-        let scan_ms = times[times.len() / 2];
+        let (mut times, covered) = scan_times(&solid, &camera, (w, h), CsgMethod::Segments, args.frames.max(1));
+        let scan_ms = median(&mut times);
         let pattern = pattern_cell(&solid, &camera, w, h, args.frames.max(1));
         let caster = CsgCaster::new(&solid);
         let near = |ray: &kage::scene::Ray| camera.distance_at_depth(ray, 1.0);
@@ -111,8 +103,25 @@ fn pattern_cell(solid: &CsgSolid, camera: &Camera, w: u32, h: u32, frames: usize
         Err(e) => return format!("> {} segments", e.limit),
     };
     let method = CsgMethod::PatternMatrix { limit: PATTERN_LIMIT };
-    let mut times: Vec<f64> = (0..frames).map(|_| timed(|| scan_solid_with(solid, camera, w, h, method)).0).collect();
+    let (mut times, _) = scan_times(solid, camera, (w, h), method, frames);
     format!("{}, {:.1}", matrix.segments.len(), median(&mut times))
+}
+
+/// Milliseconds of `frames` scans of `solid` by `method` into one output
+/// buffer (allocated by a first, untimed scan, as a renderer keeps its
+/// visibility buffer), and the pixels covered.
+fn scan_times(
+    solid: &CsgSolid,
+    camera: &Camera,
+    size: (u32, u32),
+    method: CsgMethod,
+    frames: usize,
+) -> (Vec<f64>, usize) {
+    let mut out = Vec::new();
+    let scan = |out: &mut Vec<_>| scan_solid_into(solid, camera, size, method, out).expect("expanded before");
+    scan(&mut out);
+    let times = (0..frames).map(|_| timed(|| scan(&mut out)).0).collect();
+    (times, out.iter().filter(|p| p.is_some()).count())
 }
 
 /// The median of `v` (0 when empty).
@@ -201,9 +210,12 @@ pub fn run_random(args: &BenchArgs) -> Result<()> {
         for (segments, per) in rows {
             let solid = random_spheres(segments as u64 * 31 + per as u64, segments, per);
             for (w, h) in [(160, 100), (1920, 1080)] {
-                let scan_ms = best_of(args.frames.max(1), || scan_solid(&solid, &camera, w, h));
-                let method = CsgMethod::PatternMatrix { limit: PATTERN_LIMIT };
-                let pattern_ms = best_of(args.frames.max(1), || scan_solid_with(&solid, &camera, w, h, method));
+                let best = |method| {
+                    let (times, _) = scan_times(&solid, &camera, (w, h), method, args.frames.max(1));
+                    times.into_iter().fold(f64::INFINITY, f64::min)
+                };
+                let scan_ms = best(CsgMethod::Segments);
+                let pattern_ms = best(CsgMethod::PatternMatrix { limit: PATTERN_LIMIT });
                 let caster = CsgCaster::new(&solid);
                 let (naive_ms, _) =
                     timed(|| cast(&camera, w, h, |ray| caster.first_hit_every_primitive(ray, 0.0).is_some()));
@@ -223,11 +235,6 @@ pub fn run_random(args: &BenchArgs) -> Result<()> {
         rayon::current_num_threads()
     );
     Ok(())
-}
-
-/// The fastest of `n` runs of `f`, in milliseconds.
-fn best_of<T>(n: usize, mut f: impl FnMut() -> T) -> f64 {
-    (0..n).map(|_| timed(&mut f).0).fold(f64::INFINITY, f64::min)
 }
 
 /// OpenSCAD's preview seconds per model, from the peers' TIMINGS.md table.
