@@ -279,6 +279,60 @@ impl Segments {
     }
 }
 
+/// The visible-segment list (seed 003 §5.2.1): segment ids, with each one's
+/// place in the list, so a segment joins or leaves in constant time.
+#[derive(Debug)]
+pub(super) struct VisibleSegments {
+    list: Vec<usize>,
+    place: Vec<usize>,
+}
+
+impl VisibleSegments {
+    /// An empty list for `segments` segments.
+    pub(super) fn new(segments: usize) -> Self {
+        VisibleSegments { list: Vec::new(), place: vec![usize::MAX; segments] }
+    }
+
+    /// Whether segment `s` is in the list.
+    pub(super) fn contains(&self, s: usize) -> bool {
+        self.place[s] != usize::MAX
+    }
+
+    /// Adds segment `s` (not in the list).
+    pub(super) fn insert(&mut self, s: usize) {
+        self.place[s] = self.list.len();
+        self.list.push(s);
+    }
+
+    /// Removes segment `s` (in the list).
+    pub(super) fn remove(&mut self, s: usize) {
+        let k = self.place[s];
+        self.list.swap_remove(k);
+        if let Some(&moved) = self.list.get(k) {
+            self.place[moved] = k;
+        }
+        self.place[s] = usize::MAX;
+    }
+
+    /// The segments in the list.
+    pub(super) fn ids(&self) -> &[usize] {
+        &self.list
+    }
+}
+
+/// An occupant of a scanline: primitive, left end, right end (columns).
+pub(super) type RowEnds = (usize, i64, i64);
+
+/// A scanline's x-entry table (occupants by left end) and x-exit order (by
+/// right end).
+pub(super) fn x_order(ends: impl IntoIterator<Item = RowEnds>) -> (Vec<RowEnds>, Vec<RowEnds>) {
+    let mut entry: Vec<RowEnds> = ends.into_iter().collect();
+    entry.sort_by_key(|e| e.1);
+    let mut exit = entry.clone();
+    exit.sort_by_key(|e| e.2);
+    (entry, exit)
+}
+
 /// Per scanline, each segment cut down to the primitives occupying the
 /// current pixel: seed 003's reference counts (§5.2.1) in tree form. A
 /// primitive entering or leaving the x-occupancy list marks its segment; only
@@ -290,9 +344,8 @@ struct SegmentCuts<'s> {
     cuts: Vec<Option<CsgTree>>,
     marked: Vec<usize>,
     is_marked: Vec<bool>,
-    /// Segments whose cut is not empty, and each one's place in it.
-    visible: Vec<usize>,
-    place: Vec<usize>,
+    /// Segments whose cut is not empty.
+    visible: VisibleSegments,
 }
 
 impl<'s> SegmentCuts<'s> {
@@ -304,8 +357,7 @@ impl<'s> SegmentCuts<'s> {
             cuts: vec![None; n],
             marked: Vec::new(),
             is_marked: vec![false; n],
-            visible: Vec::new(),
-            place: vec![usize::MAX; n],
+            visible: VisibleSegments::new(n),
         }
     }
 
@@ -325,26 +377,16 @@ impl<'s> SegmentCuts<'s> {
             self.is_marked[s] = false;
             let active = &self.active;
             self.cuts[s] = self.segments.trees[s].restricted(&|i| active[i]);
-            match (self.cuts[s].is_some(), self.place[s] != usize::MAX) {
-                (true, false) => {
-                    self.place[s] = self.visible.len();
-                    self.visible.push(s);
-                }
-                (false, true) => {
-                    let k = self.place[s];
-                    self.visible.swap_remove(k);
-                    if let Some(&moved) = self.visible.get(k) {
-                        self.place[moved] = k;
-                    }
-                    self.place[s] = usize::MAX;
-                }
+            match (self.cuts[s].is_some(), self.visible.contains(s)) {
+                (true, false) => self.visible.insert(s),
+                (false, true) => self.visible.remove(s),
                 _ => {}
             }
         }
     }
 
     fn visible(&self) -> impl Iterator<Item = &CsgTree> {
-        self.visible.iter().filter_map(|&s| self.cuts[s].as_ref())
+        self.visible.ids().iter().filter_map(|&s| self.cuts[s].as_ref())
     }
 }
 
@@ -359,10 +401,7 @@ fn scan_row(
     near: f32,
     row: &mut [Option<Crossing>],
 ) {
-    let mut entry: Vec<(usize, i64, i64)> = ends.to_vec();
-    entry.sort_by_key(|e| e.1);
-    let mut exit = entry.clone();
-    exit.sort_by_key(|e| e.2);
+    let (entry, exit) = x_order(ends.iter().copied());
     let (mut next_in, mut next_out) = (0, 0);
     let mut cuts = SegmentCuts::new(segments, caster.primitives());
     let mut scratch = SpanScratch::default();
@@ -373,7 +412,7 @@ fn scan_row(
             next_in += 1;
         }
         cuts.update();
-        if !cuts.visible.is_empty() {
+        if !cuts.visible.ids().is_empty() {
             *px = caster.first_hit_in_by(cuts.visible(), &|i| span(i, x), near, &mut scratch);
         }
         // Primitives whose right end is this pixel leave the x-occupancy list.

@@ -25,6 +25,7 @@
 
 use crate::raytrace::csg::{Crossing, CsgCaster, Span, SpanScratch};
 use crate::scene::csg::CsgTree;
+use crate::visibility::csg::{x_order, VisibleSegments};
 
 /// One segment: an intersection of positive primitives and complements of
 /// negative ones (indices into the solid's primitives, sorted).
@@ -89,12 +90,9 @@ impl PatternMatrix {
         // Only positive members of live segments, and negative members of any,
         // need walking.
         let wanted = |i: usize| self.positive_in[i].iter().any(|&s| live[s as usize]) || self.negative_somewhere[i];
-        let mut entry: Vec<(usize, i64, i64)> = ends.iter().copied().filter(|&(i, _, _)| wanted(i)).collect();
-        entry.sort_by_key(|e| e.1);
-        let mut exit = entry.clone();
-        exit.sort_by_key(|e| e.2);
+        let (entry, exit) = x_order(ends.iter().copied().filter(|&(i, _, _)| wanted(i)));
         let mut rcx: Vec<usize> = self.segments.iter().map(|s| s.positive.len()).collect();
-        let (mut visible, mut place) = (Vec::new(), vec![usize::MAX; self.segments.len()]);
+        let mut visible = VisibleSegments::new(self.segments.len());
         let mut flagged = vec![false; n];
         let (mut next_in, mut next_out) = (0, 0);
         let mut spans = PixelSpans::new(n);
@@ -108,16 +106,15 @@ impl PatternMatrix {
                     let s = s as usize;
                     rcx[s] -= 1;
                     if rcx[s] == 0 && live[s] {
-                        place[s] = visible.len();
-                        visible.push(s);
+                        visible.insert(s);
                     }
                 }
                 next_in += 1;
             }
-            if !visible.is_empty() {
+            if !visible.ids().is_empty() {
                 spans.next_pixel();
                 *px = caster.first_hit_of_segments(
-                    visible.iter().map(|&s| &self.segments[s]),
+                    visible.ids().iter().map(|&s| &self.segments[s]),
                     &|i| flagged[i],
                     &mut |i| spans.get(i, || span(i, x)),
                     near,
@@ -130,11 +127,7 @@ impl PatternMatrix {
                 for &s in &self.positive_in[i] {
                     let s = s as usize;
                     if rcx[s] == 0 && live[s] {
-                        let k = place[s];
-                        visible.swap_remove(k);
-                        if let Some(&moved) = visible.get(k) {
-                            place[moved] = k;
-                        }
+                        visible.remove(s);
                     }
                     rcx[s] += 1;
                 }
