@@ -428,11 +428,16 @@ fn facing_normal(inp: &LaneInputs, w: [F; 3], v: &V3) -> V3 {
     V3::select(facing, V3 { x: -n.x, y: -n.y, z: -n.z }, n)
 }
 
+/// A light whose diffuse and specular a pass adds, with the shadow terms whose
+/// mean multiplies them: one term, or an area light's jittered samples' (see
+/// [`crate::shading::passes`]).
+pub type Direct<'a> = (&'a Light, &'a [ShadowTerm]);
+
 /// What one shading pass adds (seed 002 eq. 4): the ambient of some lights, the
 /// shadowed diffuse and specular of some lights, and perhaps emission.
 #[derive(Debug, Clone)]
 pub struct Lighting<'a> {
-    direct: Vec<(&'a Light, &'a ShadowTerm)>,
+    direct: Vec<Direct<'a>>,
     ambient: Vec3,
     emission: bool,
     diffuse: f32,
@@ -441,13 +446,9 @@ pub struct Lighting<'a> {
 
 impl<'a> Lighting<'a> {
     /// The ambient terms of `ambient`, the diffuse and specular terms of `direct`
-    /// (each multiplied by its shadow term) and, if `emission`, Ke.
+    /// (each multiplied by the mean of its shadow terms) and, if `emission`, Ke.
     #[must_use]
-    pub fn pass(
-        ambient: impl IntoIterator<Item = &'a Light>,
-        direct: Vec<(&'a Light, &'a ShadowTerm)>,
-        emission: bool,
-    ) -> Self {
+    pub fn pass(ambient: impl IntoIterator<Item = &'a Light>, direct: Vec<Direct<'a>>, emission: bool) -> Self {
         let ambient = ambient.into_iter().map(|l| l.color * l.ambient).sum();
         Lighting { direct, ambient, emission, diffuse: 1.0, specular: 1.0 }
     }
@@ -478,11 +479,12 @@ impl<'a> Lighting<'a> {
         let mut diffuse = V3::splat(Vec3::ZERO);
         let mut specular = V3::splat(Vec3::ZERO);
         let direct = if self.diffuse > 0.0 || self.specular > 0.0 { self.direct.as_slice() } else { &[] };
-        for &(light, term) in direct {
+        for &(light, terms) in direct {
             let (l, radiance) = incident(light, &s.p);
             let cos_theta = s.n.dot(l);
             let lit = cos_theta.simd_gt(F::ZERO);
-            let radiance = if term.casts() { radiance.scale(shadow(term, s, cos_theta)) } else { radiance };
+            let casts = terms.iter().any(ShadowTerm::casts);
+            let radiance = if casts { radiance.scale(shadow(terms, s, cos_theta)) } else { radiance };
             let r = s.n.scale(cos_theta + cos_theta).sub(l);
             let cos_alpha = r.dot(s.v).max(F::ZERO);
             let spec = power(cos_alpha, inp.shininess, inp.whole);
@@ -499,14 +501,15 @@ impl<'a> Lighting<'a> {
     }
 }
 
-/// The shadow term per lane (where the surface faces away from the light it is
-/// irrelevant: the diffuse and specular terms are zero there anyway).
+/// The shadow term per lane: the mean of `terms` (where the surface faces away
+/// from the light it is irrelevant: the diffuse and specular terms are zero
+/// there anyway).
 #[inline(always)]
-fn shadow(term: &ShadowTerm, s: &LaneSurface, cos_theta: F) -> F {
+fn shadow(terms: &[ShadowTerm], s: &LaneSurface, cos_theta: F) -> F {
     if !cos_theta.simd_gt(F::ZERO).any() {
         return F::ZERO;
     }
-    term.lit_lanes([s.p.x, s.p.y, s.p.z], cos_theta)
+    ShadowTerm::mean_lit_lanes(terms, [s.p.x, s.p.y, s.p.z], cos_theta)
 }
 
 /// `x^n` per lane for x ≥ 0: by repeated squaring when every lane has the same

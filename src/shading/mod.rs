@@ -25,7 +25,7 @@ use crate::shadows::ShadowTerm;
 use crate::visibility::{ItemId, VisibilityBuffer};
 
 pub use lanes::{Blend, Lighting};
-pub use passes::{frame_lights, shade_lit, PassStats, Target};
+pub use passes::{frame_lights, shade_lit, FrameLight, PassStats, Target};
 pub use phong::Components;
 pub use phong::{Component, ComponentSet};
 pub use surface::{ObjectFrames, PreparedTriangle, SurfacePoint};
@@ -177,11 +177,12 @@ impl TriangleCache {
 
 /// The scalar reference of [`shade_lit`]: one pixel at a time through
 /// [`PreparedTriangle::surface`] and [`phong::add_light`], with the frame's
-/// lights ([`passes::frame_lights`]), each one's shadow term and its
-/// selective-lighting list.
+/// lights ([`passes::frame_lights`]), each one's shadow term (the mean of its
+/// samples') and its selective-lighting list.
 pub fn shade_into_scalar(scene: &Scene, vb: &VisibilityBuffer, image: &mut LinearImage) {
     let lights = passes::frame_lights(scene);
-    let terms: Vec<ShadowTerm> = lights.iter().map(|l| ShadowTerm::build(scene, l)).collect();
+    let terms: Vec<Vec<ShadowTerm>> =
+        lights.iter().map(|l| l.samples.iter().map(|s| ShadowTerm::build(scene, s)).collect()).collect();
     let w = vb.width() as usize;
     let frames = ObjectFrames::new(scene);
     let rays = scene.camera.pixel_rays(Vec2::new(w as f32, vb.height() as f32));
@@ -201,12 +202,12 @@ pub fn shade_into_scalar(scene: &Scene, vb: &VisibilityBuffer, image: &mut Linea
             s.duv = [at(1.0, 0.0).uv - s.uv, at(0.0, 1.0).uv - s.uv];
             let k = Coefficients::at(&scene.materials[s.material], &s);
             let mut acc = Components { emission: k.parts().3, ..Default::default() };
-            for (light, term) in lights.iter().zip(&terms) {
+            for (light, terms) in lights.iter().map(|l| &l.light).zip(&terms) {
                 if light.only.as_ref().is_some_and(|o| !o.contains(&(item.object as usize))) {
                     continue;
                 }
                 let cos_theta = s.normal.dot(light.incident(s.position).to_light);
-                let shadow = if cos_theta > 0.0 { term.lit(s.position, cos_theta) } else { 1.0 };
+                let shadow = if cos_theta > 0.0 { ShadowTerm::mean_lit(terms, s.position, cos_theta) } else { 1.0 };
                 phong::add_light(&mut acc, light, &k, &s, shadow);
             }
             *px = acc.total();

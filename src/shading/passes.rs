@@ -13,6 +13,16 @@
 //!    specular (and, if selective, its ambient, on its objects only) are added,
 //!    and its maps are dropped, so memory stays bounded however many lights there
 //!    are, and time grows linearly with them.
+//!
+//! An area light (a point or spot light with a `size` and several shadow
+//! samples) is shadowed by its jittered samples' maps, each rendered with the
+//! light moved to another point of its disc (§3.3), but lit once: its diffuse
+//! and specular at its centre times the mean of the samples' shadow terms. The
+//! paper sums a full pass per moved light instead; the two differ only by how
+//! N·L and the highlight vary across the disc (small for the small lights soft
+//! shadows are for), one evaluation is what the reference renderer computes
+//! (its shadow rays average over the disc, its Phong term is the centre's), and
+//! it costs one Phong term instead of n.
 
 use std::time::Instant;
 
@@ -52,12 +62,37 @@ pub struct Target<'a> {
 /// Most bytes of shadow maps held at once for the first, fused pass.
 pub const FUSED_SHADOW_BUDGET: usize = 64 << 20;
 
-/// The lights a frame is shaded with: the scene's, with each area light replaced
-/// by its jittered samples (§3.3; [`Light::jittered`]).
+/// A scene light as a frame shades it.
+#[derive(Debug, Clone)]
+pub struct FrameLight {
+    /// The light itself: its ambient, diffuse and specular terms.
+    pub light: Light,
+    /// The lights its shadow maps are rendered from: its jittered samples (an
+    /// area light, §3.3; [`Light::jittered`]) or itself. The mean of their
+    /// shadow terms is its shadow term.
+    pub samples: Vec<Light>,
+}
+
+/// The lights a frame is shaded with: the scene's, each with its shadow samples.
 #[must_use]
-pub fn frame_lights(scene: &Scene) -> Vec<Light> {
+pub fn frame_lights(scene: &Scene) -> Vec<FrameLight> {
     let centre = scene.bounds().map_or(glam::Vec3::ZERO, |(lo, hi)| (lo + hi) * 0.5);
-    scene.lights.iter().flat_map(|l| l.jittered(centre)).collect()
+    scene.lights.iter().map(|l| FrameLight { light: l.clone(), samples: l.jittered(centre) }).collect()
+}
+
+/// The shadow terms of `light`'s samples (taken from `pool`: last frame's where
+/// they still hold), timed into `stats`.
+fn terms(
+    scene: &Scene,
+    light: &FrameLight,
+    bounds: (Vec3, Vec3),
+    pool: &mut MapPool,
+    stats: &mut PassStats,
+) -> Vec<ShadowTerm> {
+    let t = Instant::now();
+    let terms = light.samples.iter().map(|s| pool.term(scene, s, bounds)).collect();
+    stats.shadow_ms += t.elapsed().as_secs_f64() * 1e3;
+    terms
 }
 
 /// Shades `vb` with every light of `scene`, shadows included, into each target:
@@ -69,48 +104,40 @@ pub fn shade_lit(scene: &Scene, vb: &VisibilityBuffer, targets: &mut [Target], p
     pool.begin_frame(scene);
     let mut budget = FUSED_SHADOW_BUDGET;
     let bounds = scene.bounds().unwrap_or_default();
-    // Area lights become several jittered lights (§3.3), each with its own maps.
     let lights = frame_lights(scene);
     let (mut fused, mut own) = (Vec::new(), Vec::new());
     for light in &lights {
-        let bytes = ShadowTerm::bytes_needed(light, bounds);
-        if light.only.is_none() && bytes <= budget {
+        let bytes: usize = light.samples.iter().map(|s| ShadowTerm::bytes_needed(s, bounds)).sum();
+        if light.light.only.is_none() && bytes <= budget {
             budget -= bytes;
-            let t = Instant::now();
-            fused.push((light, pool.term(scene, light, bounds)));
-            stats.shadow_ms += t.elapsed().as_secs_f64() * 1e3;
+            fused.push((light, terms(scene, light, bounds, pool, &mut stats)));
         } else {
             own.push(light);
         }
     }
     stats.shadow_bytes = FUSED_SHADOW_BUDGET - budget;
-    let direct = fused.iter().map(|(l, t)| (*l, t)).collect();
-    let ambient = lights.iter().filter(|l| l.only.is_none());
+    let direct = fused.iter().map(|(l, t)| (&l.light, t.as_slice())).collect();
+    let ambient = lights.iter().map(|l| &l.light).filter(|l| l.only.is_none());
     run(scene, vb, targets, &Lighting::pass(ambient, direct, true), Blend::Replace, None);
     stats.passes = 1;
     // The fused terms stay for the next frame (within the same budget).
-    fused.into_iter().for_each(|(light, term)| pool.keep(scene, light, bounds, term));
-    for light in own {
-        let term = build(scene, light, bounds, pool, &mut stats);
-        stats.shadow_bytes = stats.shadow_bytes.max(term.memory_bytes());
+    for (light, terms) in fused {
+        light.samples.iter().zip(terms).for_each(|(s, term)| pool.keep(scene, s, bounds, term));
+    }
+    for frame_light in own {
+        let terms = terms(scene, frame_light, bounds, pool, &mut stats);
+        let light = &frame_light.light;
+        stats.shadow_bytes = stats.shadow_bytes.max(terms.iter().map(ShadowTerm::memory_bytes).sum());
         let receivers = light.only.as_ref().map(|only| (0..scene.objects.len()).map(|i| only.contains(&i)).collect());
         // A light that lights every object had its ambient added in the first pass.
         let ambient = light.only.is_some().then_some(light);
-        run(scene, vb, targets, &Lighting::pass(ambient, vec![(light, &term)], false), Blend::Add, receivers);
+        run(scene, vb, targets, &Lighting::pass(ambient, vec![(light, &terms)], false), Blend::Add, receivers);
         stats.passes += 1;
-        pool.recycle(term);
+        terms.into_iter().for_each(|t| pool.recycle(t));
     }
     add_reflection_map(scene, vb, targets);
     stats.maps_reused = pool.reused();
     stats
-}
-
-/// The shadow term of `light`, timed into `stats`.
-fn build(scene: &Scene, light: &Light, bounds: (Vec3, Vec3), pool: &mut MapPool, stats: &mut PassStats) -> ShadowTerm {
-    let t = Instant::now();
-    let term = ShadowTerm::build_within(scene, light, bounds, pool);
-    stats.shadow_ms += t.elapsed().as_secs_f64() * 1e3;
-    term
 }
 
 /// One pass into every target.

@@ -22,8 +22,8 @@ use rayon::prelude::*;
 
 use super::phong::{self, Coefficients, Components};
 use super::reflection_map::reflection_map;
-use super::{Component, ObjectFrames, SurfacePoint, Target};
-use crate::scene::{Light, Scene};
+use super::{Component, FrameLight, ObjectFrames, SurfacePoint, Target};
+use crate::scene::Scene;
 use crate::shadows::{MapPool, ShadowTerm};
 use crate::visibility::Fragment;
 
@@ -54,7 +54,7 @@ pub fn composite(
     scene: &Scene,
     mut fragments: Vec<Fragment>,
     order: TranslucencyOrder,
-    lights: &[Light],
+    lights: &[FrameLight],
     targets: &mut [Target],
     pool: &mut MapPool,
 ) -> usize {
@@ -80,15 +80,15 @@ pub fn composite(
     }
     let mut layers = prepare(scene, &fragments, &weights, w, h);
     let bounds = scene.bounds().unwrap_or_default();
-    for light in lights {
-        let term = ShadowTerm::build_within(scene, light, bounds, pool);
+    for FrameLight { light, samples } in lights {
+        let terms: Vec<ShadowTerm> = samples.iter().map(|s| ShadowTerm::build_within(scene, s, bounds, pool)).collect();
         layers.par_iter_mut().filter(|l| light.only.as_ref().is_none_or(|o| o.contains(&l.object))).for_each(|l| {
             let s = &l.surface;
             let cos = s.normal.dot(light.incident(s.position).to_light);
-            let shadow = if cos > 0.0 { term.lit(s.position, cos) } else { 1.0 };
+            let shadow = if cos > 0.0 { ShadowTerm::mean_lit(&terms, s.position, cos) } else { 1.0 };
             phong::add_light(&mut l.lit, light, &l.k, s, shadow);
         });
-        pool.recycle(term);
+        terms.into_iter().for_each(|t| pool.recycle(t));
     }
     for t in targets.iter_mut() {
         add_layers(scene, &layers, t);

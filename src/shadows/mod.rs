@@ -125,6 +125,30 @@ impl ShadowTerm {
         }
     }
 
+    /// The mean of `terms`' [`ShadowTerm::lit`] (1 when there are none): the
+    /// shadow term of an area light from its jittered samples' maps.
+    #[must_use]
+    pub fn mean_lit(terms: &[ShadowTerm], p: Vec3, cos_theta: f32) -> f32 {
+        match terms {
+            [] => 1.0,
+            [one] => one.lit(p, cos_theta),
+            _ => terms.iter().map(|t| t.lit(p, cos_theta)).sum::<f32>() / terms.len() as f32,
+        }
+    }
+
+    /// [`ShadowTerm::mean_lit`] for eight points.
+    #[must_use]
+    pub fn mean_lit_lanes(terms: &[ShadowTerm], p: [f32x8; 3], cos_theta: f32x8) -> f32x8 {
+        match terms {
+            [] => f32x8::ONE,
+            [one] => one.lit_lanes(p, cos_theta),
+            _ => {
+                let sum = terms.iter().fold(f32x8::ZERO, |acc, t| acc + t.lit_lanes(p, cos_theta));
+                sum * f32x8::splat(1.0 / terms.len() as f32)
+            }
+        }
+    }
+
     /// Bytes held by the maps.
     #[must_use]
     pub fn memory_bytes(&self) -> usize {
