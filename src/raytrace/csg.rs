@@ -175,9 +175,9 @@ impl CsgCaster {
     /// describe (seed 003's nearest surface over segments), each primitive's
     /// span (normals not yet carried to solid space) from `leaf` — e.g.
     /// [`CsgCaster::span_on`] — with buffers reused from pixel to pixel.
-    pub fn first_hit_in_by<'t>(
+    pub fn first_hit_in_by<B: Booleans>(
         &self,
-        trees: impl IntoIterator<Item = &'t CsgTree>,
+        trees: impl IntoIterator<Item = B>,
         leaf: &impl Fn(usize) -> Option<Span>,
         t_min: f32,
         scratch: &mut SpanScratch,
@@ -304,29 +304,75 @@ pub struct SpanScratch {
     met: Vec<u32>,
 }
 
+/// What a node of a tree of booleans does.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Operation {
+    /// A primitive (its index).
+    Leaf(usize),
+    /// Inside any operand.
+    Union,
+    /// Inside every operand.
+    Intersection,
+    /// Inside the first operand, outside the others.
+    Difference,
+}
+
+/// A tree of booleans the span combiner ([`combine`]) walks: a [`CsgTree`], or
+/// a view of one that leaves out what cannot matter at a pixel
+/// ([`crate::visibility::occupancy`]).
+pub trait Booleans: Copy {
+    /// What this node does.
+    fn operation(self) -> Operation;
+    /// The operands the combiner reads: all of them, or (a view) those that
+    /// can change the result; a difference's first operand comes first.
+    fn operands(self) -> impl Iterator<Item = Self>;
+}
+
+impl<'t> Booleans for &'t CsgTree {
+    fn operation(self) -> Operation {
+        match self {
+            CsgTree::Leaf(i) => Operation::Leaf(*i),
+            CsgTree::Union(_) => Operation::Union,
+            CsgTree::Intersection(_) => Operation::Intersection,
+            CsgTree::Difference(..) => Operation::Difference,
+        }
+    }
+
+    fn operands(self) -> impl Iterator<Item = &'t CsgTree> {
+        let (first, rest): (Option<&CsgTree>, &[CsgTree]) = match self {
+            CsgTree::Leaf(_) => (None, &[]),
+            CsgTree::Union(kids) | CsgTree::Intersection(kids) => (None, kids),
+            CsgTree::Difference(a, kids) => (Some(a), kids),
+        };
+        first.into_iter().chain(rest)
+    }
+}
+
+impl SpanScratch {
+    /// The spans on the stack: after one [`combine`] from empty, the tree's.
+    #[must_use]
+    pub fn spans(&self) -> &[Span] {
+        &self.stack
+    }
+}
+
 /// The spans of the subtree `tree`, given each leaf's span (at most one: a
 /// primitive is convex), left on top of `scratch.stack`; returns where they start.
-pub fn combine(tree: &CsgTree, leaf: &impl Fn(usize) -> Option<Span>, scratch: &mut SpanScratch) -> usize {
+pub fn combine<B: Booleans>(tree: B, leaf: &impl Fn(usize) -> Option<Span>, scratch: &mut SpanScratch) -> usize {
     let base = scratch.stack.len();
-    match tree {
-        CsgTree::Leaf(i) => scratch.stack.extend(leaf(*i)),
-        CsgTree::Union(kids) => {
-            for k in kids {
+    match tree.operation() {
+        Operation::Leaf(i) => scratch.stack.extend(leaf(i)),
+        Operation::Union => {
+            for k in tree.operands() {
                 combine(k, leaf, scratch);
             }
             union(&mut scratch.stack, base);
         }
-        CsgTree::Intersection(kids) | CsgTree::Difference(_, kids) => {
-            let (first, rest) = match tree {
-                CsgTree::Difference(a, _) => (&**a, &kids[..]),
-                _ => match kids.split_first() {
-                    Some((f, r)) => (f, r),
-                    None => return base,
-                },
-            };
+        op @ (Operation::Intersection | Operation::Difference) => {
+            let mut operands = tree.operands();
+            let Some(first) = operands.next() else { return base };
             combine(first, leaf, scratch);
-            let cut = matches!(tree, CsgTree::Difference(..));
-            for k in rest {
+            for k in operands {
                 if scratch.stack.len() == base {
                     break; // nothing left to intersect with or cut from
                 }
@@ -334,7 +380,7 @@ pub fn combine(tree: &CsgTree, leaf: &impl Fn(usize) -> Option<Span>, scratch: &
                 let SpanScratch { stack, out, .. } = scratch;
                 out.clear();
                 let (a, b) = stack[base..].split_at(mid - base);
-                if cut {
+                if op == Operation::Difference {
                     difference(a, b, out);
                 } else {
                     intersection(a, b, out);

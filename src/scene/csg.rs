@@ -143,34 +143,6 @@ impl CsgTree {
         }
     }
 
-    /// The tree as seen where only the primitives `active` says are present: the
-    /// others are empty, so unions drop them, intersections and differences whose
-    /// first part they are vanish, and differences drop them as cutters. `None`
-    /// if nothing is left.
-    #[must_use]
-    pub fn restricted(&self, active: &impl Fn(usize) -> bool) -> Option<CsgTree> {
-        match self {
-            CsgTree::Leaf(i) => active(*i).then_some(CsgTree::Leaf(*i)),
-            CsgTree::Union(kids) => {
-                let mut kept: Vec<CsgTree> = kids.iter().filter_map(|k| k.restricted(active)).collect();
-                match kept.len() {
-                    0 => None,
-                    1 => kept.pop(),
-                    _ => Some(CsgTree::Union(kept)),
-                }
-            }
-            CsgTree::Intersection(kids) => {
-                let kept: Option<Vec<CsgTree>> = kids.iter().map(|k| k.restricted(active)).collect();
-                kept.map(CsgTree::Intersection)
-            }
-            CsgTree::Difference(a, cutters) => {
-                let a = a.restricted(active)?;
-                let cutters: Vec<CsgTree> = cutters.iter().filter_map(|c| c.restricted(active)).collect();
-                Some(if cutters.is_empty() { a } else { CsgTree::Difference(Box::new(a), cutters) })
-            }
-        }
-    }
-
     /// Axis-aligned bounds of the tree given each primitive's: unions join
     /// them, intersections overlap them, a difference keeps its first part's.
     /// `None` when the bounds show the tree empty.

@@ -16,14 +16,12 @@
 //! segment, a count of its primitives not yet occupying the pixel; a segment
 //! whose count is zero enters the visible-segment list. Expanding can explode
 //! (the paper names it; OpenSCAD aborts previews past 100,000 terms), so the
-//! tree is not expanded: the root's unions are flattened and each remaining
-//! child is one segment, however deep. A primitive entering or
-//! leaving the x-occupancy list marks its segment; a marked segment is cut down
-//! to its occupying primitives ([`CsgTree::restricted`]: a difference drops the
-//! cutters absent here — the fast path for negative primitives — and vanishes
-//! with its positive part), and the segments with something left are the
-//! visible-segment list. The pixels until the next change share those cut
-//! trees, and a pixel's surface is the nearest over the visible segments.
+//! tree is not expanded: the same counts are kept at every node of it
+//! ([`super::occupancy`]). A primitive entering or leaving the x-occupancy list
+//! updates its leaf and the few nodes above it whose emptiness changes; the
+//! root's list of non-empty operands is the visible-segment list, a
+//! difference's list of non-empty cutters is the fast path for negative
+//! primitives, and a pixel's booleans visit only what is non-empty there.
 //!
 //! Extents (procedures 1 and 2): an ellipsoid seen in perspective from outside
 //! gets the paper's exact rows (scanline planes through the eye tangent to it)
@@ -42,8 +40,9 @@ use rayon::prelude::*;
 use crate::raytrace::csg::{Crossing, CsgCaster, Span, SpanScratch};
 use crate::scene::camera::PixelRays;
 use crate::scene::camera::RowLine;
-use crate::scene::csg::{CsgSolid, CsgTree, Primitive, Shape};
+use crate::scene::csg::{CsgSolid, Primitive, Shape};
 use crate::scene::{Camera, Scene};
+use crate::visibility::occupancy::{OccupancyTree, Occupied};
 use crate::visibility::pattern::{PatternMatrix, TooManySegments};
 use crate::visibility::{ItemId, VisibilityBuffer};
 
@@ -121,7 +120,7 @@ pub fn scan_solid_into(
 
 /// What walks a scanline's pixels.
 enum RowWalker {
-    Segments(Segments),
+    Segments(OccupancyTree),
     Pattern(PatternMatrix),
     /// A solid with no volume.
     Empty,
@@ -132,7 +131,7 @@ impl RowWalker {
         let n = solid.primitives.len();
         let Some(tree) = &solid.tree else { return Ok(RowWalker::Empty) };
         Ok(match method {
-            CsgMethod::Segments => RowWalker::Segments(Segments::new(tree, n)),
+            CsgMethod::Segments => RowWalker::Segments(OccupancyTree::new(tree, n)),
             CsgMethod::PatternMatrix { limit } => RowWalker::Pattern(PatternMatrix::expand(tree, n, limit)?),
         })
     }
@@ -211,8 +210,14 @@ fn scan_bands<B: Send>(
     // near plane lies at t = near, under either projection.
     let near = camera.near;
     bands.enumerate().for_each_init(
-        || (vec![None; w], vec![RowLine::default(); solid.primitives.len()]),
-        |(row, lines), (band, mut out)| {
+        || {
+            let counts = match walker {
+                RowWalker::Segments(tree) => Some(Occupied::new(tree)),
+                _ => None,
+            };
+            (vec![None; w], vec![RowLine::default(); solid.primitives.len()], counts)
+        },
+        |(row, lines, counts), (band, mut out)| {
             let first = (band * BAND_ROWS) as i64;
             // The y-occupancy list as the band's first scanline finds it, then kept
             // row by row.
@@ -236,10 +241,10 @@ fn scan_bands<B: Send>(
                 let line = rays.row_line(y as usize);
                 ends.iter().for_each(|&(i, _, _)| lines[i] = caster.unit_line(i, &line));
                 let span = |i: usize, x: usize| caster.span_on(i, &lines[i], x as f32);
-                match walker {
-                    RowWalker::Segments(segments) => scan_row(&caster, segments, &ends, &span, near, row),
-                    RowWalker::Pattern(matrix) => matrix.walk_row(&caster, &ends, &span, near, row),
-                    RowWalker::Empty => {}
+                match (walker, counts.as_mut()) {
+                    (RowWalker::Pattern(matrix), _) => matrix.walk_row(&caster, &ends, &span, near, row),
+                    (_, Some(counts)) => scan_row(&caster, counts, &ends, &span, near, row),
+                    _ => {}
                 }
                 // Distances along the unnormalised row line become distances
                 // along the unit pixel ray.
@@ -250,33 +255,6 @@ fn scan_bands<B: Send>(
             }
         },
     );
-}
-
-/// The solid as a union of segments (seed 003's sum of products, without
-/// expanding anything: the root's unions are flattened, and each remaining
-/// child is one segment, however deep), and which segment each primitive is in.
-struct Segments {
-    trees: Vec<CsgTree>,
-    /// Per primitive: its segment (`usize::MAX` if the tree does not use it).
-    of: Vec<usize>,
-}
-
-impl Segments {
-    fn new(tree: &CsgTree, primitives: usize) -> Segments {
-        fn flatten(t: &CsgTree, out: &mut Vec<CsgTree>) {
-            match t {
-                CsgTree::Union(kids) => kids.iter().for_each(|k| flatten(k, out)),
-                other => out.push(other.clone()),
-            }
-        }
-        let mut trees = Vec::new();
-        flatten(tree, &mut trees);
-        let mut of = vec![usize::MAX; primitives];
-        for (s, t) in trees.iter().enumerate() {
-            t.leaves().into_iter().for_each(|i| of[i] = s);
-        }
-        Segments { trees, of }
-    }
 }
 
 /// The visible-segment list (seed 003 §5.2.1): segment ids, with each one's
@@ -291,11 +269,6 @@ impl VisibleSegments {
     /// An empty list for `segments` segments.
     pub(super) fn new(segments: usize) -> Self {
         VisibleSegments { list: Vec::new(), place: vec![usize::MAX; segments] }
-    }
-
-    /// Whether segment `s` is in the list.
-    pub(super) fn contains(&self, s: usize) -> bool {
-        self.place[s] != usize::MAX
     }
 
     /// Adds segment `s` (not in the list).
@@ -333,69 +306,13 @@ pub(super) fn x_order(ends: impl IntoIterator<Item = RowEnds>) -> (Vec<RowEnds>,
     (entry, exit)
 }
 
-/// Per scanline, each segment cut down to the primitives occupying the
-/// current pixel: seed 003's reference counts (§5.2.1) in tree form. A
-/// primitive entering or leaving the x-occupancy list marks its segment; only
-/// marked segments are cut down again, and only segments with something left
-/// (the visible-segment list) are evaluated at a pixel.
-struct SegmentCuts<'s> {
-    segments: &'s Segments,
-    active: Vec<bool>,
-    cuts: Vec<Option<CsgTree>>,
-    marked: Vec<usize>,
-    is_marked: Vec<bool>,
-    /// Segments whose cut is not empty.
-    visible: VisibleSegments,
-}
-
-impl<'s> SegmentCuts<'s> {
-    fn new(segments: &'s Segments, primitives: usize) -> Self {
-        let n = segments.trees.len();
-        SegmentCuts {
-            segments,
-            active: vec![false; primitives],
-            cuts: vec![None; n],
-            marked: Vec::new(),
-            is_marked: vec![false; n],
-            visible: VisibleSegments::new(n),
-        }
-    }
-
-    /// Primitive `i` enters (`true`) or leaves the x-occupancy list.
-    fn set(&mut self, i: usize, on: bool) {
-        self.active[i] = on;
-        let s = self.segments.of[i];
-        if s != usize::MAX && !self.is_marked[s] {
-            self.is_marked[s] = true;
-            self.marked.push(s);
-        }
-    }
-
-    /// Cuts the marked segments down again; returns the visible ones' trees.
-    fn update(&mut self) {
-        for s in self.marked.drain(..) {
-            self.is_marked[s] = false;
-            let active = &self.active;
-            self.cuts[s] = self.segments.trees[s].restricted(&|i| active[i]);
-            match (self.cuts[s].is_some(), self.visible.contains(s)) {
-                (true, false) => self.visible.insert(s),
-                (false, true) => self.visible.remove(s),
-                _ => {}
-            }
-        }
-    }
-
-    fn visible(&self) -> impl Iterator<Item = &CsgTree> {
-        self.visible.ids().iter().filter_map(|&s| self.cuts[s].as_ref())
-    }
-}
-
 /// One scanline: the x-entry table of the occupants (sorted by left end), the
-/// x-exit order (by right end), the x-occupancy list as segment cuts, and each
-/// occupied pixel's surface from the visible segments.
+/// x-exit order (by right end), the x-occupancy list as the counts of
+/// `occupied` (empty on entry and on return), and each occupied pixel's
+/// surface from the non-empty part of the tree.
 fn scan_row(
     caster: &CsgCaster,
-    segments: &Segments,
+    occupied: &mut Occupied,
     ends: &[(usize, i64, i64)],
     span: &impl Fn(usize, usize) -> Option<Span>,
     near: f32,
@@ -403,27 +320,26 @@ fn scan_row(
 ) {
     let (entry, exit) = x_order(ends.iter().copied());
     let (mut next_in, mut next_out) = (0, 0);
-    let mut cuts = SegmentCuts::new(segments, caster.primitives());
     let mut scratch = SpanScratch::default();
     let Some(first) = entry.first().map(|e| e.1.max(0) as usize) else { return };
     for (x, px) in row.iter_mut().enumerate().skip(first) {
         while next_in < entry.len() && entry[next_in].1 <= x as i64 {
-            cuts.set(entry[next_in].0, true);
+            occupied.set(entry[next_in].0, true);
             next_in += 1;
         }
-        cuts.update();
-        if !cuts.visible.ids().is_empty() {
-            *px = caster.first_hit_in_by(cuts.visible(), &|i| span(i, x), near, &mut scratch);
+        if let Some(root) = occupied.root() {
+            *px = caster.first_hit_in_by([root], &|i| span(i, x), near, &mut scratch);
         }
         // Primitives whose right end is this pixel leave the x-occupancy list.
         while next_out < exit.len() && exit[next_out].2 <= x as i64 {
-            cuts.set(exit[next_out].0, false);
+            occupied.set(exit[next_out].0, false);
             next_out += 1;
         }
         if next_out == exit.len() {
             break;
         }
     }
+    occupied.clear();
 }
 
 /// Where a primitive shows on the screen: its scanlines (the y-entry table's

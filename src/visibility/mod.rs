@@ -10,6 +10,7 @@
 
 pub mod clip;
 pub mod csg;
+pub mod occupancy;
 pub mod pattern;
 pub mod raster;
 pub mod scan;
