@@ -212,8 +212,8 @@ fn scan_bands<B: Send>(
     bands.enumerate().for_each_init(
         || {
             let counts = match walker {
-                RowWalker::Segments(tree) => Some(Occupied::new(tree)),
-                _ => None,
+                RowWalker::Segments(tree) => Occupied::new(tree),
+                _ => Occupied::default(),
             };
             (vec![None; w], vec![RowLine::default(); solid.primitives.len()], counts)
         },
@@ -241,10 +241,10 @@ fn scan_bands<B: Send>(
                 let line = rays.row_line(y as usize);
                 ends.iter().for_each(|&(i, _, _)| lines[i] = caster.unit_line(i, &line));
                 let span = |i: usize, x: usize| caster.span_on(i, &lines[i], x as f32);
-                match (walker, counts.as_mut()) {
-                    (RowWalker::Pattern(matrix), _) => matrix.walk_row(&caster, &ends, &span, near, row),
-                    (_, Some(counts)) => scan_row(&caster, counts, &ends, &span, near, row),
-                    _ => {}
+                match walker {
+                    RowWalker::Segments(tree) => scan_row(&caster, (tree, counts), &ends, &span, near, row),
+                    RowWalker::Pattern(matrix) => matrix.walk_row(&caster, &ends, &span, near, row),
+                    RowWalker::Empty => {}
                 }
                 // Distances along the unnormalised row line become distances
                 // along the unit pixel ray.
@@ -312,7 +312,7 @@ pub(super) fn x_order(ends: impl IntoIterator<Item = RowEnds>) -> (Vec<RowEnds>,
 /// surface from the non-empty part of the tree.
 fn scan_row(
     caster: &CsgCaster,
-    occupied: &mut Occupied,
+    (tree, counts): (&OccupancyTree, &mut Occupied),
     ends: &[(usize, i64, i64)],
     span: &impl Fn(usize, usize) -> Option<Span>,
     near: f32,
@@ -324,22 +324,22 @@ fn scan_row(
     let Some(first) = entry.first().map(|e| e.1.max(0) as usize) else { return };
     for (x, px) in row.iter_mut().enumerate().skip(first) {
         while next_in < entry.len() && entry[next_in].1 <= x as i64 {
-            occupied.set(entry[next_in].0, true);
+            counts.set(tree, entry[next_in].0, true);
             next_in += 1;
         }
-        if let Some(root) = occupied.root() {
+        if let Some(root) = counts.root(tree) {
             *px = caster.first_hit_in_by([root], &|i| span(i, x), near, &mut scratch);
         }
         // Primitives whose right end is this pixel leave the x-occupancy list.
         while next_out < exit.len() && exit[next_out].2 <= x as i64 {
-            occupied.set(exit[next_out].0, false);
+            counts.set(tree, exit[next_out].0, false);
             next_out += 1;
         }
         if next_out == exit.len() {
             break;
         }
     }
-    occupied.clear();
+    counts.clear(tree);
 }
 
 /// Where a primitive shows on the screen: its scanlines (the y-entry table's

@@ -20,25 +20,32 @@
 //! the change climbs only while a node's emptiness changes: a few nodes
 //! however large the tree, with no allocation. A pixel's booleans
 //! ([`crate::raytrace::csg::combine`] through [`Booleans`]) then visit only
-//! the non-empty parts. Nested unions, intersections and cutters are merged
-//! into their parents first (`(a − b) − c` is `a − b − c`, `a − (b ∪ c)` too),
-//! so the lists are long and the tree shallow.
+//! the non-empty parts. Nested unions, intersections and differences are
+//! merged into their parents first (`(a − b) − c` is `a − b − c`), so the
+//! lists are long and the tree shallow.
 
-use crate::raytrace::csg::{Booleans, Operation};
+use crate::raytrace::csg::{Booleans, Operation, Parts};
 use crate::scene::csg::CsgTree;
 
 /// No node.
 const NONE: u32 = u32::MAX;
 
+/// One node of an [`OccupancyTree`].
+#[derive(Debug, Clone, Copy)]
+struct Node {
+    operation: Operation,
+    parent: u32,
+    /// Its operands: `operands[start..start + count]` of the tree (a
+    /// difference's first operand first).
+    start: u32,
+    count: u32,
+}
+
 /// The shape of a tree, flattened into arrays, ready to have its counts kept by
 /// [`Occupied`].
 #[derive(Debug, Clone)]
 pub struct OccupancyTree {
-    operation: Vec<Operation>,
-    parent: Vec<u32>,
-    /// Each node's operands: `operands[start[n]..start[n] + count[n]]`.
-    start: Vec<u32>,
-    count: Vec<u32>,
+    nodes: Vec<Node>,
     operands: Vec<u32>,
     /// Per primitive, its first leaf; further leaves of the same primitive
     /// chain through `next_leaf`.
@@ -52,10 +59,7 @@ impl OccupancyTree {
     #[must_use]
     pub fn new(tree: &CsgTree, primitives: usize) -> OccupancyTree {
         let mut t = OccupancyTree {
-            operation: Vec::new(),
-            parent: Vec::new(),
-            start: Vec::new(),
-            count: Vec::new(),
+            nodes: Vec::new(),
             operands: Vec::new(),
             first_leaf: vec![NONE; primitives],
             next_leaf: Vec::new(),
@@ -67,41 +71,43 @@ impl OccupancyTree {
 
     /// Adds `tree` under `parent`; returns its node.
     fn add(&mut self, tree: &CsgTree, parent: u32) -> u32 {
-        let node = self.operation.len() as u32;
-        let operation = tree.operation();
-        self.operation.push(operation);
-        self.parent.push(parent);
+        let node = self.nodes.len() as u32;
+        let operation = tree.parts().operation;
+        self.nodes.push(Node { operation, parent, start: 0, count: 0 });
         self.next_leaf.push(NONE);
         if let Operation::Leaf(i) = operation {
             self.next_leaf[node as usize] = std::mem::replace(&mut self.first_leaf[i], node);
         }
-        self.start.push(0);
-        self.count.push(0);
         let mut kids = Vec::new();
         merged_operands(tree, &mut kids);
         let ids: Vec<u32> = kids.into_iter().map(|k| self.add(k, node)).collect();
         // After the subtrees: each node's operands lie together.
-        self.start[node as usize] = self.operands.len() as u32;
-        self.count[node as usize] = ids.len() as u32;
+        let n = &mut self.nodes[node as usize];
+        (n.start, n.count) = (self.operands.len() as u32, ids.len() as u32);
         self.operands.extend(ids);
         node
     }
 
-    /// The nodes (for sizing [`Occupied`]).
-    fn len(&self) -> usize {
-        self.operation.len()
+    /// How many nodes the tree has.
+    #[must_use]
+    pub fn len(&self) -> usize {
+        self.nodes.len()
     }
 
-    fn operands_of(&self, node: u32) -> &[u32] {
-        let (s, c) = (self.start[node as usize] as usize, self.count[node as usize] as usize);
-        &self.operands[s..s + c]
+    /// Whether the tree has no nodes (never: a tree has a root).
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.nodes.is_empty()
+    }
+
+    fn operands_of(&self, node: &Node) -> &[u32] {
+        &self.operands[node.start as usize..(node.start + node.count) as usize]
     }
 }
 
 /// The operands of `tree` with nested nodes of the same kind merged in: a
-/// union's unions, an intersection's intersections, a difference's first
-/// operand when it is itself a difference (`(a − b) − c`), and cutters that are
-/// unions (`a − (b ∪ c)`).
+/// union's unions, an intersection's intersections, and a difference's first
+/// operand when it is itself a difference (`(a − b) − c`).
 fn merged_operands<'t>(tree: &'t CsgTree, out: &mut Vec<&'t CsgTree>) {
     let mut merge = |k: &'t CsgTree, same: bool| if same { merged_operands(k, out) } else { out.push(k) };
     match tree {
@@ -110,16 +116,20 @@ fn merged_operands<'t>(tree: &'t CsgTree, out: &mut Vec<&'t CsgTree>) {
         CsgTree::Intersection(kids) => kids.iter().for_each(|k| merge(k, matches!(k, CsgTree::Intersection(_)))),
         CsgTree::Difference(a, cutters) => {
             merge(a, matches!(**a, CsgTree::Difference(..)));
-            cutters.iter().for_each(|c| merge(c, matches!(c, CsgTree::Union(_))));
+            // A union of cutters stays one operand: its spans are merged once
+            // and cut out in one pass, where cutting them one by one would
+            // walk the ever more fragmented remainder once per cutter.
+            cutters.iter().for_each(|c| out.push(c));
         }
     }
 }
 
 /// The counts of an [`OccupancyTree`] for the primitives occupying the
-/// current pixel (all empty at first).
-#[derive(Debug, Clone)]
-pub struct Occupied<'t> {
-    tree: &'t OccupancyTree,
+/// current pixel (all empty at first). Kept apart from the tree, so one set of
+/// buffers serves every tree a thread meets ([`Occupied::fit`]); each call
+/// names the tree.
+#[derive(Debug, Clone, Default)]
+pub struct Occupied {
     /// Per node: whether it is non-empty here.
     full: Vec<bool>,
     /// Per node: how many of its operands are non-empty (an intersection's RC),
@@ -130,77 +140,86 @@ pub struct Occupied<'t> {
     list: Vec<u32>,
     /// Per node: where it stands in its parent's list.
     place: Vec<u32>,
-    /// Primitives occupying the pixel, to empty the tree quickly.
+    /// Primitives occupying the pixel, to empty the tree quickly, and each
+    /// primitive's place in that list (`NONE`: absent).
     present: Vec<u32>,
-    is_present: Vec<bool>,
+    place_present: Vec<u32>,
 }
 
-impl<'t> Occupied<'t> {
+impl Occupied {
     /// Counts for `tree` with no primitive present.
     #[must_use]
-    pub fn new(tree: &'t OccupancyTree) -> Occupied<'t> {
+    pub fn new(tree: &OccupancyTree) -> Occupied {
+        let mut counts = Occupied::default();
+        counts.fit(tree);
+        counts
+    }
+
+    /// Sizes empty counts for `tree` (they stay empty).
+    pub fn fit(&mut self, tree: &OccupancyTree) {
+        debug_assert!(self.present.is_empty(), "fitted while primitives are present");
         let n = tree.len();
-        Occupied {
-            tree,
-            full: vec![false; n],
-            live: vec![0; n],
-            list: vec![NONE; tree.operands.len()],
-            place: vec![NONE; n],
-            present: Vec::new(),
-            is_present: vec![false; tree.first_leaf.len()],
-        }
+        self.full.resize(n, false);
+        self.live.resize(n, 0);
+        self.place.resize(n, NONE);
+        self.list.resize(tree.operands.len(), NONE);
+        self.place_present.resize(tree.first_leaf.len(), NONE);
     }
 
     /// Primitive `i` starts (`on`) or stops occupying the pixel.
-    pub fn set(&mut self, i: usize, on: bool) {
-        if self.is_present[i] == on {
+    pub fn set(&mut self, tree: &OccupancyTree, i: usize, on: bool) {
+        let at = self.place_present[i];
+        if (at != NONE) == on {
             return;
         }
-        self.is_present[i] = on;
         if on {
+            self.place_present[i] = self.present.len() as u32;
             self.present.push(i as u32);
-        } else if let Some(k) = self.present.iter().position(|&p| p == i as u32) {
-            self.present.swap_remove(k);
+        } else {
+            self.present.swap_remove(at as usize);
+            if let Some(&moved) = self.present.get(at as usize) {
+                self.place_present[moved as usize] = at;
+            }
+            self.place_present[i] = NONE;
         }
-        let mut leaf = self.tree.first_leaf[i];
+        let mut leaf = tree.first_leaf[i];
         while leaf != NONE {
             self.full[leaf as usize] = on;
-            self.climb(leaf);
-            leaf = self.tree.next_leaf[leaf as usize];
+            self.climb(tree, leaf);
+            leaf = tree.next_leaf[leaf as usize];
         }
     }
 
     /// Every primitive leaves.
-    pub fn clear(&mut self) {
+    pub fn clear(&mut self, tree: &OccupancyTree) {
         while let Some(&i) = self.present.last() {
-            self.set(i as usize, false);
+            self.set(tree, i as usize, false);
         }
     }
 
     /// `node` just became full or empty: its parent's count or list follows,
     /// and so on up while a node's own emptiness changes.
-    fn climb(&mut self, mut node: u32) {
-        let t = self.tree;
+    fn climb(&mut self, t: &OccupancyTree, mut node: u32) {
         loop {
-            let parent = t.parent[node as usize];
+            let parent = t.nodes[node as usize].parent;
             if parent == NONE {
                 return;
             }
-            let p = parent as usize;
+            let (p, pn) = (parent as usize, t.nodes[parent as usize]);
             let on = self.full[node as usize];
-            let first = t.operands_of(parent)[0];
-            let full = match t.operation[p] {
+            let first = t.operands[pn.start as usize];
+            let full = match pn.operation {
                 Operation::Intersection => {
                     if on {
                         self.live[p] += 1;
                     } else {
                         self.live[p] -= 1;
                     }
-                    self.live[p] == t.count[p]
+                    self.live[p] == pn.count
                 }
                 Operation::Difference if node == first => on,
                 op => {
-                    self.listed(parent, node, on);
+                    self.listed(pn.start as usize, p, node, on);
                     if op == Operation::Union {
                         self.live[p] > 0
                     } else {
@@ -216,9 +235,9 @@ impl<'t> Occupied<'t> {
         }
     }
 
-    /// Adds `node` to `parent`'s list or removes it.
-    fn listed(&mut self, parent: u32, node: u32, on: bool) {
-        let (p, start) = (parent as usize, self.tree.start[parent as usize] as usize);
+    /// Adds `node` to the list of node `p` (which starts at `start`) or
+    /// removes it.
+    fn listed(&mut self, start: usize, p: usize, node: u32, on: bool) {
         if on {
             self.place[node as usize] = self.live[p];
             self.list[start + self.live[p] as usize] = node;
@@ -233,17 +252,17 @@ impl<'t> Occupied<'t> {
         }
     }
 
-    /// The tree as the pixel sees it, `None` when it is empty here.
+    /// `tree` as the pixel sees it, `None` when it is empty here.
     #[must_use]
-    pub fn root(&self) -> Option<OccupiedNode<'_>> {
-        let root = self.tree.root;
-        self.full[root as usize].then_some(OccupiedNode { occupied: self, node: root })
+    pub fn root<'a>(&'a self, tree: &'a OccupancyTree) -> Option<OccupiedNode<'a>> {
+        let node = tree.root;
+        self.full[node as usize].then_some(OccupiedNode { tree, counts: self, node })
     }
 
-    /// Whether the tree is non-empty here.
+    /// Whether `tree` is non-empty here.
     #[must_use]
-    pub fn is_full(&self) -> bool {
-        self.full[self.tree.root as usize]
+    pub fn is_full(&self, tree: &OccupancyTree) -> bool {
+        self.full[tree.root as usize]
     }
 }
 
@@ -252,27 +271,29 @@ impl<'t> Occupied<'t> {
 /// cutters, an intersection all its operands.
 #[derive(Debug, Clone, Copy)]
 pub struct OccupiedNode<'a> {
-    occupied: &'a Occupied<'a>,
+    tree: &'a OccupancyTree,
+    counts: &'a Occupied,
     node: u32,
 }
 
 impl<'a> Booleans for OccupiedNode<'a> {
-    fn operation(self) -> Operation {
-        self.occupied.tree.operation[self.node as usize]
-    }
-
-    fn operands(self) -> impl Iterator<Item = OccupiedNode<'a>> {
-        let o = self.occupied;
-        let t = o.tree;
-        let n = self.node as usize;
-        let listed = |start: usize| &o.list[start..start + o.live[n] as usize];
-        let (first, rest): (Option<u32>, &[u32]) = match t.operation[n] {
-            Operation::Leaf(_) => (None, &[]),
-            Operation::Intersection => (None, t.operands_of(self.node)),
-            Operation::Union => (None, listed(t.start[n] as usize)),
-            Operation::Difference => (Some(t.operands_of(self.node)[0]), listed(t.start[n] as usize)),
+    #[inline]
+    fn parts(self) -> Parts<Self, impl Iterator<Item = Self>> {
+        let (t, c, n) = (self.tree, self.counts, self.node as usize);
+        let node = t.nodes[n];
+        let start = node.start as usize;
+        let listed = || &c.list[start..start + c.live[n] as usize];
+        let (first, others) = match node.operation {
+            Operation::Leaf(_) => (None, &[][..]),
+            Operation::Intersection => match t.operands_of(&node).split_first() {
+                Some((&first, others)) => (Some(first), others),
+                None => (None, &[][..]),
+            },
+            Operation::Union => (None, listed()),
+            Operation::Difference => (Some(t.operands[start]), listed()),
         };
-        first.into_iter().chain(rest.iter().copied()).map(move |node| OccupiedNode { occupied: o, node })
+        let at = move |node| OccupiedNode { tree: t, counts: c, node };
+        Parts { operation: node.operation, first: first.map(at), others: others.iter().map(move |&n| at(n)) }
     }
 }
 
@@ -330,13 +351,13 @@ mod tests {
             let mut on = [false; N];
             let spans: Vec<Span> = ends.iter().enumerate().map(|(i, &(a, b))| span(i, a, b)).collect();
             for (i, present) in changes {
-                counts.set(i, present);
+                counts.set(&shape, i, present);
                 on[i] = present;
-                prop_assert_eq!(counts.is_full(), non_empty(&t, &on));
+                prop_assert_eq!(counts.is_full(&shape), non_empty(&t, &on));
                 let mut whole = SpanScratch::default();
                 combine(&t, &|k| on[k].then_some(spans[k]), &mut whole);
                 let mut seen = SpanScratch::default();
-                if let Some(root) = counts.root() {
+                if let Some(root) = counts.root(&shape) {
                     combine(root, &|k| {
                         assert!(on[k], "an absent primitive was read");
                         Some(spans[k])
@@ -344,8 +365,8 @@ mod tests {
                 }
                 prop_assert_eq!(whole.spans(), seen.spans());
             }
-            counts.clear();
-            prop_assert!(!counts.is_full());
+            counts.clear(&shape);
+            prop_assert!(!counts.is_full(&shape));
             prop_assert!(counts.full.iter().all(|f| !f) && counts.live.iter().all(|&l| l == 0));
         }
     }
