@@ -257,42 +257,6 @@ fn scan_bands<B: Send>(
     );
 }
 
-/// The visible-segment list (seed 003 §5.2.1): segment ids, with each one's
-/// place in the list, so a segment joins or leaves in constant time.
-#[derive(Debug)]
-pub(super) struct VisibleSegments {
-    list: Vec<usize>,
-    place: Vec<usize>,
-}
-
-impl VisibleSegments {
-    /// An empty list for `segments` segments.
-    pub(super) fn new(segments: usize) -> Self {
-        VisibleSegments { list: Vec::new(), place: vec![usize::MAX; segments] }
-    }
-
-    /// Adds segment `s` (not in the list).
-    pub(super) fn insert(&mut self, s: usize) {
-        self.place[s] = self.list.len();
-        self.list.push(s);
-    }
-
-    /// Removes segment `s` (in the list).
-    pub(super) fn remove(&mut self, s: usize) {
-        let k = self.place[s];
-        self.list.swap_remove(k);
-        if let Some(&moved) = self.list.get(k) {
-            self.place[moved] = k;
-        }
-        self.place[s] = usize::MAX;
-    }
-
-    /// The segments in the list.
-    pub(super) fn ids(&self) -> &[usize] {
-        &self.list
-    }
-}
-
 /// An occupant of a scanline: primitive, left end, right end (columns).
 pub(super) type RowEnds = (usize, i64, i64);
 

@@ -25,7 +25,7 @@
 
 use crate::raytrace::csg::{Crossing, CsgCaster, Span, SpanScratch};
 use crate::scene::csg::CsgTree;
-use crate::visibility::csg::{x_order, VisibleSegments};
+use crate::visibility::csg::x_order;
 
 /// One segment: an intersection of positive primitives and complements of
 /// negative ones (indices into the solid's primitives, sorted).
@@ -228,6 +228,42 @@ fn meet(a: &[Segment], b: &[Segment], limit: usize) -> Result<Vec<Segment>, TooM
         }
     }
     Ok(out)
+}
+
+/// The visible-segment list (seed 003 §5.2.1): segment ids, with each one's
+/// place in the list, so a segment joins or leaves in constant time.
+#[derive(Debug)]
+struct VisibleSegments {
+    list: Vec<usize>,
+    place: Vec<usize>,
+}
+
+impl VisibleSegments {
+    /// An empty list for `segments` segments.
+    fn new(segments: usize) -> Self {
+        VisibleSegments { list: Vec::new(), place: vec![usize::MAX; segments] }
+    }
+
+    /// Adds segment `s` (not in the list).
+    fn insert(&mut self, s: usize) {
+        self.place[s] = self.list.len();
+        self.list.push(s);
+    }
+
+    /// Removes segment `s` (in the list).
+    fn remove(&mut self, s: usize) {
+        let k = self.place[s];
+        self.list.swap_remove(k);
+        if let Some(&moved) = self.list.get(k) {
+            self.place[moved] = k;
+        }
+        self.place[s] = usize::MAX;
+    }
+
+    /// The segments in the list.
+    fn ids(&self) -> &[usize] {
+        &self.list
+    }
 }
 
 #[cfg(test)]
