@@ -160,16 +160,6 @@ impl CsgTree {
         };
         (b.0.cmple(b.1).all()).then_some(b)
     }
-
-    /// The primitives the tree uses, in order.
-    #[must_use]
-    pub fn leaves(&self) -> Vec<usize> {
-        match self {
-            CsgTree::Leaf(i) => vec![*i],
-            CsgTree::Union(c) | CsgTree::Intersection(c) => c.iter().flat_map(CsgTree::leaves).collect(),
-            CsgTree::Difference(a, b) => a.leaves().into_iter().chain(b.iter().flat_map(CsgTree::leaves)).collect(),
-        }
-    }
 }
 
 /// A solid: primitives and the booleans that combine them.

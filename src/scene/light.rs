@@ -133,10 +133,12 @@ impl Default for ShadowSettings {
 
 impl Light {
     /// Seed 002 §3.3's soft shadows by jittering: a shadowed point or spot light
-    /// with a `size` becomes `shadow.samples` lights spread over the disc of that
-    /// radius facing `towards`, each carrying 1/n of the light and a shadow map of
-    /// half the resolution (the averaged penumbra hides the coarser texels; the n
-    /// maps cost n/4 of full ones); any other light is itself. The disc points are
+    /// with a `size` is shadowed from `shadow.samples` points spread over the disc
+    /// of that radius facing `towards`: these are the lights its shadow maps are
+    /// rendered from, each map at half the resolution (the averaged penumbra hides
+    /// the coarser texels; the n maps cost n/4 of full ones); the light itself is
+    /// still lit once, from its centre ([`crate::shading::FrameLight`]). Any other
+    /// light is itself. The disc points are
     /// stratified (Halton 2, 3 through an area-preserving square-to-disc map), the
     /// same on every frame.
     #[must_use]
@@ -165,13 +167,7 @@ impl Light {
                     _ => LightKind::Point { position: moved },
                 };
                 let shadow = ShadowSettings { resolution: (self.shadow.resolution / 2).max(16), ..self.shadow };
-                Light {
-                    kind,
-                    intensity: self.intensity / n as f32,
-                    ambient: self.ambient / n as f32,
-                    shadow,
-                    ..self.clone()
-                }
+                Light { kind, shadow, ..self.clone() }
             })
             .collect()
     }

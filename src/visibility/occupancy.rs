@@ -124,6 +124,57 @@ fn merged_operands<'t>(tree: &'t CsgTree, out: &mut Vec<&'t CsgTree>) {
     }
 }
 
+/// A set of ids below a bound, listed, with each id's place in the list, so
+/// an id joins or leaves in constant time (the visible-segment list of seed
+/// 003 §5.2.1; the primitives present in [`Occupied`]).
+#[derive(Debug, Clone, Default)]
+pub struct PlacedSet {
+    list: Vec<u32>,
+    place: Vec<u32>,
+}
+
+impl PlacedSet {
+    /// An empty set of ids below `n`.
+    #[must_use]
+    pub fn new(n: usize) -> Self {
+        PlacedSet { list: Vec::new(), place: vec![NONE; n] }
+    }
+
+    /// Takes ids below `n` (only while empty).
+    fn resize(&mut self, n: usize) {
+        debug_assert!(self.list.is_empty(), "resized while holding ids");
+        self.place.resize(n, NONE);
+    }
+
+    /// Whether `id` is in the set.
+    #[must_use]
+    pub fn contains(&self, id: usize) -> bool {
+        self.place[id] != NONE
+    }
+
+    /// Adds `id` (not in the set).
+    pub fn insert(&mut self, id: usize) {
+        self.place[id] = self.list.len() as u32;
+        self.list.push(id as u32);
+    }
+
+    /// Removes `id` (in the set).
+    pub fn remove(&mut self, id: usize) {
+        let k = self.place[id] as usize;
+        self.list.swap_remove(k);
+        if let Some(&moved) = self.list.get(k) {
+            self.place[moved as usize] = k as u32;
+        }
+        self.place[id] = NONE;
+    }
+
+    /// The ids, in no particular order.
+    #[must_use]
+    pub fn ids(&self) -> &[u32] {
+        &self.list
+    }
+}
+
 /// The counts of an [`OccupancyTree`] for the primitives occupying the
 /// current pixel (all empty at first). Kept apart from the tree, so one set of
 /// buffers serves every tree a thread meets ([`Occupied::fit`]); each call
@@ -140,10 +191,8 @@ pub struct Occupied {
     list: Vec<u32>,
     /// Per node: where it stands in its parent's list.
     place: Vec<u32>,
-    /// Primitives occupying the pixel, to empty the tree quickly, and each
-    /// primitive's place in that list (`NONE`: absent).
-    present: Vec<u32>,
-    place_present: Vec<u32>,
+    /// Primitives occupying the pixel, to empty the tree quickly.
+    present: PlacedSet,
 }
 
 impl Occupied {
@@ -157,30 +206,23 @@ impl Occupied {
 
     /// Sizes empty counts for `tree` (they stay empty).
     pub fn fit(&mut self, tree: &OccupancyTree) {
-        debug_assert!(self.present.is_empty(), "fitted while primitives are present");
         let n = tree.len();
         self.full.resize(n, false);
         self.live.resize(n, 0);
         self.place.resize(n, NONE);
         self.list.resize(tree.operands.len(), NONE);
-        self.place_present.resize(tree.first_leaf.len(), NONE);
+        self.present.resize(tree.first_leaf.len());
     }
 
     /// Primitive `i` starts (`on`) or stops occupying the pixel.
     pub fn set(&mut self, tree: &OccupancyTree, i: usize, on: bool) {
-        let at = self.place_present[i];
-        if (at != NONE) == on {
+        if self.present.contains(i) == on {
             return;
         }
         if on {
-            self.place_present[i] = self.present.len() as u32;
-            self.present.push(i as u32);
+            self.present.insert(i);
         } else {
-            self.present.swap_remove(at as usize);
-            if let Some(&moved) = self.present.get(at as usize) {
-                self.place_present[moved as usize] = at;
-            }
-            self.place_present[i] = NONE;
+            self.present.remove(i);
         }
         let mut leaf = tree.first_leaf[i];
         while leaf != NONE {
@@ -192,7 +234,7 @@ impl Occupied {
 
     /// Every primitive leaves.
     pub fn clear(&mut self, tree: &OccupancyTree) {
-        while let Some(&i) = self.present.last() {
+        while let Some(&i) = self.present.ids().last() {
             self.set(tree, i as usize, false);
         }
     }

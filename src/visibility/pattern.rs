@@ -26,6 +26,7 @@
 use crate::raytrace::csg::{Crossing, CsgCaster, Span, SpanScratch};
 use crate::scene::csg::CsgTree;
 use crate::visibility::csg::x_order;
+use crate::visibility::occupancy::PlacedSet;
 
 /// One segment: an intersection of positive primitives and complements of
 /// negative ones (indices into the solid's primitives, sorted).
@@ -92,7 +93,8 @@ impl PatternMatrix {
         let wanted = |i: usize| self.positive_in[i].iter().any(|&s| live[s as usize]) || self.negative_somewhere[i];
         let (entry, exit) = x_order(ends.iter().copied().filter(|&(i, _, _)| wanted(i)));
         let mut rcx: Vec<usize> = self.segments.iter().map(|s| s.positive.len()).collect();
-        let mut visible = VisibleSegments::new(self.segments.len());
+        // The visible-segment list (seed 003 §5.2.1).
+        let mut visible = PlacedSet::new(self.segments.len());
         let mut flagged = vec![false; n];
         let (mut next_in, mut next_out) = (0, 0);
         let mut spans = PixelSpans::new(n);
@@ -114,7 +116,7 @@ impl PatternMatrix {
             if !visible.ids().is_empty() {
                 spans.next_pixel();
                 *px = caster.first_hit_of_segments(
-                    visible.ids().iter().map(|&s| &self.segments[s]),
+                    visible.ids().iter().map(|&s| &self.segments[s as usize]),
                     &|i| flagged[i],
                     &mut |i| spans.get(i, || span(i, x)),
                     near,
@@ -228,42 +230,6 @@ fn meet(a: &[Segment], b: &[Segment], limit: usize) -> Result<Vec<Segment>, TooM
         }
     }
     Ok(out)
-}
-
-/// The visible-segment list (seed 003 §5.2.1): segment ids, with each one's
-/// place in the list, so a segment joins or leaves in constant time.
-#[derive(Debug)]
-struct VisibleSegments {
-    list: Vec<usize>,
-    place: Vec<usize>,
-}
-
-impl VisibleSegments {
-    /// An empty list for `segments` segments.
-    fn new(segments: usize) -> Self {
-        VisibleSegments { list: Vec::new(), place: vec![usize::MAX; segments] }
-    }
-
-    /// Adds segment `s` (not in the list).
-    fn insert(&mut self, s: usize) {
-        self.place[s] = self.list.len();
-        self.list.push(s);
-    }
-
-    /// Removes segment `s` (in the list).
-    fn remove(&mut self, s: usize) {
-        let k = self.place[s];
-        self.list.swap_remove(k);
-        if let Some(&moved) = self.list.get(k) {
-            self.place[moved] = k;
-        }
-        self.place[s] = usize::MAX;
-    }
-
-    /// The segments in the list.
-    fn ids(&self) -> &[usize] {
-        &self.list
-    }
 }
 
 #[cfg(test)]
