@@ -15,7 +15,7 @@ use crate::resolve::edges::{self, EdgeCache, EdgeOptions};
 use crate::resolve::solid_edges;
 use crate::resolve::{Antialias, LinearImage};
 use crate::scene::Scene;
-use crate::shading::{self, fog, translucency, Component, ComponentSet, Target};
+use crate::shading::{self, fog, translucency, Component, ComponentSet, SubpixelShading, Target};
 use crate::shadows::MapPool;
 use crate::visibility::{self, RasterStats, VisibilityBuffer};
 
@@ -183,21 +183,20 @@ fn render_into(scene: &Scene, frame: &mut Frame, scratch: &mut Scratch, options:
     scratch.aovs.resize_with(frame.aovs.len(), LinearImage::default);
     scratch.aovs.iter_mut().for_each(|a| a.resize(w, h));
     if offsets.len() == 1 && offsets[0] == Vec2::ZERO {
-        render_pass(scene, frame, scratch, options.ray_depth);
-        if let Antialias::Edge(mode) = scene.antialias {
+        let edge = match scene.antialias {
+            Antialias::Edge(mode) => Some(EdgeOptions { mode, ..EdgeOptions::default() }),
+            _ => None,
+        };
+        render_pass(scene, frame, scratch, options.ray_depth, edge.as_ref());
+        if edge.is_some() && scene.objects.iter().any(|o| o.solid().is_some()) {
+            // Solids' outlines are curves no mesh edge bounds: measured by rays.
             let t = Instant::now();
             let mut images: Vec<&mut LinearImage> =
                 std::iter::once(&mut frame.image).chain(&mut scratch.aovs).collect();
-            let options = EdgeOptions { mode, ..EdgeOptions::default() };
-            frame.stats.edge_blends =
-                edges::antialias_edges(scene, &frame.visibility, &mut images, &options, &mut scratch.edges);
-            if scene.objects.iter().any(|o| o.solid().is_some()) {
-                // Solids' outlines are curves no mesh edge bounds: measured by rays.
-                let blends = solid_edges::find_outline_blends(scene, &frame.visibility, scratch.trace.get(scene));
-                images.iter_mut().for_each(|image| solid_edges::apply_outline_blends(image, &blends));
-                frame.stats.edge_blends += blends.len();
-            }
-            frame.stats.edge_ms = t.elapsed().as_secs_f64() * 1e3;
+            let blends = solid_edges::find_outline_blends(scene, &frame.visibility, scratch.trace.get(scene));
+            images.iter_mut().for_each(|image| solid_edges::apply_outline_blends(image, &blends));
+            frame.stats.edge_blends += blends.len();
+            frame.stats.edge_ms += t.elapsed().as_secs_f64() * 1e3;
         }
         frame.aovs.iter_mut().zip(&mut scratch.aovs).for_each(|((_, a), s)| std::mem::swap(a, s));
     } else {
@@ -212,7 +211,7 @@ fn render_into(scene: &Scene, frame: &mut Frame, scratch: &mut Scratch, options:
         for &o in &offsets {
             // Pixel offsets (y down) to NDC (y up).
             pass.camera.shift = scene.camera.shift + Vec2::new(o.x, -o.y) * pixel;
-            render_pass(&pass, frame, scratch, options.ray_depth);
+            render_pass(&pass, frame, scratch, options.ray_depth, None);
             add_scaled(&mut scratch.accum, &frame.image, k);
             frame.aovs.iter_mut().zip(&scratch.aovs).for_each(|((_, a), s)| add_scaled(a, s, k));
         }
@@ -231,13 +230,20 @@ fn add_scaled(acc: &mut LinearImage, img: &LinearImage, k: f32) {
 }
 
 /// One visibility pass, its shading and its traced term into `frame.image`, and
-/// the components `frame.aovs` names into `scratch.aovs` (same order); adds its
-/// timings to the frame's statistics.
-fn render_pass(scene: &Scene, frame: &mut Frame, scratch: &mut Scratch, ray_depth: u32) {
-    let Scratch { aovs, maps, trace, .. } = scratch;
+/// the components `frame.aovs` names into `scratch.aovs` (same order), with
+/// seed 004's edge pass if `edge` says so; adds its timings to the frame's
+/// statistics.
+fn render_pass(scene: &Scene, frame: &mut Frame, scratch: &mut Scratch, ray_depth: u32, edge: Option<&EdgeOptions>) {
+    let Scratch { aovs, maps, trace, edges: edge_cache, .. } = scratch;
     let t0 = Instant::now();
     frame.visibility.resize(scene.width, scene.height);
     frame.stats.raster = visibility::rasterize(scene, &mut frame.visibility);
+    let t1 = Instant::now();
+    // The edges are found before shading, so the passes shade the sub-pixel
+    // points the crossed pixels' parts need.
+    let plan = edge.map(|o| edges::plan(scene, &frame.visibility, o, edge_cache));
+    let mut subpixel = SubpixelShading::new(plan.as_ref().map_or_else(Vec::new, |p| p.samples(scene.width)));
+    let planned = t1.elapsed();
     let t1 = Instant::now();
     frame.image.resize(scene.width, scene.height);
     let mut targets = vec![Target { parts: ComponentSet::ALL, image: &mut frame.image }];
@@ -250,7 +256,7 @@ fn render_pass(scene: &Scene, frame: &mut Frame, scratch: &mut Scratch, ray_dept
         }
     }
     let vb = &frame.visibility;
-    let lit = shading::shade_lit(scene, vb, &mut targets, maps);
+    let lit = shading::shade_lit(scene, vb, &mut targets, maps, &mut subpixel);
     let t2 = Instant::now();
     let builds = trace.builds();
     frame.stats.traced_pixels += match &mut traced_aov {
@@ -262,16 +268,18 @@ fn render_pass(scene: &Scene, frame: &mut Frame, scratch: &mut Scratch, ray_dept
             n
         }
     };
+    item_buffer::trace_subpixel(scene, vb, &mut subpixel, ray_depth, trace);
     let t3 = Instant::now();
     frame.stats.bvh_built |= trace.builds() > builds;
     targets.extend(traced_aov.map(|image| Target { parts: ComponentSet::only(Component::Traced), image }));
-    if let Some(fog) = &scene.fog {
+    let fogged = scene.fog.as_ref().map(|fog| {
         let amounts = fog::fog_amounts(scene, fog, vb);
         for t in &mut targets {
             let color = if t.parts.contains(Component::Fog) { fog.color } else { Vec3::ZERO };
             fog::apply(t.image, &amounts, color);
         }
-    }
+        amounts
+    });
     // Translucent surfaces last, over everything opaque (seed 002 §3.4).
     let layers = visibility::fragments(scene, vb);
     if !layers.is_empty() {
@@ -279,7 +287,13 @@ fn render_pass(scene: &Scene, frame: &mut Frame, scratch: &mut Scratch, ray_dept
         frame.stats.translucent_fragments +=
             translucency::composite(scene, layers, scene.translucency, &lights, &mut targets, maps);
     }
-    frame.stats.visibility_ms += (t1 - t0).as_secs_f64() * 1e3;
+    if let Some(plan) = &plan {
+        let t = Instant::now();
+        targets.iter_mut().for_each(|t| plan.apply(t.image, t.parts, &subpixel, fogged.as_deref()));
+        frame.stats.edge_blends = plan.len();
+        frame.stats.edge_ms = (planned + t.elapsed()).as_secs_f64() * 1e3;
+    }
+    frame.stats.visibility_ms += (t1 - t0 - planned).as_secs_f64() * 1e3;
     frame.stats.shading_ms += ((t2 - t1) + t3.elapsed()).as_secs_f64() * 1e3 - lit.shadow_ms;
     frame.stats.shadow_ms += lit.shadow_ms;
     frame.stats.shadow_maps_reused += lit.maps_reused;

@@ -53,11 +53,12 @@
 use std::collections::HashMap;
 use std::sync::Arc;
 
-use glam::{DVec4, Mat4, Vec3, Vec4};
+use glam::{DVec4, Mat4, Vec2, Vec3, Vec4};
 use rayon::prelude::*;
 
-use super::LinearImage;
+use super::{intersections, LinearImage};
 use crate::scene::{Camera, Mesh, Projection, Scene};
+use crate::shading::{Component, ComponentSet, SubpixelSample, SubpixelShading};
 use crate::visibility::{ItemId, VisibilityBuffer};
 
 /// Which edges the edge pass walks.
@@ -266,46 +267,168 @@ pub struct EdgeBlend {
     pub inside: bool,
     /// The edge: object index (high 32 bits) and edge index within its mesh.
     pub source: u64,
+    /// Where in `c` the part on `o`'s side of the edge has its centroid, from
+    /// `c`'s centre (pixels, y down).
+    pub far: Vec2,
 }
 
-/// Runs seed 004's edge pass over the frame: finds the blends from `vb` and the
-/// frame `images[0]` as pass 1 left it, then applies them to every image in
-/// `images` (the frame and its component images, same size as `vb`). Returns the
-/// number of pixel blends applied.
-pub fn antialias_edges(
-    scene: &Scene,
-    vb: &VisibilityBuffer,
-    images: &mut [&mut LinearImage],
-    options: &EdgeOptions,
-    cache: &mut EdgeCache,
-) -> usize {
+/// The edge pass of one frame: its blends, found from the visibility buffer
+/// alone, before shading, so the passes can shade the sub-pixel points they
+/// need ([`EdgePlan::samples`]).
+#[derive(Debug, Clone, Default)]
+pub struct EdgePlan {
+    /// Merged blends, sorted by pixel, then neighbour.
+    blends: Vec<EdgeBlend>,
+    /// Whether the parts of a crossed pixel are re-shaded at their centroids
+    /// (the coverage filter), or take the pixels' colours as they are (the
+    /// paper's filter, which blends the edge's colour).
+    reshade: bool,
+}
+
+/// Plans seed 004's edge pass over the frame whose visibility buffer is `vb`.
+#[must_use]
+pub fn plan(scene: &Scene, vb: &VisibilityBuffer, options: &EdgeOptions, cache: &mut EdgeCache) -> EdgePlan {
     let edges = cache.edges_of(scene, options.crease_deg);
-    let blends = find_blends(scene, vb, &edges, options.mode);
+    let clips = ClipMap::of_objects(scene, vb.width(), vb.height());
+    let mut blends = find_blends(scene, vb, (&edges, &clips), options.mode);
+    if options.mode.filter == EdgeFilter::Coverage {
+        // Where an edge runs between two pixels it bounds what they show; an
+        // intersection is only looked for where none does.
+        let walked: std::collections::HashSet<(u32, u32)> =
+            blends.iter().flat_map(|b| [(b.c, b.o), (b.o, b.c)]).collect();
+        let crossings = intersections::find_intersection_blends(scene, vb, &clips);
+        blends.extend(crossings.into_iter().filter(|b| !walked.contains(&(b.c, b.o))));
+    }
     // One straight edge moves a pixel by at most ½ under the coverage filter; the
     // paper's Wu weights reach 1.
     let cap = match options.mode.filter {
         EdgeFilter::Coverage => 0.5,
         EdgeFilter::Paper => 1.0,
     };
-    let blends = merge(blends, cap);
-    for image in images.iter_mut() {
-        apply(image, &blends);
+    EdgePlan { blends: merge(blends, cap), reshade: options.mode.filter == EdgeFilter::Coverage }
+}
+
+impl EdgePlan {
+    /// Pixel blends: one per pixel and neighbour across an edge.
+    #[must_use]
+    pub fn len(&self) -> usize {
+        self.blends.len()
     }
-    blends.len()
+
+    /// Whether no edge crosses a pixel.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.blends.is_empty()
+    }
+
+    /// The points the shading passes shade for [`EdgePlan::apply`] on a `width`
+    /// pixels wide frame. Per crossed pixel `c`: its own surface at its centre
+    /// and at the centroid of its part on its centre's side of the edges; per
+    /// neighbour `o` across an edge: `o`'s surface at `o`'s centre and at the
+    /// centroid of `c`'s part on `o`'s side. (None under the paper's filter.)
+    #[must_use]
+    pub fn samples(&self, width: u32) -> Vec<SubpixelSample> {
+        if !self.reshade {
+            return Vec::new();
+        }
+        let pixel = |i: u32| (i % width, i / width);
+        let centre = |(x, y): (u32, u32)| Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
+        let at = |p: (u32, u32), offset: Vec2| SubpixelSample { pixel: p, at: centre(p) + offset };
+        let mut out = Vec::with_capacity(self.blends.len() * 4);
+        for crossed in self.blends.chunk_by(|a, b| a.c == b.c) {
+            let c = pixel(crossed[0].c);
+            out.extend([at(c, Vec2::ZERO), at(c, near_centroid(crossed))]);
+            for b in crossed {
+                out.extend([at(pixel(b.o), Vec2::ZERO), SubpixelSample { pixel: pixel(b.o), at: centre(c) + b.far }]);
+            }
+        }
+        out
+    }
+
+    /// Blends `image` (holding the components `parts`): each crossed pixel
+    /// becomes its parts' colours weighted by their areas. A part's colour is
+    /// the colour of the pixel whose surface it shows, moved by what the lit
+    /// passes found between that pixel's centre and the part's centroid
+    /// (`shaded`: [`EdgePlan::samples`] after the passes; the difference is
+    /// fogged as the pixel is, by `1 − fog[pixel]`). Every blend reads the image
+    /// as it was before any of them.
+    pub fn apply(&self, image: &mut LinearImage, parts: ComponentSet, shaded: &SubpixelShading, fog: Option<&[f32]>) {
+        let reshaded = self.reshade && shaded.lit.len() == 2 * (self.blends.len() + self.crossed_pixels());
+        let moved = |pixel: u32, k: usize| {
+            let clear = fog.map_or(1.0, |f| 1.0 - f[pixel as usize]);
+            let lit = shaded.lit[k + 1].total_of(parts) - shaded.lit[k].total_of(parts);
+            let traced = if parts.contains(Component::Traced) { shaded.traced[k + 1] - shaded.traced[k] } else { Vec3::ZERO };
+            (lit + traced) * clear
+        };
+        let mut k = 0;
+        let updates: Vec<(u32, Vec3)> = {
+            let px = image.pixels();
+            self.blends
+                .chunk_by(|a, b| a.c == b.c)
+                .map(|crossed| {
+                    let c = crossed[0].c;
+                    let mut own = px[c as usize];
+                    if reshaded {
+                        own += moved(c, k);
+                        k += 2;
+                    }
+                    let mut colour = own;
+                    for b in crossed {
+                        let mut across = px[b.o as usize];
+                        if reshaded {
+                            across += moved(b.o, k);
+                            k += 2;
+                        }
+                        colour += (across - own) * b.alpha;
+                    }
+                    (c, colour)
+                })
+                .collect()
+        };
+        let px = image.pixels_mut();
+        for (c, colour) in updates {
+            px[c as usize] = colour;
+        }
+    }
+
+    /// Pixels with at least one blend.
+    fn crossed_pixels(&self) -> usize {
+        self.blends.chunk_by(|a, b| a.c == b.c).count()
+    }
+}
+
+/// The centroid of a crossed pixel's part on its centre's side of its edges,
+/// from the centre: the pixel's centroid (its centre) is the parts' centroids
+/// weighted by their areas.
+fn near_centroid(crossed: &[EdgeBlend]) -> Vec2 {
+    let across: f32 = crossed.iter().map(|b| b.alpha).sum();
+    let moment: Vec2 = crossed.iter().map(|b| b.far * b.alpha).sum();
+    -moment / (1.0 - across).max(0.5)
 }
 
 /// Every blend, in scene order (object, then edge).
 fn find_blends(
     scene: &Scene,
     vb: &VisibilityBuffer,
-    edges: &[Option<Arc<MeshEdges>>],
+    (edges, clips): (&[Option<Arc<MeshEdges>>], &[ClipMap]),
     mode: EdgeMode,
 ) -> Vec<EdgeBlend> {
     let camera = &scene.camera;
     let (w, h) = (vb.width(), vb.height());
-    let view_proj = camera.view_projection(w as f32 / h as f32);
     let depth = DepthScale::of(camera, h);
-    let screen = Screen { width: w as f64, height: h as f64, far: f64::from(camera.far_plane_factor()) };
+    let screen = Screen::of(camera, w, h);
+    // The depth at the edge's point of the surface pixel `i` shows: its
+    // triangle's plane carried there (a surface resting on another meets it at
+    // the edge's depth, though its pixel beside the edge lies nearer), else
+    // the pixel's own depth.
+    let depth_at = |i: usize, point: glam::DVec3| {
+        let item = vb.items()[i];
+        let mesh = (!item.is_none() && item.primitive().is_none())
+            .then(|| scene.objects[item.object as usize].triangles())
+            .flatten();
+        mesh.and_then(|m| screen.plane_depth(&clips[item.object as usize], m, item.triangle, point))
+            .unwrap_or(f64::from(vb.depths()[i]))
+    };
     let mut blends = Vec::new();
     for (object, (o, mesh_edges)) in scene.objects.iter().zip(edges).enumerate() {
         // Solids' outlines are not mesh edges: they keep their aliased edges.
@@ -315,7 +438,7 @@ fn find_blends(
             continue; // blended over the opaque frame later; its edges are not walked
         }
         let facing = Facing::new(camera, o.transform.inverse());
-        let to_clip = (view_proj * Mat4::from(o.transform)).as_dmat4();
+        let clip = &clips[object];
         let per_edge: Vec<Vec<EdgeBlend>> = mesh_edges
             .edges
             .par_iter()
@@ -323,11 +446,11 @@ fn find_blends(
             .filter(|(_, e)| selected(e, mesh_edges, &facing, material.two_sided, mode.selection))
             .filter_map(|(k, e)| {
                 let source = ((object as u64) << 32) | k as u64;
-                let [a, b] = e.v.map(|i| to_clip * mesh.positions[i as usize].as_dvec3().extend(1.0));
+                let [a, b] = e.v.map(|i| clip.points * mesh.positions[i as usize].as_dvec3().extend(1.0));
                 let (a, b) = screen.clip_and_project(a, b)?;
                 let mut out = Vec::new();
                 let near = mesh_edges.neighbourhood(mesh, e);
-                let visit = |c: (u32, u32), other: (u32, u32), alpha, point: glam::DVec3| {
+                let visit = |c: (u32, u32), other: (u32, u32), alpha, point: glam::DVec3, far: Vec2| {
                     // A pixel shows the edge's own surface if its triangle touches the
                     // faces beside the edge, or if its plane passes near the edge point
                     // (a fine mesh: the triangle at the pixel is a few rings away).
@@ -335,11 +458,12 @@ fn find_blends(
                         item.object == object as u32
                             && (mesh_edges.touches(mesh, item.triangle, &near)
                                 || screen
-                                    .plane_depth(&to_clip, mesh, item.triangle, point)
+                                    .plane_depth(clip, mesh, item.triangle, point)
                                     .is_some_and(|z| depth.close(z, point.z)))
                     };
-                    if let Some(blend) = depth_tested(vb, &own, c, other, alpha, point.z as f32, mode.filter) {
-                        out.push(EdgeBlend { source, ..blend });
+                    let occludes = |i: usize| depth.in_front(depth_at(i, point), point.z);
+                    if let Some(blend) = depth_tested(vb, (&own, &occludes), c, other, alpha, mode.filter) {
+                        out.push(EdgeBlend { source, far, ..blend });
                     }
                 };
                 walk(a, b, visit, (w, h), mode.filter);
@@ -393,19 +517,6 @@ fn merge(mut blends: Vec<EdgeBlend>, cap: f32) -> Vec<EdgeBlend> {
     merged
 }
 
-/// `c ← c + alpha·(o − c)` for every blend, reading `o` and `c` as they were
-/// before any blend.
-fn apply(image: &mut LinearImage, blends: &[EdgeBlend]) {
-    let deltas: Vec<Vec3> = {
-        let px = image.pixels();
-        blends.iter().map(|b| (px[b.o as usize] - px[b.c as usize]) * b.alpha).collect()
-    };
-    let px = image.pixels_mut();
-    for (b, d) in blends.iter().zip(deltas) {
-        px[b.c as usize] += d;
-    }
-}
-
 /// Which faces look at the eye, tested in the object's own space (the sign of a
 /// point's side of a plane survives any affine map).
 struct Facing {
@@ -449,7 +560,7 @@ fn selected(e: &MeshEdge, mesh: &MeshEdges, facing: &Facing, two_sided: bool, se
 }
 
 /// Clip space to the pixel grid, as the polygon pass maps it.
-struct Screen {
+pub(super) struct Screen {
     width: f64,
     height: f64,
     /// The far plane `z = far·w` (reversed depth).
@@ -479,36 +590,81 @@ impl Screen {
         glam::DVec3::new((c.x * inv_w * 0.5 + 0.5) * self.width, (0.5 - c.y * inv_w * 0.5) * self.height, c.z * inv_w)
     }
 
+    /// The screen from `scene`'s camera onto a `width` × `height` image.
+    pub(super) fn of(camera: &Camera, width: u32, height: u32) -> Screen {
+        Screen { width: f64::from(width), height: f64::from(height), far: f64::from(camera.far_plane_factor()) }
+    }
+
     /// Depth of triangle `t`'s plane at screen point `p` (x, y), extrapolated
     /// beyond the triangle if need be; `None` if the triangle reaches behind the eye
     /// or is seen edge-on.
-    fn plane_depth(&self, to_clip: &glam::DMat4, mesh: &Mesh, t: u32, p: glam::DVec3) -> Option<f64> {
-        let tri = mesh.triangles.get(t as usize)?;
-        let c = tri.map(|v| *to_clip * mesh.positions[v as usize].as_dvec3().extend(1.0));
-        if c.iter().any(|c| c.w <= 0.0) {
+    fn plane_depth(&self, clip: &ClipMap, mesh: &Mesh, t: u32, p: glam::DVec3) -> Option<f64> {
+        self.depth_plane(clip, mesh, t).map(|plane| plane.at(p.x, p.y))
+    }
+
+    /// Triangle `t`'s plane as the depth it stores over the screen (depth is
+    /// affine in screen x, y over a plane, in perspective too: z/w and 1/w
+    /// are), found from the plane itself, so a triangle reaching behind the eye
+    /// (a large floor) has one too. `None` if the plane is seen edge-on.
+    pub(super) fn depth_plane(&self, clip: &ClipMap, mesh: &Mesh, t: u32) -> Option<DepthPlane> {
+        let [a, b, c] = mesh.triangles.get(t as usize)?.map(|v| mesh.positions[v as usize].as_dvec3());
+        let n = (b - a).cross(c - a);
+        // The plane a·x + b·y + c·z + d = 0 in clip space over NDC (x, y, z).
+        let p = clip.planes * n.extend(-n.dot(a));
+        if p.z.abs() < 1e-12 * p.truncate().length().max(f64::MIN_POSITIVE) {
             return None;
         }
-        let [v0, v1, v2] = c.map(|c| self.project(c));
-        let (e1, e2, d) = (v1 - v0, v2 - v0, p - v0);
-        let det = e1.x * e2.y - e2.x * e1.y;
-        if det.abs() < 1e-12 {
-            return None;
-        }
-        let (b1, b2) = ((d.x * e2.y - e2.x * d.y) / det, (e1.x * d.y - d.x * e1.y) / det);
-        Some(v0.z + b1 * e1.z + b2 * e2.z)
+        // NDC x = 2·sx/width − 1, y = 1 − 2·sy/height; z = −(p.x·x + p.y·y + p.w)/p.z.
+        let gx = -2.0 * p.x / (p.z * self.width);
+        let gy = 2.0 * p.y / (p.z * self.height);
+        Some(DepthPlane { z0: (p.x - p.y - p.w) / p.z, gx, gy })
+    }
+}
+
+/// An object's map from its own space to clip space, for points and for
+/// planes (`n·x + d = 0` as (n, d): the inverse transpose).
+#[derive(Debug, Clone, Copy)]
+pub(super) struct ClipMap {
+    pub(super) points: glam::DMat4,
+    pub(super) planes: glam::DMat4,
+}
+
+impl ClipMap {
+    /// Every object's, for a `width` × `height` view of `scene`.
+    pub(super) fn of_objects(scene: &Scene, width: u32, height: u32) -> Vec<ClipMap> {
+        let view_proj = scene.camera.view_projection(width as f32 / height as f32);
+        let clip = |o: &crate::scene::Object| (view_proj * Mat4::from(o.transform)).as_dmat4();
+        scene.objects.iter().map(clip).map(|points| ClipMap { points, planes: points.inverse().transpose() }).collect()
+    }
+}
+
+/// A surface's stored depth over the screen: `z0 + gx·x + gy·y` (pixels).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct DepthPlane {
+    pub(super) z0: f64,
+    pub(super) gx: f64,
+    pub(super) gy: f64,
+}
+
+impl DepthPlane {
+    /// The depth at screen point (x, y).
+    pub(super) fn at(&self, x: f64, y: f64) -> f64 {
+        self.z0 + self.gx * x + self.gy * y
     }
 }
 
 /// The DDA of pass 2, one walker for both axes: steps column by column along the
 /// major axis through the column centres the segment spans, and in each column
 /// through the (one or two) pixels the edge's line crosses. For each it calls
-/// `visit(c, o, alpha, point)`: the crossed pixel `c`, its neighbour `o` across the
-/// edge, the share of `c`'s area on `o`'s side of the line (exact) and the edge's
-/// point at the column centre (screen x, y and depth). Pixels are (x, y); pairs reaching outside the image are skipped.
+/// `visit(c, o, alpha, point, far)`: the crossed pixel `c`, its neighbour `o`
+/// across the edge, the share of `c`'s area on `o`'s side of the line (exact),
+/// the edge's point at the column centre (screen x, y and depth) and the
+/// centroid of `c`'s part on `o`'s side, from `c`'s centre. Pixels are (x, y);
+/// pairs reaching outside the image are skipped.
 fn walk(
     a: glam::DVec3,
     b: glam::DVec3,
-    mut visit: impl FnMut((u32, u32), (u32, u32), f32, glam::DVec3),
+    mut visit: impl FnMut((u32, u32), (u32, u32), f32, glam::DVec3, Vec2),
     size: (u32, u32),
     filter: EdgeFilter,
 ) {
@@ -543,7 +699,10 @@ fn walk(
         let point = if swap { glam::DVec3::new(yc, centre, z) } else { glam::DVec3::new(centre, yc, z) };
         let mut emit = |r: i64, o: i64, alpha: f64| {
             if alpha > 1e-6 && inside(r) && inside(o) {
-                visit(to_xy(i as u32, r), to_xy(i as u32, o), alpha as f32, point);
+                // The part towards o (smaller minor coordinate if o = r − 1).
+                let (u, v) = part_centroid(y0 - r as f64, y1 - r as f64, o > r);
+                let far = if swap { Vec2::new(v as f32, u as f32) } else { Vec2::new(u as f32, v as f32) };
+                visit(to_xy(i as u32, r), to_xy(i as u32, o), alpha as f32, point, far);
             }
         };
         match filter {
@@ -571,6 +730,48 @@ fn walk(
             }
         }
     }
+}
+
+/// The centroid, from the square's centre, of the part of the unit square
+/// (u, v) ∈ [0, 1]² beyond the line from (0, `v0`) to (1, `v1`): where v is
+/// greater than the line's if `beyond_below`, else where it is smaller (the
+/// square's centre if that part is empty).
+fn part_centroid(v0: f64, v1: f64, beyond_below: bool) -> (f64, f64) {
+    let sign = if beyond_below { 1.0 } else { -1.0 };
+    square_part(|(u, v)| sign * (v - (v0 + (v1 - v0) * u))).1
+}
+
+/// The part of the unit square (u, v) ∈ [0, 1]² where the affine function
+/// `side` is ≥ 0: its area and its centroid from the square's centre (the
+/// centre if the part is empty).
+pub(super) fn square_part(side: impl Fn((f64, f64)) -> f64) -> (f64, (f64, f64)) {
+    // The square clipped to side ≥ 0 (Sutherland–Hodgman, one plane).
+    let square = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)];
+    let mut part: Vec<(f64, f64)> = Vec::with_capacity(5);
+    for (k, &p) in square.iter().enumerate() {
+        let q = square[(k + 1) % 4];
+        let (sp, sq) = (side(p), side(q));
+        if sp >= 0.0 {
+            part.push(p);
+        }
+        if (sp >= 0.0) != (sq >= 0.0) {
+            let t = sp / (sp - sq);
+            part.push((p.0 + (q.0 - p.0) * t, p.1 + (q.1 - p.1) * t));
+        }
+    }
+    // Area and centroid of the polygon (shoelace).
+    let (mut area, mut cu, mut cv) = (0.0, 0.0, 0.0);
+    for (k, &(pu, pv)) in part.iter().enumerate() {
+        let (qu, qv) = part[(k + 1) % part.len()];
+        let cross = pu * qv - qu * pv;
+        area += cross;
+        cu += (pu + qu) * cross;
+        cv += (pv + qv) * cross;
+    }
+    if area.abs() < 1e-12 {
+        return (0.0, (0.0, 0.0));
+    }
+    (area * 0.5, (cu / (3.0 * area) - 0.5, cv / (3.0 * area) - 0.5))
 }
 
 /// ∫₀¹ clamp(a + k·t, 0, 1) dt, exactly: the integrand is linear between the
@@ -621,11 +822,21 @@ impl DepthScale {
     /// against the supersampled truth).
     fn close(&self, a: f64, b: f64) -> bool {
         let (da, db) = (self.distance(a), self.distance(b));
-        let pixel = match self.projection {
-            Projection::Perspective { .. } => self.pixel * db,
+        (da - db).abs() <= 8.0 * self.pixel_at(db)
+    }
+
+    /// Whether depth `a` lies in front of depth `b` by more than a pixel's size.
+    fn in_front(&self, a: f64, b: f64) -> bool {
+        let (da, db) = (self.distance(a), self.distance(b));
+        da < db - self.pixel_at(db)
+    }
+
+    /// A pixel's size at view distance `d`.
+    fn pixel_at(&self, d: f64) -> f64 {
+        match self.projection {
+            Projection::Perspective { .. } => self.pixel * d,
             Projection::Orthographic { .. } => self.pixel,
-        };
-        (da - db).abs() <= 8.0 * pixel
+        }
     }
 }
 
@@ -644,21 +855,20 @@ enum Side {
 /// hides it, and one of them is its own surface.
 fn depth_tested(
     vb: &VisibilityBuffer,
-    own: &impl Fn(ItemId) -> bool,
+    (own, occludes): (&impl Fn(ItemId) -> bool, &impl Fn(usize) -> bool),
     c: (u32, u32),
     o: (u32, u32),
     alpha: f32,
-    z: f32,
     filter: EdgeFilter,
 ) -> Option<EdgeBlend> {
     let w = vb.width();
     let index = |(x, y): (u32, u32)| y * w + x;
     let side = |p: (u32, u32)| {
         let i = index(p) as usize;
-        let (zp, item) = (vb.depths()[i], vb.items()[i]);
+        let item = vb.items()[i];
         if !item.is_none() && own(item) {
             Side::Own
-        } else if zp > z {
+        } else if !item.is_none() && occludes(i) {
             Side::Occluder
         } else {
             Side::Behind
@@ -671,7 +881,7 @@ fn depth_tested(
         EdgeFilter::Paper => so == Side::Own && sc != Side::Own,
     };
     let shows = sc != Side::Occluder && so != Side::Occluder && source;
-    shows.then(|| EdgeBlend { c: index(c), o: index(o), alpha, inside: sc == Side::Own, source: 0 })
+    shows.then(|| EdgeBlend { c: index(c), o: index(o), alpha, inside: sc == Side::Own, source: 0, far: Vec2::ZERO })
 }
 
 #[cfg(test)]
@@ -708,33 +918,34 @@ mod tests {
         let (a, b) = (glam::DVec3::new(0.4, 2.48, 0.5), glam::DVec3::new(10.3, 9.41, 0.5));
         let line = |x: f64| 0.7 * x + 2.2;
         let mut seen = Vec::new();
-        walk(a, b, |c, o, alpha, _| seen.push((c, o, alpha)), (20, 20), EdgeFilter::Coverage);
+        walk(a, b, |c, o, alpha, _, far| seen.push((c, o, alpha, far)), (20, 20), EdgeFilter::Coverage);
         let swapped = {
             let mut v = Vec::new();
             let t = |p: glam::DVec3| glam::DVec3::new(p.y, p.x, p.z);
-            walk(t(b), t(a), |c, o, alpha, _| v.push(((c.1, c.0), (o.1, o.0), alpha)), (20, 20), EdgeFilter::Coverage);
+            let mut visit = |c: (u32, u32), o: (u32, u32), alpha, _, far: Vec2| {
+                v.push(((c.1, c.0), (o.1, o.0), alpha, Vec2::new(far.y, far.x)));
+            };
+            walk(t(b), t(a), &mut visit, (20, 20), EdgeFilter::Coverage);
             v
         };
         assert_eq!(seen, swapped, "y-major is x-major with the axes swapped");
         assert!(seen.len() > 12, "{} blends", seen.len());
-        for ((cx, cy), (ox, oy), alpha) in seen {
+        for ((cx, cy), (ox, oy), alpha, far) in seen {
             assert_eq!(cx, ox);
             assert_eq!(oy.abs_diff(cy), 1);
             // Numerically: the share of pixel (cx, cy) on the other side of the
-            // line from its centre.
+            // line from its centre, and that part's centroid.
             let centre_below = f64::from(cy) + 0.5 > line(f64::from(cx) + 0.5);
-            let n = 2000;
-            let share: f64 = (0..n * n)
-                .map(|k| {
-                    (
-                        f64::from(cx) + ((k % n) as f64 + 0.5) / n as f64,
-                        f64::from(cy) + ((k / n) as f64 + 0.5) / n as f64,
-                    )
-                })
-                .filter(|&(x, y)| (y > line(x)) != centre_below)
-                .count() as f64
-                / (n * n) as f64;
+            let n = 1000;
+            let part: Vec<(f64, f64)> = (0..n * n)
+                .map(|k| (((k % n) as f64 + 0.5) / n as f64, ((k / n) as f64 + 0.5) / n as f64))
+                .filter(|&(x, y)| (f64::from(cy) + y > line(f64::from(cx) + x)) != centre_below)
+                .collect();
+            let share = part.len() as f64 / (n * n) as f64;
             assert!((f64::from(alpha) - share).abs() < 2e-3, "pixel ({cx}, {cy}): alpha {alpha} vs {share}");
+            let mean = |f: fn(&(f64, f64)) -> f64| part.iter().map(f).sum::<f64>() / part.len() as f64 - 0.5;
+            let centroid = Vec2::new(mean(|p| p.0) as f32, mean(|p| p.1) as f32);
+            assert!(far.distance(centroid) < 2e-3, "pixel ({cx}, {cy}): part's centroid {far} vs {centroid}");
             assert_eq!(oy > cy, !centre_below, "o lies across the edge");
         }
     }

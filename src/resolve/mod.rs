@@ -3,6 +3,7 @@
 //! this stage and keep the buffer's values.
 
 pub mod edges;
+mod intersections;
 pub mod jitter;
 pub mod solid_edges;
 

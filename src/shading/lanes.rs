@@ -11,7 +11,7 @@
 use glam::{Vec2, Vec3};
 use wide::f32x8;
 
-use super::phong::{Coefficients, Component, ComponentSet};
+use super::phong::{self, Coefficients, Component, ComponentSet, Components};
 use super::surface::{PreparedTriangle, SurfacePoint, TriangleGeometry};
 use crate::scene::camera::PixelRays;
 use crate::scene::{Falloff, Light, LightKind};
@@ -471,6 +471,32 @@ impl<'a> Lighting<'a> {
     pub fn is_empty(&self) -> bool {
         let direct = !self.direct.is_empty() && (self.diffuse > 0.0 || self.specular > 0.0);
         !direct && self.ambient == Vec3::ZERO && !self.emission
+    }
+
+    /// What the pass adds at one surface point with coefficients `k`, by
+    /// component: the scalar statement of the lanes' sum (ambient of the pass's
+    /// ambient lights, each direct light's diffuse and specular times the mean
+    /// of its shadow terms, perhaps emission).
+    #[must_use]
+    pub fn shade_point(&self, k: &Coefficients, s: &SurfacePoint) -> Components {
+        let (ka, _, _, ke, _) = k.parts();
+        let mut acc = Components { ambient: self.ambient * ka, ..Default::default() };
+        if self.emission {
+            acc.emission = ke;
+        }
+        if self.diffuse > 0.0 || self.specular > 0.0 {
+            for &(light, terms) in &self.direct {
+                let cos_theta = s.normal.dot(light.incident(s.position).to_light);
+                if cos_theta <= 0.0 {
+                    continue;
+                }
+                let mut one = Components::default();
+                phong::add_light(&mut one, light, k, s, ShadowTerm::mean_lit(terms, s.position, cos_theta));
+                acc.diffuse += one.diffuse * self.diffuse;
+                acc.specular += one.specular * self.specular;
+            }
+        }
+        acc
     }
 
     /// Seed 002 eq. 1 summed over the pass's lights, per lane.

@@ -13,6 +13,7 @@ pub mod lanes;
 pub mod passes;
 pub mod phong;
 pub mod reflection_map;
+pub mod subpixel;
 pub mod surface;
 pub mod translucency;
 
@@ -28,6 +29,7 @@ pub use lanes::{Blend, Lighting};
 pub use passes::{frame_lights, shade_lit, FrameLight, PassStats, Target};
 pub use phong::Components;
 pub use phong::{Component, ComponentSet};
+pub use subpixel::{SubpixelSample, SubpixelShading};
 pub use surface::{ObjectFrames, PreparedTriangle, SurfacePoint};
 
 use phong::Coefficients;

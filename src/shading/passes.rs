@@ -29,7 +29,7 @@ use std::time::Instant;
 use glam::Vec3;
 
 use super::reflection_map::{add_reflection_map, flat_background};
-use super::{shade_pass, Blend, Component, ComponentSet, Lighting, ShadingPass};
+use super::{shade_pass, Blend, Component, ComponentSet, Lighting, ShadingPass, SubpixelShading};
 use crate::resolve::LinearImage;
 use crate::scene::{Light, Scene};
 use crate::shadows::{MapPool, ShadowTerm};
@@ -98,8 +98,15 @@ fn terms(
 /// Shades `vb` with every light of `scene`, shadows included, into each target:
 /// each pass runs once per target, restricted to the target's components, so the
 /// shadow maps of a light are rendered once for all targets. Map buffers come
-/// from `pool` and go back to it.
-pub fn shade_lit(scene: &Scene, vb: &VisibilityBuffer, targets: &mut [Target], pool: &mut MapPool) -> PassStats {
+/// from `pool` and go back to it. Every pass is also added at the `subpixel`
+/// samples.
+pub fn shade_lit(
+    scene: &Scene,
+    vb: &VisibilityBuffer,
+    targets: &mut [Target],
+    pool: &mut MapPool,
+    subpixel: &mut SubpixelShading,
+) -> PassStats {
     let mut stats = PassStats::default();
     pool.begin_frame(scene);
     let mut budget = FUSED_SHADOW_BUDGET;
@@ -118,7 +125,7 @@ pub fn shade_lit(scene: &Scene, vb: &VisibilityBuffer, targets: &mut [Target], p
     stats.shadow_bytes = FUSED_SHADOW_BUDGET - budget;
     let direct = fused.iter().map(|(l, t)| (&l.light, t.as_slice())).collect();
     let ambient = lights.iter().map(|l| &l.light).filter(|l| l.only.is_none());
-    run(scene, vb, targets, &Lighting::pass(ambient, direct, true), Blend::Replace, None);
+    run(scene, vb, (targets, &mut *subpixel), &Lighting::pass(ambient, direct, true), Blend::Replace, None);
     stats.passes = 1;
     // The fused terms stay for the next frame (within the same budget).
     for (light, terms) in fused {
@@ -131,7 +138,8 @@ pub fn shade_lit(scene: &Scene, vb: &VisibilityBuffer, targets: &mut [Target], p
         let receivers = light.only.as_ref().map(|only| (0..scene.objects.len()).map(|i| only.contains(&i)).collect());
         // A light that lights every object had its ambient added in the first pass.
         let ambient = light.only.is_some().then_some(light);
-        run(scene, vb, targets, &Lighting::pass(ambient, vec![(light, &terms)], false), Blend::Add, receivers);
+        let lighting = Lighting::pass(ambient, vec![(light, &terms)], false);
+        run(scene, vb, (targets, &mut *subpixel), &lighting, Blend::Add, receivers);
         stats.passes += 1;
         terms.into_iter().for_each(|t| pool.recycle(t));
     }
@@ -140,15 +148,16 @@ pub fn shade_lit(scene: &Scene, vb: &VisibilityBuffer, targets: &mut [Target], p
     stats
 }
 
-/// One pass into every target.
+/// One pass into every target and at every sub-pixel sample.
 fn run(
     scene: &Scene,
     vb: &VisibilityBuffer,
-    targets: &mut [Target],
+    (targets, subpixel): (&mut [Target], &mut SubpixelShading),
     lighting: &Lighting,
     blend: Blend,
     receivers: Option<Vec<bool>>,
 ) {
+    subpixel.add_pass(scene, vb, lighting, receivers.as_deref());
     for t in targets {
         let lighting = lighting.restricted(t.parts);
         if blend == Blend::Add && lighting.is_empty() {

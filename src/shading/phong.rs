@@ -30,6 +30,25 @@ impl Components {
     pub fn total(&self) -> Vec3 {
         self.ambient + self.diffuse + self.specular + self.emission
     }
+
+    /// The sum of the components in `parts` (an image that holds only those).
+    #[must_use]
+    pub fn total_of(&self, parts: ComponentSet) -> Vec3 {
+        let keep = |c, v: Vec3| if parts.contains(c) { v } else { Vec3::ZERO };
+        keep(Component::Ambient, self.ambient)
+            + keep(Component::Diffuse, self.diffuse)
+            + keep(Component::Specular, self.specular)
+            + keep(Component::Emission, self.emission)
+    }
+}
+
+impl std::ops::AddAssign for Components {
+    fn add_assign(&mut self, o: Components) {
+        self.ambient += o.ambient;
+        self.diffuse += o.diffuse;
+        self.specular += o.specular;
+        self.emission += o.emission;
+    }
 }
 
 /// One term of seed 002 eq. 4/5, as a pass writes it out on its own (an AOV, the

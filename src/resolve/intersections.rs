@@ -1,0 +1,111 @@
+//! Outlines where surfaces pass through each other: a box standing in a floor,
+//! a ball sunk into a stage. No mesh edge bounds them, so seed 004's walker
+//! (which steps along polygon edges, [`super::edges`]) never meets them, yet
+//! they are outlines like any other: aliased, the line where one surface dives
+//! under the other is a staircase.
+//!
+//! They are found in the visibility buffer instead. Where two neighbouring
+//! pixels `c` and `o` show triangles of different objects, A at `c` and B at
+//! `o`, each triangle's plane gives a depth over the screen (affine in x and
+//! y: [`Screen::depth_plane`]). If B's plane lies behind A's at `c`'s centre
+//! and in front of it at `o`'s, the two surfaces cross between the centres:
+//! the outline is the line where the planes' depths are equal, and the part of
+//! `c` beyond it — where B's plane is in front — shows B. That part's area and
+//! centroid come from clipping the pixel's square by the line, exactly as for a
+//! polygon edge, and become an ordinary [`EdgeBlend`]. (Where instead A's plane
+//! is in front at `o` too, A's triangle simply ends between the pixels: that is
+//! an edge, the walker's.)
+
+use glam::Vec2;
+use rayon::prelude::*;
+
+use super::edges::{square_part, ClipMap, DepthPlane, EdgeBlend, Screen};
+use crate::scene::Scene;
+use crate::visibility::{ItemId, VisibilityBuffer};
+
+/// The `source` of a blend across an intersection (no edge of a mesh).
+pub(super) const INTERSECTION: u64 = u64::MAX;
+
+/// The blends of every pixel an intersection of two objects' surfaces crosses,
+/// by row. `clips` holds every object's map to clip space.
+pub(super) fn find_intersection_blends(scene: &Scene, vb: &VisibilityBuffer, clips: &[ClipMap]) -> Vec<EdgeBlend> {
+    let (w, h) = (vb.width(), vb.height());
+    let screen = Screen::of(&scene.camera, w, h);
+    let plane = |item: ItemId| -> Option<DepthPlane> {
+        if item.is_none() || item.primitive().is_some() {
+            return None;
+        }
+        let object = &scene.objects[item.object as usize];
+        if scene.materials[object.material].translucent() {
+            return None;
+        }
+        screen.depth_plane(&clips[item.object as usize], object.triangles()?, item.triangle)
+    };
+    let rows: Vec<Vec<EdgeBlend>> = (0..h)
+        .into_par_iter()
+        .map(|y| {
+            let mut out = Vec::new();
+            for x in 0..w {
+                let a = vb.item(x, y);
+                let neighbours = [(x.wrapping_sub(1), y), (x + 1, y), (x, y.wrapping_sub(1)), (x, y + 1)];
+                let mut plane_a = None;
+                for (ox, oy) in neighbours.into_iter().filter(|&(ox, oy)| ox < w && oy < h) {
+                    let b = vb.item(ox, oy);
+                    if a.is_none() || b.is_none() || a.object == b.object {
+                        continue;
+                    }
+                    let Some(pa) = *plane_a.get_or_insert_with(|| plane(a)) else { break };
+                    let Some(pb) = plane(b) else { continue };
+                    if let Some(blend) = crossing((x, y), (ox, oy), &pa, &pb, w) {
+                        out.push(blend);
+                    }
+                }
+            }
+            out
+        })
+        .collect();
+    rows.concat()
+}
+
+/// The blend of pixel `c` (showing plane `a`) towards its neighbour `o`
+/// (showing plane `b`) if the planes cross between their centres. Depths are
+/// reversed: greater is nearer.
+fn crossing(c: (u32, u32), o: (u32, u32), a: &DepthPlane, b: &DepthPlane, width: u32) -> Option<EdgeBlend> {
+    let centre = |(x, y): (u32, u32)| (f64::from(x) + 0.5, f64::from(y) + 0.5);
+    // How far B's plane lies in front of A's.
+    let ahead = |(x, y): (f64, f64)| b.at(x, y) - a.at(x, y);
+    if !(ahead(centre(c)) < 0.0 && ahead(centre(o)) > 0.0) {
+        return None;
+    }
+    let (x0, y0) = (f64::from(c.0), f64::from(c.1));
+    let (alpha, (du, dv)) = square_part(|(u, v)| ahead((x0 + u, y0 + v)));
+    (alpha > 1e-6).then(|| EdgeBlend {
+        c: c.1 * width + c.0,
+        o: o.1 * width + o.0,
+        alpha: alpha as f32,
+        inside: true,
+        source: INTERSECTION,
+        far: Vec2::new(du as f32, dv as f32),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn two_crossing_planes_share_each_pixel_by_the_line_where_their_depths_meet() {
+        // A comes nearer to the right, B is level: they meet at x = 10.3, so
+        // pixel 10 (centre 10.5) shows A and pixel 9 shows B.
+        let a = DepthPlane { z0: 0.5 - 0.01 * 10.3, gx: 0.01, gy: 0.0 };
+        let b = DepthPlane { z0: 0.5, gx: 0.0, gy: 0.0 };
+        let blend = crossing((10, 4), (9, 4), &a, &b, 32).expect("the planes cross between the centres");
+        assert!((blend.alpha - 0.3).abs() < 1e-6, "the part of pixel 10 left of x = 10.3: {}", blend.alpha);
+        assert!((blend.far - Vec2::new(-0.35, 0.0)).length() < 1e-6, "its centroid: {}", blend.far);
+        let back = crossing((9, 4), (10, 4), &b, &a, 32);
+        assert!(back.is_none(), "pixel 9 lies wholly left of the line");
+        // A plane in front at both centres ends between them: an edge, not this.
+        let near = DepthPlane { z0: 0.9, gx: 0.0, gy: 0.0 };
+        assert!(crossing((10, 4), (9, 4), &near, &b, 32).is_none());
+    }
+}

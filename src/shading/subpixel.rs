@@ -1,0 +1,101 @@
+//! Sub-pixel samples: points inside a pixel, off its centre, that the lit passes
+//! shade besides the pixel centres.
+//!
+//! Seed 002's passes shade one point per pixel, its centre. The edge pass
+//! ([`crate::resolve::edges`]) knows more: which part of a pixel an edge cuts off
+//! and which surface that part shows. To colour the part it asks for the surface
+//! at the part's centroid, shaded by the same passes (same lights, same shadow
+//! maps, same selective lighting) while those passes run — a shadow that ends
+//! right behind a silhouette is then seen in the pixel the silhouette crosses,
+//! not taken from the lit pixel beyond it.
+//!
+//! A sample names the pixel whose visible surface it shades (its item, as the
+//! visibility buffer holds it; a triangle's plane or a solid's tangent plane is
+//! met by the ray through the sample's point, extrapolated past the triangle if
+//! need be) and the point the ray goes through. The passes add each sample's
+//! components, scalar ([`Lighting::shade_point`]): there are few of them; the
+//! traced term ([`crate::raytrace::item_buffer`]) traces its bounces from there.
+
+use glam::{Vec2, Vec3};
+use rayon::prelude::*;
+
+use super::lanes::Lighting;
+use super::phong::{Coefficients, Components};
+use super::surface::{ObjectFrames, SurfacePoint};
+use crate::scene::camera::PixelRays;
+use crate::scene::{Ray, Scene};
+use crate::visibility::VisibilityBuffer;
+
+/// A point to shade on the surface a pixel shows.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SubpixelSample {
+    /// The pixel (x, y) whose visible surface is shaded.
+    pub pixel: (u32, u32),
+    /// The image point (pixels, y down; a pixel's centre is at + ½) the ray goes
+    /// through.
+    pub at: Vec2,
+}
+
+/// Samples and what the lit passes have added at each so far.
+#[derive(Debug, Clone, Default)]
+pub struct SubpixelShading {
+    /// The points.
+    pub samples: Vec<SubpixelSample>,
+    /// Per sample, the sum of the passes' components (zero where the pixel shows
+    /// nothing).
+    pub lit: Vec<Components>,
+    /// Per sample, the traced term: reflection and refraction (zero where the
+    /// material neither reflects nor refracts).
+    pub traced: Vec<Vec3>,
+}
+
+impl SubpixelSample {
+    /// The sample's ray and the surface point it meets, on the surface its pixel
+    /// shows in `vb` (`None` where that is nothing).
+    #[must_use]
+    pub fn surface(
+        &self,
+        scene: &Scene,
+        vb: &VisibilityBuffer,
+        frames: &ObjectFrames,
+        rays: &PixelRays,
+    ) -> Option<(Ray, SurfacePoint)> {
+        let (x, y) = self.pixel;
+        if vb.item(x, y).is_none() {
+            return None;
+        }
+        // A solid's tangent plane is taken where the pixel's own ray meets it.
+        let centre = rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
+        let ray = rays.ray(self.at);
+        let point = frames.prepare_at(scene, vb, x, y, &centre).surface(&ray);
+        Some((ray, point))
+    }
+}
+
+impl SubpixelShading {
+    /// The samples, nothing added yet.
+    #[must_use]
+    pub fn new(samples: Vec<SubpixelSample>) -> Self {
+        let (lit, traced) = (vec![Components::default(); samples.len()], vec![Vec3::ZERO; samples.len()]);
+        SubpixelShading { samples, lit, traced }
+    }
+
+    /// Adds one pass (`lighting`, reaching the objects `receivers` marks, or
+    /// all) at every sample.
+    pub fn add_pass(&mut self, scene: &Scene, vb: &VisibilityBuffer, lighting: &Lighting, receivers: Option<&[bool]>) {
+        if self.samples.is_empty() {
+            return;
+        }
+        let frames = ObjectFrames::new(scene);
+        let rays = scene.camera.pixel_rays(Vec2::new(vb.width() as f32, vb.height() as f32));
+        self.lit.par_iter_mut().zip(self.samples.par_iter()).for_each(|(acc, s)| {
+            let item = vb.item(s.pixel.0, s.pixel.1);
+            if receivers.is_some_and(|r| !item.is_none() && !r[item.object as usize]) {
+                return;
+            }
+            let Some((_, point)) = s.surface(scene, vb, &frames, &rays) else { return };
+            let k = Coefficients::at(&scene.materials[point.material], &point);
+            *acc += lighting.shade_point(&k, &point);
+        });
+    }
+}
