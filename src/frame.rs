@@ -242,7 +242,8 @@ fn render_pass(scene: &Scene, frame: &mut Frame, scratch: &mut Scratch, ray_dept
     // The edges are found before shading, so the passes shade the sub-pixel
     // points the crossed pixels' parts need.
     let plan = edge.map(|o| edges::plan(scene, &frame.visibility, o, edge_cache));
-    let mut subpixel = SubpixelShading::new(plan.as_ref().map_or_else(Vec::new, |p| p.samples(scene.width)));
+    let samples = plan.as_ref().map_or_else(Vec::new, |p| p.samples(scene.width));
+    let mut subpixel = SubpixelShading::new(scene, &frame.visibility, samples);
     let planned = t1.elapsed();
     let t1 = Instant::now();
     frame.image.resize(scene.width, scene.height);
@@ -268,7 +269,7 @@ fn render_pass(scene: &Scene, frame: &mut Frame, scratch: &mut Scratch, ray_dept
             n
         }
     };
-    item_buffer::trace_subpixel(scene, vb, &mut subpixel, ray_depth, trace);
+    item_buffer::trace_subpixel(scene, &mut subpixel, ray_depth, trace);
     let t3 = Instant::now();
     frame.stats.bvh_built |= trace.builds() > builds;
     targets.extend(traced_aov.map(|image| Target { parts: ComponentSet::only(Component::Traced), image }));

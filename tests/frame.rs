@@ -204,3 +204,35 @@ fn simd_shading_matches_the_scalar_reference() {
         assert!(off * 1000 < diffs.len() && worst < 0.2, "{off} of {} pixels differ, worst {worst}", diffs.len());
     }
 }
+
+/// Sub-pixel samples taken at pixel centres get what the lit passes write there
+/// (scalar samples against the eight-lane passes, every pass and shadow term of
+/// a scene with three shadowed spot lights).
+#[test]
+fn subpixel_samples_at_pixel_centres_match_the_passes() {
+    use kage::shading::{shade_lit, ComponentSet, SubpixelSample, SubpixelShading, Target};
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenes/spotlights.toml");
+    let mut scene = kage::scene::file::load_scene(&path).unwrap();
+    (scene.width, scene.height) = (240, 135);
+    let frame = render(&scene, &RenderOptions::default()).unwrap();
+    let vb = &frame.visibility;
+    let pixels: Vec<(u32, u32)> =
+        (0..scene.height).step_by(3).flat_map(|y| (0..scene.width).step_by(7).map(move |x| (x, y))).collect();
+    let centre = |(x, y): (u32, u32)| glam::Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
+    let samples = pixels.iter().map(|&p| SubpixelSample { pixel: p, at: centre(p) }).collect();
+    let mut subpixel = SubpixelShading::new(&scene, vb, samples);
+    let mut image = kage::resolve::LinearImage::new(scene.width, scene.height);
+    let mut targets = [Target { parts: ComponentSet::ALL, image: &mut image }];
+    shade_lit(&scene, vb, &mut targets, &mut kage::shadows::MapPool::default(), &mut subpixel);
+    let mut off = 0;
+    for (k, &(x, y)) in pixels.iter().enumerate() {
+        if vb.item(x, y).is_none() {
+            assert_eq!(subpixel.lit[k].total(), Vec3::ZERO, "nothing seen: nothing added");
+            continue;
+        }
+        let d = (subpixel.lit[k].total() - image.get(x, y)).abs().max_element();
+        off += usize::from(d >= 2e-3);
+        assert!(d < 0.2, "pixel ({x}, {y}): sample {} vs pass {}", subpixel.lit[k].total(), image.get(x, y));
+    }
+    assert!(off * 100 < pixels.len(), "{off} of {} samples differ from their pixels", pixels.len());
+}

@@ -14,6 +14,7 @@ use super::reference::{ReferenceOptions, Tracer};
 use super::TraceCache;
 use crate::resolve::LinearImage;
 use crate::scene::Scene;
+use crate::shading::subpixel::SampleSurface;
 use crate::shading::{ObjectFrames, SubpixelShading};
 use crate::visibility::VisibilityBuffer;
 
@@ -56,29 +57,19 @@ pub fn add_traced(
 
 /// The traced term at every sub-pixel sample of `subpixel` whose surface
 /// reflects or refracts (as [`add_traced`] traces it at pixel centres).
-pub fn trace_subpixel(
-    scene: &Scene,
-    vb: &VisibilityBuffer,
-    subpixel: &mut SubpixelShading,
-    depth: u32,
-    cache: &mut TraceCache,
-) {
-    let traces = |s: &crate::shading::SubpixelSample| {
-        let item = vb.item(s.pixel.0, s.pixel.1);
-        !item.is_none() && scene.materials[scene.item_material(item)].traces()
-    };
-    if depth == 0 || !subpixel.samples.iter().any(traces) {
+pub fn trace_subpixel(scene: &Scene, subpixel: &mut SubpixelShading, depth: u32, cache: &mut TraceCache) {
+    let traces = |s: &Option<SampleSurface>| s.as_ref().is_some_and(|s| scene.materials[s.point.material].traces());
+    if depth == 0 || !subpixel.surfaces.iter().any(traces) {
         return;
     }
     let trace = cache.get(scene);
     let frames = ObjectFrames::new(scene);
     let opts = ReferenceOptions { pixel_samples: 1, light_samples: 1, shadows: true, max_depth: depth };
     let tracer = Tracer::new(scene, trace, &frames, opts);
-    let rays = scene.camera.pixel_rays(Vec2::new(vb.width() as f32, vb.height() as f32));
-    let SubpixelShading { samples, traced, .. } = subpixel;
-    traced.par_iter_mut().zip(samples.par_iter()).filter(|(_, s)| traces(s)).for_each(|(out, s)| {
-        if let Some((ray, point)) = s.surface(scene, vb, &frames, &rays) {
-            *out = tracer.bounces(&ray, &point, depth);
+    let SubpixelShading { surfaces, traced, .. } = subpixel;
+    traced.par_iter_mut().zip(surfaces.par_iter()).for_each(|(out, s)| {
+        if let Some(s) = s.as_ref().filter(|s| scene.materials[s.point.material].traces()) {
+            *out = tracer.bounces(&s.ray, &s.point, depth);
         }
     });
 }

@@ -283,6 +283,8 @@ pub struct EdgePlan {
     /// (the coverage filter), or take the pixels' colours as they are (the
     /// paper's filter, which blends the edge's colour).
     reshade: bool,
+    /// Every pixel a blend reads, sorted.
+    centres: Vec<u32>,
 }
 
 /// Plans seed 004's edge pass over the frame whose visibility buffer is `vb`.
@@ -305,7 +307,11 @@ pub fn plan(scene: &Scene, vb: &VisibilityBuffer, options: &EdgeOptions, cache: 
         EdgeFilter::Coverage => 0.5,
         EdgeFilter::Paper => 1.0,
     };
-    EdgePlan { blends: merge(blends, cap), reshade: options.mode.filter == EdgeFilter::Coverage }
+    let blends = merge(blends, cap);
+    let mut centres: Vec<u32> = blends.iter().flat_map(|b| [b.c, b.o]).collect();
+    centres.sort_unstable();
+    centres.dedup();
+    EdgePlan { blends, reshade: options.mode.filter == EdgeFilter::Coverage, centres }
 }
 
 impl EdgePlan {
@@ -322,27 +328,28 @@ impl EdgePlan {
     }
 
     /// The points the shading passes shade for [`EdgePlan::apply`] on a `width`
-    /// pixels wide frame. Per crossed pixel `c`: its own surface at its centre
-    /// and at the centroid of its part on its centre's side of the edges; per
-    /// neighbour `o` across an edge: `o`'s surface at `o`'s centre and at the
-    /// centroid of `c`'s part on `o`'s side. (None under the paper's filter.)
+    /// pixels wide frame (none under the paper's filter): the centre of every
+    /// pixel a blend reads; per crossed pixel, its own surface at the centroid
+    /// of its part on its centre's side of the edges; per blend that moves the
+    /// pixel by at least [`RESHADED_SHARE`], the surface across at the centroid
+    /// of the part beyond.
     #[must_use]
     pub fn samples(&self, width: u32) -> Vec<SubpixelSample> {
         if !self.reshade {
             return Vec::new();
         }
         let pixel = |i: u32| (i % width, i / width);
-        let centre = |(x, y): (u32, u32)| Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
-        let at = |p: (u32, u32), offset: Vec2| SubpixelSample { pixel: p, at: centre(p) + offset };
-        let mut out = Vec::with_capacity(self.blends.len() * 4);
-        for crossed in self.blends.chunk_by(|a, b| a.c == b.c) {
-            let c = pixel(crossed[0].c);
-            out.extend([at(c, Vec2::ZERO), at(c, near_centroid(crossed))]);
-            for b in crossed {
-                out.extend([at(pixel(b.o), Vec2::ZERO), SubpixelSample { pixel: pixel(b.o), at: centre(c) + b.far }]);
-            }
-        }
-        out
+        let at = |i: u32, offset: Vec2| {
+            let p = pixel(i);
+            SubpixelSample { pixel: p, at: Vec2::new(p.0 as f32 + 0.5, p.1 as f32 + 0.5) + offset }
+        };
+        let centres = self.centres.iter().map(|&i| at(i, Vec2::ZERO));
+        let near = self.blends.chunk_by(|a, b| a.c == b.c).map(|crossed| at(crossed[0].c, near_centroid(crossed)));
+        let far = self.blends.iter().filter(|b| reshaded_across(b)).map(|b| {
+            // The surface `o` shows, met by a ray through `c`.
+            SubpixelSample { pixel: pixel(b.o), ..at(b.c, b.far) }
+        });
+        centres.chain(near).chain(far).collect()
     }
 
     /// Blends `image` (holding the components `parts`): each crossed pixel
@@ -353,14 +360,19 @@ impl EdgePlan {
     /// fogged as the pixel is, by `1 − fog[pixel]`). Every blend reads the image
     /// as it was before any of them.
     pub fn apply(&self, image: &mut LinearImage, parts: ComponentSet, shaded: &SubpixelShading, fog: Option<&[f32]>) {
-        let reshaded = self.reshade && shaded.lit.len() == 2 * (self.blends.len() + self.crossed_pixels());
+        let crossed_pixels = self.blends.chunk_by(|a, b| a.c == b.c).count();
+        let across = self.blends.iter().filter(|b| reshaded_across(b)).count();
+        let reshaded = self.reshade && shaded.lit.len() == self.centres.len() + crossed_pixels + across;
+        // Sample `k`'s colour less the centre's of the pixel whose surface it shows.
         let moved = |pixel: u32, k: usize| {
+            let centre = self.centres.binary_search(&pixel).expect("every pixel a blend reads has a centre sample");
             let clear = fog.map_or(1.0, |f| 1.0 - f[pixel as usize]);
-            let lit = shaded.lit[k + 1].total_of(parts) - shaded.lit[k].total_of(parts);
-            let traced = if parts.contains(Component::Traced) { shaded.traced[k + 1] - shaded.traced[k] } else { Vec3::ZERO };
+            let lit = shaded.lit[k].total_of(parts) - shaded.lit[centre].total_of(parts);
+            let traced =
+                if parts.contains(Component::Traced) { shaded.traced[k] - shaded.traced[centre] } else { Vec3::ZERO };
             (lit + traced) * clear
         };
-        let mut k = 0;
+        let (mut near, mut far) = (self.centres.len(), self.centres.len() + crossed_pixels);
         let updates: Vec<(u32, Vec3)> = {
             let px = image.pixels();
             self.blends
@@ -369,15 +381,15 @@ impl EdgePlan {
                     let c = crossed[0].c;
                     let mut own = px[c as usize];
                     if reshaded {
-                        own += moved(c, k);
-                        k += 2;
+                        own += moved(c, near);
+                        near += 1;
                     }
                     let mut colour = own;
                     for b in crossed {
                         let mut across = px[b.o as usize];
-                        if reshaded {
-                            across += moved(b.o, k);
-                            k += 2;
+                        if reshaded && reshaded_across(b) {
+                            across += moved(b.o, far);
+                            far += 1;
                         }
                         colour += (across - own) * b.alpha;
                     }
@@ -390,11 +402,16 @@ impl EdgePlan {
             px[c as usize] = colour;
         }
     }
+}
 
-    /// Pixels with at least one blend.
-    fn crossed_pixels(&self) -> usize {
-        self.blends.chunk_by(|a, b| a.c == b.c).count()
-    }
+/// The least share of a pixel beyond an edge whose colour is re-shaded at its
+/// centroid; a smaller part takes the colour of the pixel across as it is
+/// (measured: re-shading them changes no scene's error by 0.1%).
+pub const RESHADED_SHARE: f32 = 0.1;
+
+/// Whether the part of `b.c` beyond the edge is re-shaded.
+fn reshaded_across(b: &EdgeBlend) -> bool {
+    b.alpha >= RESHADED_SHARE
 }
 
 /// The centroid of a crossed pixel's part on its centre's side of its edges,

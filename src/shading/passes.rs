@@ -157,7 +157,7 @@ fn run(
     blend: Blend,
     receivers: Option<Vec<bool>>,
 ) {
-    subpixel.add_pass(scene, vb, lighting, receivers.as_deref());
+    subpixel.add_pass(lighting, receivers.as_deref());
     for t in targets {
         let lighting = lighting.restricted(t.parts);
         if blend == Blend::Add && lighting.is_empty() {

@@ -36,11 +36,26 @@ pub struct SubpixelSample {
     pub at: Vec2,
 }
 
+/// A sample's surface, reconstructed once for all passes.
+#[derive(Debug, Clone, Copy)]
+pub struct SampleSurface {
+    /// The ray through the sample's point.
+    pub ray: Ray,
+    /// The surface point it meets.
+    pub point: SurfacePoint,
+    /// The material's coefficients there.
+    pub coefficients: Coefficients,
+    /// The object it belongs to.
+    pub object: u32,
+}
+
 /// Samples and what the lit passes have added at each so far.
 #[derive(Debug, Clone, Default)]
 pub struct SubpixelShading {
     /// The points.
     pub samples: Vec<SubpixelSample>,
+    /// Per sample, its surface (`None` where the pixel shows nothing).
+    pub surfaces: Vec<Option<SampleSurface>>,
     /// Per sample, the sum of the passes' components (zero where the pixel shows
     /// nothing).
     pub lit: Vec<Components>,
@@ -50,52 +65,53 @@ pub struct SubpixelShading {
 }
 
 impl SubpixelSample {
-    /// The sample's ray and the surface point it meets, on the surface its pixel
-    /// shows in `vb` (`None` where that is nothing).
-    #[must_use]
-    pub fn surface(
+    /// The surface the sample's ray meets on what its pixel shows in `vb`.
+    fn surface(
         &self,
         scene: &Scene,
         vb: &VisibilityBuffer,
         frames: &ObjectFrames,
         rays: &PixelRays,
-    ) -> Option<(Ray, SurfacePoint)> {
+    ) -> Option<SampleSurface> {
         let (x, y) = self.pixel;
-        if vb.item(x, y).is_none() {
+        let item = vb.item(x, y);
+        if item.is_none() {
             return None;
         }
         // A solid's tangent plane is taken where the pixel's own ray meets it.
         let centre = rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
         let ray = rays.ray(self.at);
-        let point = frames.prepare_at(scene, vb, x, y, &centre).surface(&ray);
-        Some((ray, point))
+        let surface = frames.prepare_at(scene, vb, x, y, &centre);
+        let mut point = surface.surface(&ray);
+        // Texture footprint: the same surface met one pixel right and one below
+        // (ray differentials, as the passes take them).
+        let uv = |dx: f32, dy: f32| surface.surface(&rays.ray(self.at + Vec2::new(dx, dy))).uv;
+        point.duv = [uv(1.0, 0.0) - point.uv, uv(0.0, 1.0) - point.uv];
+        let coefficients = Coefficients::at(&scene.materials[point.material], &point);
+        Some(SampleSurface { ray, point, coefficients, object: item.object })
     }
 }
 
 impl SubpixelShading {
-    /// The samples, nothing added yet.
+    /// The `samples` on the frame whose visibility buffer is `vb`, their
+    /// surfaces found, nothing added yet.
     #[must_use]
-    pub fn new(samples: Vec<SubpixelSample>) -> Self {
+    pub fn new(scene: &Scene, vb: &VisibilityBuffer, samples: Vec<SubpixelSample>) -> Self {
+        let frames = ObjectFrames::new(scene);
+        let rays = scene.camera.pixel_rays(Vec2::new(vb.width() as f32, vb.height() as f32));
+        let surfaces = samples.par_iter().map(|s| s.surface(scene, vb, &frames, &rays)).collect();
         let (lit, traced) = (vec![Components::default(); samples.len()], vec![Vec3::ZERO; samples.len()]);
-        SubpixelShading { samples, lit, traced }
+        SubpixelShading { samples, surfaces, lit, traced }
     }
 
     /// Adds one pass (`lighting`, reaching the objects `receivers` marks, or
     /// all) at every sample.
-    pub fn add_pass(&mut self, scene: &Scene, vb: &VisibilityBuffer, lighting: &Lighting, receivers: Option<&[bool]>) {
-        if self.samples.is_empty() {
-            return;
-        }
-        let frames = ObjectFrames::new(scene);
-        let rays = scene.camera.pixel_rays(Vec2::new(vb.width() as f32, vb.height() as f32));
-        self.lit.par_iter_mut().zip(self.samples.par_iter()).for_each(|(acc, s)| {
-            let item = vb.item(s.pixel.0, s.pixel.1);
-            if receivers.is_some_and(|r| !item.is_none() && !r[item.object as usize]) {
-                return;
+    pub fn add_pass(&mut self, lighting: &Lighting, receivers: Option<&[bool]>) {
+        self.lit.par_iter_mut().zip(self.surfaces.par_iter()).for_each(|(acc, s)| {
+            let Some(s) = s else { return };
+            if receivers.is_none_or(|r| r[s.object as usize]) {
+                *acc += lighting.shade_point(&s.coefficients, &s.point);
             }
-            let Some((_, point)) = s.surface(scene, vb, &frames, &rays) else { return };
-            let k = Coefficients::at(&scene.materials[point.material], &point);
-            *acc += lighting.shade_point(&k, &point);
         });
     }
 }
