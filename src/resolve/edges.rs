@@ -25,6 +25,19 @@
 //!   of a column, both crossed pixels are blended, each by its own share, so for a
 //!   straight edge every pixel ends at its exact covered area. The paper's weights
 //!   are kept as [`EdgeFilter::Paper`], to measure against.
+//! - The parts' colours. The paper's colours come from pass 1's pixel centres;
+//!   but a part of a pixel beyond a silhouette can lie in a shadow that begins
+//!   right behind the silhouette, and a grazing surface's shading changes fast
+//!   within one pixel. So the blends are found before shading ([`plan`]) and the
+//!   passes also shade, at sub-pixel samples ([`crate::shading::subpixel`]), each
+//!   crossed pixel's own part at its centroid and each part beyond an edge at
+//!   its centroid (on the surface the pixel across shows); a part's colour is
+//!   then its pixel's colour moved by the sample's difference from that pixel's
+//!   centre ([`EdgePlan::apply`]). Measured: this takes the bunny from 57% to
+//!   66% of the aliased edge error removed, spotlights from 51% to 61%.
+//! - Intersections. Where two objects pass through each other (a box standing
+//!   in a floor) the outline is no mesh edge: `super::intersections` finds it from
+//!   the two pixels' depth planes, and it is blended like an edge.
 //! - Gamma. The frame is linear light, so blending there is the gamma-corrected
 //!   filter the paper asks for; the sRGB curve is applied at output.
 //! - Which edges. By default the outline: silhouette edges (one adjacent face towards
@@ -40,7 +53,12 @@
 //!   the edge's depth at that point: an occluder (nearer) or what lies behind. (A
 //!   depth tolerance alone cannot tell a visible silhouette, whose inside pixels lie
 //!   a few per cent nearer at grazing angles, from the hidden silhouette of the same
-//!   object's far side a few per cent farther.) Nothing is blended where either pixel is an occluder, so a hidden
+//!   object's far side a few per cent farther.)
+//!   An occluder is judged at the edge's point, not at its pixel's centre: the
+//!   pixel's surface plane carried to the point must lie a pixel's size nearer
+//!   than the edge (a floor pixel just below a box standing on it lies nearer than
+//!   the box's bottom edge, but the floor meets that edge). Nothing is blended
+//!   where either pixel is an occluder, so a hidden
 //!   edge never bleeds through; the blend happens when at least one pixel is the
 //!   edge's own surface. The pixel across the edge is always read from the frame as
 //!   pass 1 left it.
