@@ -55,8 +55,8 @@
 //!   a few per cent nearer at grazing angles, from the hidden silhouette of the same
 //!   object's far side a few per cent farther.)
 //!   An occluder is judged at the edge's point, not at its pixel's centre: the
-//!   pixel's surface plane carried to the point must lie a pixel's size nearer
-//!   than the edge (a floor pixel just below a box standing on it lies nearer than
+//!   pixel's surface plane carried to the point must lie nearer than the edge
+//!   (beyond rounding) (a floor pixel just below a box standing on it lies nearer than
 //!   the box's bottom edge, but the floor meets that edge). Nothing is blended
 //!   where either pixel is an occluder, so a hidden
 //!   edge never bleeds through; the blend happens when at least one pixel is the
@@ -860,10 +860,11 @@ impl DepthScale {
         (da - db).abs() <= 8.0 * self.pixel_at(db)
     }
 
-    /// Whether depth `a` lies in front of depth `b` by more than a pixel's size.
+    /// Whether depth `a` lies in front of depth `b` by more than a hundredth
+    /// of a pixel's size (surfaces that meet differ only by rounding).
     fn in_front(&self, a: f64, b: f64) -> bool {
         let (da, db) = (self.distance(a), self.distance(b));
-        da < db - self.pixel_at(db)
+        da < db - 0.01 * self.pixel_at(db)
     }
 
     /// A pixel's size at view distance `d`.
