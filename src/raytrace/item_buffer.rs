@@ -33,7 +33,7 @@ pub fn add_traced(
     }
     let trace = cache.get(scene);
     let frames = ObjectFrames::new(scene);
-    let opts = ReferenceOptions { pixel_samples: 1, light_samples: 1, shadows: true, max_depth: depth };
+    let opts = traced_term(depth);
     let tracer = Tracer::new(scene, trace, &frames, opts);
     let w = vb.width() as usize;
     let rays = scene.camera.pixel_rays(Vec2::new(w as f32, vb.height() as f32));
@@ -55,6 +55,12 @@ pub fn add_traced(
         .sum()
 }
 
+/// The reference tracer's settings for the traced term: one ray from the
+/// known surface, shadow rays, `depth` bounces.
+fn traced_term(depth: u32) -> ReferenceOptions {
+    ReferenceOptions { pixel_samples: 1, light_samples: 1, shadows: true, max_depth: depth }
+}
+
 /// The traced term at every sub-pixel sample of `subpixel` whose surface
 /// reflects or refracts (as [`add_traced`] traces it at pixel centres).
 pub fn trace_subpixel(scene: &Scene, subpixel: &mut SubpixelShading, depth: u32, cache: &mut TraceCache) {
@@ -64,7 +70,7 @@ pub fn trace_subpixel(scene: &Scene, subpixel: &mut SubpixelShading, depth: u32,
     }
     let trace = cache.get(scene);
     let frames = ObjectFrames::new(scene);
-    let opts = ReferenceOptions { pixel_samples: 1, light_samples: 1, shadows: true, max_depth: depth };
+    let opts = traced_term(depth);
     let tracer = Tracer::new(scene, trace, &frames, opts);
     let SubpixelShading { surfaces, traced, .. } = subpixel;
     traced.par_iter_mut().zip(surfaces.par_iter()).for_each(|(out, s)| {

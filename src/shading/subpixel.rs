@@ -97,6 +97,9 @@ impl SubpixelShading {
     /// surfaces found, nothing added yet.
     #[must_use]
     pub fn new(scene: &Scene, vb: &VisibilityBuffer, samples: Vec<SubpixelSample>) -> Self {
+        if samples.is_empty() {
+            return SubpixelShading::default(); // most frames: nothing to set up
+        }
         let frames = ObjectFrames::new(scene);
         let rays = scene.camera.pixel_rays(Vec2::new(vb.width() as f32, vb.height() as f32));
         let surfaces = samples.par_iter().map(|s| s.surface(scene, vb, &frames, &rays)).collect();
