@@ -241,7 +241,7 @@ fn render_pass(scene: &Scene, frame: &mut Frame, scratch: &mut Scratch, ray_dept
     let t1 = Instant::now();
     // The edges are found before shading, so the passes shade the sub-pixel
     // points the crossed pixels' parts need.
-    let plan = edge.map(|o| edges::plan(scene, &frame.visibility, o, edge_cache));
+    let mut plan = edge.map(|o| edges::plan(scene, &frame.visibility, o, edge_cache));
     let samples = plan.as_ref().map_or_else(Vec::new, |p| p.samples(scene.width));
     let mut subpixel = SubpixelShading::new(scene, &frame.visibility, samples);
     let planned = t1.elapsed();
@@ -273,6 +273,9 @@ fn render_pass(scene: &Scene, frame: &mut Frame, scratch: &mut Scratch, ray_dept
     let t3 = Instant::now();
     frame.stats.bvh_built |= trace.builds() > builds;
     targets.extend(traced_aov.map(|image| Target { parts: ComponentSet::only(Component::Traced), image }));
+    if let Some(plan) = &mut plan {
+        plan.record(&targets);
+    }
     let fogged = scene.fog.as_ref().map(|fog| {
         let amounts = fog::fog_amounts(scene, fog, vb);
         for t in &mut targets {

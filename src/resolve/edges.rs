@@ -76,7 +76,7 @@ use rayon::prelude::*;
 
 use super::{intersections, LinearImage};
 use crate::scene::{Camera, Mesh, Projection, Scene};
-use crate::shading::{Component, ComponentSet, SubpixelSample, SubpixelShading};
+use crate::shading::{ComponentSet, SubpixelSample, SubpixelShading, Target};
 use crate::visibility::{ItemId, VisibilityBuffer};
 
 /// Which edges the edge pass walks.
@@ -303,6 +303,9 @@ pub struct EdgePlan {
     reshade: bool,
     /// Every pixel a blend reads, sorted.
     centres: Vec<u32>,
+    /// Per target image (by its components), the colour of each of `centres`
+    /// before fog and translucency ([`EdgePlan::record`]).
+    recorded: Vec<(ComponentSet, Vec<Vec3>)>,
 }
 
 /// Plans seed 004's edge pass over the frame whose visibility buffer is `vb`.
@@ -314,10 +317,8 @@ pub fn plan(scene: &Scene, vb: &VisibilityBuffer, options: &EdgeOptions, cache: 
     if options.mode.filter == EdgeFilter::Coverage {
         // Where an edge runs between two pixels it bounds what they show; an
         // intersection is only looked for where none does.
-        let walked: std::collections::HashSet<(u32, u32)> =
-            blends.iter().flat_map(|b| [(b.c, b.o), (b.o, b.c)]).collect();
-        let crossings = intersections::find_intersection_blends(scene, vb, &clips);
-        blends.extend(crossings.into_iter().filter(|b| !walked.contains(&(b.c, b.o))));
+        let walked = intersections::WalkedPairs::of(&blends, vb.width(), vb.height());
+        blends.extend(intersections::find_intersection_blends(scene, vb, &clips, &walked));
     }
     // One straight edge moves a pixel by at most ½ under the coverage filter; the
     // paper's Wu weights reach 1.
@@ -329,7 +330,7 @@ pub fn plan(scene: &Scene, vb: &VisibilityBuffer, options: &EdgeOptions, cache: 
     let mut centres: Vec<u32> = blends.iter().flat_map(|b| [b.c, b.o]).collect();
     centres.sort_unstable();
     centres.dedup();
-    EdgePlan { blends, reshade: options.mode.filter == EdgeFilter::Coverage, centres }
+    EdgePlan { blends, reshade: options.mode.filter == EdgeFilter::Coverage, centres, recorded: Vec::new() }
 }
 
 impl EdgePlan {
@@ -346,11 +347,12 @@ impl EdgePlan {
     }
 
     /// The points the shading passes shade for [`EdgePlan::apply`] on a `width`
-    /// pixels wide frame (none under the paper's filter): the centre of every
-    /// pixel a blend reads; per crossed pixel, its own surface at the centroid
-    /// of its part on its centre's side of the edges; per blend that moves the
-    /// pixel by at least [`RESHADED_SHARE`], the surface across at the centroid
-    /// of the part beyond.
+    /// pixels wide frame (none under the paper's filter): per crossed pixel, its
+    /// own surface at the centroid of its part on its centre's side of the
+    /// edges; per blend that moves the pixel by at least [`RESHADED_SHARE`],
+    /// the surface across at the centroid of the part beyond. (The pixels'
+    /// centres, which they are compared with, are the passes' own pixels:
+    /// [`EdgePlan::record`].)
     #[must_use]
     pub fn samples(&self, width: u32) -> Vec<SubpixelSample> {
         if !self.reshade {
@@ -361,13 +363,26 @@ impl EdgePlan {
             let p = pixel(i);
             SubpixelSample { pixel: p, at: Vec2::new(p.0 as f32 + 0.5, p.1 as f32 + 0.5) + offset }
         };
-        let centres = self.centres.iter().map(|&i| at(i, Vec2::ZERO));
         let near = self.blends.chunk_by(|a, b| a.c == b.c).map(|crossed| at(crossed[0].c, near_centroid(crossed)));
         let far = self.blends.iter().filter(|b| reshaded_across(b)).map(|b| {
             // The surface `o` shows, met by a ray through `c`.
             SubpixelSample { pixel: pixel(b.o), ..at(b.c, b.far) }
         });
-        centres.chain(near).chain(far).collect()
+        near.chain(far).collect()
+    }
+
+    /// Records, in every target, the colour of each pixel a blend reads as the
+    /// lit passes, the reflection map and the traced term left it (before fog
+    /// and translucency): what the samples' colours are compared with.
+    pub fn record(&mut self, targets: &[Target]) {
+        if !self.reshade {
+            return;
+        }
+        let centres = &self.centres;
+        self.recorded = targets
+            .iter()
+            .map(|t| (t.parts, centres.iter().map(|&i| t.image.pixels()[i as usize]).collect()))
+            .collect();
     }
 
     /// Blends `image` (holding the components `parts`): each crossed pixel
@@ -380,17 +395,18 @@ impl EdgePlan {
     pub fn apply(&self, image: &mut LinearImage, parts: ComponentSet, shaded: &SubpixelShading, fog: Option<&[f32]>) {
         let crossed_pixels = self.blends.chunk_by(|a, b| a.c == b.c).count();
         let across = self.blends.iter().filter(|b| reshaded_across(b)).count();
-        let reshaded = self.reshade && shaded.lit.len() == self.centres.len() + crossed_pixels + across;
-        // Sample `k`'s colour less the centre's of the pixel whose surface it shows.
+        let recorded = self.recorded.iter().find(|(p, _)| *p == parts).map(|(_, colours)| colours);
+        let recorded = recorded.filter(|_| self.reshade && shaded.lit.len() == crossed_pixels + across);
+        let reshaded = recorded.is_some();
+        // Sample `k`'s colour less the recorded colour of the pixel whose
+        // surface it shows (nothing where that pixel shows nothing).
         let moved = |pixel: u32, k: usize| {
-            let centre = self.centres.binary_search(&pixel).expect("every pixel a blend reads has a centre sample");
+            let (Some(recorded), Some(colour)) = (recorded, shaded.colour(k, parts)) else { return Vec3::ZERO };
+            let centre = self.centres.binary_search(&pixel).expect("every pixel a blend reads is recorded");
             let clear = fog.map_or(1.0, |f| 1.0 - f[pixel as usize]);
-            let lit = shaded.lit[k].total_of(parts) - shaded.lit[centre].total_of(parts);
-            let traced =
-                if parts.contains(Component::Traced) { shaded.traced[k] - shaded.traced[centre] } else { Vec3::ZERO };
-            (lit + traced) * clear
+            (colour - recorded[centre]) * clear
         };
-        let (mut near, mut far) = (self.centres.len(), self.centres.len() + crossed_pixels);
+        let (mut near, mut far) = (0, crossed_pixels);
         let updates: Vec<(u32, Vec3)> = {
             let px = image.pixels();
             self.blends
@@ -529,10 +545,14 @@ fn merge(mut blends: Vec<EdgeBlend>, cap: f32) -> Vec<EdgeBlend> {
     // A sliver: the pixel across is itself crossed by another edge, from outside,
     // towards this pixel — a thin surface lies between the two edges, so nothing of
     // this pixel shows the colour across.
-    let outside: HashMap<(u32, u32), u64> =
-        blends.iter().filter(|b| !b.inside).map(|b| ((b.c, b.o), b.source)).collect();
-    blends.retain(|b| !b.inside || outside.get(&(b.o, b.c)).is_none_or(|&s| s == b.source));
-    blends.sort_unstable_by_key(|b| (b.c, b.o));
+    blends.par_sort_unstable_by_key(|b| (b.c, b.o, b.inside, b.source));
+    let sliver = |b: &EdgeBlend| {
+        let from = blends.partition_point(|x| (x.c, x.o) < (b.o, b.c));
+        blends[from..].iter().take_while(|x| (x.c, x.o) == (b.o, b.c)).any(|x| !x.inside && x.source != b.source)
+    };
+    let slivers: Vec<bool> = blends.iter().map(|b| b.inside && sliver(b)).collect();
+    let mut kept = slivers.iter();
+    blends.retain(|_| !kept.next().is_some_and(|&s| s));
     let mut merged: Vec<EdgeBlend> = Vec::with_capacity(blends.len());
     for b in blends {
         match merged.last_mut().filter(|m| (m.c, m.o) == (b.c, b.o)) {

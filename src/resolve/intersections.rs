@@ -26,9 +26,47 @@ use crate::visibility::{ItemId, VisibilityBuffer};
 /// The `source` of a blend across an intersection (no edge of a mesh).
 pub(super) const INTERSECTION: u64 = u64::MAX;
 
+/// Which neighbouring pixels a walked edge already runs between: per pixel,
+/// bit 0 for the pair with its right neighbour, bit 1 for the pair with the
+/// one below.
+pub(super) struct WalkedPairs {
+    bits: Vec<u8>,
+    width: u32,
+}
+
+impl WalkedPairs {
+    /// The pairs `blends` join, on a `width` × `height` frame.
+    pub(super) fn of(blends: &[EdgeBlend], width: u32, height: u32) -> Self {
+        let mut bits = vec![0u8; width as usize * height as usize];
+        for b in blends {
+            let (first, second) = (b.c.min(b.o), b.c.max(b.o));
+            bits[first as usize] |= if second == first + 1 { RIGHT } else { BELOW };
+        }
+        WalkedPairs { bits, width }
+    }
+
+    /// Whether an edge runs between pixel `i` and its neighbour `towards`
+    /// ([`RIGHT`] or [`BELOW`]).
+    fn contains(&self, i: usize, towards: u8) -> bool {
+        debug_assert!(self.width > 0);
+        self.bits[i] & towards != 0
+    }
+}
+
+/// The neighbour to the right.
+const RIGHT: u8 = 1;
+/// The neighbour below.
+const BELOW: u8 = 2;
+
 /// The blends of every pixel an intersection of two objects' surfaces crosses,
-/// by row. `clips` holds every object's map to clip space.
-pub(super) fn find_intersection_blends(scene: &Scene, vb: &VisibilityBuffer, clips: &[ClipMap]) -> Vec<EdgeBlend> {
+/// where no walked edge runs between the two pixels. `clips` holds every
+/// object's map to clip space. Each pair of neighbours is looked at once.
+pub(super) fn find_intersection_blends(
+    scene: &Scene,
+    vb: &VisibilityBuffer,
+    clips: &[ClipMap],
+    walked: &WalkedPairs,
+) -> Vec<EdgeBlend> {
     let (w, h) = (vb.width(), vb.height());
     let screen = Screen::of(&scene.camera, w, h);
     let plane = |item: ItemId| -> Option<DepthPlane> {
@@ -41,23 +79,21 @@ pub(super) fn find_intersection_blends(scene: &Scene, vb: &VisibilityBuffer, cli
         }
         screen.depth_plane(&clips[item.object as usize], object.triangles()?, item.triangle)
     };
+    let items = vb.items();
     let rows: Vec<Vec<EdgeBlend>> = (0..h)
         .into_par_iter()
         .map(|y| {
             let mut out = Vec::new();
+            let row = (y * w) as usize;
             for x in 0..w {
-                let a = vb.item(x, y);
-                let neighbours = [(x.wrapping_sub(1), y), (x + 1, y), (x, y.wrapping_sub(1)), (x, y + 1)];
-                let mut plane_a = None;
-                for (ox, oy) in neighbours.into_iter().filter(|&(ox, oy)| ox < w && oy < h) {
-                    let b = vb.item(ox, oy);
-                    if a.is_none() || b.is_none() || a.object == b.object {
-                        continue;
-                    }
-                    let Some(pa) = *plane_a.get_or_insert_with(|| plane(a)) else { break };
-                    let Some(pb) = plane(b) else { continue };
-                    if let Some(blend) = crossing((x, y), (ox, oy), &pa, &pb, w) {
-                        out.push(blend);
+                let i = row + x as usize;
+                let a = items[i].object;
+                let right = x + 1 < w && items[i + 1].object != a;
+                let below = y + 1 < h && items[i + w as usize].object != a;
+                if right || below {
+                    let pairs = [(right, (x + 1, y), RIGHT), (below, (x, y + 1), BELOW)];
+                    for (_, o, _) in pairs.into_iter().filter(|p| p.0 && !walked.contains(i, p.2)) {
+                        out.extend(crossings(&plane, items, (x, y), o, w));
                     }
                 }
             }
@@ -65,6 +101,22 @@ pub(super) fn find_intersection_blends(scene: &Scene, vb: &VisibilityBuffer, cli
         })
         .collect();
     rows.concat()
+}
+
+/// The blends of pixels `c` and `o`, neighbours showing different objects, if
+/// their surfaces cross between them; `plane` gives an item's depth plane.
+fn crossings(
+    plane: impl Fn(ItemId) -> Option<DepthPlane>,
+    items: &[ItemId],
+    c: (u32, u32),
+    o: (u32, u32),
+    width: u32,
+) -> impl Iterator<Item = EdgeBlend> {
+    let item = |(x, y): (u32, u32)| items[(y * width + x) as usize];
+    let planes = plane(item(c)).zip(plane(item(o)));
+    planes
+        .into_iter()
+        .flat_map(move |(pc, po)| crossing(c, o, &pc, &po, width).into_iter().chain(crossing(o, c, &po, &pc, width)))
 }
 
 /// The blend of pixel `c` (showing plane `a`) towards its neighbour `o`

@@ -11,7 +11,7 @@
 use glam::{Vec2, Vec3};
 use wide::f32x8;
 
-use super::phong::{self, Coefficients, Component, ComponentSet, Components};
+use super::phong::{Coefficients, Component, ComponentSet, Components};
 use super::surface::{PreparedTriangle, SurfacePoint, TriangleGeometry};
 use crate::scene::camera::PixelRays;
 use crate::scene::{Falloff, Light, LightKind};
@@ -473,35 +473,46 @@ impl<'a> Lighting<'a> {
         !direct && self.ambient == Vec3::ZERO && !self.emission
     }
 
-    /// What the pass adds at one surface point with coefficients `k`, by
-    /// component: the scalar statement of the lanes' sum (ambient of the pass's
-    /// ambient lights, each direct light's diffuse and specular times the mean
-    /// of its shadow terms, perhaps emission).
+    /// Seed 002 eq. 1 summed over the pass's lights at up to eight points of
+    /// any surfaces (`None`: an empty lane, left at zero), each with its
+    /// material's coefficients there: the passes' arithmetic, lane for lane,
+    /// for points that are not a row of pixels (sub-pixel samples).
     #[must_use]
-    pub fn shade_point(&self, k: &Coefficients, s: &SurfacePoint) -> Components {
-        let (ka, _, _, ke, _) = k.parts();
-        let mut acc = Components { ambient: self.ambient * ka, ..Default::default() };
-        if self.emission {
-            acc.emission = ke;
+    pub fn shade_points(&self, points: &[Option<(&Coefficients, &SurfacePoint)>; LANES]) -> [Components; LANES] {
+        let Some(first) = points.iter().flatten().next() else { return [Components::default(); LANES] };
+        let (mut k, mut p, mut n, mut v) = (Block::default(), Gather::default(), Gather::default(), Gather::default());
+        // Empty lanes repeat the first point (shaded, then dropped).
+        for (i, (k_i, s)) in points.iter().map(|q| q.unwrap_or(*first)).enumerate() {
+            k.set_coefficients(i, k_i);
+            p.set(i, s.position);
+            n.set(i, s.normal);
+            v.set(i, s.to_eye);
         }
-        if self.diffuse > 0.0 || self.specular > 0.0 {
-            for &(light, terms) in &self.direct {
-                let cos_theta = s.normal.dot(light.incident(s.position).to_light);
-                if cos_theta <= 0.0 {
-                    continue;
-                }
-                let mut one = Components::default();
-                phong::add_light(&mut one, light, k, s, ShadowTerm::mean_lit(terms, s.position, cos_theta));
-                acc.diffuse += one.diffuse * self.diffuse;
-                acc.specular += one.specular * self.specular;
+        let inputs = k.inputs();
+        let zero = F::ZERO;
+        let surface = LaneSurface { p: p.load(), n: n.load(), v: v.load(), weights: [zero; 3] };
+        let [ambient, diffuse, specular, emission] = self.components(&inputs, &surface);
+        std::array::from_fn(|i| {
+            if points[i].is_none() {
+                return Components::default();
             }
-        }
-        acc
+            let (ambient, diffuse, specular, emission) =
+                (ambient.lane(i), diffuse.lane(i), specular.lane(i), emission.lane(i));
+            Components { ambient, diffuse, specular, emission }
+        })
     }
 
     /// Seed 002 eq. 1 summed over the pass's lights, per lane.
     #[inline(always)]
     fn shade(&self, inp: &LaneInputs, s: &LaneSurface) -> V3 {
+        let [ambient, diffuse, specular, emission] = self.components(inp, s);
+        ambient.add(diffuse).add(specular).add(emission)
+    }
+
+    /// Seed 002 eq. 1's components summed over the pass's lights, per lane:
+    /// ambient, diffuse, specular, emission.
+    #[inline(always)]
+    fn components(&self, inp: &LaneInputs, s: &LaneSurface) -> [V3; 4] {
         let mut diffuse = V3::splat(Vec3::ZERO);
         let mut specular = V3::splat(Vec3::ZERO);
         let direct = if self.diffuse > 0.0 || self.specular > 0.0 { self.direct.as_slice() } else { &[] };
@@ -518,12 +529,8 @@ impl<'a> Lighting<'a> {
             specular = specular.add(radiance.scale(lit.select(spec, F::ZERO)));
         }
         let (kd, ks) = (inp.kd.scale(F::splat(self.diffuse)), inp.ks.scale(F::splat(self.specular)));
-        let lit = inp.ka.mul(V3::splat(self.ambient)).add(kd.mul(diffuse)).add(ks.mul(specular));
-        if self.emission {
-            lit.add(inp.ke)
-        } else {
-            lit
-        }
+        let emission = if self.emission { inp.ke } else { V3::splat(Vec3::ZERO) };
+        [inp.ka.mul(V3::splat(self.ambient)), kd.mul(diffuse), ks.mul(specular), emission]
     }
 }
 

@@ -13,14 +13,16 @@
 //! visibility buffer holds it; a triangle's plane or a solid's tangent plane is
 //! met by the ray through the sample's point, extrapolated past the triangle if
 //! need be) and the point the ray goes through. The passes add each sample's
-//! components, scalar ([`Lighting::shade_point`]): there are few of them; the
-//! traced term ([`crate::raytrace::item_buffer`]) traces its bounces from there.
+//! components eight at a time ([`Lighting::shade_points`], the arithmetic they
+//! shade pixels with); the reflection map's term is looked up once; the traced
+//! term ([`crate::raytrace::item_buffer`]) traces its bounces from there.
 
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
-use super::lanes::Lighting;
-use super::phong::{Coefficients, Components};
+use super::lanes::{Lighting, LANES};
+use super::phong::{Coefficients, Component, ComponentSet, Components};
+use super::reflection_map::reflection_map;
 use super::surface::{ObjectFrames, SurfacePoint};
 use crate::scene::camera::PixelRays;
 use crate::scene::{Ray, Scene};
@@ -59,6 +61,9 @@ pub struct SubpixelShading {
     /// Per sample, the sum of the passes' components (zero where the pixel shows
     /// nothing).
     pub lit: Vec<Components>,
+    /// Per sample, the reflection map's term (seed 002's Ie, zero without an
+    /// environment or a Km).
+    pub reflected: Vec<Vec3>,
     /// Per sample, the traced term: reflection and refraction (zero where the
     /// material neither reflects nor refracts).
     pub traced: Vec<Vec3>,
@@ -102,18 +107,39 @@ impl SubpixelShading {
         }
         let frames = ObjectFrames::new(scene);
         let rays = scene.camera.pixel_rays(Vec2::new(vb.width() as f32, vb.height() as f32));
-        let surfaces = samples.par_iter().map(|s| s.surface(scene, vb, &frames, &rays)).collect();
+        let surfaces: Vec<_> = samples.par_iter().map(|s| s.surface(scene, vb, &frames, &rays)).collect();
+        let reflected =
+            surfaces.iter().map(|s| s.as_ref().map_or(Vec3::ZERO, |s| reflection_map(scene, &s.point))).collect();
         let (lit, traced) = (vec![Components::default(); samples.len()], vec![Vec3::ZERO; samples.len()]);
-        SubpixelShading { samples, surfaces, lit, traced }
+        SubpixelShading { samples, surfaces, lit, reflected, traced }
+    }
+
+    /// Sample `k`'s colour in an image holding the components `parts`, as the
+    /// frame's pixels have it before fog and translucency: the lit passes, the
+    /// reflection map and the traced term. `None` where its pixel shows
+    /// nothing.
+    #[must_use]
+    pub fn colour(&self, k: usize, parts: ComponentSet) -> Option<Vec3> {
+        self.surfaces[k].as_ref()?;
+        let keep = |c, v: Vec3| if parts.contains(c) { v } else { Vec3::ZERO };
+        let extra = keep(Component::Reflection, self.reflected[k]) + keep(Component::Traced, self.traced[k]);
+        Some(self.lit[k].total_of(parts) + extra)
     }
 
     /// Adds one pass (`lighting`, reaching the objects `receivers` marks, or
     /// all) at every sample.
     pub fn add_pass(&mut self, lighting: &Lighting, receivers: Option<&[bool]>) {
-        self.lit.par_iter_mut().zip(self.surfaces.par_iter()).for_each(|(acc, s)| {
-            let Some(s) = s else { return };
-            if receivers.is_none_or(|r| r[s.object as usize]) {
-                *acc += lighting.shade_point(&s.coefficients, &s.point);
+        let lanes = self.lit.par_chunks_mut(LANES).zip(self.surfaces.par_chunks(LANES));
+        lanes.for_each(|(acc, surfaces)| {
+            let lit = |i: usize| {
+                let s = surfaces.get(i)?.as_ref()?;
+                receivers.is_none_or(|r| r[s.object as usize]).then_some((&s.coefficients, &s.point))
+            };
+            let points = std::array::from_fn(lit);
+            for ((sum, added), point) in acc.iter_mut().zip(lighting.shade_points(&points)).zip(points) {
+                if point.is_some() {
+                    *sum += added;
+                }
             }
         });
     }
