@@ -468,18 +468,6 @@ fn find_blends(
     let (w, h) = (vb.width(), vb.height());
     let depth = DepthScale::of(camera, h);
     let screen = Screen::of(camera, w, h);
-    // The depth at the edge's point of the surface pixel `i` shows: its
-    // triangle's plane carried there (a surface resting on another meets it at
-    // the edge's depth, though its pixel beside the edge lies nearer), else
-    // the pixel's own depth.
-    let depth_at = |i: usize, point: glam::DVec3| {
-        let item = vb.items()[i];
-        let mesh = (!item.is_none() && item.primitive().is_none())
-            .then(|| scene.objects[item.object as usize].triangles())
-            .flatten();
-        mesh.and_then(|m| screen.plane_depth(&clips[item.object as usize], m, item.triangle, point))
-            .unwrap_or(f64::from(vb.depths()[i]))
-    };
     let mut blends = Vec::new();
     for (object, (o, mesh_edges)) in scene.objects.iter().zip(edges).enumerate() {
         // Solids' outlines are not mesh edges: they keep their aliased edges.
@@ -489,31 +477,50 @@ fn find_blends(
             continue; // blended over the opaque frame later; its edges are not walked
         }
         let facing = Facing::new(camera, o.transform.inverse());
+        let front: Vec<bool> = mesh_edges.planes.par_iter().map(|&plane| facing.front(plane)).collect();
         let clip = &clips[object];
         let per_edge: Vec<Vec<EdgeBlend>> = mesh_edges
             .edges
             .par_iter()
             .enumerate()
-            .filter(|(_, e)| selected(e, mesh_edges, &facing, material.two_sided, mode.selection))
+            .filter(|(_, e)| selected(e, &front, material.two_sided, mode.selection))
             .filter_map(|(k, e)| {
                 let source = ((object as u64) << 32) | k as u64;
                 let [a, b] = e.v.map(|i| clip.points * mesh.positions[i as usize].as_dvec3().extend(1.0));
                 let (a, b) = screen.clip_and_project(a, b)?;
                 let mut out = Vec::new();
                 let near = mesh_edges.neighbourhood(mesh, e);
+                let mut planes = PlaneMemo::default();
                 let visit = |c: (u32, u32), other: (u32, u32), alpha, point: glam::DVec3, far: Vec2| {
-                    // A pixel shows the edge's own surface if its triangle touches the
-                    // faces beside the edge, or if its plane passes near the edge point
-                    // (a fine mesh: the triangle at the pixel is a few rings away).
-                    let own = |item: ItemId| {
-                        item.object == object as u32
-                            && (mesh_edges.touches(mesh, item.triangle, &near)
-                                || screen
-                                    .plane_depth(clip, mesh, item.triangle, point)
-                                    .is_some_and(|z| depth.close(z, point.z)))
+                    let mut side = |i: usize| {
+                        let item = vb.items()[i];
+                        if item.is_none() {
+                            return Side::Behind;
+                        }
+                        let ours = item.object == object as u32;
+                        if ours && mesh_edges.touches(mesh, item.triangle, &near) {
+                            return Side::Own; // a triangle beside the edge
+                        }
+                        // The pixel's surface plane carried to the edge's point (a
+                        // surface resting on another meets it at the edge's depth,
+                        // though its pixel beside the edge lies nearer), else the
+                        // pixel's own depth.
+                        let z = planes.depth_at(item, point, |item| {
+                            let mesh = scene.objects[item.object as usize].triangles()?;
+                            (item.primitive().is_none())
+                                .then(|| screen.depth_plane(&clips[item.object as usize], mesh, item.triangle))?
+                        });
+                        if ours && z.is_some_and(|z| depth.close(z, point.z)) {
+                            // A fine mesh: the triangle at the pixel is a few rings
+                            // away from the edge, but its plane passes near it.
+                            Side::Own
+                        } else if depth.in_front(z.unwrap_or(f64::from(vb.depths()[i])), point.z) {
+                            Side::Occluder
+                        } else {
+                            Side::Behind
+                        }
                     };
-                    let occludes = |i: usize| depth.in_front(depth_at(i, point), point.z);
-                    if let Some(blend) = depth_tested(vb, (&own, &occludes), c, other, alpha, mode.filter) {
+                    if let Some(blend) = depth_tested(w, &mut side, c, other, alpha, mode.filter) {
                         out.push(EdgeBlend { source, far, ..blend });
                     }
                 };
@@ -597,18 +604,17 @@ impl Facing {
     }
 }
 
-fn selected(e: &MeshEdge, mesh: &MeshEdges, facing: &Facing, two_sided: bool, selection: EdgeSelection) -> bool {
-    let front = |f: u32| f != NO_FACE && (two_sided || facing.front(mesh.planes[f as usize]));
-    let (f0, f1) = (front(e.faces[0]), front(e.faces[1]));
-    if !(f0 || f1) {
+/// Whether edge `e` is walked, given which faces look at the eye (`front`).
+fn selected(e: &MeshEdge, front: &[bool], two_sided: bool, selection: EdgeSelection) -> bool {
+    let drawn = |f: u32| f != NO_FACE && (two_sided || front[f as usize]);
+    if !(drawn(e.faces[0]) || drawn(e.faces[1])) {
         return false; // both faces culled: nothing of it is drawn
     }
     match selection {
         EdgeSelection::All => true,
         EdgeSelection::Outline => {
             let boundary = e.faces[1] == NO_FACE;
-            let silhouette = !boundary
-                && (facing.front(mesh.planes[e.faces[0] as usize]) != facing.front(mesh.planes[e.faces[1] as usize]));
+            let silhouette = !boundary && front[e.faces[0] as usize] != front[e.faces[1] as usize];
             boundary || silhouette || e.crease
         }
     }
@@ -648,13 +654,6 @@ impl Screen {
     /// The screen from `scene`'s camera onto a `width` × `height` image.
     pub(super) fn of(camera: &Camera, width: u32, height: u32) -> Screen {
         Screen { width: f64::from(width), height: f64::from(height), far: f64::from(camera.far_plane_factor()) }
-    }
-
-    /// Depth of triangle `t`'s plane at screen point `p` (x, y), extrapolated
-    /// beyond the triangle if need be; `None` if the triangle reaches behind the eye
-    /// or is seen edge-on.
-    fn plane_depth(&self, clip: &ClipMap, mesh: &Mesh, t: u32, p: glam::DVec3) -> Option<f64> {
-        self.depth_plane(clip, mesh, t).map(|plane| plane.at(p.x, p.y))
     }
 
     /// Triangle `t`'s plane as the depth it stores over the screen (depth is
@@ -802,22 +801,27 @@ fn part_centroid(v0: f64, v1: f64, beyond_below: bool) -> (f64, f64) {
 pub(super) fn square_part(side: impl Fn((f64, f64)) -> f64) -> (f64, (f64, f64)) {
     // The square clipped to side ≥ 0 (Sutherland–Hodgman, one plane).
     let square = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)];
-    let mut part: Vec<(f64, f64)> = Vec::with_capacity(5);
+    let sides = square.map(&side);
+    // A line cuts a square's boundary at most twice: at most five corners.
+    let (mut corners, mut n) = ([(0.0, 0.0); 5], 0);
     for (k, &p) in square.iter().enumerate() {
         let q = square[(k + 1) % 4];
-        let (sp, sq) = (side(p), side(q));
+        let (sp, sq) = (sides[k], sides[(k + 1) % 4]);
         if sp >= 0.0 {
-            part.push(p);
+            corners[n] = p;
+            n += 1;
         }
         if (sp >= 0.0) != (sq >= 0.0) {
             let t = sp / (sp - sq);
-            part.push((p.0 + (q.0 - p.0) * t, p.1 + (q.1 - p.1) * t));
+            corners[n] = (p.0 + (q.0 - p.0) * t, p.1 + (q.1 - p.1) * t);
+            n += 1;
         }
     }
+    let part = &corners[..n];
     // Area and centroid of the polygon (shoelace).
     let (mut area, mut cu, mut cv) = (0.0, 0.0, 0.0);
     for (k, &(pu, pv)) in part.iter().enumerate() {
-        let (qu, qv) = part[(k + 1) % part.len()];
+        let (qu, qv) = part[(k + 1) % n];
         let cross = pu * qv - qu * pv;
         area += cross;
         cu += (pu + qu) * cross;
@@ -910,27 +914,15 @@ enum Side {
 /// The blend of `c` towards `o` if the depth test lets the edge show: neither pixel
 /// hides it, and one of them is its own surface.
 fn depth_tested(
-    vb: &VisibilityBuffer,
-    (own, occludes): (&impl Fn(ItemId) -> bool, &impl Fn(usize) -> bool),
+    width: u32,
+    side: &mut impl FnMut(usize) -> Side,
     c: (u32, u32),
     o: (u32, u32),
     alpha: f32,
     filter: EdgeFilter,
 ) -> Option<EdgeBlend> {
-    let w = vb.width();
-    let index = |(x, y): (u32, u32)| y * w + x;
-    let side = |p: (u32, u32)| {
-        let i = index(p) as usize;
-        let item = vb.items()[i];
-        if !item.is_none() && own(item) {
-            Side::Own
-        } else if !item.is_none() && occludes(i) {
-            Side::Occluder
-        } else {
-            Side::Behind
-        }
-    };
-    let (sc, so) = (side(c), side(o));
+    let index = |(x, y): (u32, u32)| y * width + x;
+    let (sc, so) = (side(index(c) as usize), side(index(o) as usize));
     // The paper blends the edge's own colour: the pixel across must show it.
     let source = match filter {
         EdgeFilter::Coverage => sc == Side::Own || so == Side::Own,
@@ -938,6 +930,38 @@ fn depth_tested(
     };
     let shows = sc != Side::Occluder && so != Side::Occluder && source;
     shows.then(|| EdgeBlend { c: index(c), o: index(o), alpha, inside: sc == Side::Own, source: 0, far: Vec2::ZERO })
+}
+
+/// The depth planes of the last two items an edge's walk met: neighbouring
+/// steps along an edge mostly see the same few triangles.
+#[derive(Default)]
+struct PlaneMemo {
+    last: [Option<(ItemId, Option<DepthPlane>)>; 2],
+}
+
+impl PlaneMemo {
+    /// The depth at screen point `p` of `item`'s plane, found by `plane` unless
+    /// met just before.
+    fn depth_at(
+        &mut self,
+        item: ItemId,
+        p: glam::DVec3,
+        plane: impl FnOnce(ItemId) -> Option<DepthPlane>,
+    ) -> Option<f64> {
+        let found = match self.last {
+            [Some((i, found)), _] if i == item => found,
+            [_, Some((i, found))] if i == item => {
+                self.last.swap(0, 1);
+                found
+            }
+            _ => {
+                let found = plane(item);
+                self.last = [Some((item, found)), self.last[0]];
+                found
+            }
+        };
+        found.map(|plane| plane.at(p.x, p.y))
+    }
 }
 
 #[cfg(test)]

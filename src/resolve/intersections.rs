@@ -84,23 +84,53 @@ pub(super) fn find_intersection_blends(
         .into_par_iter()
         .map(|y| {
             let mut out = Vec::new();
-            let row = (y * w) as usize;
-            for x in 0..w {
-                let i = row + x as usize;
-                let a = items[i].object;
-                let right = x + 1 < w && items[i + 1].object != a;
-                let below = y + 1 < h && items[i + w as usize].object != a;
-                if right || below {
-                    let pairs = [(right, (x + 1, y), RIGHT), (below, (x, y + 1), BELOW)];
-                    for (_, o, _) in pairs.into_iter().filter(|p| p.0 && !walked.contains(i, p.2)) {
-                        out.extend(crossings(&plane, items, (x, y), o, w));
-                    }
+            let start = (y * w) as usize;
+            let row = &items[start..start + w as usize];
+            let next = items.get(start + w as usize..start + 2 * w as usize).unwrap_or_default();
+            for_each_boundary(row, next, |x, right, below| {
+                let (i, x) = (start + x, x as u32);
+                let pairs = [(right, (x + 1, y), RIGHT), (below, (x, y + 1), BELOW)];
+                for (_, o, _) in pairs.into_iter().filter(|p| p.0 && !walked.contains(i, p.2)) {
+                    out.extend(crossings(&plane, items, (x, y), o, w));
                 }
-            }
+            });
             out
         })
         .collect();
     rows.concat()
+}
+
+/// Calls `f(x, right, below)` for each pixel x of `row` that shows another
+/// object than its right neighbour (`right`) or than the pixel below it in
+/// `next` (`below`; `next` is empty on the last row). Pixels are looked at
+/// eight at a time: a block inside one object, the common case, costs a few
+/// compares without branches.
+fn for_each_boundary(row: &[ItemId], next: &[ItemId], mut f: impl FnMut(usize, bool, bool)) {
+    const BLOCK: usize = 8;
+    let w = row.len();
+    let differs = |x: usize| {
+        let right = x + 1 < w && row[x].object != row[x + 1].object;
+        (right, next.get(x).is_some_and(|b| b.object != row[x].object))
+    };
+    for x0 in (0..w).step_by(BLOCK) {
+        let whole = x0 + BLOCK < w && next.len() == w;
+        let uniform = whole && {
+            let (a, r, n) = (&row[x0..x0 + BLOCK], &row[x0 + 1..x0 + BLOCK + 1], &next[x0..x0 + BLOCK]);
+            a.iter()
+                .zip(r)
+                .zip(n)
+                .fold(true, |same, ((a, r), n)| same & (a.object == r.object) & (a.object == n.object))
+        };
+        if uniform {
+            continue;
+        }
+        for x in x0..(x0 + BLOCK).min(w) {
+            let (right, below) = differs(x);
+            if right || below {
+                f(x, right, below);
+            }
+        }
+    }
 }
 
 /// The blends of pixels `c` and `o`, neighbours showing different objects, if

@@ -180,9 +180,13 @@ impl Coefficients {
                 maps.iter().map(|t| sample(t)).sum()
             }
         };
+        let diffuse = map(&m.maps.diffuse);
+        // glTF's base colour is both maps: sampled once.
+        let shared = m.maps.ambient.len() == m.maps.diffuse.len()
+            && m.maps.ambient.iter().zip(&m.maps.diffuse).all(|(a, d)| std::sync::Arc::ptr_eq(a, d));
         Coefficients {
-            ka: m.ka * map(&m.maps.ambient),
-            kd: m.kd * map(&m.maps.diffuse),
+            ka: m.ka * if shared { diffuse } else { map(&m.maps.ambient) },
+            kd: m.kd * diffuse,
             ks: m.ks * map(&m.maps.specular),
             ke: m.ke * map(&m.maps.emission),
             n: m.shininess,

@@ -83,16 +83,22 @@ impl SubpixelSample {
         if item.is_none() {
             return None;
         }
-        // A solid's tangent plane is taken where the pixel's own ray meets it.
-        let centre = rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
         let ray = rays.ray(self.at);
-        let surface = frames.prepare_at(scene, vb, x, y, &centre);
+        let surface = if item.primitive().is_some() {
+            // A solid's tangent plane is taken where the pixel's own ray meets it.
+            frames.prepare_at(scene, vb, x, y, &rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5)))
+        } else {
+            frames.prepare(scene, item)
+        };
         let mut point = surface.surface(&ray);
-        // Texture footprint: the same surface met one pixel right and one below
-        // (ray differentials, as the passes take them).
-        let uv = |dx: f32, dy: f32| surface.surface(&rays.ray(self.at + Vec2::new(dx, dy))).uv;
-        point.duv = [uv(1.0, 0.0) - point.uv, uv(0.0, 1.0) - point.uv];
-        let coefficients = Coefficients::at(&scene.materials[point.material], &point);
+        let material = &scene.materials[point.material];
+        let coefficients = Coefficients::constant(material).unwrap_or_else(|| {
+            // Texture footprint: the same surface met one pixel right and one
+            // below (ray differentials, as the passes take them).
+            let uv = |dx: f32, dy: f32| surface.uv(&rays.ray(self.at + Vec2::new(dx, dy)));
+            point.duv = [uv(1.0, 0.0) - point.uv, uv(0.0, 1.0) - point.uv];
+            Coefficients::at(material, &point)
+        });
         Some(SampleSurface { ray, point, coefficients, object: item.object })
     }
 }

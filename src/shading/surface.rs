@@ -173,6 +173,15 @@ impl PreparedTriangle {
         }
     }
 
+    /// The texture coordinates where `ray` meets the triangle's plane (zero
+    /// without them): [`PreparedTriangle::surface`]'s uv alone.
+    #[must_use]
+    pub fn uv(&self, ray: &Ray) -> Vec2 {
+        let Some(u) = self.uvs else { return Vec2::ZERO };
+        let (_, b) = intersect_plane(ray, self.a, self.e1, self.e2);
+        u[0] * (1.0 - b.x - b.y) + u[1] * b.x + u[2] * b.y
+    }
+
     /// The surface point where `ray` meets the triangle's plane.
     #[must_use]
     pub fn surface(&self, ray: &Ray) -> SurfacePoint {
