@@ -114,6 +114,8 @@ struct Scratch {
     trace: TraceCache,
     /// The meshes' edges for the edge pass (seed 004), kept while the meshes live.
     edges: EdgeCache,
+    /// The edge pass's sub-pixel samples and what the passes added there.
+    subpixel: SubpixelShading,
 }
 
 impl Renderer {
@@ -234,7 +236,7 @@ fn add_scaled(acc: &mut LinearImage, img: &LinearImage, k: f32) {
 /// seed 004's edge pass if `edge` says so; adds its timings to the frame's
 /// statistics.
 fn render_pass(scene: &Scene, frame: &mut Frame, scratch: &mut Scratch, ray_depth: u32, edge: Option<&EdgeOptions>) {
-    let Scratch { aovs, maps, trace, edges: edge_cache, .. } = scratch;
+    let Scratch { aovs, maps, trace, edges: edge_cache, subpixel, .. } = scratch;
     let t0 = Instant::now();
     frame.visibility.resize(scene.width, scene.height);
     frame.stats.raster = visibility::rasterize(scene, &mut frame.visibility);
@@ -243,7 +245,7 @@ fn render_pass(scene: &Scene, frame: &mut Frame, scratch: &mut Scratch, ray_dept
     // points the crossed pixels' parts need.
     let mut plan = edge.map(|o| edges::plan(scene, &frame.visibility, o, edge_cache));
     let samples = plan.as_ref().map_or_else(Vec::new, |p| p.samples(scene.width));
-    let mut subpixel = SubpixelShading::new(scene, &frame.visibility, samples);
+    subpixel.reset(scene, &frame.visibility, samples);
     let planned = t1.elapsed();
     let t1 = Instant::now();
     frame.image.resize(scene.width, scene.height);
@@ -257,7 +259,7 @@ fn render_pass(scene: &Scene, frame: &mut Frame, scratch: &mut Scratch, ray_dept
         }
     }
     let vb = &frame.visibility;
-    let lit = shading::shade_lit(scene, vb, &mut targets, maps, &mut subpixel);
+    let lit = shading::shade_lit(scene, vb, &mut targets, maps, subpixel);
     let t2 = Instant::now();
     let builds = trace.builds();
     frame.stats.traced_pixels += match &mut traced_aov {
@@ -269,12 +271,12 @@ fn render_pass(scene: &Scene, frame: &mut Frame, scratch: &mut Scratch, ray_dept
             n
         }
     };
-    item_buffer::trace_subpixel(scene, &mut subpixel, ray_depth, trace);
+    item_buffer::trace_subpixel(scene, subpixel, ray_depth, trace);
     let t3 = Instant::now();
     frame.stats.bvh_built |= trace.builds() > builds;
     targets.extend(traced_aov.map(|image| Target { parts: ComponentSet::only(Component::Traced), image }));
     if let Some(plan) = &mut plan {
-        plan.record(&targets);
+        plan.record(&targets, subpixel);
     }
     let fogged = scene.fog.as_ref().map(|fog| {
         let amounts = fog::fog_amounts(scene, fog, vb);
@@ -293,7 +295,7 @@ fn render_pass(scene: &Scene, frame: &mut Frame, scratch: &mut Scratch, ray_dept
     }
     if let Some(plan) = &plan {
         let t = Instant::now();
-        targets.iter_mut().for_each(|t| plan.apply(t.image, t.parts, &subpixel, fogged.as_deref()));
+        targets.iter_mut().for_each(|t| plan.apply(t.image, t.parts, subpixel, fogged.as_deref()));
         frame.stats.edge_blends = plan.len();
         frame.stats.edge_ms = (planned + t.elapsed()).as_secs_f64() * 1e3;
     }

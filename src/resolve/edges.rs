@@ -71,7 +71,7 @@
 use std::collections::HashMap;
 use std::sync::Arc;
 
-use glam::{DVec4, Mat4, Vec2, Vec3, Vec4};
+use glam::{DVec3, DVec4, Mat4, Vec2, Vec3, Vec4};
 use rayon::prelude::*;
 
 use super::{intersections, LinearImage};
@@ -301,10 +301,9 @@ pub struct EdgePlan {
     /// (the coverage filter), or take the pixels' colours as they are (the
     /// paper's filter, which blends the edge's colour).
     reshade: bool,
-    /// Every pixel a blend reads, sorted.
-    centres: Vec<u32>,
-    /// Per target image (by its components), the colour of each of `centres`
-    /// before fog and translucency ([`EdgePlan::record`]).
+    /// Per target image (by its components), per sample, the colour of the
+    /// pixel whose surface it shows, before fog and translucency
+    /// ([`EdgePlan::record`]).
     recorded: Vec<(ComponentSet, Vec<Vec3>)>,
 }
 
@@ -327,10 +326,7 @@ pub fn plan(scene: &Scene, vb: &VisibilityBuffer, options: &EdgeOptions, cache: 
         EdgeFilter::Paper => 1.0,
     };
     let blends = merge(blends, cap);
-    let mut centres: Vec<u32> = blends.iter().flat_map(|b| [b.c, b.o]).collect();
-    centres.sort_unstable();
-    centres.dedup();
-    EdgePlan { blends, reshade: options.mode.filter == EdgeFilter::Coverage, centres, recorded: Vec::new() }
+    EdgePlan { blends, reshade: options.mode.filter == EdgeFilter::Coverage, recorded: Vec::new() }
 }
 
 impl EdgePlan {
@@ -371,18 +367,19 @@ impl EdgePlan {
         near.chain(far).collect()
     }
 
-    /// Records, in every target, the colour of each pixel a blend reads as the
-    /// lit passes, the reflection map and the traced term left it (before fog
-    /// and translucency): what the samples' colours are compared with.
-    pub fn record(&mut self, targets: &[Target]) {
+    /// Records, in every target, the colour of the pixel whose surface each of
+    /// `shaded`'s samples shows, as the lit passes, the reflection map and the
+    /// traced term left it (before fog and translucency): what the samples'
+    /// colours are compared with.
+    pub fn record(&mut self, targets: &[Target], shaded: &SubpixelShading) {
         if !self.reshade {
             return;
         }
-        let centres = &self.centres;
-        self.recorded = targets
-            .iter()
-            .map(|t| (t.parts, centres.iter().map(|&i| t.image.pixels()[i as usize]).collect()))
-            .collect();
+        let record = |t: &Target| {
+            let (px, w) = (t.image.pixels(), t.image.width() as usize);
+            shaded.samples.iter().map(|s| px[s.pixel.1 as usize * w + s.pixel.0 as usize]).collect()
+        };
+        self.recorded = targets.iter().map(|t| (t.parts, record(t))).collect();
     }
 
     /// Blends `image` (holding the components `parts`): each crossed pixel
@@ -402,9 +399,8 @@ impl EdgePlan {
         // surface it shows (nothing where that pixel shows nothing).
         let moved = |pixel: u32, k: usize| {
             let (Some(recorded), Some(colour)) = (recorded, shaded.colour(k, parts)) else { return Vec3::ZERO };
-            let centre = self.centres.binary_search(&pixel).expect("every pixel a blend reads is recorded");
             let clear = fog.map_or(1.0, |f| 1.0 - f[pixel as usize]);
-            (colour - recorded[centre]) * clear
+            (colour - recorded[k]) * clear
         };
         let (mut near, mut far) = (0, crossed_pixels);
         let updates: Vec<(u32, Vec3)> = {
@@ -466,71 +462,113 @@ fn find_blends(
 ) -> Vec<EdgeBlend> {
     let camera = &scene.camera;
     let (w, h) = (vb.width(), vb.height());
-    let depth = DepthScale::of(camera, h);
-    let screen = Screen::of(camera, w, h);
-    let mut blends = Vec::new();
-    for (object, (o, mesh_edges)) in scene.objects.iter().zip(edges).enumerate() {
-        // Solids' outlines are not mesh edges: they keep their aliased edges.
-        let (Some(mesh), Some(mesh_edges)) = (o.triangles(), mesh_edges.as_ref()) else { continue };
-        let material = &scene.materials[o.material];
-        if material.translucent() {
-            continue; // blended over the opaque frame later; its edges are not walked
-        }
-        let facing = Facing::new(camera, o.transform.inverse());
-        let front: Vec<bool> = mesh_edges.planes.par_iter().map(|&plane| facing.front(plane)).collect();
-        let clip = &clips[object];
-        let per_edge: Vec<Vec<EdgeBlend>> = mesh_edges
-            .edges
-            .par_iter()
-            .enumerate()
-            .filter(|(_, e)| selected(e, &front, material.two_sided, mode.selection))
-            .filter_map(|(k, e)| {
-                let source = ((object as u64) << 32) | k as u64;
-                let [a, b] = e.v.map(|i| clip.points * mesh.positions[i as usize].as_dvec3().extend(1.0));
-                let (a, b) = screen.clip_and_project(a, b)?;
-                let mut out = Vec::new();
-                let near = mesh_edges.neighbourhood(mesh, e);
-                let mut planes = PlaneMemo::default();
-                let visit = |c: (u32, u32), other: (u32, u32), alpha, point: glam::DVec3, far: Vec2| {
-                    let mut side = |i: usize| {
-                        let item = vb.items()[i];
-                        if item.is_none() {
-                            return Side::Behind;
-                        }
-                        let ours = item.object == object as u32;
-                        if ours && mesh_edges.touches(mesh, item.triangle, &near) {
-                            return Side::Own; // a triangle beside the edge
-                        }
-                        // The pixel's surface plane carried to the edge's point (a
-                        // surface resting on another meets it at the edge's depth,
-                        // though its pixel beside the edge lies nearer), else the
-                        // pixel's own depth.
-                        let z = planes.depth_at(item, point, |item| {
-                            let mesh = scene.objects[item.object as usize].triangles()?;
-                            (item.primitive().is_none())
-                                .then(|| screen.depth_plane(&clips[item.object as usize], mesh, item.triangle))?
-                        });
-                        if ours && z.is_some_and(|z| depth.close(z, point.z)) {
-                            // A fine mesh: the triangle at the pixel is a few rings
-                            // away from the edge, but its plane passes near it.
-                            Side::Own
-                        } else if depth.in_front(z.unwrap_or(f64::from(vb.depths()[i])), point.z) {
-                            Side::Occluder
-                        } else {
-                            Side::Behind
-                        }
-                    };
-                    if let Some(blend) = depth_tested(w, &mut side, c, other, alpha, mode.filter) {
-                        out.push(EdgeBlend { source, far, ..blend });
-                    }
-                };
-                walk(a, b, visit, (w, h), mode.filter);
-                Some(out)
+    let walker = Walker { scene, vb, clips, mode, depth: DepthScale::of(camera, h), screen: Screen::of(camera, w, h) };
+    let objects: Vec<WalkedObject> = scene
+        .objects
+        .iter()
+        .zip(edges)
+        .enumerate()
+        .filter_map(|(index, (o, edges))| {
+            // Solids' outlines are not mesh edges: they keep their aliased edges.
+            let (mesh, edges) = (o.triangles()?, edges.as_deref()?);
+            let material = &scene.materials[o.material];
+            // A translucent surface is blended over the opaque frame later; its
+            // edges are not walked.
+            (!material.translucent()).then(|| {
+                let facing = Facing::new(camera, o.transform.inverse());
+                let front = edges.planes.par_iter().map(|&plane| facing.front(plane)).collect();
+                WalkedObject { index: index as u32, mesh, edges, front, two_sided: material.two_sided }
             })
-            .collect();
-        blends.extend(per_edge.into_iter().flatten());
+        })
+        .collect();
+    // One parallel sweep over the selected edges of all objects (a scene of
+    // many small parts has few edges per object).
+    let selected: Vec<(usize, usize)> = objects
+        .par_iter()
+        .enumerate()
+        .flat_map_iter(|(j, o)| {
+            let edges = o.edges.edges.iter().enumerate();
+            edges.filter(|(_, e)| selected(e, &o.front, o.two_sided, mode.selection)).map(move |(k, _)| (j, k))
+        })
+        .collect();
+    let chunks: Vec<Vec<EdgeBlend>> = selected
+        .par_iter()
+        .fold(Vec::new, |mut out, &(j, k)| {
+            walker.walk_edge(&objects[j], k, &mut out);
+            out
+        })
+        .collect();
+    chunks.concat()
+}
+
+/// An object whose edges the pass walks, as this frame sees it.
+struct WalkedObject<'a> {
+    index: u32,
+    mesh: &'a Mesh,
+    edges: &'a MeshEdges,
+    /// Per face, whether it looks at the eye.
+    front: Vec<bool>,
+    two_sided: bool,
+}
+
+/// What walking an edge reads: the frame's visibility buffer and the view.
+struct Walker<'a> {
+    scene: &'a Scene,
+    vb: &'a VisibilityBuffer,
+    clips: &'a [ClipMap],
+    mode: EdgeMode,
+    depth: DepthScale,
+    screen: Screen,
+}
+
+impl Walker<'_> {
+    /// Walks edge `k` of `object`, adding its blends to `out`.
+    fn walk_edge(&self, object: &WalkedObject, k: usize, out: &mut Vec<EdgeBlend>) {
+        let (mesh, e, clip) = (object.mesh, &object.edges.edges[k], &self.clips[object.index as usize]);
+        let source = (u64::from(object.index) << 32) | k as u64;
+        let [a, b] = e.v.map(|i| clip.points * mesh.positions[i as usize].as_dvec3().extend(1.0));
+        let Some((a, b)) = self.screen.clip_and_project(a, b) else { return };
+        let near = object.edges.neighbourhood(mesh, e);
+        let mut planes = PlaneMemo::default();
+        let (w, h) = (self.vb.width(), self.vb.height());
+        let visit = |c: (u32, u32), other: (u32, u32), alpha, point: glam::DVec3, far: Vec2| {
+            let mut side = |i: usize| self.side(object, &near, &mut planes, i, point);
+            if let Some(blend) = depth_tested(w, &mut side, c, other, alpha, self.mode.filter) {
+                out.push(EdgeBlend { source, far, ..blend });
+            }
+        };
+        walk(a, b, visit, (w, h), self.mode.filter);
     }
-    blends
+
+    /// How pixel `i` relates to an edge of `object` whose point there is
+    /// `point` (screen x, y, depth); `near` is the edge's neighbourhood.
+    fn side(&self, object: &WalkedObject, near: &[u32; 6], planes: &mut PlaneMemo, i: usize, point: DVec3) -> Side {
+        let item = self.vb.items()[i];
+        if item.is_none() {
+            return Side::Behind;
+        }
+        let ours = item.object == object.index;
+        if ours && object.edges.touches(object.mesh, item.triangle, near) {
+            return Side::Own; // a triangle beside the edge
+        }
+        // The pixel's surface plane carried to the edge's point (a surface
+        // resting on another meets it at the edge's depth, though its pixel
+        // beside the edge lies nearer), else the pixel's own depth.
+        let z = planes.depth_at(item, point, |item| {
+            let mesh = self.scene.objects[item.object as usize].triangles()?;
+            let clip = &self.clips[item.object as usize];
+            item.primitive().is_none().then(|| self.screen.depth_plane(clip, mesh, item.triangle))?
+        });
+        if ours && z.is_some_and(|z| self.depth.close(z, point.z)) {
+            // A fine mesh: the triangle at the pixel is a few rings away from
+            // the edge, but its plane passes near it.
+            Side::Own
+        } else if self.depth.in_front(z.unwrap_or(f64::from(self.vb.depths()[i])), point.z) {
+            Side::Occluder
+        } else {
+            Side::Behind
+        }
+    }
 }
 
 /// One blend per pixel and neighbour, from all the edges that cross the pixel
@@ -552,12 +590,19 @@ fn merge(mut blends: Vec<EdgeBlend>, cap: f32) -> Vec<EdgeBlend> {
     // A sliver: the pixel across is itself crossed by another edge, from outside,
     // towards this pixel — a thin surface lies between the two edges, so nothing of
     // this pixel shows the colour across.
-    blends.par_sort_unstable_by_key(|b| (b.c, b.o, b.inside, b.source));
+    let pair = |b: &EdgeBlend| (u64::from(b.c) << 32) | u64::from(b.o);
+    blends.sort_unstable_by_key(|b| (pair(b), b.inside, b.source));
+    // Pixels crossed from outside by some edge: only towards those can a
+    // blend be a sliver.
+    let mut crossed_from_outside = PixelSet::new(blends.iter().map(|b| b.c.max(b.o) + 1).max().unwrap_or(0));
+    blends.iter().filter(|b| !b.inside).for_each(|b| crossed_from_outside.insert(b.c));
     let sliver = |b: &EdgeBlend| {
-        let from = blends.partition_point(|x| (x.c, x.o) < (b.o, b.c));
-        blends[from..].iter().take_while(|x| (x.c, x.o) == (b.o, b.c)).any(|x| !x.inside && x.source != b.source)
+        let reverse = (u64::from(b.o) << 32) | u64::from(b.c);
+        let from = blends.partition_point(|x| pair(x) < reverse);
+        blends[from..].iter().take_while(|x| pair(x) == reverse).any(|x| !x.inside && x.source != b.source)
     };
-    let slivers: Vec<bool> = blends.iter().map(|b| b.inside && sliver(b)).collect();
+    let slivers: Vec<bool> =
+        blends.iter().map(|b| b.inside && crossed_from_outside.contains(b.o) && sliver(b)).collect();
     let mut kept = slivers.iter();
     blends.retain(|_| !kept.next().is_some_and(|&s| s));
     let mut merged: Vec<EdgeBlend> = Vec::with_capacity(blends.len());
@@ -577,6 +622,26 @@ fn merge(mut blends: Vec<EdgeBlend>, cap: f32) -> Vec<EdgeBlend> {
         }
     }
     merged
+}
+
+/// A set of pixels (row-major indices) as one bit each.
+struct PixelSet {
+    words: Vec<u64>,
+}
+
+impl PixelSet {
+    /// An empty set of pixels below `len`.
+    fn new(len: u32) -> PixelSet {
+        PixelSet { words: vec![0; (len as usize).div_ceil(64)] }
+    }
+
+    fn insert(&mut self, i: u32) {
+        self.words[i as usize / 64] |= 1 << (i % 64);
+    }
+
+    fn contains(&self, i: u32) -> bool {
+        self.words.get(i as usize / 64).is_some_and(|w| w & (1 << (i % 64)) != 0)
+    }
 }
 
 /// Which faces look at the eye, tested in the object's own space (the sign of a

@@ -28,28 +28,27 @@ pub(super) const INTERSECTION: u64 = u64::MAX;
 
 /// Which neighbouring pixels a walked edge already runs between: per pixel,
 /// bit 0 for the pair with its right neighbour, bit 1 for the pair with the
-/// one below.
+/// one below (two bits a pixel, packed).
 pub(super) struct WalkedPairs {
-    bits: Vec<u8>,
-    width: u32,
+    words: Vec<u64>,
 }
 
 impl WalkedPairs {
     /// The pairs `blends` join, on a `width` × `height` frame.
     pub(super) fn of(blends: &[EdgeBlend], width: u32, height: u32) -> Self {
-        let mut bits = vec![0u8; width as usize * height as usize];
+        let mut words = vec![0u64; (2 * width as usize * height as usize).div_ceil(64)];
         for b in blends {
-            let (first, second) = (b.c.min(b.o), b.c.max(b.o));
-            bits[first as usize] |= if second == first + 1 { RIGHT } else { BELOW };
+            let (first, second) = (b.c.min(b.o) as usize, b.c.max(b.o) as usize);
+            let towards = if second == first + 1 { RIGHT } else { BELOW };
+            words[2 * first / 64] |= u64::from(towards) << (2 * first % 64);
         }
-        WalkedPairs { bits, width }
+        WalkedPairs { words }
     }
 
     /// Whether an edge runs between pixel `i` and its neighbour `towards`
     /// ([`RIGHT`] or [`BELOW`]).
     fn contains(&self, i: usize, towards: u8) -> bool {
-        debug_assert!(self.width > 0);
-        self.bits[i] & towards != 0
+        (self.words[2 * i / 64] >> (2 * i % 64)) & u64::from(towards) != 0
     }
 }
 

@@ -108,16 +108,32 @@ impl SubpixelShading {
     /// surfaces found, nothing added yet.
     #[must_use]
     pub fn new(scene: &Scene, vb: &VisibilityBuffer, samples: Vec<SubpixelSample>) -> Self {
-        if samples.is_empty() {
-            return SubpixelShading::default(); // most frames: nothing to set up
+        let mut shading = SubpixelShading::default();
+        shading.reset(scene, vb, samples);
+        shading
+    }
+
+    /// [`SubpixelShading::new`] into this one's buffers (an interactive
+    /// preview shades a similar number of samples frame after frame).
+    pub fn reset(&mut self, scene: &Scene, vb: &VisibilityBuffer, samples: Vec<SubpixelSample>) {
+        self.samples = samples;
+        let n = self.samples.len();
+        for v in [&mut self.reflected, &mut self.traced] {
+            v.clear();
+            v.resize(n, Vec3::ZERO);
+        }
+        self.lit.clear();
+        self.lit.resize(n, Components::default());
+        self.surfaces.clear();
+        if n == 0 {
+            return; // most frames: nothing to set up
         }
         let frames = ObjectFrames::new(scene);
         let rays = scene.camera.pixel_rays(Vec2::new(vb.width() as f32, vb.height() as f32));
-        let surfaces: Vec<_> = samples.par_iter().map(|s| s.surface(scene, vb, &frames, &rays)).collect();
-        let reflected =
-            surfaces.iter().map(|s| s.as_ref().map_or(Vec3::ZERO, |s| reflection_map(scene, &s.point))).collect();
-        let (lit, traced) = (vec![Components::default(); samples.len()], vec![Vec3::ZERO; samples.len()]);
-        SubpixelShading { samples, surfaces, lit, reflected, traced }
+        self.samples.par_iter().map(|s| s.surface(scene, vb, &frames, &rays)).collect_into_vec(&mut self.surfaces);
+        for (r, s) in self.reflected.iter_mut().zip(&self.surfaces) {
+            *r = s.as_ref().map_or(Vec3::ZERO, |s| reflection_map(scene, &s.point));
+        }
     }
 
     /// Sample `k`'s colour in an image holding the components `parts`, as the
