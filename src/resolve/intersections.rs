@@ -173,6 +173,36 @@ fn crossing(c: (u32, u32), o: (u32, u32), a: &DepthPlane, b: &DepthPlane, width:
 #[cfg(test)]
 mod tests {
     use super::*;
+    use proptest::prelude::*;
+
+    /// A row of objects in runs of 1 to 16 equal ones.
+    fn runs() -> impl Strategy<Value = Vec<u32>> {
+        proptest::collection::vec((0u32..3, 1usize..16), 1..8)
+            .prop_map(|runs| runs.into_iter().flat_map(|(object, n)| std::iter::repeat_n(object, n)).collect())
+    }
+
+    proptest! {
+        /// The blockwise scan reports exactly the pixels a plain scan finds
+        /// beside another object (runs of one object, so that whole blocks
+        /// are skipped, mixed with boundaries; with and without a row below).
+        #[test]
+        fn the_boundary_scan_finds_every_pair_of_different_objects(row in runs(), below in runs(), last in any::<bool>()) {
+            let item = |object: &u32| ItemId { object: *object, triangle: 0 };
+            let row: Vec<ItemId> = row.iter().map(item).collect();
+            let next: Vec<ItemId> =
+                if last { Vec::new() } else { (0..row.len()).map(|x| item(&below[x % below.len()])).collect() };
+            let mut found = Vec::new();
+            for_each_boundary(&row, &next, |x, right, below| found.push((x, right, below)));
+            let expected: Vec<(usize, bool, bool)> = (0..row.len())
+                .map(|x| {
+                    let right = x + 1 < row.len() && row[x].object != row[x + 1].object;
+                    (x, right, !next.is_empty() && next[x].object != row[x].object)
+                })
+                .filter(|&(_, right, below)| right || below)
+                .collect();
+            prop_assert_eq!(found, expected);
+        }
+    }
 
     #[test]
     fn two_crossing_planes_share_each_pixel_by_the_line_where_their_depths_meet() {

@@ -56,7 +56,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     println!("|---|---|---:|---:|---:|---:|---:|---:|---:|");
     for (label, scene) in scenes(args)? {
         let truth = frame(&scene, Antialias::Jitter(TRUTH_PASSES), 1)?.0;
-        let (aliased, (aliased_ms, _), vb) = frame(&scene, Antialias::None, args.frames)?;
+        let (aliased, (aliased_ms, _, _), vb) = frame(&scene, Antialias::None, args.frames)?;
         let (mask, near) = (crossed(&scene), silhouettes(&vb));
         let (base, base_near) = (rmse(&aliased, &truth, Some(&mask)), rmse(&aliased, &truth, Some(&near)));
         let methods = [
@@ -69,15 +69,14 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         ];
         let mut edged = None;
         for (name, aa) in methods {
-            let (image, (ms, edge_ms), _) = if aa == Antialias::None {
-                (aliased.clone(), (aliased_ms, 0.0), vb.clone())
+            let (image, (ms, edge_ms, ratio), _) = if aa == Antialias::None {
+                (aliased.clone(), (aliased_ms, 0.0, 1.0), vb.clone())
             } else {
                 frame(&scene, aa, args.frames.min(if matches!(aa, Antialias::Jitter(_)) { 3 } else { args.frames }))?
             };
             let e = rmse(&image, &truth, Some(&mask));
             println!(
-                "| {label} | {name} | {ms:.1} | {edge_ms:.1} | {:.2} | {e:.4} | {:.0}% | {:.0}% | {:.4} |",
-                ms / aliased_ms,
+                "| {label} | {name} | {ms:.1} | {edge_ms:.1} | {ratio:.2} | {e:.4} | {:.0}% | {:.0}% | {:.4} |",
                 100.0 * (1.0 - e / base),
                 100.0 * (1.0 - rmse(&image, &truth, Some(&near)) / base_near),
                 rmse(&image, &truth, None)
@@ -95,7 +94,8 @@ pub fn run(args: &BenchArgs) -> Result<()> {
          outline crosses (their truth samples see more than one object, or an object and the background); 3 x 3 \
          mask = pixels whose 3 x 3 neighbourhood in the aliased visibility buffer holds more than one object, which \
          adds the pixels beside an outline (their error is shading: shadows, reflections); median of {} frames \
-         (jittered rows: 3); 2 threads.",
+         (jittered rows: 3); x aliased = median over those frames of each frame's time over an aliased frame's \
+         rendered just before it; 2 threads.",
         args.width, args.height, args.frames
     );
     Ok(())
@@ -103,23 +103,32 @@ pub fn run(args: &BenchArgs) -> Result<()> {
 
 /// The frame of `scene` antialiased by `aa`: image, median ms per frame and of its
 /// edge pass over `frames` renders (after one warm-up, which builds the meshes'
-/// edge lists), and the visibility buffer.
-fn frame(scene: &Scene, aa: Antialias, frames: usize) -> Result<(LinearImage, (f64, f64), VisibilityBuffer)> {
-    let scene = Scene { antialias: aa, ..scene.clone() };
-    let mut renderer = Renderer::new(&RenderOptions::default()).map_err(|e| miette!("{e}"))?;
+/// edge lists), the median ratio of each render's time to an aliased render's
+/// just before it (interleaved, so both meet the same load on a shared
+/// machine), and the visibility buffer.
+fn frame(scene: &Scene, aa: Antialias, frames: usize) -> Result<(LinearImage, (f64, f64, f64), VisibilityBuffer)> {
+    let (scene, aliased) =
+        (Scene { antialias: aa, ..scene.clone() }, Scene { antialias: Antialias::None, ..scene.clone() });
+    let new = || Renderer::new(&RenderOptions::default()).map_err(|e| miette!("{e}"));
+    let (mut renderer, mut reference) = (new()?, new()?);
     renderer.render(&scene).map_err(|e| miette!("{e}"))?;
-    let (mut times, mut edge) = (Vec::new(), Vec::new());
+    reference.render(&aliased).map_err(|e| miette!("{e}"))?;
+    let (mut times, mut edge, mut ratios) = (Vec::new(), Vec::new(), Vec::new());
     for _ in 0..frames.max(1) {
+        let t = std::time::Instant::now();
+        reference.render(&aliased).map_err(|e| miette!("{e}"))?;
+        let aliased_ms = t.elapsed().as_secs_f64() * 1e3;
         let t = std::time::Instant::now();
         edge.push(renderer.render(&scene).map_err(|e| miette!("{e}"))?.stats.edge_ms);
         times.push(t.elapsed().as_secs_f64() * 1e3);
+        ratios.push(times[times.len() - 1] / aliased_ms);
     }
     let median = |mut v: Vec<f64>| {
         v.sort_by(f64::total_cmp);
         v[v.len() / 2]
     };
     let f = renderer.into_frame();
-    Ok((f.image, (median(times), median(edge)), f.visibility))
+    Ok((f.image, (median(times), median(edge), median(ratios)), f.visibility))
 }
 
 /// Pixels an object's outline crosses: at the truth's sample positions the pixel
