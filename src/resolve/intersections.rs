@@ -19,7 +19,8 @@
 use glam::Vec2;
 use rayon::prelude::*;
 
-use super::edges::{square_part, ClipMap, DepthPlane, EdgeBlend, Screen};
+use super::dda::square_part;
+use super::edges::{ClipMap, DepthPlane, EdgeBlend, Screen};
 use crate::scene::Scene;
 use crate::visibility::{ItemId, VisibilityBuffer};
 

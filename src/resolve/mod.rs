@@ -2,6 +2,7 @@
 //! (exposure, clamp to [0, 1], then the sRGB transfer curve). Float outputs skip
 //! this stage and keep the buffer's values.
 
+mod dda;
 pub mod edges;
 mod intersections;
 pub mod jitter;
