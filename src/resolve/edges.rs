@@ -392,43 +392,49 @@ impl EdgePlan {
     /// fogged as the pixel is, by `1 − fog[pixel]`). Every blend reads the image
     /// as it was before any of them.
     pub fn apply(&self, image: &mut LinearImage, parts: ComponentSet, shaded: &SubpixelShading, fog: Option<&[f32]>) {
-        let crossed_pixels = self.blends.chunk_by(|a, b| a.c == b.c).count();
-        let across = self.blends.iter().filter(|b| reshaded_across(b)).count();
+        // Each crossed pixel's blends, with how many parts across (re-shaded)
+        // come before them: its near sample is the pixel's ordinal, its far
+        // samples follow all near ones.
+        let mut across = 0;
+        let crossed: Vec<(&[EdgeBlend], usize)> = self
+            .blends
+            .chunk_by(|a, b| a.c == b.c)
+            .map(|blends| {
+                let before = across;
+                across += blends.iter().filter(|b| reshaded_across(b)).count();
+                (blends, before)
+            })
+            .collect();
         let recorded = self.recorded.iter().find(|(p, _)| *p == parts).map(|(_, colours)| colours);
-        let recorded = recorded.filter(|_| self.reshade && shaded.lit.len() == crossed_pixels + across);
-        let reshaded = recorded.is_some();
+        let recorded = recorded.filter(|_| self.reshade && shaded.lit.len() == crossed.len() + across);
         // Sample `k`'s colour less the recorded colour of the pixel whose
         // surface it shows (nothing where that pixel shows nothing).
         let moved = |pixel: u32, k: usize| {
-            let (Some(recorded), Some(colour)) = (recorded, shaded.colour(k, parts)) else { return Vec3::ZERO };
+            let Some(recorded) = recorded else { return Vec3::ZERO }; // not re-shaded
+            let Some(colour) = shaded.colour(k, parts) else { return Vec3::ZERO };
             let clear = fog.map_or(1.0, |f| 1.0 - f[pixel as usize]);
             (colour - recorded[k]) * clear
         };
-        let (mut near, mut far) = (0, crossed_pixels);
-        let updates: Vec<(u32, Vec3)> = {
-            let px = image.pixels();
-            self.blends
-                .chunk_by(|a, b| a.c == b.c)
-                .map(|crossed| {
-                    let c = crossed[0].c;
-                    let mut own = px[c as usize];
-                    if reshaded {
-                        own += moved(c, near);
-                        near += 1;
+        let px = image.pixels();
+        let updates: Vec<(u32, Vec3)> = crossed
+            .par_iter()
+            .enumerate()
+            .map(|(near, &(blends, before))| {
+                let c = blends[0].c;
+                let own = px[c as usize] + moved(c, near);
+                let mut far = crossed.len() + before;
+                let mut colour = own;
+                for b in blends {
+                    let mut across = px[b.o as usize];
+                    if reshaded_across(b) {
+                        across += moved(b.o, far);
+                        far += 1;
                     }
-                    let mut colour = own;
-                    for b in crossed {
-                        let mut across = px[b.o as usize];
-                        if reshaded && reshaded_across(b) {
-                            across += moved(b.o, far);
-                            far += 1;
-                        }
-                        colour += (across - own) * b.alpha;
-                    }
-                    (c, colour)
-                })
-                .collect()
-        };
+                    colour += (across - own) * b.alpha;
+                }
+                (c, colour)
+            })
+            .collect();
         let px = image.pixels_mut();
         for (c, colour) in updates {
             px[c as usize] = colour;
@@ -600,7 +606,7 @@ fn merge(mut blends: Vec<EdgeBlend>, cap: f32) -> Vec<EdgeBlend> {
     // towards this pixel — a thin surface lies between the two edges, so nothing of
     // this pixel shows the colour across.
     let pair = |b: &EdgeBlend| (u64::from(b.c) << 32) | u64::from(b.o);
-    blends.sort_unstable_by_key(|b| (pair(b), b.inside, b.source));
+    blends.par_sort_unstable_by_key(|b| (pair(b), b.inside, b.source));
     // Pixels crossed from outside by some edge: only towards those can a
     // blend be a sliver.
     let mut crossed_from_outside = PixelSet::new(blends.iter().map(|b| b.c.max(b.o) + 1).max().unwrap_or(0));
@@ -611,7 +617,7 @@ fn merge(mut blends: Vec<EdgeBlend>, cap: f32) -> Vec<EdgeBlend> {
         blends[from..].iter().take_while(|x| pair(x) == reverse).any(|x| !x.inside && x.source != b.source)
     };
     let slivers: Vec<bool> =
-        blends.iter().map(|b| b.inside && crossed_from_outside.contains(b.o) && sliver(b)).collect();
+        blends.par_iter().map(|b| b.inside && crossed_from_outside.contains(b.o) && sliver(b)).collect();
     let mut kept = slivers.iter();
     blends.retain(|_| !kept.next().is_some_and(|&s| s));
     let mut merged: Vec<EdgeBlend> = Vec::with_capacity(blends.len());
