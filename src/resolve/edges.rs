@@ -76,7 +76,7 @@ use glam::{DVec3, DVec4, Mat4, Vec2, Vec3, Vec4};
 use rayon::prelude::*;
 
 use super::dda::walk;
-use super::{intersections, LinearImage};
+use super::{intersections, LinearImage, PixelSet};
 use crate::scene::{Camera, Mesh, Projection, Scene};
 use crate::shading::{ComponentSet, SubpixelSample, SubpixelShading, Target};
 use crate::visibility::{ItemId, VisibilityBuffer};
@@ -602,19 +602,18 @@ impl Walker<'_> {
 /// the larger part), so a pixel keeps at least half its own colour — and 1 for the
 /// paper's weights, instead of overshooting.
 fn merge(mut blends: Vec<EdgeBlend>, cap: f32) -> Vec<EdgeBlend> {
+    let key = |c: u32, o: u32| (u64::from(c) << 32) | u64::from(o);
+    blends.par_sort_unstable_by_key(|b| (key(b.c, b.o), b.inside, b.source));
     // A sliver: the pixel across is itself crossed by another edge, from outside,
     // towards this pixel — a thin surface lies between the two edges, so nothing of
-    // this pixel shows the colour across.
-    let pair = |b: &EdgeBlend| (u64::from(b.c) << 32) | u64::from(b.o);
-    blends.par_sort_unstable_by_key(|b| (pair(b), b.inside, b.source));
-    // Pixels crossed from outside by some edge: only towards those can a
-    // blend be a sliver.
+    // this pixel shows the colour across. Only towards a pixel crossed from
+    // outside at all can a blend be one.
     let mut crossed_from_outside = PixelSet::new(blends.iter().map(|b| b.c.max(b.o) + 1).max().unwrap_or(0));
     blends.iter().filter(|b| !b.inside).for_each(|b| crossed_from_outside.insert(b.c));
     let sliver = |b: &EdgeBlend| {
-        let reverse = (u64::from(b.o) << 32) | u64::from(b.c);
-        let from = blends.partition_point(|x| pair(x) < reverse);
-        blends[from..].iter().take_while(|x| pair(x) == reverse).any(|x| !x.inside && x.source != b.source)
+        let reverse = key(b.o, b.c);
+        let from = blends.partition_point(|x| key(x.c, x.o) < reverse);
+        blends[from..].iter().take_while(|x| key(x.c, x.o) == reverse).any(|x| !x.inside && x.source != b.source)
     };
     let slivers: Vec<bool> =
         blends.par_iter().map(|b| b.inside && crossed_from_outside.contains(b.o) && sliver(b)).collect();
@@ -637,26 +636,6 @@ fn merge(mut blends: Vec<EdgeBlend>, cap: f32) -> Vec<EdgeBlend> {
         }
     }
     merged
-}
-
-/// A set of pixels (row-major indices) as one bit each.
-struct PixelSet {
-    words: Vec<u64>,
-}
-
-impl PixelSet {
-    /// An empty set of pixels below `len`.
-    fn new(len: u32) -> PixelSet {
-        PixelSet { words: vec![0; (len as usize).div_ceil(64)] }
-    }
-
-    fn insert(&mut self, i: u32) {
-        self.words[i as usize / 64] |= 1 << (i % 64);
-    }
-
-    fn contains(&self, i: u32) -> bool {
-        self.words.get(i as usize / 64).is_some_and(|w| w & (1 << (i % 64)) != 0)
-    }
 }
 
 /// Which faces look at the eye, tested in the object's own space (the sign of a

@@ -21,6 +21,7 @@ use rayon::prelude::*;
 
 use super::dda::square_part;
 use super::edges::{ClipMap, DepthPlane, EdgeBlend, Screen};
+use super::PixelSet;
 use crate::scene::Scene;
 use crate::visibility::{ItemId, VisibilityBuffer};
 
@@ -28,28 +29,28 @@ use crate::visibility::{ItemId, VisibilityBuffer};
 pub(super) const INTERSECTION: u64 = u64::MAX;
 
 /// Which neighbouring pixels a walked edge already runs between: per pixel,
-/// bit 0 for the pair with its right neighbour, bit 1 for the pair with the
-/// one below (two bits a pixel, packed).
+/// one bit for the pair with its right neighbour and one for the pair with the
+/// one below.
 pub(super) struct WalkedPairs {
-    words: Vec<u64>,
+    /// Bit `2·i + k` for pixel `i`: k = 0 right, 1 below.
+    bits: PixelSet,
 }
 
 impl WalkedPairs {
     /// The pairs `blends` join, on a `width` × `height` frame.
     pub(super) fn of(blends: &[EdgeBlend], width: u32, height: u32) -> Self {
-        let mut words = vec![0u64; (2 * width as usize * height as usize).div_ceil(64)];
+        let mut bits = PixelSet::new(2 * width * height);
         for b in blends {
-            let (first, second) = (b.c.min(b.o) as usize, b.c.max(b.o) as usize);
-            let towards = if second == first + 1 { RIGHT } else { BELOW };
-            words[2 * first / 64] |= u64::from(towards) << (2 * first % 64);
+            let (first, second) = (b.c.min(b.o), b.c.max(b.o));
+            bits.insert(2 * first + u32::from(second != first + 1));
         }
-        WalkedPairs { words }
+        WalkedPairs { bits }
     }
 
     /// Whether an edge runs between pixel `i` and its neighbour `towards`
     /// ([`RIGHT`] or [`BELOW`]).
     fn contains(&self, i: usize, towards: u8) -> bool {
-        (self.words[2 * i / 64] >> (2 * i % 64)) & u64::from(towards) != 0
+        self.bits.contains(2 * i as u32 + u32::from(towards == BELOW))
     }
 }
 
