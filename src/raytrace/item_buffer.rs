@@ -73,8 +73,8 @@ pub fn trace_subpixel(scene: &Scene, subpixel: &mut SubpixelShading, depth: u32,
     let opts = traced_term(depth);
     let tracer = Tracer::new(scene, trace, &frames, opts);
     let SubpixelShading { surfaces, traced, .. } = subpixel;
-    traced.par_iter_mut().zip(surfaces.par_iter()).for_each(|(out, s)| {
-        if let Some(s) = s.as_ref().filter(|s| scene.materials[s.point.material].traces()) {
+    traced.par_iter_mut().zip(surfaces.par_iter()).filter(|(_, s)| traces(s)).for_each(|(out, s)| {
+        if let Some(s) = s {
             *out = tracer.bounces(&s.ray, &s.point, depth);
         }
     });

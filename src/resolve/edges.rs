@@ -406,7 +406,7 @@ impl EdgePlan {
             })
             .collect();
         let recorded = self.recorded.iter().find(|(p, _)| *p == parts).map(|(_, colours)| colours);
-        let recorded = recorded.filter(|_| self.reshade && shaded.lit.len() == crossed.len() + across);
+        let recorded = recorded.filter(|_| shaded.lit.len() == crossed.len() + across);
         // Sample `k`'s colour less the recorded colour of the pixel whose
         // surface it shows (nothing where that pixel shows nothing).
         let moved = |pixel: u32, k: usize| {

@@ -177,9 +177,16 @@ impl PreparedTriangle {
     /// without them): [`PreparedTriangle::surface`]'s uv alone.
     #[must_use]
     pub fn uv(&self, ray: &Ray) -> Vec2 {
-        let Some(u) = self.uvs else { return Vec2::ZERO };
+        if self.uvs.is_none() {
+            return Vec2::ZERO;
+        }
         let (_, b) = intersect_plane(ray, self.a, self.e1, self.e2);
-        u[0] * (1.0 - b.x - b.y) + u[1] * b.x + u[2] * b.y
+        self.uv_at([1.0 - b.x - b.y, b.x, b.y])
+    }
+
+    /// The texture coordinates at barycentric weights `w` (zero without them).
+    fn uv_at(&self, w: [f32; 3]) -> Vec2 {
+        self.uvs.map_or(Vec2::ZERO, |u| u[0] * w[0] + u[1] * w[1] + u[2] * w[2])
     }
 
     /// The surface point where `ray` meets the triangle's plane.
@@ -191,7 +198,7 @@ impl PreparedTriangle {
         let n = n.normalize_or(self.geometric);
         let to_eye = -ray.dir;
         let normal = if n.dot(to_eye) < 0.0 { -n } else { n };
-        let uv = self.uvs.map_or(Vec2::ZERO, |u| u[0] * w[0] + u[1] * w[1] + u[2] * w[2]);
+        let uv = self.uv_at(w);
         let front = self.geometric.dot(to_eye) >= 0.0;
         SurfacePoint {
             position: ray.origin + ray.dir * t,
