@@ -295,7 +295,7 @@ fn render_pass(scene: &Scene, frame: &mut Frame, scratch: &mut Scratch, ray_dept
     }
     if let Some(plan) = &plan {
         let t = Instant::now();
-        targets.iter_mut().for_each(|t| plan.apply(t.image, t.parts, subpixel, fogged.as_deref()));
+        targets.iter_mut().for_each(|t| plan.apply(t.image, t.parts, fogged.as_deref()));
         frame.stats.edge_blends = plan.len();
         frame.stats.edge_ms = (planned + t.elapsed()).as_secs_f64() * 1e3;
     }

@@ -65,7 +65,8 @@ fn traced_term(depth: u32) -> ReferenceOptions {
 /// reflects or refracts (as [`add_traced`] traces it at pixel centres).
 pub fn trace_subpixel(scene: &Scene, subpixel: &mut SubpixelShading, depth: u32, cache: &mut TraceCache) {
     let traces = |s: &Option<SampleSurface>| s.as_ref().is_some_and(|s| scene.materials[s.point.material].traces());
-    if depth == 0 || !subpixel.surfaces.iter().any(traces) {
+    let any_material = scene.materials.iter().any(|m| m.traces());
+    if depth == 0 || !any_material || !subpixel.surfaces.iter().any(traces) {
         return;
     }
     let trace = cache.get(scene);

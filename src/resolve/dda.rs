@@ -26,7 +26,7 @@ use super::edges::EdgeFilter;
 pub(super) fn walk(
     a: DVec3,
     b: DVec3,
-    mut visit: impl FnMut((u32, u32), (u32, u32), f32, DVec3, Vec2),
+    mut visit: impl FnMut((u32, u32), (u32, u32), f32, DVec3, PartBeyond),
     size: (u32, u32),
     filter: EdgeFilter,
 ) {
@@ -63,8 +63,7 @@ pub(super) fn walk(
         let mut emit = |r: i64, o: i64, alpha: f64| {
             if alpha > 1e-6 && inside(r) && inside(o) {
                 // The part towards o (smaller minor coordinate if o = r − 1).
-                let (u, v) = part_centroid(y0 - r as f64, y1 - r as f64, o > r);
-                let far = if swap { Vec2::new(v as f32, u as f32) } else { Vec2::new(u as f32, v as f32) };
+                let far = PartBeyond { v0: y0 - r as f64, v1: y1 - r as f64, below: o > r, swap };
                 visit(to_xy(i as u32, r), to_xy(i as u32, o), alpha as f32, point, far);
             }
         };
@@ -91,6 +90,32 @@ pub(super) fn walk(
                 emit(p, p + 1, 1.0 - d_p);
                 emit(p + 1, p, d_p);
             }
+        }
+    }
+}
+
+/// The part of a crossed pixel beyond an edge, as the walker meets it: its
+/// centroid is worked out only for the blends the depth test keeps.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct PartBeyond {
+    /// The edge's line across the pixel's column (rows for a y-major edge),
+    /// from the pixel's minor-axis origin, at its two sides.
+    v0: f64,
+    v1: f64,
+    /// Whether the part lies towards greater minor coordinates.
+    below: bool,
+    /// Whether the edge is y-major (the axes swapped).
+    swap: bool,
+}
+
+impl PartBeyond {
+    /// The part's centroid from the pixel's centre (pixels, x right, y down).
+    pub(super) fn centroid(self) -> Vec2 {
+        let (u, v) = part_centroid(self.v0, self.v1, self.below);
+        if self.swap {
+            Vec2::new(v as f32, u as f32)
+        } else {
+            Vec2::new(u as f32, v as f32)
         }
     }
 }
@@ -165,11 +190,18 @@ mod tests {
         let (a, b) = (DVec3::new(0.4, 2.48, 0.5), DVec3::new(10.3, 9.41, 0.5));
         let line = |x: f64| 0.7 * x + 2.2;
         let mut seen = Vec::new();
-        walk(a, b, |c, o, alpha, _, far| seen.push((c, o, alpha, far)), (20, 20), EdgeFilter::Coverage);
+        walk(
+            a,
+            b,
+            |c, o, alpha, _, far: PartBeyond| seen.push((c, o, alpha, far.centroid())),
+            (20, 20),
+            EdgeFilter::Coverage,
+        );
         let swapped = {
             let mut v = Vec::new();
             let t = |p: DVec3| DVec3::new(p.y, p.x, p.z);
-            let mut visit = |c: (u32, u32), o: (u32, u32), alpha, _, far: Vec2| {
+            let mut visit = |c: (u32, u32), o: (u32, u32), alpha, _, far: PartBeyond| {
+                let far = far.centroid();
                 v.push(((c.1, c.0), (o.1, o.0), alpha, Vec2::new(far.y, far.x)));
             };
             walk(t(b), t(a), &mut visit, (20, 20), EdgeFilter::Coverage);

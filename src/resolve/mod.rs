@@ -6,6 +6,7 @@ mod dda;
 pub mod edges;
 mod intersections;
 pub mod jitter;
+mod parts;
 pub mod solid_edges;
 
 use glam::Vec3;

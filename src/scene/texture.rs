@@ -32,6 +32,16 @@ impl Wrap {
             }
         }
     }
+
+    /// Texel indices `i` and `i + 1` of a row of `n`, wrapped (the two a
+    /// bilinear lookup blends; inside the row, as nearly all are, no division).
+    fn pair(self, i: i64, n: i64) -> [usize; 2] {
+        if i >= 0 && i + 1 < n {
+            [i as usize, i as usize + 1]
+        } else {
+            [self.index(i, n) as usize, self.index(i + 1, n) as usize]
+        }
+    }
 }
 
 /// One level of the mip chain.
@@ -52,10 +62,11 @@ impl Level {
         }
         let (x0, y0) = (x.floor(), y.floor());
         let (fx, fy) = (x - x0, y - y0);
-        let at = |i: i64, j: i64| self.texels[(wrap.index(j, h) * w + wrap.index(i, w)) as usize];
-        let (i, j) = (x0 as i64, y0 as i64);
-        let top = at(i, j).lerp(at(i + 1, j), fx);
-        let bottom = at(i, j + 1).lerp(at(i + 1, j + 1), fx);
+        let [i0, i1] = wrap.pair(x0 as i64, w);
+        let [j0, j1] = wrap.pair(y0 as i64, h).map(|j| j * w as usize);
+        let at = |i: usize, j: usize| self.texels[j + i];
+        let top = at(i0, j0).lerp(at(i1, j0), fx);
+        let bottom = at(i0, j1).lerp(at(i1, j1), fx);
         top.lerp(bottom, fy)
     }
 
@@ -183,6 +194,13 @@ mod tests {
         assert_eq!(idx(Wrap::Repeat), [2, 3, 0, 3, 0, 1]);
         assert_eq!(idx(Wrap::Clamp), [0, 0, 0, 3, 3, 3]);
         assert_eq!(idx(Wrap::Mirror), [1, 0, 0, 3, 3, 2]);
+        // The pair a bilinear lookup takes, with and without its fast path.
+        for wrap in [Wrap::Repeat, Wrap::Clamp, Wrap::Mirror] {
+            for i in -9..9 {
+                let expected = [i, i + 1].map(|i| wrap.index(i, n) as usize);
+                assert_eq!(wrap.pair(i, n), expected, "{wrap:?} {i}");
+            }
+        }
     }
 
     #[test]

@@ -1,0 +1,298 @@
+//! The colours of the parts of the pixels an edge crosses: seed 004's blends
+//! (Kato & Kameyama, §3 (2)), with each part's colour found where the part
+//! lies rather than at its pixel's centre.
+//!
+//! A pixel `c` that edges cross is made of its own part (on its centre's side
+//! of every edge) and, per edge, a part beyond it showing the surface of the
+//! pixel across, `o`. The aliased frame gives each pixel the colour of its
+//! centre; [`EdgePlan::apply`] makes `c` the parts' colours weighted by their
+//! areas. A part's colour is the colour of the pixel whose surface it shows,
+//! moved by how the shading changes from that pixel's centre to the part's
+//! centroid:
+//!
+//! - a part beyond an edge (at least [`RESHADED_SHARE`] of `c`) is shaded at its
+//!   centroid on `o`'s surface, by the lit passes themselves (a sub-pixel sample,
+//!   [`crate::shading::subpixel`]): a shadow that begins right behind a
+//!   silhouette is seen there, and no neighbour of `o` could tell;
+//! - the own part of a pixel on a curved (smooth-shaded) surface is shaded at its
+//!   centroid too: a terminator or a highlight can turn within one pixel;
+//! - the own part of a pixel on a flat face (its vertex normals all the face's)
+//!   is moved along the colour steps from `c` to its neighbours on the same
+//!   object, on the centroid's side, in x and in y ([`OwnPart::Stepped`]): on a
+//!   plane the passes' colour changes slowly, and the neighbours are already
+//!   shaded. Measured against 256 jittered passes this keeps every scene's
+//!   error within 0.6% of shading the part (the flat-shaded milk truck, the CAD
+//!   parts, and showroom slightly better) while the flat scenes shade a third to
+//!   a half fewer samples.
+
+use glam::{Vec2, Vec3};
+use rayon::prelude::*;
+
+use super::edges::EdgeBlend;
+use super::LinearImage;
+use crate::shading::{ComponentSet, SubpixelSample, SubpixelShading, Target};
+use crate::visibility::{ItemId, VisibilityBuffer};
+
+/// The least share of a pixel beyond an edge whose colour is re-shaded at its
+/// centroid; a smaller part takes the colour of the pixel across as it is
+/// (measured: re-shading them changes no scene's error by 0.1%).
+pub const RESHADED_SHARE: f32 = 0.1;
+
+/// How the colour of a crossed pixel's own part is found.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum OwnPart {
+    /// Shaded at its centroid (a sub-pixel sample).
+    Shaded,
+    /// The pixel's colour plus, per axis, the step to a neighbour (pixel index)
+    /// times the centroid's distance from the centre along that axis (weight 0:
+    /// no neighbour on that side shows the same object).
+    Stepped([(u32, f32); 2]),
+}
+
+/// The edge pass of one frame: its blends, found from the visibility buffer
+/// alone, before shading, so the passes can shade the sub-pixel points they
+/// need ([`EdgePlan::samples`]).
+#[derive(Debug, Clone, Default)]
+pub struct EdgePlan {
+    /// Merged blends, sorted by pixel, then neighbour.
+    blends: Vec<EdgeBlend>,
+    /// Per crossed pixel (in `blends`' order), how its own part is coloured.
+    own: Vec<OwnPart>,
+    /// Per target image (by its components), per part whose colour moves from
+    /// its pixel's (the crossed pixels' own parts, then the re-shaded parts
+    /// beyond edges), how far it moves, before fog ([`EdgePlan::record`]).
+    moved: Vec<(ComponentSet, Vec<Vec3>)>,
+}
+
+impl EdgePlan {
+    /// The plan for `blends` (merged, sorted by pixel) on the frame whose
+    /// visibility buffer is `vb`; `reshade` says whether the parts' colours are
+    /// found where they lie (the coverage filter) or taken from the pixels as
+    /// they are (the paper's filter, which blends the edge's colour); `flat`
+    /// says whether an item's surface is flat-shaded.
+    pub(super) fn new(
+        blends: Vec<EdgeBlend>,
+        reshade: bool,
+        vb: &VisibilityBuffer,
+        flat: impl Fn(ItemId) -> bool + Sync,
+    ) -> EdgePlan {
+        let own = if reshade {
+            let groups: Vec<&[EdgeBlend]> = blends.chunk_by(|a, b| a.c == b.c).collect();
+            groups.par_iter().map(|crossed| own_part(crossed, vb.items(), vb.width(), &flat)).collect()
+        } else {
+            Vec::new()
+        };
+        EdgePlan { blends, own, moved: Vec::new() }
+    }
+
+    /// Pixel blends: one per pixel and neighbour across an edge.
+    #[must_use]
+    pub fn len(&self) -> usize {
+        self.blends.len()
+    }
+
+    /// Whether no edge crosses a pixel.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.blends.is_empty()
+    }
+
+    /// Whether the parts' colours are found where they lie (else the pixels'
+    /// colours are blended as they are).
+    fn reshades(&self) -> bool {
+        !self.own.is_empty()
+    }
+
+    /// The points the shading passes shade for [`EdgePlan::apply`] on a `width`
+    /// pixels wide frame (none under the paper's filter): per crossed pixel
+    /// whose own part is shaded, its surface at that part's centroid; per blend
+    /// that moves the pixel by at least [`RESHADED_SHARE`], the surface across
+    /// at the centroid of the part beyond. (The pixels' centres, which they
+    /// are compared with, are the passes' own pixels: [`EdgePlan::record`].)
+    #[must_use]
+    pub fn samples(&self, width: u32) -> Vec<SubpixelSample> {
+        if !self.reshades() {
+            return Vec::new();
+        }
+        let pixel = |i: u32| (i % width, i / width);
+        let at = |i: u32, offset: Vec2| {
+            let p = pixel(i);
+            SubpixelSample { pixel: p, at: Vec2::new(p.0 as f32 + 0.5, p.1 as f32 + 0.5) + offset }
+        };
+        let crossed = self.blends.chunk_by(|a, b| a.c == b.c).zip(&self.own);
+        let near = crossed.filter(|(_, own)| **own == OwnPart::Shaded).map(|(b, _)| at(b[0].c, near_centroid(b)));
+        let far = self.blends.iter().filter(|b| reshaded_across(b)).map(|b| {
+            // The surface `o` shows, met by a ray through `c`.
+            SubpixelSample { pixel: pixel(b.o), ..at(b.c, b.far) }
+        });
+        near.chain(far).collect()
+    }
+
+    /// Records, in every target, how far each part's colour moves from the
+    /// colour of the pixel whose surface it shows, as the lit passes, the
+    /// reflection map and the traced term left the image (before fog and
+    /// translucency): a shaded part by its sample's colour in `shaded` (the
+    /// samples of [`EdgePlan::samples`], shaded), a stepped part by its
+    /// neighbours' colours.
+    pub fn record(&mut self, targets: &[Target], shaded: &SubpixelShading) {
+        let far = self.blends.iter().filter(|b| reshaded_across(b)).count();
+        let near = self.own.iter().filter(|o| **o == OwnPart::Shaded).count();
+        if !self.reshades() || shaded.samples.len() != near + far {
+            return;
+        }
+        // Each crossed pixel's own part: its pixel and its sample, if shaded.
+        let mut next = 0..;
+        let own: Vec<(u32, OwnPart, usize)> = (self.blends.chunk_by(|a, b| a.c == b.c).zip(&self.own))
+            .map(|(b, &own)| (b[0].c, own, if own == OwnPart::Shaded { next.next().unwrap_or(0) } else { 0 }))
+            .collect();
+        let record = |t: &Target| {
+            let (px, w) = (t.image.pixels(), t.image.width() as usize);
+            let sampled = |k: usize| {
+                let (x, y) = shaded.samples[k].pixel;
+                shaded.colour(k, t.parts).map_or(Vec3::ZERO, |colour| colour - px[y as usize * w + x as usize])
+            };
+            let stepped = |c: u32, steps: [(u32, f32); 2]| {
+                steps.iter().map(|&(m, weight)| (px[m as usize] - px[c as usize]) * weight).sum()
+            };
+            let own = own.par_iter().map(|&(c, part, k)| match part {
+                OwnPart::Shaded => sampled(k),
+                OwnPart::Stepped(steps) => stepped(c, steps),
+            });
+            own.chain((near..near + far).into_par_iter().map(sampled)).collect()
+        };
+        self.moved = targets.iter().map(|t| (t.parts, record(t))).collect();
+    }
+
+    /// Blends `image` (holding the components `parts`): each crossed pixel
+    /// becomes its parts' colours weighted by their areas, each part's colour
+    /// its pixel's moved as [`EdgePlan::record`] found (the move fogged as the
+    /// pixel is, by `1 − fog[pixel]`). Every blend reads the image as it was
+    /// before any of them.
+    pub fn apply(&self, image: &mut LinearImage, parts: ComponentSet, fog: Option<&[f32]>) {
+        // Each crossed pixel's blends, with how many parts across (re-shaded)
+        // come before them: its own part is the pixel's ordinal, the parts
+        // across follow all own parts.
+        let mut across = 0;
+        let crossed: Vec<(&[EdgeBlend], usize)> = self
+            .blends
+            .chunk_by(|a, b| a.c == b.c)
+            .map(|blends| {
+                let before = across;
+                across += blends.iter().filter(|b| reshaded_across(b)).count();
+                (blends, before)
+            })
+            .collect();
+        let moved = self.moved.iter().find(|(p, _)| *p == parts).map(|(_, moved)| moved);
+        let moved = |pixel: u32, k: usize| {
+            let Some(moved) = moved else { return Vec3::ZERO }; // not re-shaded
+            moved[k] * fog.map_or(1.0, |f| 1.0 - f[pixel as usize])
+        };
+        let px = image.pixels();
+        let updates: Vec<(u32, Vec3)> = crossed
+            .par_iter()
+            .enumerate()
+            .map(|(near, &(blends, before))| {
+                let c = blends[0].c;
+                let own = px[c as usize] + moved(c, near);
+                let mut far = crossed.len() + before;
+                let mut colour = own;
+                for b in blends {
+                    let mut across = px[b.o as usize];
+                    if reshaded_across(b) {
+                        across += moved(b.o, far);
+                        far += 1;
+                    }
+                    colour += (across - own) * b.alpha;
+                }
+                (c, colour)
+            })
+            .collect();
+        let px = image.pixels_mut();
+        for (c, colour) in updates {
+            px[c as usize] = colour;
+        }
+    }
+}
+
+/// Whether the part of `b.c` beyond the edge is re-shaded.
+fn reshaded_across(b: &EdgeBlend) -> bool {
+    b.alpha >= RESHADED_SHARE
+}
+
+/// How the own part of the pixel `crossed` blends cross is coloured, on a frame
+/// whose pixels show `items` (`width` pixels a row); `flat` says whether an
+/// item's surface is flat-shaded.
+fn own_part(crossed: &[EdgeBlend], items: &[ItemId], width: u32, flat: impl Fn(ItemId) -> bool) -> OwnPart {
+    let c = crossed[0].c;
+    let item = items[c as usize];
+    if !item.is_none() && !flat(item) {
+        return OwnPart::Shaded;
+    }
+    // Nothing to shade, or a flat face: per axis, the neighbour on the
+    // centroid's side if it shows the same object and lies across none of the
+    // pixel's edges.
+    let d = near_centroid(crossed);
+    let (x, n) = (c % width, items.len() as u32);
+    let towards = |along: f32, step: u32, first: bool, last: bool| match along {
+        a if a > 0.0 && !last => c.checked_add(step).filter(|&m| m < n),
+        a if a < 0.0 && !first => c.checked_sub(step),
+        _ => None,
+    };
+    let same =
+        |m: &u32| !item.is_none() && items[*m as usize].object == item.object && crossed.iter().all(|b| b.o != *m);
+    let step = |m: Option<u32>, along: f32| m.filter(same).map_or((c, 0.0), |m| (m, along.abs()));
+    OwnPart::Stepped([step(towards(d.x, 1, x == 0, x + 1 == width), d.x), step(towards(d.y, width, false, false), d.y)])
+}
+
+/// The centroid of a crossed pixel's part on its centre's side of its edges,
+/// from the centre: the pixel's centroid (its centre) is the parts' centroids
+/// weighted by their areas.
+fn near_centroid(crossed: &[EdgeBlend]) -> Vec2 {
+    let across: f32 = crossed.iter().map(|b| b.alpha).sum();
+    let moment: Vec2 = crossed.iter().map(|b| b.far * b.alpha).sum();
+    -moment / (1.0 - across).max(0.5)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A blend of pixel `c` towards `o`, moving it by `alpha`, the part's
+    /// centroid at `far` from `c`'s centre.
+    fn blend(c: u32, o: u32, alpha: f32, far: Vec2) -> EdgeBlend {
+        EdgeBlend { c, o, alpha, inside: true, source: 0, far }
+    }
+
+    #[test]
+    fn a_flat_face_steps_towards_its_neighbours_on_the_centroids_side() {
+        // 4 × 3 pixels of object 0, but pixel 2 (x 2, y 0) shows object 1.
+        let mut items = vec![ItemId { object: 0, triangle: 0 }; 12];
+        items[2] = ItemId { object: 1, triangle: 0 };
+        // Pixel 5 (x 1, y 1) crossed towards its left neighbour 4: the part
+        // beyond lies left, so its own part's centroid lies right and below.
+        let crossed = [blend(5, 4, 0.25, Vec2::new(-0.375, -0.1))];
+        let d = near_centroid(&crossed);
+        assert!(d.x > 0.0 && d.y > 0.0, "{d}");
+        let flat = |_| true;
+        assert_eq!(own_part(&crossed, &items, 4, flat), OwnPart::Stepped([(6, d.x), (9, d.y)]));
+        // Upwards (the part beyond lies below) the neighbour shows another
+        // object: no step in y.
+        let crossed = [blend(6, 10, 0.25, Vec2::new(0.1, 0.375))];
+        let d = near_centroid(&crossed);
+        assert_eq!(own_part(&crossed, &items, 4, flat), OwnPart::Stepped([(5, d.x.abs()), (6, 0.0)]));
+        // Never towards the pixel across an edge, nor past the image's side.
+        let crossed = [blend(7, 6, 0.2, Vec2::new(-0.4, 0.0)), blend(7, 11, 0.2, Vec2::new(0.0, 0.4))];
+        let d = near_centroid(&crossed);
+        assert!(d.x > 0.0 && d.y < 0.0, "{d}");
+        assert_eq!(own_part(&crossed, &items, 4, flat), OwnPart::Stepped([(7, 0.0), (3, -d.y)]));
+    }
+
+    #[test]
+    fn a_curved_surface_is_shaded_and_nothing_is_neither() {
+        let mut items = vec![ItemId { object: 0, triangle: 0 }; 9];
+        let crossed = [blend(4, 3, 0.25, Vec2::new(-0.375, 0.0))];
+        assert_eq!(own_part(&crossed, &items, 3, |_| false), OwnPart::Shaded);
+        items[4] = ItemId::NONE;
+        assert_eq!(own_part(&crossed, &items, 3, |_| false), OwnPart::Stepped([(4, 0.0); 2]));
+    }
+}
