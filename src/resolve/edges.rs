@@ -153,6 +153,8 @@ pub struct MeshEdges {
     weld: Vec<u32>,
     /// Per face: whether it is flat-shaded (its vertex normals all its own).
     flat: Vec<bool>,
+    /// The mesh's bounds `(min, max)`.
+    bounds: (Vec3, Vec3),
 }
 
 impl MeshEdges {
@@ -211,7 +213,7 @@ impl MeshEdges {
                 t.iter().all(|&v| mesh.normals[v as usize].normalize_or_zero().dot(plane.truncate()).abs() > FLAT_COS)
             })
             .collect();
-        MeshEdges { edges, planes, weld, flat }
+        MeshEdges { edges, planes, weld, flat, bounds: mesh.bounds() }
     }
 
     /// The welded vertices of the faces beside edge `e`: a pixel showing a triangle
@@ -315,7 +317,11 @@ pub fn plan(scene: &Scene, vb: &VisibilityBuffer, options: &EdgeOptions, cache: 
         // Where an edge runs between two pixels it bounds what they show; an
         // intersection is only looked for where none does.
         let walked = intersections::WalkedPairs::of(&blends, vb.width(), vb.height());
-        blends.extend(intersections::find_intersection_blends(scene, vb, &clips, &walked));
+        let opaque = |o: &crate::scene::Object| !scene.materials[o.material].translucent();
+        let objects = scene.objects.iter().zip(&edges);
+        let boxes: Vec<(Vec3, Vec3)> =
+            objects.filter(|(o, _)| opaque(o)).filter_map(|(o, e)| Some(o.world_box(e.as_ref()?.bounds))).collect();
+        blends.extend(intersections::find_intersection_blends(scene, vb, &clips, &walked, &boxes));
     }
     // One straight edge moves a pixel by at most ½ under the coverage filter; the
     // paper's Wu weights reach 1.
@@ -575,7 +581,9 @@ impl Screen {
         (a.w > 0.0 && b.w > 0.0).then(|| (self.project(a), self.project(b)))
     }
 
-    fn project(&self, c: DVec4) -> glam::DVec3 {
+    /// A clip-space point in front of the eye as a screen point (x, y in pixels,
+    /// z = depth).
+    pub(super) fn project(&self, c: DVec4) -> glam::DVec3 {
         let inv_w = 1.0 / c.w;
         glam::DVec3::new((c.x * inv_w * 0.5 + 0.5) * self.width, (0.5 - c.y * inv_w * 0.5) * self.height, c.z * inv_w)
     }

@@ -16,7 +16,9 @@
 //! is in front at `o` too, A's triangle simply ends between the pixels: that is
 //! an edge, the walker's.)
 
-use glam::Vec2;
+use std::ops::Range;
+
+use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
 use super::dda::square_part;
@@ -61,12 +63,14 @@ const BELOW: u8 = 2;
 
 /// The blends of every pixel an intersection of two objects' surfaces crosses,
 /// where no walked edge runs between the two pixels. `clips` holds every
-/// object's map to clip space. Each pair of neighbours is looked at once.
+/// object's map to clip space; `boxes` the world bounds of the opaque meshes
+/// (only where two overlap is a pair of neighbours looked at, each once).
 pub(super) fn find_intersection_blends(
     scene: &Scene,
     vb: &VisibilityBuffer,
     clips: &[ClipMap],
     walked: &WalkedPairs,
+    boxes: &[(Vec3, Vec3)],
 ) -> Vec<EdgeBlend> {
     let (w, h) = (vb.width(), vb.height());
     let screen = Screen::of(&scene.camera, w, h);
@@ -81,14 +85,23 @@ pub(super) fn find_intersection_blends(
         screen.depth_plane(&clips[item.object as usize], object.triangles()?, item.triangle)
     };
     let items = vb.items();
+    let spans = overlap_spans(scene, &screen, boxes, (w, h));
     let rows: Vec<Vec<EdgeBlend>> = (0..h)
         .into_par_iter()
         .map(|y| {
             let mut out = Vec::new();
+            let span = &spans[y as usize];
+            if span.is_empty() {
+                return out;
+            }
+            // The span, and the pixel after it (its pair with the last one).
+            let span = span.start as usize..(span.end as usize + 1).min(w as usize);
             let start = (y * w) as usize;
             let row = &items[start..start + w as usize];
             let next = items.get(start + w as usize..start + 2 * w as usize).unwrap_or_default();
-            for_each_boundary(row, next, |x, right, below| {
+            let next = next.get(span.clone()).unwrap_or_default();
+            for_each_boundary(&row[span.clone()], next, |x, right, below| {
+                let x = span.start + x;
                 let (i, x) = (start + x, x as u32);
                 let pairs = [(right, (x + 1, y), RIGHT), (below, (x, y + 1), BELOW)];
                 for (_, o, _) in pairs.into_iter().filter(|p| p.0 && !walked.contains(i, p.2)) {
@@ -99,6 +112,68 @@ pub(super) fn find_intersection_blends(
         })
         .collect();
     rows.concat()
+}
+
+/// The most object pairs whose bounds are compared; a scene with more objects
+/// is scanned whole.
+const MAX_OBJECTS_PAIRED: usize = 256;
+
+/// Per row of a `width` × `height` frame, the columns where two of the world
+/// `boxes` overlap, as seen through `screen` (only there can two surfaces pass
+/// through each other), with a pixel's margin; empty where no pair overlaps.
+/// Boxes that touch (a part standing on a plate) overlap.
+fn overlap_spans(
+    scene: &Scene,
+    screen: &Screen,
+    boxes: &[(Vec3, Vec3)],
+    (width, height): (u32, u32),
+) -> Vec<Range<u32>> {
+    if boxes.len() > MAX_OBJECTS_PAIRED {
+        return vec![0..width; height as usize];
+    }
+    let view_proj = scene.camera.view_projection(width as f32 / height as f32).as_dmat4();
+    let margin = boxes.iter().map(|(lo, hi)| (*hi - *lo).length()).fold(0.0, f32::max) * 1e-4;
+    let mut spans = vec![width..0; height as usize];
+    for (k, &(lo_a, hi_a)) in boxes.iter().enumerate() {
+        for &(lo_b, hi_b) in &boxes[k + 1..] {
+            let (lo, hi) = (lo_a.max(lo_b) - margin, hi_a.min(hi_b) + margin);
+            if lo.cmpgt(hi).any() {
+                continue;
+            }
+            let (x, y) = screen_rect(&view_proj, screen, (lo, hi), (width, height));
+            for span in &mut spans[y] {
+                *span = span.start.min(x.start)..span.end.max(x.end);
+            }
+        }
+    }
+    spans
+}
+
+/// The pixel columns and rows the box `(lo, hi)` (world space) covers on a
+/// `width` × `height` frame, widened by a pixel; the whole frame if the box
+/// reaches behind the eye.
+fn screen_rect(
+    view_proj: &glam::DMat4,
+    screen: &Screen,
+    (lo, hi): (Vec3, Vec3),
+    (width, height): (u32, u32),
+) -> (Range<u32>, Range<usize>) {
+    let corners = (0..8).map(|k| {
+        let pick = |bit: usize, a: f32, b: f32| f64::from(if k >> bit & 1 == 0 { a } else { b });
+        *view_proj * glam::DVec4::new(pick(0, lo.x, hi.x), pick(1, lo.y, hi.y), pick(2, lo.z, hi.z), 1.0)
+    });
+    let mut rect = (f64::INFINITY, f64::INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY);
+    for c in corners {
+        if c.w <= 1e-9 {
+            return (0..width, 0..height as usize);
+        }
+        let p = screen.project(c);
+        rect = (rect.0.min(p.x), rect.1.min(p.y), rect.2.max(p.x), rect.3.max(p.y));
+    }
+    let clamp = |v: f64, n: u32| (v.max(0.0) as u32).min(n);
+    let x = clamp(rect.0.floor() - 1.0, width)..clamp(rect.2.ceil() + 1.0, width);
+    let y = clamp(rect.1.floor() - 1.0, height) as usize..clamp(rect.3.ceil() + 1.0, height) as usize;
+    (x, y)
 }
 
 /// Calls `f(x, right, below)` for each pixel x of `row` that shows another
@@ -204,6 +279,34 @@ mod tests {
                 .collect();
             prop_assert_eq!(found, expected);
         }
+    }
+
+    #[test]
+    fn scanning_only_where_bounds_overlap_finds_what_the_whole_frame_holds() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenes/cad-ortho.toml");
+        let scene = crate::scene::file::load_scene(&path).expect("cad-ortho loads");
+        let (w, h) = (240, 135);
+        let mut found = 0;
+        for yaw in [0.0f32, 40.0, 110.0, 200.0] {
+            let mut turned = scene.clone();
+            let turn = glam::Quat::from_rotation_y(yaw.to_radians());
+            turned.camera.eye = turned.camera.target + turn * (scene.camera.eye - scene.camera.target);
+            let mut vb = VisibilityBuffer::new(w, h);
+            crate::visibility::rasterize(&turned, &mut vb);
+            let clips = ClipMap::of_objects(&turned, w, h);
+            let walked = WalkedPairs::of(&[], w, h);
+            let opaque =
+                |o: &&crate::scene::Object| o.triangles().is_some() && !turned.materials[o.material].translucent();
+            let boxes: Vec<(Vec3, Vec3)> =
+                turned.objects.iter().filter(opaque).filter_map(|o| o.world_bounds()).collect();
+            // A box around the eye reaches behind it: the whole frame.
+            let everywhere = [(Vec3::splat(-1e6), Vec3::splat(1e6)); 2];
+            let restricted = find_intersection_blends(&turned, &vb, &clips, &walked, &boxes);
+            let whole = find_intersection_blends(&turned, &vb, &clips, &walked, &everywhere);
+            assert_eq!(restricted, whole, "yaw {yaw}");
+            found += whole.len();
+        }
+        assert!(found > 20, "the parts stand in the plate: {found} blends");
     }
 
     #[test]

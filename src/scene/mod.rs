@@ -100,6 +100,24 @@ impl Object {
         }
     }
 
+    /// Bounds `(min, max)` in world space: the object-space box's eight corners
+    /// transformed (`None` for an empty body).
+    #[must_use]
+    pub fn world_bounds(&self) -> Option<(Vec3, Vec3)> {
+        Some(self.world_box(self.local_bounds()?))
+    }
+
+    /// The world-space bounds of the object-space box `(lo, hi)`: its eight
+    /// corners transformed.
+    #[must_use]
+    pub fn world_box(&self, (lo, hi): (Vec3, Vec3)) -> (Vec3, Vec3) {
+        let corners = (0..8).map(|k| {
+            let pick = |bit: usize, a: f32, b: f32| if k >> bit & 1 == 0 { a } else { b };
+            self.transform.transform_point3(Vec3::new(pick(0, lo.x, hi.x), pick(1, lo.y, hi.y), pick(2, lo.z, hi.z)))
+        });
+        corners.fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), c| (lo.min(c), hi.max(c)))
+    }
+
     /// Bounds `(min, max)` in object space (`None` for an empty body).
     #[must_use]
     pub fn local_bounds(&self) -> Option<(Vec3, Vec3)> {
@@ -173,19 +191,7 @@ impl Scene {
     /// World-space bounds `(min, max)` of all objects (`None` if there are none).
     #[must_use]
     pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
-        self.objects.iter().fold(None, |acc, o| {
-            let Some((lo, hi)) = o.local_bounds() else { return acc };
-            let corners = (0..8).map(|k| {
-                let pick = |bit: usize, a: f32, b: f32| if k >> bit & 1 == 0 { a } else { b };
-                o.transform.transform_point3(Vec3::new(pick(0, lo.x, hi.x), pick(1, lo.y, hi.y), pick(2, lo.z, hi.z)))
-            });
-            let (mut lo, mut hi) = acc.unwrap_or((Vec3::INFINITY, Vec3::NEG_INFINITY));
-            for c in corners {
-                lo = lo.min(c);
-                hi = hi.max(c);
-            }
-            Some((lo, hi))
-        })
+        self.objects.iter().filter_map(Object::world_bounds).reduce(|(a, b), (c, d)| (a.min(c), b.max(d)))
     }
 
     /// What a ray leaving the scene along `dir` sees: the environment if it is
