@@ -329,7 +329,7 @@ pub fn plan(scene: &Scene, vb: &VisibilityBuffer, options: &EdgeOptions, cache: 
         EdgeFilter::Coverage => 0.5,
         EdgeFilter::Paper => 1.0,
     };
-    let blends = merge(blends, cap);
+    let blends = merge(blends, cap, vb.width());
     let flat = |item: ItemId| {
         let edges = edges.get(item.object as usize).and_then(Option::as_ref);
         item.primitive().is_none() && edges.is_some_and(|e| e.flat.get(item.triangle as usize) == Some(&true))
@@ -477,9 +477,9 @@ impl Walker<'_> {
 /// one straight edge never takes more (the half-plane holding the pixel centre holds
 /// the larger part), so a pixel keeps at least half its own colour — and 1 for the
 /// paper's weights, instead of overshooting.
-fn merge(mut blends: Vec<EdgeBlend>, cap: f32) -> Vec<EdgeBlend> {
+fn merge(blends: Vec<EdgeBlend>, cap: f32, width: u32) -> Vec<EdgeBlend> {
     let key = |c: u32, o: u32| (u64::from(c) << 32) | u64::from(o);
-    blends.par_sort_unstable_by_key(|b| (key(b.c, b.o), b.inside, b.source));
+    let mut blends = sorted_by_pixel(blends, width);
     // A sliver: the pixel across is itself crossed by another edge, from outside,
     // towards this pixel — a thin surface lies between the two edges, so nothing of
     // this pixel shows the colour across. Only towards a pixel crossed from
@@ -512,6 +512,30 @@ fn merge(mut blends: Vec<EdgeBlend>, cap: f32) -> Vec<EdgeBlend> {
         }
     }
     merged
+}
+
+/// `blends` sorted by pixel, neighbour, then (for a fixed order of the edges
+/// meeting there) inside first and by edge: bucketed by image row (a counting
+/// sort on a `width` pixels wide frame), then each row's few blends compared.
+fn sorted_by_pixel(blends: Vec<EdgeBlend>, width: u32) -> Vec<EdgeBlend> {
+    let row = |b: &EdgeBlend| (b.c / width.max(1)) as usize;
+    let rows = blends.iter().map(row).max().map_or(0, |r| r + 1);
+    let mut starts = vec![0; rows + 1];
+    blends.iter().for_each(|b| starts[row(b) + 1] += 1);
+    for r in 0..rows {
+        starts[r + 1] += starts[r];
+    }
+    let mut order = vec![0u32; blends.len()];
+    let mut next = starts.clone();
+    for (i, b) in blends.iter().enumerate() {
+        order[next[row(b)]] = i as u32;
+        next[row(b)] += 1;
+    }
+    let mut sorted: Vec<EdgeBlend> = order.iter().map(|&i| blends[i as usize]).collect();
+    for r in 0..rows {
+        sorted[starts[r]..starts[r + 1]].sort_unstable_by_key(|b| (b.c, b.o, b.inside, b.source));
+    }
+    sorted
 }
 
 /// Which faces look at the eye, tested in the object's own space (the sign of a
@@ -762,6 +786,20 @@ impl PlaneMemo {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    proptest::proptest! {
+        /// The row-bucketed sort orders blends as one comparison sort would.
+        #[test]
+        fn blends_sorted_by_row_buckets_are_sorted(raw in proptest::collection::vec((0u32..600, 0u32..600, proptest::prelude::any::<bool>(), 0u64..4), 0..200)) {
+            let blends: Vec<EdgeBlend> = raw
+                .iter()
+                .map(|&(c, o, inside, source)| EdgeBlend { c, o, alpha: 0.1, inside, source, far: Vec2::ZERO })
+                .collect();
+            let mut expected = blends.clone();
+            expected.sort_by_key(|b| (b.c, b.o, b.inside, b.source));
+            proptest::prop_assert_eq!(sorted_by_pixel(blends, 20), expected);
+        }
+    }
 
     #[test]
     fn a_flat_shaded_cube_is_flat_and_a_smooth_sphere_is_not() {

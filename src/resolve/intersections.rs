@@ -15,6 +15,10 @@
 //! polygon edge, and become an ordinary [`EdgeBlend`]. (Where instead A's plane
 //! is in front at `o` too, A's triangle simply ends between the pixels: that is
 //! an edge, the walker's.)
+//!
+//! Two surfaces can only meet where their objects' bounds overlap, so only the
+//! screen rows' spans under the overlap of two objects' world boxes are scanned
+//! (a part standing on a plate: a thin slab along its foot).
 
 use std::ops::Range;
 
@@ -24,7 +28,7 @@ use rayon::prelude::*;
 use super::dda::square_part;
 use super::edges::{ClipMap, DepthPlane, EdgeBlend, Screen};
 use super::PixelSet;
-use crate::scene::Scene;
+use crate::scene::{box_corners, Scene};
 use crate::visibility::{ItemId, VisibilityBuffer};
 
 /// The `source` of a blend across an intersection (no edge of a mesh).
@@ -114,7 +118,7 @@ pub(super) fn find_intersection_blends(
     rows.concat()
 }
 
-/// The most object pairs whose bounds are compared; a scene with more objects
+/// The most objects whose bounds are compared pair by pair; a scene with more
 /// is scanned whole.
 const MAX_OBJECTS_PAIRED: usize = 256;
 
@@ -158,10 +162,7 @@ fn screen_rect(
     (lo, hi): (Vec3, Vec3),
     (width, height): (u32, u32),
 ) -> (Range<u32>, Range<usize>) {
-    let corners = (0..8).map(|k| {
-        let pick = |bit: usize, a: f32, b: f32| f64::from(if k >> bit & 1 == 0 { a } else { b });
-        *view_proj * glam::DVec4::new(pick(0, lo.x, hi.x), pick(1, lo.y, hi.y), pick(2, lo.z, hi.z), 1.0)
-    });
+    let corners = box_corners((lo, hi)).map(|c| *view_proj * c.as_dvec3().extend(1.0));
     let mut rect = (f64::INFINITY, f64::INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY);
     for c in corners {
         if c.w <= 1e-9 {

@@ -110,12 +110,9 @@ impl Object {
     /// The world-space bounds of the object-space box `(lo, hi)`: its eight
     /// corners transformed.
     #[must_use]
-    pub fn world_box(&self, (lo, hi): (Vec3, Vec3)) -> (Vec3, Vec3) {
-        let corners = (0..8).map(|k| {
-            let pick = |bit: usize, a: f32, b: f32| if k >> bit & 1 == 0 { a } else { b };
-            self.transform.transform_point3(Vec3::new(pick(0, lo.x, hi.x), pick(1, lo.y, hi.y), pick(2, lo.z, hi.z)))
-        });
-        corners.fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), c| (lo.min(c), hi.max(c)))
+    pub fn world_box(&self, bounds: (Vec3, Vec3)) -> (Vec3, Vec3) {
+        let corners = box_corners(bounds).map(|c| self.transform.transform_point3(c));
+        corners.iter().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &c| (lo.min(c), hi.max(c)))
     }
 
     /// Bounds `(min, max)` in object space (`None` for an empty body).
@@ -126,6 +123,15 @@ impl Object {
             Body::Solid { solid, .. } => solid.bounds(),
         }
     }
+}
+
+/// The eight corners of the box `(lo, hi)`.
+#[must_use]
+pub fn box_corners((lo, hi): (Vec3, Vec3)) -> [Vec3; 8] {
+    std::array::from_fn(|k| {
+        let pick = |bit: usize, a: f32, b: f32| if k >> bit & 1 == 0 { a } else { b };
+        Vec3::new(pick(0, lo.x, hi.x), pick(1, lo.y, hi.y), pick(2, lo.z, hi.z))
+    })
 }
 
 /// A complete scene.
