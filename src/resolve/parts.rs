@@ -49,6 +49,18 @@ enum OwnPart {
     Stepped([(u32, f32); 2]),
 }
 
+/// A pixel that edges cross, as the plan holds it.
+#[derive(Debug, Clone, Copy)]
+struct Crossed {
+    /// Its blends: `blends[start..end]`.
+    start: u32,
+    end: u32,
+    /// How its own part is coloured.
+    own: OwnPart,
+    /// How many re-shaded parts beyond edges the crossed pixels before it have.
+    across_before: u32,
+}
+
 /// The edge pass of one frame: its blends, found from the visibility buffer
 /// alone, before shading, so the passes can shade the sub-pixel points they
 /// need ([`EdgePlan::samples`]).
@@ -56,8 +68,11 @@ enum OwnPart {
 pub struct EdgePlan {
     /// Merged blends, sorted by pixel, then neighbour.
     blends: Vec<EdgeBlend>,
-    /// Per crossed pixel (in `blends`' order), how its own part is coloured.
-    own: Vec<OwnPart>,
+    /// The crossed pixels, in `blends`' order.
+    crossed: Vec<Crossed>,
+    /// Whether the parts' colours are found where they lie (else the pixels'
+    /// colours are blended as they are).
+    reshade: bool,
     /// Per target image (by its components), per part whose colour moves from
     /// its pixel's (the crossed pixels' own parts, then the re-shaded parts
     /// beyond edges), how far it moves, before fog ([`EdgePlan::record`]).
@@ -76,13 +91,41 @@ impl EdgePlan {
         vb: &VisibilityBuffer,
         flat: impl Fn(ItemId) -> bool + Sync,
     ) -> EdgePlan {
-        let own = if reshade {
-            let groups: Vec<&[EdgeBlend]> = blends.chunk_by(|a, b| a.c == b.c).collect();
-            groups.par_iter().map(|crossed| own_part(crossed, vb.items(), vb.width(), &flat)).collect()
-        } else {
-            Vec::new()
-        };
-        EdgePlan { blends, own, moved: Vec::new() }
+        let (mut start, mut across) = (0, 0);
+        let groups: Vec<(u32, u32, u32)> = blends
+            .chunk_by(|a, b| a.c == b.c)
+            .map(|group| {
+                let (first, before) = (start, across);
+                start += group.len() as u32;
+                across += group.iter().filter(|b| reshaded_across(b)).count() as u32;
+                (first, start, before)
+            })
+            .collect();
+        let crossed = groups
+            .par_iter()
+            .map(|&(start, end, across_before)| {
+                let group = &blends[start as usize..end as usize];
+                let own = if reshade {
+                    own_part(group, vb.items(), vb.width(), &flat)
+                } else {
+                    OwnPart::Stepped([(group[0].c, 0.0); 2]) // the paper's: pixels as they are
+                };
+                Crossed { start, end, own, across_before }
+            })
+            .collect();
+        EdgePlan { blends, crossed, reshade, moved: Vec::new() }
+    }
+
+    /// The blends of crossed pixel `c`.
+    fn blends_of(&self, c: &Crossed) -> &[EdgeBlend] {
+        &self.blends[c.start as usize..c.end as usize]
+    }
+
+    /// How many parts beyond edges are re-shaded.
+    fn across(&self) -> usize {
+        self.crossed
+            .last()
+            .map_or(0, |c| c.across_before as usize + self.blends_of(c).iter().filter(|b| reshaded_across(b)).count())
     }
 
     /// Pixel blends: one per pixel and neighbour across an edge.
@@ -97,12 +140,6 @@ impl EdgePlan {
         self.blends.is_empty()
     }
 
-    /// Whether the parts' colours are found where they lie (else the pixels'
-    /// colours are blended as they are).
-    fn reshades(&self) -> bool {
-        !self.own.is_empty()
-    }
-
     /// The points the shading passes shade for [`EdgePlan::apply`] on a `width`
     /// pixels wide frame (none under the paper's filter): per crossed pixel
     /// whose own part is shaded, its surface at that part's centroid; per blend
@@ -111,7 +148,7 @@ impl EdgePlan {
     /// are compared with, are the passes' own pixels: [`EdgePlan::record`].)
     #[must_use]
     pub fn samples(&self, width: u32) -> Vec<SubpixelSample> {
-        if !self.reshades() {
+        if !self.reshade {
             return Vec::new();
         }
         let pixel = |i: u32| (i % width, i / width);
@@ -119,8 +156,8 @@ impl EdgePlan {
             let p = pixel(i);
             SubpixelSample { pixel: p, at: Vec2::new(p.0 as f32 + 0.5, p.1 as f32 + 0.5) + offset }
         };
-        let crossed = self.blends.chunk_by(|a, b| a.c == b.c).zip(&self.own);
-        let near = crossed.filter(|(_, own)| **own == OwnPart::Shaded).map(|(b, _)| at(b[0].c, near_centroid(b)));
+        let shaded = self.crossed.iter().filter(|c| c.own == OwnPart::Shaded).map(|c| self.blends_of(c));
+        let near = shaded.map(|b| at(b[0].c, near_centroid(b)));
         let far = self.blends.iter().filter(|b| reshaded_across(b)).map(|b| {
             // The surface `o` shows, met by a ray through `c`.
             SubpixelSample { pixel: pixel(b.o), ..at(b.c, b.far) }
@@ -135,18 +172,16 @@ impl EdgePlan {
     /// samples of [`EdgePlan::samples`], shaded), a stepped part by its
     /// neighbours' colours.
     pub fn record(&mut self, targets: &[Target], shaded: &SubpixelShading) {
-        let far = self.blends.iter().filter(|b| reshaded_across(b)).count();
-        let near = self.own.iter().filter(|o| **o == OwnPart::Shaded).count();
-        if !self.reshades() || shaded.samples.len() != near + far {
+        let (far, near) = (self.across(), self.crossed.iter().filter(|c| c.own == OwnPart::Shaded).count());
+        if !self.reshade || shaded.samples.len() != near + far {
             return;
         }
         // Each crossed pixel's own part: its pixel and its sample, if shaded.
-        let crossed = self.blends.chunk_by(|a, b| a.c == b.c).zip(&self.own);
-        let own: Vec<(u32, OwnPart, usize)> = crossed
-            .scan(0, |shaded_before, (b, &own)| {
+        let own: Vec<(u32, OwnPart, usize)> = (self.crossed.iter())
+            .scan(0, |shaded_before, c| {
                 let k = *shaded_before;
-                *shaded_before += usize::from(own == OwnPart::Shaded);
-                Some((b[0].c, own, k))
+                *shaded_before += usize::from(c.own == OwnPart::Shaded);
+                Some((self.blends[c.start as usize].c, c.own, k))
             })
             .collect();
         let record = |t: &Target| {
@@ -173,32 +208,20 @@ impl EdgePlan {
     /// pixel is, by `1 − fog[pixel]`). Every blend reads the image as it was
     /// before any of them.
     pub fn apply(&self, image: &mut LinearImage, parts: ComponentSet, fog: Option<&[f32]>) {
-        // Each crossed pixel's blends, with how many parts across (re-shaded)
-        // come before them: its own part is the pixel's ordinal, the parts
-        // across follow all own parts.
-        let mut across = 0;
-        let crossed: Vec<(&[EdgeBlend], usize)> = self
-            .blends
-            .chunk_by(|a, b| a.c == b.c)
-            .map(|blends| {
-                let before = across;
-                across += blends.iter().filter(|b| reshaded_across(b)).count();
-                (blends, before)
-            })
-            .collect();
+        // A crossed pixel's own part moves by the move of its ordinal; its
+        // re-shaded parts across follow all own parts.
         let moved = self.moved.iter().find(|(p, _)| *p == parts).map(|(_, moved)| moved);
         let moved = |pixel: u32, k: usize| {
             let Some(moved) = moved else { return Vec3::ZERO }; // not re-shaded
             moved[k] * fog.map_or(1.0, |f| 1.0 - f[pixel as usize])
         };
         let px = image.pixels();
-        let updates: Vec<(u32, Vec3)> = crossed
-            .par_iter()
-            .enumerate()
-            .map(|(near, &(blends, before))| {
+        let updates: Vec<(u32, Vec3)> = (self.crossed.par_iter().enumerate())
+            .map(|(near, crossed)| {
+                let blends = self.blends_of(crossed);
                 let c = blends[0].c;
                 let own = px[c as usize] + moved(c, near);
-                let mut far = crossed.len() + before;
+                let mut far = self.crossed.len() + crossed.across_before as usize;
                 let mut colour = own;
                 for b in blends {
                     let mut across = px[b.o as usize];
