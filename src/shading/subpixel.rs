@@ -131,9 +131,8 @@ impl SubpixelShading {
         let frames = ObjectFrames::new(scene);
         let rays = scene.camera.pixel_rays(Vec2::new(vb.width() as f32, vb.height() as f32));
         self.samples.par_iter().map(|s| s.surface(scene, vb, &frames, &rays)).collect_into_vec(&mut self.surfaces);
-        for (r, s) in self.reflected.iter_mut().zip(&self.surfaces) {
-            *r = s.as_ref().map_or(Vec3::ZERO, |s| reflection_map(scene, &s.point));
-        }
+        let reflected = self.reflected.par_iter_mut().zip(&self.surfaces);
+        reflected.for_each(|(r, s)| *r = s.as_ref().map_or(Vec3::ZERO, |s| reflection_map(scene, &s.point)));
     }
 
     /// Sample `k`'s colour in an image holding the components `parts`, as the
