@@ -207,12 +207,18 @@ fn simd_shading_matches_the_scalar_reference() {
 
 /// Sub-pixel samples taken at pixel centres get what the lit passes write there
 /// (samples shaded eight at a time from their own surface points, against the
-/// passes' rows of pixels; every pass and shadow term of a scene with three
-/// shadowed spot lights).
+/// passes' rows of pixels): every pass and shadow term of a scene with three
+/// shadowed spot lights, and the demo's textured surfaces (whose samples take
+/// their texture footprints from samples nearby on the same triangle).
 #[test]
 fn subpixel_samples_at_pixel_centres_match_the_passes() {
+    subpixel_samples_match_the_passes_in("spotlights.toml");
+    subpixel_samples_match_the_passes_in("demo.toml");
+}
+
+fn subpixel_samples_match_the_passes_in(name: &str) {
     use kage::shading::{shade_lit, ComponentSet, SubpixelSample, SubpixelShading, Target};
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenes/spotlights.toml");
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenes").join(name);
     let mut scene = kage::scene::file::load_scene(&path).unwrap();
     (scene.width, scene.height) = (240, 135);
     let frame = render(&scene, &RenderOptions::default()).unwrap();
@@ -235,7 +241,7 @@ fn subpixel_samples_at_pixel_centres_match_the_passes() {
         let colour = colour.expect("a surface seen: a colour");
         let d = (colour - image.get(x, y)).abs().max_element();
         off += usize::from(d >= 2e-3);
-        assert!(d < 0.2, "pixel ({x}, {y}): sample {colour} vs pass {}", image.get(x, y));
+        assert!(d < 0.2, "{name}, pixel ({x}, {y}): sample {colour} vs pass {}", image.get(x, y));
     }
-    assert!(off * 100 < pixels.len(), "{off} of {} samples differ from their pixels", pixels.len());
+    assert!(off * 100 < pixels.len(), "{name}: {off} of {} samples differ from their pixels", pixels.len());
 }

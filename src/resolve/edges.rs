@@ -349,7 +349,7 @@ fn find_blends(
     let walker = Walker { scene, vb, clips, mode, depth: DepthScale::of(camera, h), screen: Screen::of(camera, w, h) };
     let objects: Vec<WalkedObject> = scene
         .objects
-        .iter()
+        .par_iter()
         .zip(edges)
         .enumerate()
         .filter_map(|(index, (o, edges))| {
@@ -414,9 +414,19 @@ impl Walker<'_> {
         let Some((a, b)) = self.screen.clip_and_project(a, b) else { return };
         let near = object.edges.neighbourhood(mesh, e);
         let mut planes = PlaneMemo::default();
+        // The last two pixels' sides: a column the edge crosses in two rows
+        // visits both pixels twice, each as the other's neighbour.
+        let mut sides = [(usize::MAX, DVec3::ZERO, Side::Behind); 2];
         let (w, h) = (self.vb.width(), self.vb.height());
         let visit = |c: (u32, u32), other: (u32, u32), alpha, point: glam::DVec3, far: PartBeyond| {
-            let mut side = |i: usize| self.side((object, e), &near, &mut planes, i, point);
+            let mut side = |i: usize| match sides.iter().find(|(j, at, _)| *j == i && *at == point) {
+                Some(&(_, _, side)) => side,
+                None => {
+                    let side = self.side((object, e), &near, &mut planes, i, point);
+                    sides = [(i, point, side), sides[0]];
+                    side
+                }
+            };
             if let Some(blend) = depth_tested(w, &mut side, c, other, alpha, self.mode.filter) {
                 out.push(EdgeBlend { source, far: far.centroid(), ..blend });
             }

@@ -59,6 +59,9 @@ struct Crossed {
     own: OwnPart,
     /// How many re-shaded parts beyond edges the crossed pixels before it have.
     across_before: u32,
+    /// How many crossed pixels before it have their own part shaded (its
+    /// sample's ordinal, if its own is shaded too).
+    shaded_before: u32,
 }
 
 /// The edge pass of one frame: its blends, found from the visibility buffer
@@ -101,7 +104,7 @@ impl EdgePlan {
                 (first, start, before)
             })
             .collect();
-        let crossed = groups
+        let mut crossed: Vec<Crossed> = groups
             .par_iter()
             .map(|&(start, end, across_before)| {
                 let group = &blends[start as usize..end as usize];
@@ -110,9 +113,14 @@ impl EdgePlan {
                 } else {
                     OwnPart::Stepped([(group[0].c, 0.0); 2]) // the paper's: pixels as they are
                 };
-                Crossed { start, end, own, across_before }
+                Crossed { start, end, own, across_before, shaded_before: 0 }
             })
             .collect();
+        let mut shaded = 0;
+        for c in &mut crossed {
+            c.shaded_before = shaded;
+            shaded += u32::from(c.own == OwnPart::Shaded);
+        }
         EdgePlan { blends, crossed, reshade, moved: Vec::new() }
     }
 
@@ -176,14 +184,6 @@ impl EdgePlan {
         if !self.reshade || shaded.samples.len() != near + far {
             return;
         }
-        // Each crossed pixel's own part: its pixel and its sample, if shaded.
-        let own: Vec<(u32, OwnPart, usize)> = (self.crossed.iter())
-            .scan(0, |shaded_before, c| {
-                let k = *shaded_before;
-                *shaded_before += usize::from(c.own == OwnPart::Shaded);
-                Some((self.blends[c.start as usize].c, c.own, k))
-            })
-            .collect();
         let record = |t: &Target| {
             let (px, w) = (t.image.pixels(), t.image.width() as usize);
             let sampled = |k: usize| {
@@ -193,9 +193,9 @@ impl EdgePlan {
             let stepped = |c: u32, steps: [(u32, f32); 2]| {
                 steps.iter().map(|&(m, weight)| (px[m as usize] - px[c as usize]) * weight).sum()
             };
-            let own = own.par_iter().map(|&(c, part, k)| match part {
-                OwnPart::Shaded => sampled(k),
-                OwnPart::Stepped(steps) => stepped(c, steps),
+            let own = self.crossed.par_iter().map(|c| match c.own {
+                OwnPart::Shaded => sampled(c.shaded_before as usize),
+                OwnPart::Stepped(steps) => stepped(self.blends[c.start as usize].c, steps),
             });
             own.chain((near..near + far).into_par_iter().map(sampled)).collect()
         };

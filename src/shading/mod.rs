@@ -71,7 +71,7 @@ pub fn shade_pass(scene: &Scene, vb: &VisibilityBuffer, image: &mut LinearImage,
     // from (a block copy is faster than writing one 12-byte pixel at a time).
     let (background, black) = (vec![pass.background; w], vec![Vec3::ZERO; w]);
     let rows = image.pixels_mut().par_chunks_mut(w).zip(vb.items().par_chunks(w));
-    let caches = || (TriangleCache::new(), lanes::Block::default());
+    let caches = || (TriangleCache::new(512), lanes::Block::default());
     rows.enumerate().for_each_init(caches, |(cache, block), (y, (out, items))| {
         let row = lanes::RowRays::new(&rays, y);
         let mut x = 0;
@@ -153,21 +153,22 @@ fn run_end(items: &[ItemId], x: usize) -> usize {
     x + whole + rest[whole..].iter().position(|i| i.key() != key).unwrap_or(rest.len() - whole)
 }
 
-/// A small direct-mapped cache of prepared triangles, one per worker: the rows a
-/// worker shades in turn keep meeting the same triangles.
-struct TriangleCache {
+/// A small direct-mapped cache of prepared triangles: one per worker of the
+/// passes (the rows a worker shades in turn keep meeting the same triangles),
+/// one per chunk of sub-pixel samples.
+pub(crate) struct TriangleCache {
     slots: Vec<Option<PreparedTriangle>>,
 }
 
 impl TriangleCache {
-    const SLOTS: usize = 512;
-
-    fn new() -> Self {
-        TriangleCache { slots: vec![None; Self::SLOTS] }
+    /// A cache of `slots` entries.
+    pub(crate) fn new(slots: usize) -> Self {
+        TriangleCache { slots: vec![None; slots.max(1)] }
     }
 
-    fn get(&mut self, scene: &Scene, frames: &ObjectFrames, item: ItemId) -> &PreparedTriangle {
-        let key = (item.triangle as usize ^ (item.object as usize).wrapping_mul(0x9E37)) % Self::SLOTS;
+    /// `item`'s triangle (a mesh's), prepared now unless it is held.
+    pub(crate) fn get(&mut self, scene: &Scene, frames: &ObjectFrames, item: ItemId) -> &PreparedTriangle {
+        let key = (item.triangle as usize ^ (item.object as usize).wrapping_mul(0x9E37)) % self.slots.len();
         let slot = &mut self.slots[key];
         match slot {
             Some(t) if t.item == item => {}

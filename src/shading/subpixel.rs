@@ -24,6 +24,7 @@ use super::lanes::{Lighting, LANES};
 use super::phong::{Coefficients, Component, ComponentSet, Components};
 use super::reflection_map::reflection_map;
 use super::surface::{ObjectFrames, SurfacePoint};
+use super::TriangleCache;
 use crate::scene::camera::PixelRays;
 use crate::scene::{Ray, Scene};
 use crate::visibility::VisibilityBuffer;
@@ -70,13 +71,14 @@ pub struct SubpixelShading {
 }
 
 impl SubpixelSample {
-    /// The surface the sample's ray meets on what its pixel shows in `vb`.
+    /// The surface the sample's ray meets on what its pixel shows in `vb`;
+    /// `triangles` holds the triangles earlier samples met.
     fn surface(
         &self,
-        scene: &Scene,
-        vb: &VisibilityBuffer,
+        (scene, vb): (&Scene, &VisibilityBuffer),
         frames: &ObjectFrames,
         rays: &PixelRays,
+        triangles: &mut TriangleCache,
     ) -> Option<SampleSurface> {
         let (x, y) = self.pixel;
         let item = vb.item(x, y);
@@ -88,7 +90,7 @@ impl SubpixelSample {
             // A solid's tangent plane is taken where the pixel's own ray meets it.
             frames.prepare_at(scene, vb, x, y, &rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5)))
         } else {
-            frames.prepare(scene, item)
+            *triangles.get(scene, frames, item)
         };
         let mut point = surface.surface(&ray);
         let material = &scene.materials[point.material];
@@ -130,7 +132,11 @@ impl SubpixelShading {
         }
         let frames = ObjectFrames::new(scene);
         let rays = scene.camera.pixel_rays(Vec2::new(vb.width() as f32, vb.height() as f32));
-        self.samples.par_iter().map(|s| s.surface(scene, vb, &frames, &rays)).collect_into_vec(&mut self.surfaces);
+        // One cache of triangles per worker: samples along an edge keep
+        // meeting the same few.
+        let surface =
+            |triangles: &mut TriangleCache, s: &SubpixelSample| s.surface((scene, vb), &frames, &rays, triangles);
+        self.samples.par_iter().map_init(|| TriangleCache::new(64), surface).collect_into_vec(&mut self.surfaces);
         let reflected = self.reflected.par_iter_mut().zip(&self.surfaces);
         reflected.for_each(|(r, s)| *r = s.as_ref().map_or(Vec3::ZERO, |s| reflection_map(scene, &s.point)));
     }
