@@ -4,7 +4,7 @@
 //! A [`Renderer`] keeps its buffers between frames, as an interactive preview
 //! re-renders the same size again and again; [`render`] is the one-shot form.
 
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
@@ -241,13 +241,6 @@ fn render_pass(scene: &Scene, frame: &mut Frame, scratch: &mut Scratch, ray_dept
     frame.visibility.resize(scene.width, scene.height);
     frame.stats.raster = visibility::rasterize(scene, &mut frame.visibility);
     let t1 = Instant::now();
-    // The edges are found before shading, so the passes shade the sub-pixel
-    // points the crossed pixels' parts need.
-    let mut plan = edge.map(|o| edges::plan(scene, &frame.visibility, o, edge_cache));
-    let samples = plan.as_ref().map_or_else(Vec::new, |p| p.samples(scene.width));
-    subpixel.reset(scene, &frame.visibility, samples);
-    let planned = t1.elapsed();
-    let t1 = Instant::now();
     frame.image.resize(scene.width, scene.height);
     let mut targets = vec![Target { parts: ComponentSet::ALL, image: &mut frame.image }];
     let mut traced_aov = None;
@@ -259,7 +252,18 @@ fn render_pass(scene: &Scene, frame: &mut Frame, scratch: &mut Scratch, ray_dept
         }
     }
     let vb = &frame.visibility;
-    let lit = shading::shade_lit(scene, vb, &mut targets, maps, subpixel);
+    // The edges are found while the first pass shades the pixels (they need
+    // only the visibility buffer), so every pass shades the sub-pixel points
+    // the crossed pixels' parts need.
+    let (mut plan, mut planned) = (None, Duration::ZERO);
+    let prepare = |subpixel: &mut SubpixelShading| {
+        let t = Instant::now();
+        plan = edge.map(|o| edges::plan(scene, vb, o, edge_cache));
+        let samples = plan.as_ref().map_or_else(Vec::new, |p| p.samples(scene.width));
+        subpixel.reset(scene, vb, samples);
+        planned = t.elapsed();
+    };
+    let lit = shading::shade_lit_while(scene, vb, (&mut targets, maps), subpixel, prepare);
     let t2 = Instant::now();
     let builds = trace.builds();
     frame.stats.traced_pixels += match &mut traced_aov {
@@ -299,8 +303,9 @@ fn render_pass(scene: &Scene, frame: &mut Frame, scratch: &mut Scratch, ray_dept
         frame.stats.edge_blends = plan.len();
         frame.stats.edge_ms = (planned + t.elapsed()).as_secs_f64() * 1e3;
     }
-    frame.stats.visibility_ms += (t1 - t0 - planned).as_secs_f64() * 1e3;
-    frame.stats.shading_ms += ((t2 - t1) + t3.elapsed()).as_secs_f64() * 1e3 - lit.shadow_ms;
+    frame.stats.visibility_ms += (t1 - t0).as_secs_f64() * 1e3;
+    // The plan ran beside the first pass: its time is the edge pass's.
+    frame.stats.shading_ms += ((t2 - t1) + t3.elapsed()).saturating_sub(planned).as_secs_f64() * 1e3 - lit.shadow_ms;
     frame.stats.shadow_ms += lit.shadow_ms;
     frame.stats.shadow_maps_reused += lit.maps_reused;
     frame.stats.shadow_bytes = frame.stats.shadow_bytes.max(lit.shadow_bytes);

@@ -107,6 +107,21 @@ pub fn shade_lit(
     pool: &mut MapPool,
     subpixel: &mut SubpixelShading,
 ) -> PassStats {
+    shade_lit_while(scene, vb, (targets, pool), subpixel, |_| {})
+}
+
+/// [`shade_lit`] with the sub-pixel samples set up by `prepare` while the
+/// first pass shades the pixels: work that needs only the visibility buffer
+/// (the edge pass's plan) fills the gaps the pixels' shading leaves on the
+/// workers, instead of running before it. The samples get every pass,
+/// the first included, once `prepare` is done.
+pub fn shade_lit_while(
+    scene: &Scene,
+    vb: &VisibilityBuffer,
+    (targets, pool): (&mut [Target], &mut MapPool),
+    subpixel: &mut SubpixelShading,
+    prepare: impl FnOnce(&mut SubpixelShading) + Send,
+) -> PassStats {
     let mut stats = PassStats::default();
     pool.begin_frame(scene);
     let mut budget = FUSED_SHADOW_BUDGET;
@@ -125,7 +140,8 @@ pub fn shade_lit(
     stats.shadow_bytes = FUSED_SHADOW_BUDGET - budget;
     let direct = fused.iter().map(|(l, t)| (&l.light, t.as_slice())).collect();
     let ambient = lights.iter().map(|l| &l.light).filter(|l| l.only.is_none());
-    run(scene, vb, (targets, &mut *subpixel), &Lighting::pass(ambient, direct, true), Blend::Replace, None);
+    let first = Lighting::pass(ambient, direct, true);
+    run(scene, vb, (targets, &mut *subpixel), (&first, Blend::Replace, None), prepare);
     stats.passes = 1;
     // The fused terms stay for the next frame (within the same budget).
     for (light, terms) in fused {
@@ -139,7 +155,7 @@ pub fn shade_lit(
         // A light that lights every object had its ambient added in the first pass.
         let ambient = light.only.is_some().then_some(light);
         let lighting = Lighting::pass(ambient, vec![(light, &terms)], false);
-        run(scene, vb, (targets, &mut *subpixel), &lighting, Blend::Add, receivers);
+        run(scene, vb, (targets, &mut *subpixel), (&lighting, Blend::Add, receivers), |_| {});
         stats.passes += 1;
         terms.into_iter().for_each(|t| pool.recycle(t));
     }
@@ -148,23 +164,27 @@ pub fn shade_lit(
     stats
 }
 
-/// One pass into every target and at every sub-pixel sample.
+/// One pass (its lighting, how it writes, whom it reaches) into every target,
+/// with the sub-pixel samples set up by `prepare` meanwhile, then at every
+/// sample.
 fn run(
     scene: &Scene,
     vb: &VisibilityBuffer,
     (targets, subpixel): (&mut [Target], &mut SubpixelShading),
-    lighting: &Lighting,
-    blend: Blend,
-    receivers: Option<Vec<bool>>,
+    (lighting, blend, receivers): (&Lighting, Blend, Option<Vec<bool>>),
+    prepare: impl FnOnce(&mut SubpixelShading) + Send,
 ) {
-    subpixel.add_pass(lighting, receivers.as_deref());
-    for t in targets {
-        let lighting = lighting.restricted(t.parts);
-        if blend == Blend::Add && lighting.is_empty() {
-            continue;
+    let pixels = || {
+        for t in targets {
+            let lighting = lighting.restricted(t.parts);
+            if blend == Blend::Add && lighting.is_empty() {
+                continue;
+            }
+            let background = if t.parts.contains(Component::Emission) { flat_background(scene) } else { Vec3::ZERO };
+            let pass = ShadingPass { lighting, blend, background, receivers: receivers.clone() };
+            shade_pass(scene, vb, t.image, &pass);
         }
-        let background = if t.parts.contains(Component::Emission) { flat_background(scene) } else { Vec3::ZERO };
-        let pass = ShadingPass { lighting, blend, background, receivers: receivers.clone() };
-        shade_pass(scene, vb, t.image, &pass);
-    }
+    };
+    rayon::join(|| prepare(subpixel), pixels);
+    subpixel.add_pass(lighting, receivers.as_deref());
 }
