@@ -244,4 +244,15 @@ fn subpixel_samples_match_the_passes_in(name: &str) {
         assert!(d < 0.2, "{name}, pixel ({x}, {y}): sample {colour} vs pass {}", image.get(x, y));
     }
     assert!(off * 100 < pixels.len(), "{name}: {off} of {} samples differ from their pixels", pixels.len());
+    // Set up while the first pass shades the pixels (as the edge pass does),
+    // the samples get the same passes.
+    let mut beside = SubpixelShading::default();
+    let mut image = kage::resolve::LinearImage::new(scene.width, scene.height);
+    let mut targets = [Target { parts: ComponentSet::ALL, image: &mut image }];
+    let mut pool = kage::shadows::MapPool::default();
+    let prepare = |s: &mut SubpixelShading| s.reset(&scene, vb, subpixel.samples.clone());
+    kage::shading::shade_lit_while(&scene, vb, (&mut targets, &mut pool), &mut beside, prepare);
+    for k in 0..pixels.len() {
+        assert_eq!(beside.colour(k, ComponentSet::ALL), subpixel.colour(k, ComponentSet::ALL), "{name}: sample {k}");
+    }
 }

@@ -113,8 +113,8 @@ pub fn shade_lit(
 /// [`shade_lit`] with the sub-pixel samples set up by `prepare` while the
 /// first pass shades the pixels: work that needs only the visibility buffer
 /// (the edge pass's plan) fills the gaps the pixels' shading leaves on the
-/// workers, instead of running before it. The samples get every pass,
-/// the first included, once `prepare` is done.
+/// workers, instead of running before it. The samples get every pass, the
+/// first included (shaded beside the pixels too, once `prepare` is done).
 pub fn shade_lit_while(
     scene: &Scene,
     vb: &VisibilityBuffer,
@@ -164,9 +164,8 @@ pub fn shade_lit_while(
     stats
 }
 
-/// One pass (its lighting, how it writes, whom it reaches) into every target,
-/// with the sub-pixel samples set up by `prepare` meanwhile, then at every
-/// sample.
+/// One pass (its lighting, how it writes, whom it reaches) into every target
+/// and, beside it, at every sub-pixel sample, once `prepare` has set them up.
 fn run(
     scene: &Scene,
     vb: &VisibilityBuffer,
@@ -185,6 +184,9 @@ fn run(
             shade_pass(scene, vb, t.image, &pass);
         }
     };
-    rayon::join(|| prepare(subpixel), pixels);
-    subpixel.add_pass(lighting, receivers.as_deref());
+    let samples = || {
+        prepare(subpixel);
+        subpixel.add_pass(lighting, receivers.as_deref());
+    };
+    rayon::join(samples, pixels);
 }
