@@ -153,9 +153,9 @@ fn run_end(items: &[ItemId], x: usize) -> usize {
     x + whole + rest[whole..].iter().position(|i| i.key() != key).unwrap_or(rest.len() - whole)
 }
 
-/// A small direct-mapped cache of prepared triangles: one per worker of the
-/// passes (the rows a worker shades in turn keep meeting the same triangles),
-/// one per chunk of sub-pixel samples.
+/// A small direct-mapped cache of prepared triangles, one per worker: the rows
+/// a worker shades in turn keep meeting the same triangles, and so do the
+/// sub-pixel samples it sets up along an edge.
 pub(crate) struct TriangleCache {
     slots: Vec<Option<PreparedTriangle>>,
 }
