@@ -415,20 +415,13 @@ impl Walker<'_> {
         let [a, b] = e.v.map(|i| clip.points * mesh.positions[i as usize].as_dvec3().extend(1.0));
         let Some((a, b)) = self.screen.clip_and_project(a, b) else { return };
         let near = object.edges.neighbourhood(mesh, e);
-        let mut planes = PlaneMemo::default();
-        // The last two pixels' sides: a column the edge crosses in two rows
-        // visits both pixels twice, each as the other's neighbour.
-        let mut sides = [(usize::MAX, DVec3::ZERO, Side::Behind); 2];
+        let mut planes = LastTwo::new();
+        // A column the edge crosses in two rows visits both pixels twice, each
+        // as the other's neighbour.
+        let mut sides = LastTwo::new();
         let (w, h) = (self.vb.width(), self.vb.height());
         let visit = |c: (u32, u32), other: (u32, u32), alpha, point: glam::DVec3, far: PartBeyond| {
-            let mut side = |i: usize| match sides.iter().find(|(j, at, _)| *j == i && *at == point) {
-                Some(&(_, _, side)) => side,
-                None => {
-                    let side = self.side((object, e), &near, &mut planes, i, point);
-                    sides = [(i, point, side), sides[0]];
-                    side
-                }
-            };
+            let mut side = |i: usize| sides.get((i, point), || self.side((object, e), &near, &mut planes, i, point));
             if let Some(blend) = depth_tested(w, &mut side, c, other, alpha, self.mode.filter) {
                 out.push(EdgeBlend { source, far: far.centroid(), ..blend });
             }
@@ -442,7 +435,7 @@ impl Walker<'_> {
         &self,
         (object, edge): (&WalkedObject, &MeshEdge),
         near: &[u32; 6],
-        planes: &mut PlaneMemo,
+        planes: &mut LastTwo<ItemId, Option<DepthPlane>>,
         i: usize,
         point: DVec3,
     ) -> Side {
@@ -457,11 +450,12 @@ impl Walker<'_> {
         // The pixel's surface plane carried to the edge's point (a surface
         // resting on another meets it at the edge's depth, though its pixel
         // beside the edge lies nearer), else the pixel's own depth.
-        let z = planes.depth_at(item, point, |item| {
+        let plane = planes.get(item, || {
             let mesh = self.scene.objects[item.object as usize].triangles()?;
             let clip = &self.clips[item.object as usize];
             item.primitive().is_none().then(|| self.screen.depth_plane(clip, mesh, item.triangle))?
         });
+        let z = plane.map(|plane| plane.at(point.x, point.y));
         if ours && z.is_some_and(|z| self.depth.close(z, point.z)) {
             // A fine mesh: the triangle at the pixel is a few rings away from
             // the edge, but its plane passes near it.
@@ -763,35 +757,32 @@ fn depth_tested(
     shows.then(|| EdgeBlend { c: index(c), o: index(o), alpha, inside: sc == Side::Own, source: 0, far: Vec2::ZERO })
 }
 
-/// The depth planes of the last two items an edge's walk met: neighbouring
-/// steps along an edge mostly see the same few triangles.
-#[derive(Default)]
-struct PlaneMemo {
-    last: [Option<(ItemId, Option<DepthPlane>)>; 2],
+/// The values of the last two keys an edge's walk asked for: neighbouring
+/// steps along an edge mostly meet the same few triangles (their depth
+/// planes) and the same pixels (their sides).
+struct LastTwo<K, V> {
+    last: [Option<(K, V)>; 2],
 }
 
-impl PlaneMemo {
-    /// The depth at screen point `p` of `item`'s plane, found by `plane` unless
-    /// met just before.
-    fn depth_at(
-        &mut self,
-        item: ItemId,
-        p: glam::DVec3,
-        plane: impl FnOnce(ItemId) -> Option<DepthPlane>,
-    ) -> Option<f64> {
-        let found = match self.last {
-            [Some((i, found)), _] if i == item => found,
-            [_, Some((i, found))] if i == item => {
+impl<K: PartialEq + Copy, V: Copy> LastTwo<K, V> {
+    fn new() -> Self {
+        LastTwo { last: [None, None] }
+    }
+
+    /// `key`'s value, found by `find` unless asked for just before.
+    fn get(&mut self, key: K, find: impl FnOnce() -> V) -> V {
+        match self.last {
+            [Some((k, v)), _] if k == key => v,
+            [_, Some((k, v))] if k == key => {
                 self.last.swap(0, 1);
-                found
+                v
             }
             _ => {
-                let found = plane(item);
-                self.last = [Some((item, found)), self.last[0]];
-                found
+                let v = find();
+                self.last = [Some((key, v)), self.last[0]];
+                v
             }
-        };
-        found.map(|plane| plane.at(p.x, p.y))
+        }
     }
 }
 

@@ -136,6 +136,11 @@ impl EdgePlan {
             .map_or(0, |c| c.across_before as usize + self.blends_of(c).iter().filter(|b| reshaded_across(b)).count())
     }
 
+    /// How many crossed pixels have their own part shaded.
+    fn shaded(&self) -> usize {
+        self.crossed.last().map_or(0, |c| c.shaded_before as usize + usize::from(c.own == OwnPart::Shaded))
+    }
+
     /// Pixel blends: one per pixel and neighbour across an edge.
     #[must_use]
     pub fn len(&self) -> usize {
@@ -180,7 +185,7 @@ impl EdgePlan {
     /// samples of [`EdgePlan::samples`], shaded), a stepped part by its
     /// neighbours' colours.
     pub fn record(&mut self, targets: &[Target], shaded: &SubpixelShading) {
-        let (far, near) = (self.across(), self.crossed.iter().filter(|c| c.own == OwnPart::Shaded).count());
+        let (far, near) = (self.across(), self.shaded());
         if !self.reshade || shaded.samples.len() != near + far {
             return;
         }
