@@ -282,9 +282,18 @@ fn render_pass(scene: &Scene, frame: &mut Frame, scratch: &mut Scratch, ray_dept
     let t3 = Instant::now();
     frame.stats.bvh_built |= trace.builds() > builds;
     targets.extend(traced_aov.map(|image| Target { parts: ComponentSet::only(Component::Traced), image }));
-    if let Some(plan) = &mut plan {
-        plan.record(&targets, subpixel);
+    // Translucent surfaces are drawn last, over everything opaque (seed 002 §3.4).
+    let layers = visibility::fragments(scene, vb);
+    // Where nothing is drawn over the passes' image, each part of a crossed
+    // pixel is coloured as the pixel is blended.
+    let fused = scene.fog.is_none() && layers.is_empty();
+    let t = Instant::now();
+    match &mut plan {
+        Some(plan) if fused => plan.record_and_apply(&mut targets, subpixel),
+        Some(plan) => plan.record(&targets, subpixel),
+        None => {}
     }
+    let mut edge_time = t.elapsed();
     let fogged = scene.fog.as_ref().map(|fog| {
         let amounts = fog::fog_amounts(scene, fog, vb);
         for t in &mut targets {
@@ -293,8 +302,6 @@ fn render_pass(scene: &Scene, frame: &mut Frame, scratch: &mut Scratch, ray_dept
         }
         amounts
     });
-    // Translucent surfaces last, over everything opaque (seed 002 §3.4).
-    let layers = visibility::fragments(scene, vb);
     if !layers.is_empty() {
         let lights = shading::frame_lights(scene);
         frame.stats.translucent_fragments +=
@@ -302,9 +309,12 @@ fn render_pass(scene: &Scene, frame: &mut Frame, scratch: &mut Scratch, ray_dept
     }
     if let Some(plan) = &plan {
         let t = Instant::now();
-        targets.iter_mut().for_each(|t| plan.apply(t.image, t.parts, fogged.as_deref()));
+        if !fused {
+            targets.iter_mut().for_each(|t| plan.apply(t.image, t.parts, fogged.as_deref()));
+        }
+        edge_time += t.elapsed();
         frame.stats.edge_blends = plan.len();
-        frame.stats.edge_ms = (planned + t.elapsed()).as_secs_f64() * 1e3;
+        frame.stats.edge_ms = (planned + edge_time).as_secs_f64() * 1e3;
     }
     frame.stats.visibility_ms += (t1 - t0).as_secs_f64() * 1e3;
     // The edge pass's plan ran beside the first pass, within this time.

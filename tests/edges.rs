@@ -12,6 +12,7 @@ use kage::resolve::edges::{EdgeFilter, EdgeMode, EdgeSelection};
 use kage::resolve::{Antialias, LinearImage};
 use kage::scene::mesh::{shapes, NormalMode};
 use kage::scene::{Camera, Material, Mesh, Object, Projection, Scene};
+use kage::shading::fog::{Fog, FogMode};
 use kage::{render, RenderOptions, Renderer};
 
 const SIZE: u32 = 64;
@@ -262,6 +263,19 @@ fn the_edge_pass_gives_the_same_frame_on_one_thread_and_two() {
         r.render(&scene).unwrap().image.clone()
     };
     assert_eq!(frame(1).pixels(), frame(2).pixels());
+}
+
+#[test]
+fn the_edge_pass_gives_the_same_frame_whether_its_parts_are_recorded_first_or_not() {
+    // Without fog the parts of the crossed pixels are coloured as the pixels
+    // are blended; a fog of zero density changes no pixel, but makes the frame
+    // record the parts' colours before fogging and blend after.
+    let scene = with_edges(&sphere_scene(), EdgeSelection::Outline);
+    let at_once = render(&scene, &RenderOptions::default()).unwrap();
+    let fog = Fog { mode: FogMode::Exp { density: 0.0 }, color: Vec3::ONE };
+    let recorded = render(&Scene { fog: Some(fog), ..scene.clone() }, &RenderOptions::default()).unwrap();
+    assert!(at_once.stats.edge_blends > 200, "{} blends", at_once.stats.edge_blends);
+    assert_eq!(at_once.image.pixels(), recorded.image.pixels());
 }
 
 /// RMSE over the pixels where the object seen changes within the 3 × 3

@@ -125,6 +125,19 @@ impl PartBeyond {
 /// greater than the line's if `beyond_below`, else where it is smaller (the
 /// square's centre if that part is empty).
 fn part_centroid(v0: f64, v1: f64, beyond_below: bool) -> (f64, f64) {
+    let k = v1 - v0;
+    if (0.0..=1.0).contains(&v0) && (0.0..=1.0).contains(&v1) {
+        // The line crosses the square from side to side: the part above it
+        // is the trapezoid 0 ≤ v ≤ v0 + k·u, whose moments are polynomials
+        // (the part below is the square less it).
+        let area = v0 + 0.5 * k;
+        let (mu, mv) = (0.5 * v0 + k / 3.0, 0.5 * (v0 * v0 + v0 * k + k * k / 3.0));
+        let (area, mu, mv) = if beyond_below { (1.0 - area, 0.5 - mu, 0.5 - mv) } else { (area, mu, mv) };
+        if area < 1e-12 {
+            return (0.0, 0.0);
+        }
+        return (mu / area - 0.5, mv / area - 0.5);
+    }
     let sign = if beyond_below { 1.0 } else { -1.0 };
     square_part(|(u, v)| sign * (v - (v0 + (v1 - v0) * u))).1
 }
@@ -170,6 +183,9 @@ pub(super) fn square_part(side: impl Fn((f64, f64)) -> f64) -> (f64, (f64, f64))
 /// ∫₀¹ clamp(a + k·t, 0, 1) dt, exactly: the integrand is linear between the
 /// points where it meets 0 and 1.
 fn clamped_mean(a: f64, k: f64) -> f64 {
+    if (0.0..=1.0).contains(&a) && (0.0..=1.0).contains(&(a + k)) {
+        return a + 0.5 * k; // no clamping: most columns cross one row
+    }
     if k.abs() <= 1e-12 {
         return a.clamp(0.0, 1.0);
     }

@@ -524,22 +524,24 @@ fn merge(blends: Vec<EdgeBlend>, cap: f32, width: u32) -> Vec<EdgeBlend> {
 /// meeting there) inside first and by edge: bucketed by image row (a counting
 /// sort on a `width` pixels wide frame), then each row's few blends compared.
 fn sorted_by_pixel(blends: Vec<EdgeBlend>, width: u32) -> Vec<EdgeBlend> {
-    let row = |b: &EdgeBlend| (b.c / width.max(1)) as usize;
-    let rows = blends.iter().map(row).max().map_or(0, |r| r + 1);
-    let mut starts = vec![0; rows + 1];
-    blends.iter().for_each(|b| starts[row(b) + 1] += 1);
-    for r in 0..rows {
+    let rows: Vec<u32> = blends.iter().map(|b| b.c / width.max(1)).collect();
+    let count = rows.iter().max().map_or(0, |&r| r as usize + 1);
+    let mut starts = vec![0; count + 1];
+    rows.iter().for_each(|&r| starts[r as usize + 1] += 1);
+    for r in 0..count {
         starts[r + 1] += starts[r];
     }
     let mut order = vec![0u32; blends.len()];
     let mut next = starts.clone();
-    for (i, b) in blends.iter().enumerate() {
-        order[next[row(b)]] = i as u32;
-        next[row(b)] += 1;
+    for (i, &r) in rows.iter().enumerate() {
+        order[next[r as usize]] = i as u32;
+        next[r as usize] += 1;
     }
     let mut sorted: Vec<EdgeBlend> = order.iter().map(|&i| blends[i as usize]).collect();
-    for r in 0..rows {
-        sorted[starts[r]..starts[r + 1]].sort_unstable_by_key(|b| (b.c, b.o, b.inside, b.source));
+    // Pixel and neighbour as one number: most comparisons end there.
+    let key = |b: &EdgeBlend| ((u64::from(b.c) << 32) | u64::from(b.o), b.inside, b.source);
+    for r in 0..count {
+        sorted[starts[r]..starts[r + 1]].sort_unstable_by_key(key);
     }
     sorted
 }
@@ -747,7 +749,13 @@ fn depth_tested(
     filter: EdgeFilter,
 ) -> Option<EdgeBlend> {
     let index = |(x, y): (u32, u32)| y * width + x;
-    let (sc, so) = (side(index(c) as usize), side(index(o) as usize));
+    // An occluder at `c` hides the edge whatever `o` shows (half the visits
+    // along a hidden silhouette end here).
+    let sc = side(index(c) as usize);
+    if sc == Side::Occluder {
+        return None;
+    }
+    let so = side(index(o) as usize);
     // The paper blends the edge's own colour: the pixel across must show it.
     let source = match filter {
         EdgeFilter::Coverage => sc == Side::Own || so == Side::Own,

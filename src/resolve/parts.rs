@@ -185,24 +185,13 @@ impl EdgePlan {
     /// samples of [`EdgePlan::samples`], shaded), a stepped part by its
     /// neighbours' colours.
     pub fn record(&mut self, targets: &[Target], shaded: &SubpixelShading) {
-        let (far, near) = (self.across(), self.shaded());
-        if !self.reshade || shaded.samples.len() != near + far {
+        if !self.matches(shaded) {
             return;
         }
         let record = |t: &Target| {
-            let (px, w) = (t.image.pixels(), t.image.width() as usize);
-            let sampled = |k: usize| {
-                let (x, y) = shaded.samples[k].pixel;
-                shaded.colour(k, t.parts).map_or(Vec3::ZERO, |colour| colour - px[y as usize * w + x as usize])
-            };
-            let stepped = |c: u32, steps: [(u32, f32); 2]| {
-                steps.iter().map(|&(m, weight)| (px[m as usize] - px[c as usize]) * weight).sum()
-            };
-            let own = self.crossed.par_iter().map(|c| match c.own {
-                OwnPart::Shaded => sampled(c.shaded_before as usize),
-                OwnPart::Stepped(steps) => stepped(self.blends[c.start as usize].c, steps),
-            });
-            own.chain((near..near + far).into_par_iter().map(sampled)).collect()
+            let moves = (0..self.moves()).into_par_iter();
+            let image = (t.image.pixels(), t.image.width() as usize);
+            moves.map(|k| self.part_move(k, image, t.parts, shaded)).collect()
         };
         self.moved = targets.iter().map(|t| (t.parts, record(t))).collect();
     }
@@ -213,25 +202,80 @@ impl EdgePlan {
     /// pixel is, by `1 − fog[pixel]`). Every blend reads the image as it was
     /// before any of them.
     pub fn apply(&self, image: &mut LinearImage, parts: ComponentSet, fog: Option<&[f32]>) {
-        // A crossed pixel's own part moves by the move of its ordinal; its
-        // re-shaded parts across follow all own parts.
-        let moved = self.moved.iter().find(|(p, _)| *p == parts).map(|(_, moved)| moved);
-        let moved = |pixel: u32, k: usize| {
-            let Some(moved) = moved else { return Vec3::ZERO }; // not re-shaded
-            moved[k] * fog.map_or(1.0, |f| 1.0 - f[pixel as usize])
+        let Some((_, moved)) = self.moved.iter().find(|(p, _)| *p == parts) else {
+            return self.blend(image, |_, _, _| Vec3::ZERO); // not re-shaded
         };
+        self.blend(image, |_, pixel, k| moved[k] * fog.map_or(1.0, |f| 1.0 - f[pixel as usize]));
+    }
+
+    /// [`EdgePlan::record`] and [`EdgePlan::apply`] in one step, for a frame
+    /// that nothing changes between its passes and the edge pass (no fog, no
+    /// translucent surfaces): each part's move is found as its pixel is
+    /// blended.
+    pub fn record_and_apply(&self, targets: &mut [Target], shaded: &SubpixelShading) {
+        let reshaded = self.matches(shaded);
+        for t in targets {
+            let (parts, width) = (t.parts, t.image.width() as usize);
+            let moved = |px: &[Vec3], _, k| {
+                if reshaded {
+                    self.part_move(k, (px, width), parts, shaded)
+                } else {
+                    Vec3::ZERO
+                }
+            };
+            self.blend(t.image, moved);
+        }
+    }
+
+    /// Whether the parts are re-shaded and `shaded` holds this plan's samples.
+    fn matches(&self, shaded: &SubpixelShading) -> bool {
+        self.reshade && shaded.samples.len() == self.shaded() + self.across()
+    }
+
+    /// How many parts have a move: the crossed pixels' own parts (by ordinal),
+    /// then the re-shaded parts beyond edges.
+    fn moves(&self) -> usize {
+        self.crossed.len() + self.across()
+    }
+
+    /// How far part `k`'s colour moves from its pixel's in an image (its
+    /// pixels, its width) holding the components `parts`: a shaded part's
+    /// sample in `shaded` less its pixel, a stepped part by its neighbours.
+    fn part_move(&self, k: usize, (px, w): (&[Vec3], usize), parts: ComponentSet, shaded: &SubpixelShading) -> Vec3 {
+        let sampled = |s: usize| {
+            let (x, y) = shaded.samples[s].pixel;
+            shaded.colour(s, parts).map_or(Vec3::ZERO, |colour| colour - px[y as usize * w + x as usize])
+        };
+        let Some(crossed) = self.crossed.get(k) else {
+            return sampled(self.shaded() + k - self.crossed.len());
+        };
+        match crossed.own {
+            OwnPart::Shaded => sampled(crossed.shaded_before as usize),
+            OwnPart::Stepped(steps) => {
+                let c = self.blends[crossed.start as usize].c as usize;
+                steps.iter().map(|&(m, weight)| (px[m as usize] - px[c]) * weight).sum()
+            }
+        }
+    }
+
+    /// Sets every crossed pixel of `image` to its parts' colours weighted by
+    /// their areas, part `k` of pixel `p` moved by `moved(pixels, p, k)` from
+    /// its pixel's colour (own parts by the crossed pixel's ordinal, re-shaded
+    /// parts across after all own parts). Every blend reads the image as it
+    /// was before any of them.
+    fn blend(&self, image: &mut LinearImage, moved: impl Fn(&[Vec3], u32, usize) -> Vec3 + Sync) {
         let px = image.pixels();
         let updates: Vec<(u32, Vec3)> = (self.crossed.par_iter().enumerate())
             .map(|(near, crossed)| {
                 let blends = self.blends_of(crossed);
                 let c = blends[0].c;
-                let own = px[c as usize] + moved(c, near);
+                let own = px[c as usize] + moved(px, c, near);
                 let mut far = self.crossed.len() + crossed.across_before as usize;
                 let mut colour = own;
                 for b in blends {
                     let mut across = px[b.o as usize];
                     if reshaded_across(b) {
-                        across += moved(b.o, far);
+                        across += moved(px, b.o, far);
                         far += 1;
                     }
                     colour += (across - own) * b.alpha;
