@@ -211,6 +211,9 @@ fn render_into(scene: &Scene, frame: &mut Frame, scratch: &mut Scratch, options:
         scratch.accum.pixels_mut().fill(Vec3::ZERO);
         frame.aovs.iter_mut().for_each(|(_, a)| a.pixels_mut().fill(Vec3::ZERO));
         let mut pass = scene.clone();
+        // Directional lights' maps are fitted to the unshifted view: the
+        // passes share them (and the next frame may reuse them).
+        scratch.maps.fit_to(Some(scene.camera));
         let pixel = 2.0 / Vec2::new(w as f32, h as f32);
         let k = 1.0 / offsets.len() as f32;
         for &o in &offsets {
@@ -220,6 +223,7 @@ fn render_into(scene: &Scene, frame: &mut Frame, scratch: &mut Scratch, options:
             add_scaled(&mut scratch.accum, &frame.image, k);
             frame.aovs.iter_mut().zip(&scratch.aovs).for_each(|((_, a), s)| add_scaled(a, s, k));
         }
+        scratch.maps.fit_to(None);
         std::mem::swap(&mut frame.image, &mut scratch.accum);
     }
     frame.stats.buffer_bytes = frame.visibility.memory_bytes()

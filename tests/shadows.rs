@@ -272,3 +272,33 @@ fn shadow_maps_are_reused_while_only_the_camera_moves() {
     assert_eq!(frame.stats.shadow_maps_reused, 0, "a moved object needs new maps");
     assert!(frame.image.pixels() == render(&scene, &RenderOptions::default()).unwrap().image.pixels());
 }
+
+/// Jittered passes shift the camera by fractions of a pixel; a directional
+/// light's map, fitted to the view, is fitted to the unshifted one, so the
+/// passes after the first reuse the first's maps and the next frame reuses
+/// them all (jitter 4 then costs about four aliased frames).
+#[test]
+fn jittered_passes_share_the_maps_fitted_to_the_view() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenes/cad-ortho.toml");
+    let mut scene = kage::scene::file::load_scene(&path).unwrap();
+    (scene.width, scene.height) = (160, 120);
+    scene.antialias = kage::resolve::Antialias::Jitter(4);
+    let maps = kage::shading::frame_lights(&scene)
+        .iter()
+        .flat_map(|l| &l.samples)
+        .filter(|l| {
+            matches!(l.kind, LightKind::Directional { .. }) && l.shadow.method != kage::scene::ShadowMethod::None
+        })
+        .count();
+    assert!(maps >= 1, "the scene has a shadowed directional light");
+    let mut renderer = kage::Renderer::new(&RenderOptions::default()).unwrap();
+    let first = renderer.render(&scene).unwrap().stats;
+    assert_eq!(first.shadow_maps_reused, 3 * maps, "passes 2-4 reuse the first pass's maps");
+    let next = renderer.render(&scene).unwrap().stats;
+    assert_eq!(next.shadow_maps_reused, 4 * maps, "the next frame reuses them in every pass");
+    // An aliased frame after the jittered ones fits its maps to its own view
+    // again: the same image as a fresh render.
+    scene.antialias = kage::resolve::Antialias::None;
+    let aliased = renderer.render(&scene).unwrap().image.clone();
+    assert!(aliased.pixels() == render(&scene, &RenderOptions::default()).unwrap().image.pixels());
+}

@@ -50,6 +50,7 @@ impl ShadowTerm {
     pub fn build_within(scene: &Scene, light: &Light, bounds: (Vec3, Vec3), pool: &mut MapPool) -> ShadowTerm {
         let settings = light.shadow;
         let res = settings.resolution.max(1);
+        let view = *pool.view(scene);
         let mut map = |cam: Camera, res: u32| DepthMap::render(scene, &cam, res, pool.take());
         match placement(light, bounds) {
             Placement::None => ShadowTerm::Unshadowed,
@@ -66,7 +67,7 @@ impl ShadowTerm {
             }
             Placement::Parallel { direction } => {
                 let aspect = scene.width as f32 / scene.height as f32;
-                ShadowTerm::Map(map(fitted_orthographic(&scene.camera, aspect, direction, bounds), res), settings)
+                ShadowTerm::Map(map(fitted_orthographic(&view, aspect, direction, bounds), res), settings)
             }
         }
     }
@@ -203,7 +204,8 @@ fn placement(light: &Light, bounds: (Vec3, Vec3)) -> Placement {
 /// of the last frame, reused while nothing they depend on changes: an
 /// interactive viewer whose camera moves re-renders no spot or point light's
 /// maps (a directional light's map is fitted to the view, so it follows the
-/// camera).
+/// camera; the jittered passes of one frame share the map fitted to the
+/// unshifted view: [`MapPool::fit_to`]).
 #[derive(Debug, Default)]
 pub struct MapPool {
     free: Vec<VisibilityBuffer>,
@@ -215,6 +217,9 @@ pub struct MapPool {
     geometry: Vec<(Body, Affine3A)>,
     /// Terms reused since [`MapPool::begin_frame`].
     reused: usize,
+    /// The view directional lights' maps are fitted to (`None`: each scene's
+    /// camera).
+    view: Option<Camera>,
 }
 
 /// What a light's shadow term depends on besides the geometry.
@@ -227,9 +232,9 @@ struct MapKey {
 }
 
 impl MapKey {
-    fn of(scene: &Scene, light: &Light, bounds: (Vec3, Vec3)) -> MapKey {
+    fn of(scene: &Scene, light: &Light, bounds: (Vec3, Vec3), view: &Camera) -> MapKey {
         let fitted = matches!(placement(light, bounds), Placement::Parallel { .. });
-        MapKey { light: light.clone(), bounds, view: fitted.then_some((scene.camera, scene.width, scene.height)) }
+        MapKey { light: light.clone(), bounds, view: fitted.then_some((*view, scene.width, scene.height)) }
     }
 }
 
@@ -253,7 +258,7 @@ impl MapPool {
     /// The shadow term of `light`: last frame's if it still holds, else newly
     /// rendered. Give it back with [`MapPool::keep`] or [`MapPool::recycle`].
     pub fn term(&mut self, scene: &Scene, light: &Light, bounds: (Vec3, Vec3)) -> ShadowTerm {
-        let key = MapKey::of(scene, light, bounds);
+        let key = MapKey::of(scene, light, bounds, self.view(scene));
         if let Some(k) = self.previous.iter().position(|(have, _)| *have == key) {
             self.reused += 1;
             return self.previous.swap_remove(k).1;
@@ -263,7 +268,19 @@ impl MapPool {
 
     /// Keeps `light`'s term for the next frame.
     pub fn keep(&mut self, scene: &Scene, light: &Light, bounds: (Vec3, Vec3), term: ShadowTerm) {
-        self.kept.push((MapKey::of(scene, light, bounds), term));
+        self.kept.push((MapKey::of(scene, light, bounds, self.view(scene)), term));
+    }
+
+    /// Fits directional lights' maps to `view` instead of each scene's camera
+    /// (`None`): the jittered passes of a frame shift the camera by a fraction
+    /// of a pixel each, and share the maps fitted to the unshifted view.
+    pub fn fit_to(&mut self, view: Option<Camera>) {
+        self.view = view;
+    }
+
+    /// The view directional lights' maps are fitted to in `scene`.
+    fn view<'a>(&'a self, scene: &'a Scene) -> &'a Camera {
+        self.view.as_ref().unwrap_or(&scene.camera)
     }
 
     /// Terms reused from the last frame since this frame began.
