@@ -139,7 +139,7 @@ fn part_centroid(v0: f64, v1: f64, beyond_below: bool) -> (f64, f64) {
         return (mu / area - 0.5, mv / area - 0.5);
     }
     let sign = if beyond_below { 1.0 } else { -1.0 };
-    square_part(|(u, v)| sign * (v - (v0 + (v1 - v0) * u))).1
+    square_part(|(u, v)| sign * (v - (v0 + k * u))).1
 }
 
 /// The part of the unit square (u, v) ∈ [0, 1]² where the affine function

@@ -521,7 +521,7 @@ fn merge(blends: Vec<EdgeBlend>, cap: f32, width: u32) -> Vec<EdgeBlend> {
 }
 
 /// `blends` sorted by pixel, neighbour, then (for a fixed order of the edges
-/// meeting there) inside first and by edge: bucketed by image row (a counting
+/// meeting there) outside first and by edge: bucketed by image row (a counting
 /// sort on a `width` pixels wide frame), then each row's few blends compared.
 fn sorted_by_pixel(blends: Vec<EdgeBlend>, width: u32) -> Vec<EdgeBlend> {
     let rows: Vec<u32> = blends.iter().map(|b| b.c / width.max(1)).collect();
