@@ -420,7 +420,14 @@ impl Walker<'_> {
         // as the other's neighbour.
         let mut sides = LastTwo::new();
         let (w, h) = (self.vb.width(), self.vb.height());
+        let items = self.vb.items();
         let visit = |c: (u32, u32), other: (u32, u32), alpha, point: glam::DVec3, far: PartBeyond| {
+            // Only a pixel of the edge's own object can be its own surface, and
+            // a blend needs one.
+            let ours = |(x, y): (u32, u32)| items[(y * w + x) as usize].object == object.index;
+            if !ours(c) && !ours(other) {
+                return;
+            }
             let mut side = |i: usize| sides.get((i, point), || self.side((object, e), &near, &mut planes, i, point));
             if let Some(blend) = depth_tested(w, &mut side, c, other, alpha, self.mode.filter) {
                 out.push(EdgeBlend { source, far: far.centroid(), ..blend });
