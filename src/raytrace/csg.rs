@@ -83,12 +83,26 @@ impl CsgCaster {
         Self::from_solid(solid.clone())
     }
 
+    /// Prepares a copy of `solid` for a caller that finds the primitives each
+    /// ray meets itself (seed 003's scanline walk knows every row's
+    /// occupants): without the BVH, which [`CsgCaster::first_hit`] alone uses.
+    #[must_use]
+    pub fn without_bvh(solid: &CsgSolid) -> Self {
+        Self::prepared(solid.clone(), false)
+    }
+
     /// Prepares `solid`.
     #[must_use]
     pub fn from_solid(solid: CsgSolid) -> Self {
+        Self::prepared(solid, true)
+    }
+
+    /// Prepares `solid`, with a BVH over its primitives if `bvh` and it has
+    /// enough of them.
+    fn prepared(solid: CsgSolid, bvh: bool) -> Self {
         let frames = solid.primitives.iter().map(|p| (p.transform.inverse(), normal_matrix(&p.transform))).collect();
         let n = solid.primitives.len();
-        let bvh = solid.tree.as_ref().filter(|_| n >= Self::BVH_PRIMITIVES).map(|tree| {
+        let bvh = solid.tree.as_ref().filter(|_| bvh && n >= Self::BVH_PRIMITIVES).map(|tree| {
             let boxes: Vec<Aabb> = solid.primitives.iter().map(|p| Aabb::around(&p.corners())).collect();
             (Bvh::build(&boxes), OccupancyTree::new(tree, n))
         });

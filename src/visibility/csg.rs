@@ -205,7 +205,7 @@ fn scan_bands<B: Send>(
     let mut entry: Vec<(usize, Extent)> =
         outlines.iter().enumerate().filter_map(|(i, o)| o.as_ref().map(|o| (i, o.rows))).collect();
     entry.sort_by_key(|(_, e)| e.y0);
-    let caster = CsgCaster::new(solid);
+    let caster = CsgCaster::without_bvh(solid);
     // Along a row line's direction (unit component along the view axis), the
     // near plane lies at t = near, under either projection.
     let near = camera.near;
