@@ -76,7 +76,12 @@ pub struct FrameLight {
 /// The lights a frame is shaded with: the scene's, each with its shadow samples.
 #[must_use]
 pub fn frame_lights(scene: &Scene) -> Vec<FrameLight> {
-    let centre = scene.bounds().map_or(glam::Vec3::ZERO, |(lo, hi)| (lo + hi) * 0.5);
+    frame_lights_within(scene, scene.bounds().unwrap_or_default())
+}
+
+/// [`frame_lights`] with the scene's bounds already known.
+fn frame_lights_within(scene: &Scene, (lo, hi): (Vec3, Vec3)) -> Vec<FrameLight> {
+    let centre = (lo + hi) * 0.5;
     scene.lights.iter().map(|l| FrameLight { light: l.clone(), samples: l.jittered(centre) }).collect()
 }
 
@@ -126,7 +131,7 @@ pub fn shade_lit_while(
     pool.begin_frame(scene);
     let mut budget = FUSED_SHADOW_BUDGET;
     let bounds = scene.bounds().unwrap_or_default();
-    let lights = frame_lights(scene);
+    let lights = frame_lights_within(scene, bounds);
     let (mut fused, mut own) = (Vec::new(), Vec::new());
     for light in &lights {
         let bytes: usize = light.samples.iter().map(|s| ShadowTerm::bytes_needed(s, bounds)).sum();
