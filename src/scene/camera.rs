@@ -154,6 +154,18 @@ impl Camera {
         along_view / ray.dir.dot((self.target - self.eye).normalize()).max(1e-6)
     }
 
+    /// The reversed depth (see [`crate::visibility::VisibilityBuffer`]) of a
+    /// point `distance` along the view axis from the eye (perspective) or the
+    /// eye plane (orthographic): what the projection's `z / w` gives, without
+    /// the matrix.
+    #[must_use]
+    pub fn depth_at_view_distance(&self, distance: f32) -> f32 {
+        match self.projection {
+            Projection::Perspective { .. } => self.near / distance,
+            Projection::Orthographic { .. } => (self.far - distance) / (self.far - self.near),
+        }
+    }
+
     /// Checks the camera can form an image; returns what is wrong otherwise.
     pub fn validate(&self) -> Result<(), String> {
         let finite = self.eye.is_finite() && self.target.is_finite() && self.up.is_finite();

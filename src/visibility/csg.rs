@@ -112,8 +112,14 @@ pub fn scan_solid_into(
     let walker = RowWalker::new(solid, method)?;
     out.resize(w * height as usize, None);
     let bands = out.par_chunks_mut(w * BAND_ROWS);
-    scan_bands(solid, &walker, camera, (width, height), bands, |band, dy, row| {
-        band[dy * w..(dy + 1) * w].copy_from_slice(row);
+    scan_bands(solid, &walker, camera, (width, height), bands, |band, dy, line, row| {
+        let out = &mut band[dy * w..(dy + 1) * w];
+        out.copy_from_slice(row);
+        // Distances along the unnormalised row line become distances along
+        // the unit pixel ray.
+        for (x, c) in out.iter_mut().enumerate().filter_map(|(x, c)| Some((x, c.as_mut()?))) {
+            c.t *= line.at(x as f32).dir.length();
+        }
     });
     Ok(())
 }
@@ -145,9 +151,7 @@ impl RowWalker {
 pub fn draw_solids(scene: &Scene, camera: &Camera, vb: &mut VisibilityBuffer) -> usize {
     let (width, height) = (vb.width(), vb.height());
     let w = width as usize;
-    let vp = camera.view_projection(width as f32 / height as f32);
     let far = camera.far_plane_factor();
-    let rays = camera.pixel_rays(Vec2::new(width as f32, height as f32));
     let mut drawn = 0;
     for (object, o) in scene.objects.iter().enumerate() {
         let Some(solid) = o.solid() else { continue };
@@ -162,12 +166,10 @@ pub fn draw_solids(scene: &Scene, camera: &Camera, vb: &mut VisibilityBuffer) ->
             .collect();
         let bands = bands.into_par_iter().enumerate();
         let walker = RowWalker::new(&world, CsgMethod::Segments).expect("segments need no expansion");
-        scan_bands(&world, &walker, camera, (width, height), bands, |(band, (depth, items, normals)), dy, row| {
-            let y = *band * BAND_ROWS + dy;
+        scan_bands(&world, &walker, camera, (width, height), bands, |(_, (depth, items, normals)), dy, _, row| {
             for (x, c) in row.iter().enumerate().filter_map(|(x, c)| Some((x, c.as_ref()?))) {
-                let point = rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5)).at(c.t);
-                let clip = vp * point.extend(1.0);
-                let z = clip.z / clip.w;
+                // A crossing's `t` along its row line is its distance along the view axis.
+                let z = camera.depth_at_view_distance(c.t);
                 let i = dy * w + x;
                 if z > depth[i] && z >= far && z <= 1.0 {
                     depth[i] = z;
@@ -184,15 +186,16 @@ pub fn draw_solids(scene: &Scene, camera: &Camera, vb: &mut VisibilityBuffer) ->
 }
 
 /// The walk itself: for each band of [`BAND_ROWS`] rows (in parallel, `bands`
-/// gives each its output), `visit(band, row_in_band, crossings)` with the row's
-/// visible crossings.
+/// gives each its output), `visit(band, row_in_band, line, crossings)` with
+/// the row's visible crossings, their `t` counted along the row's rays
+/// `line` ([`RowLine`]: the distance along the view axis).
 fn scan_bands<B: Send>(
     solid: &CsgSolid,
     walker: &RowWalker,
     camera: &Camera,
     (width, height): (u32, u32),
     bands: impl IndexedParallelIterator<Item = B>,
-    visit: impl Fn(&mut B, usize, &[Option<Crossing>]) + Sync,
+    visit: impl Fn(&mut B, usize, &RowLine, &[Option<Crossing>]) + Sync,
 ) {
     let (w, h) = (width as usize, height as usize);
     if matches!(walker, RowWalker::Empty) {
@@ -246,12 +249,7 @@ fn scan_bands<B: Send>(
                     RowWalker::Pattern(matrix) => matrix.walk_row(&caster, &ends, &span, near, row),
                     RowWalker::Empty => {}
                 }
-                // Distances along the unnormalised row line become distances
-                // along the unit pixel ray.
-                for (x, c) in row.iter_mut().enumerate().filter_map(|(x, c)| Some((x, c.as_mut()?))) {
-                    c.t *= line.at(x as f32).dir.length();
-                }
-                visit(&mut out, dy, row);
+                visit(&mut out, dy, &line, row);
             }
         },
     );
