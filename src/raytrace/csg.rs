@@ -51,6 +51,48 @@ pub struct Span {
     pub exit: Crossing,
 }
 
+/// A [`Crossing`] before its normal is found: which face of which primitive
+/// the ray crosses, and where. Combining intervals along the tree reads only
+/// `t`, so the booleans move these (12 bytes) and only the crossing finally
+/// seen pays for its normal ([`CsgCaster::crossing_on_ray`],
+/// [`CsgCaster::crossing_on_line`]), from the face and the ray.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Hit {
+    /// Ray parameter.
+    pub t: f32,
+    /// The primitive whose surface it is.
+    pub primitive: u32,
+    /// The face of the primitive's unit shape (a polyhedron's plane; a
+    /// frustum's side or cap), and in its top bit whether the surface
+    /// belongs to a subtracted primitive (a hole's wall).
+    face: u32,
+}
+
+impl Hit {
+    /// The bit of `face` that marks a hole's wall.
+    const CUT: u32 = 1 << 31;
+
+    fn new(t: f32, primitive: usize, face: u32) -> Hit {
+        Hit { t, primitive: primitive as u32, face }
+    }
+
+    /// Whether the surface belongs to a subtracted primitive (a hole's wall).
+    #[must_use]
+    pub fn cut(&self) -> bool {
+        self.face & Self::CUT != 0
+    }
+}
+
+/// A stretch of a ray inside a primitive or a part of the solid, its ends
+/// not yet given normals ([`Hit`]): what the booleans combine.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Interval {
+    /// Where the ray enters.
+    pub enter: Hit,
+    /// Where it leaves.
+    pub exit: Hit,
+}
+
 /// The spans of `ray` inside `solid`, sorted and disjoint (empty if it misses).
 #[must_use]
 pub fn spans(solid: &CsgSolid, ray: &Ray) -> Vec<Span> {
@@ -134,22 +176,26 @@ impl CsgCaster {
     /// The span of `ray` inside primitive `i`, if it meets it.
     #[must_use]
     pub fn span(&self, i: usize, ray: &Ray) -> Option<Span> {
-        self.raw_span(i, ray).map(|s| Span { enter: self.finish(s.enter), exit: self.finish(s.exit) })
+        self.interval(i, ray).map(|s| self.finish_on_ray(s, ray))
     }
 
-    /// [`CsgCaster::span`] with its normals left in the unit shape's space
-    /// (unnormalised): combining spans needs only `t`, so only the crossing
-    /// finally seen pays for its normal ([`CsgCaster::finish`]).
-    fn raw_span(&self, i: usize, ray: &Ray) -> Option<Span> {
-        let (o, d) = (self.frames[i].0.transform_point3(ray.origin), self.frames[i].0.transform_vector3(ray.dir));
-        self.unit_span_of(i, o, d)
+    /// [`CsgCaster::span`] before its ends are given normals: what the
+    /// booleans combine.
+    #[must_use]
+    pub fn interval(&self, i: usize, ray: &Ray) -> Option<Interval> {
+        let (o, d) = self.unit_ray(i, ray);
+        self.unit_interval(i, o, d)
     }
 
-    /// The raw span of primitive `i` along `o + t·d` in its unit shape's space.
-    fn unit_span_of(&self, i: usize, o: Vec3, d: Vec3) -> Option<Span> {
-        let ((t0, n0), (t1, n1)) = unit_span(&self.solid.primitives[i].shape, o, d)?;
-        let crossing = |t: f32, normal: Vec3| Crossing { t, normal, primitive: i as u32, cut: false };
-        Some(Span { enter: crossing(t0, n0), exit: crossing(t1, n1) })
+    /// `ray` carried into primitive `i`'s unit space.
+    fn unit_ray(&self, i: usize, ray: &Ray) -> (Vec3, Vec3) {
+        (self.frames[i].0.transform_point3(ray.origin), self.frames[i].0.transform_vector3(ray.dir))
+    }
+
+    /// The interval of primitive `i` along `o + t·d` in its unit shape's space.
+    fn unit_interval(&self, i: usize, o: Vec3, d: Vec3) -> Option<Interval> {
+        let ((t0, f0), (t1, f1)) = unit_span(&self.solid.primitives[i].shape, o, d)?;
+        Some(Interval { enter: Hit::new(t0, i, f0), exit: Hit::new(t1, i, f1) })
     }
 
     /// A scanline's rays ([`RowLine`]) carried into primitive `i`'s unit space
@@ -166,46 +212,74 @@ impl CsgCaster {
         }
     }
 
-    /// The raw span of primitive `i` along pixel `x`'s ray of `unit` (a line
+    /// The interval of primitive `i` along pixel `x`'s ray of `unit` (a line
     /// from [`CsgCaster::unit_line`]); `t` counts lengths of the line's
     /// (unnormalised) direction.
     #[must_use]
-    pub fn span_on(&self, i: usize, unit: &RowLine, x: f32) -> Option<Span> {
-        self.unit_span_of(i, unit.origin + unit.origin_step * x, unit.dir + unit.dir_step * x)
+    pub fn span_on(&self, i: usize, unit: &RowLine, x: f32) -> Option<Interval> {
+        let (o, d) = unit_ray_on(unit, x);
+        self.unit_interval(i, o, d)
     }
 
-    /// A crossing of [`CsgCaster::raw_span`] with its unit outward normal in
-    /// solid space.
-    fn finish(&self, c: Crossing) -> Crossing {
-        Crossing { normal: (self.frames[c.primitive as usize].1 * c.normal).normalize_or_zero(), ..c }
+    /// The crossing `hit` of `ray` with its unit outward normal (solid space).
+    #[must_use]
+    pub fn crossing_on_ray(&self, hit: Hit, ray: &Ray) -> Crossing {
+        let (o, d) = self.unit_ray(hit.primitive as usize, ray);
+        self.finish(hit, o + d * hit.t)
+    }
+
+    /// The crossing `hit` of pixel `x`'s ray of `unit` (the line of the hit's
+    /// primitive from [`CsgCaster::unit_line`]) with its unit outward normal
+    /// (solid space).
+    #[must_use]
+    pub fn crossing_on_line(&self, hit: Hit, unit: &RowLine, x: f32) -> Crossing {
+        let (o, d) = unit_ray_on(unit, x);
+        self.finish(hit, o + d * hit.t)
+    }
+
+    /// `hit` with the unit outward normal (solid space) of its face at `p`
+    /// (unit shape space): the shape's normal carried back by the inverse
+    /// transpose, reversed on a hole's wall.
+    fn finish(&self, hit: Hit, p: Vec3) -> Crossing {
+        let i = hit.primitive as usize;
+        let n = unit_normal(&self.solid.primitives[i].shape, hit.face & !Hit::CUT, p);
+        let normal = (self.frames[i].1 * n).normalize_or_zero();
+        let cut = hit.cut();
+        Crossing { t: hit.t, normal: if cut { -normal } else { normal }, primitive: hit.primitive, cut }
+    }
+
+    /// Both ends of `interval` (of `ray`) with their normals.
+    fn finish_on_ray(&self, interval: Interval, ray: &Ray) -> Span {
+        Span { enter: self.crossing_on_ray(interval.enter, ray), exit: self.crossing_on_ray(interval.exit, ray) }
     }
 
     /// The spans of `ray` inside the part of the solid `tree` describes.
     #[must_use]
     pub fn spans_of(&self, tree: &CsgTree, ray: &Ray) -> Vec<Span> {
         let mut scratch = SpanScratch::default();
-        combine(tree, &|i| self.raw_span(i, ray), &mut scratch);
-        scratch.stack.iter().map(|s| Span { enter: self.finish(s.enter), exit: self.finish(s.exit) }).collect()
+        combine(tree, &|i| self.interval(i, ray), &mut scratch);
+        scratch.stack.iter().map(|&s| self.finish_on_ray(s, ray)).collect()
     }
 
     /// The first surface of the part `tree` along `ray` at `t > t_min`, with
     /// buffers reused from pixel to pixel.
     #[must_use]
     pub fn first_hit_with(&self, tree: &CsgTree, ray: &Ray, t_min: f32, scratch: &mut SpanScratch) -> Option<Crossing> {
-        self.first_hit_in_by([tree], &|i| self.raw_span(i, ray), t_min, scratch)
+        self.first_hit_in_by([tree], &|i| self.interval(i, ray), t_min, scratch).map(|h| self.crossing_on_ray(h, ray))
     }
 
     /// The first surface at `t > t_min` of the union of the parts `trees`
     /// describe (seed 003's nearest surface over segments), each primitive's
-    /// span (normals not yet carried to solid space) from `leaf` — e.g.
-    /// [`CsgCaster::span_on`] — with buffers reused from pixel to pixel.
+    /// interval from `leaf` — e.g. [`CsgCaster::span_on`] — with buffers
+    /// reused from pixel to pixel. Its normal is found by the caller, who
+    /// knows the ray ([`CsgCaster::crossing_on_line`]).
     pub fn first_hit_in_by<B: Booleans>(
         &self,
         trees: impl IntoIterator<Item = B>,
-        leaf: &impl Fn(usize) -> Option<Span>,
+        leaf: &impl Fn(usize) -> Option<Interval>,
         t_min: f32,
         scratch: &mut SpanScratch,
-    ) -> Option<Crossing> {
+    ) -> Option<Hit> {
         scratch.stack.clear();
         let mut parts = 0;
         for tree in trees {
@@ -215,32 +289,32 @@ impl CsgCaster {
         if parts > 1 {
             union(&mut scratch.stack, 0);
         }
-        scratch.stack.iter().flat_map(|s| [s.enter, s.exit]).find(|c| c.t > t_min).map(|c| self.finish(c))
+        scratch.stack.iter().flat_map(|s| [s.enter, s.exit]).find(|c| c.t > t_min)
     }
 
     /// The first surface beyond `t_min` of a union of pattern-matrix segments
     /// (seed 003 §5.2.1): per segment, the intersection of its positive
     /// primitives' intervals minus the intervals of its negative primitives
     /// that `occupying` says cover the pixel; the nearest over the segments.
-    /// `span` gives a primitive's span, normals not yet carried to solid space
-    /// ([`CsgCaster::span_on`], cached by the caller).
+    /// `span` gives a primitive's interval ([`CsgCaster::span_on`], cached by
+    /// the caller), who finds the normal of the hit returned.
     pub fn first_hit_of_segments<'s>(
         &self,
         segments: impl IntoIterator<Item = &'s crate::visibility::pattern::Segment>,
         occupying: &impl Fn(usize) -> bool,
-        span: &mut impl FnMut(usize) -> Option<Span>,
+        span: &mut impl FnMut(usize) -> Option<Interval>,
         t_min: f32,
         scratch: &mut SpanScratch,
-    ) -> Option<Crossing> {
+    ) -> Option<Hit> {
         scratch.stack.clear();
         let mut parts = 0;
         'segments: for seg in segments {
-            let mut inside: Option<Span> = None;
+            let mut inside: Option<Interval> = None;
             for &i in &seg.positive {
                 let Some(s) = span(i) else { continue 'segments };
                 inside = Some(match inside {
                     None => s,
-                    Some(a) => Span {
+                    Some(a) => Interval {
                         enter: if a.enter.t >= s.enter.t { a.enter } else { s.enter },
                         exit: if a.exit.t <= s.exit.t { a.exit } else { s.exit },
                     },
@@ -265,7 +339,7 @@ impl CsgCaster {
         if parts > 1 {
             union(&mut scratch.stack, 0);
         }
-        scratch.stack.iter().flat_map(|s| [s.enter, s.exit]).find(|c| c.t > t_min).map(|c| self.finish(c))
+        scratch.stack.iter().flat_map(|s| [s.enter, s.exit]).find(|c| c.t > t_min)
     }
 
     /// The spans of `ray` inside the solid.
@@ -297,7 +371,7 @@ impl CsgCaster {
                 counts.fit(shape);
                 met.iter().for_each(|&i| counts.set(shape, i as usize, true));
                 let root = counts.root(shape);
-                let hit = root.and_then(|root| self.first_hit_in_by([root], &|i| self.raw_span(i, ray), t_min, s));
+                let hit = root.and_then(|root| self.first_hit_in_by([root], &|i| self.interval(i, ray), t_min, s));
                 counts.clear(shape);
                 s.counts = counts;
                 hit
@@ -306,7 +380,7 @@ impl CsgCaster {
                 let mut crossed = std::mem::take(&mut s.crossed);
                 crossed.resize(self.frames.len(), false);
                 met.iter().for_each(|&i| crossed[i as usize] = true);
-                let leaf = |i: usize| if crossed[i] { self.raw_span(i, ray) } else { None };
+                let leaf = |i: usize| if crossed[i] { self.interval(i, ray) } else { None };
                 let hit = self.first_hit_in_by([tree], &leaf, t_min, s);
                 met.iter().for_each(|&i| crossed[i as usize] = false);
                 s.crossed = crossed;
@@ -314,7 +388,7 @@ impl CsgCaster {
             };
             met.clear();
             s.met = met;
-            hit.filter(|c| c.t < t_max)
+            hit.filter(|c| c.t < t_max).map(|h| self.crossing_on_ray(h, ray))
         })
     }
 
@@ -324,8 +398,9 @@ impl CsgCaster {
     #[must_use]
     pub fn first_hit_every_primitive(&self, ray: &Ray, t_min: f32) -> Option<Crossing> {
         let tree = self.solid.tree.as_ref()?;
-        let all: Vec<Option<Span>> = (0..self.frames.len()).map(|i| self.raw_span(i, ray)).collect();
+        let all: Vec<Option<Interval>> = (0..self.frames.len()).map(|i| self.interval(i, ray)).collect();
         self.first_hit_in_by([tree], &|i| all[i], t_min, &mut SpanScratch::default())
+            .map(|h| self.crossing_on_ray(h, ray))
     }
 }
 
@@ -339,8 +414,8 @@ thread_local! {
 /// nothing: each node leaves its spans on top of `stack`.
 #[derive(Debug, Clone, Default)]
 pub struct SpanScratch {
-    stack: Vec<Span>,
-    out: Vec<Span>,
+    stack: Vec<Interval>,
+    out: Vec<Interval>,
     /// The primitives whose boxes the ray crosses.
     met: Vec<u32>,
     /// The same as flags (all false between rays).
@@ -400,16 +475,17 @@ impl Booleans for &CsgTree {
 }
 
 impl SpanScratch {
-    /// The spans on the stack: after one [`combine`] from empty, the tree's.
+    /// The intervals on the stack: after one [`combine`] from empty, the tree's.
     #[must_use]
-    pub fn spans(&self) -> &[Span] {
+    pub fn spans(&self) -> &[Interval] {
         &self.stack
     }
 }
 
-/// The spans of the subtree `tree`, given each leaf's span (at most one: a
-/// primitive is convex), left on top of `scratch.stack`; returns where they start.
-pub fn combine<B: Booleans>(tree: B, leaf: &impl Fn(usize) -> Option<Span>, scratch: &mut SpanScratch) -> usize {
+/// The intervals of the subtree `tree`, given each leaf's interval (at most
+/// one: a primitive is convex), left on top of `scratch.stack`; returns where
+/// they start.
+pub fn combine<B: Booleans>(tree: B, leaf: &impl Fn(usize) -> Option<Interval>, scratch: &mut SpanScratch) -> usize {
     let base = scratch.stack.len();
     let Parts { operation, first, others } = tree.parts();
     match operation {
@@ -451,7 +527,7 @@ pub fn combine<B: Booleans>(tree: B, leaf: &impl Fn(usize) -> Option<Span>, scra
 
 /// Merges the spans on `stack` from `base` into sorted disjoint spans covering
 /// their union.
-fn union(stack: &mut Vec<Span>, base: usize) {
+fn union(stack: &mut Vec<Interval>, base: usize) {
     stack[base..].sort_unstable_by(|x, y| x.enter.t.total_cmp(&y.enter.t));
     let mut last = base;
     for k in base..stack.len() {
@@ -471,13 +547,13 @@ fn union(stack: &mut Vec<Span>, base: usize) {
 }
 
 /// Sorted disjoint spans covering `a ∩ b`, into `out`.
-fn intersection(a: &[Span], b: &[Span], out: &mut Vec<Span>) {
+fn intersection(a: &[Interval], b: &[Interval], out: &mut Vec<Interval>) {
     for x in a {
         for y in b {
             let enter = if x.enter.t >= y.enter.t { x.enter } else { y.enter };
             let exit = if x.exit.t <= y.exit.t { x.exit } else { y.exit };
             if enter.t < exit.t {
-                out.push(Span { enter, exit });
+                out.push(Interval { enter, exit });
             }
         }
     }
@@ -487,7 +563,7 @@ fn intersection(a: &[Span], b: &[Span], out: &mut Vec<Span>) {
 /// Sorted disjoint spans covering `a` minus `b`, `b` widened by [`TIE`], into
 /// `out`: where the ray leaves a cutter it enters the remaining solid through the
 /// cutter's wall, whose outward normal (for the solid) is the cutter's, reversed.
-fn difference(a: &[Span], b: &[Span], out: &mut Vec<Span>) {
+fn difference(a: &[Interval], b: &[Interval], out: &mut Vec<Interval>) {
     for x in a {
         // `b` is sorted and disjoint: walk it once, cutting `x` from the left.
         let mut rest = Some(*x);
@@ -501,17 +577,18 @@ fn difference(a: &[Span], b: &[Span], out: &mut Vec<Span>) {
                 break;
             }
             if p.enter.t < lo {
-                out.push(Span { enter: p.enter, exit: wall(y.enter) });
+                out.push(Interval { enter: p.enter, exit: wall(y.enter) });
             }
-            rest = (p.exit.t > hi).then(|| Span { enter: wall(y.exit), exit: p.exit });
+            rest = (p.exit.t > hi).then(|| Interval { enter: wall(y.exit), exit: p.exit });
         }
         out.extend(rest);
     }
 }
 
-/// A cutter's crossing seen as the wall of the hole it makes.
-fn wall(c: Crossing) -> Crossing {
-    Crossing { normal: -c.normal, cut: !c.cut, ..c }
+/// A cutter's crossing seen as the wall of the hole it makes (its normal
+/// will be the cutter's, reversed).
+fn wall(c: Hit) -> Hit {
+    Hit { face: c.face ^ Hit::CUT, ..c }
 }
 
 /// The span of `ray` inside primitive `p` (index `index`), if it meets it.
@@ -519,15 +596,45 @@ fn wall(c: Crossing) -> Crossing {
 pub fn primitive_span(p: &Primitive, index: usize, ray: &Ray) -> Option<Span> {
     let (to_unit, to_solid) = (p.transform.inverse(), normal_matrix(&p.transform));
     let (o, d) = (to_unit.transform_point3(ray.origin), to_unit.transform_vector3(ray.dir));
-    let ((t0, n0), (t1, n1)) = unit_span(&p.shape, o, d)?;
-    let crossing = |t: f32, n: Vec3| Crossing {
+    let ((t0, f0), (t1, f1)) = unit_span(&p.shape, o, d)?;
+    let crossing = |t: f32, face: u32| Crossing {
         t,
-        normal: (to_solid * n).normalize_or_zero(),
+        normal: (to_solid * unit_normal(&p.shape, face, o + d * t)).normalize_or_zero(),
         primitive: index as u32,
         cut: false,
     };
-    Some(Span { enter: crossing(t0, n0), exit: crossing(t1, n1) })
+    Some(Span { enter: crossing(t0, f0), exit: crossing(t1, f1) })
 }
+
+/// Pixel `x`'s ray of a row line: origin and (unnormalised) direction.
+fn unit_ray_on(unit: &RowLine, x: f32) -> (Vec3, Vec3) {
+    (unit.origin + unit.origin_step * x, unit.dir + unit.dir_step * x)
+}
+
+/// The (unnormalised) outward normal of a unit shape's face `face` at its
+/// point `p`: the sphere's radius; a frustum's side (face [`SIDE`]) or caps
+/// ([`BOTTOM`], [`TOP`]); a polyhedron's plane.
+fn unit_normal(shape: &Shape, face: u32, p: Vec3) -> Vec3 {
+    match shape {
+        Shape::Sphere => p,
+        Shape::Frustum { bottom, top } => match face {
+            BOTTOM => Vec3::NEG_Z,
+            TOP => Vec3::Z,
+            _ => {
+                let k = top - bottom;
+                Vec3::new(p.x, p.y, -k * (bottom + k * p.z))
+            }
+        },
+        Shape::Polyhedron(poly) => poly.planes[face as usize].truncate(),
+    }
+}
+
+/// A frustum's faces ([`unit_normal`]).
+const SIDE: u32 = 0;
+/// See [`SIDE`].
+const BOTTOM: u32 = 1;
+/// See [`SIDE`].
+const TOP: u32 = 2;
 
 /// The span of the ray `o + t·d` inside a unit shape.
 fn unit_span(shape: &Shape, o: Vec3, d: Vec3) -> Option<UnitSpan> {
@@ -543,8 +650,9 @@ fn normal_matrix(m: &Affine3A) -> Mat3A {
     m.matrix3.inverse().transpose()
 }
 
-/// A span in unit-shape space: entry and exit parameters with their normals.
-type UnitSpan = ((f32, Vec3), (f32, Vec3));
+/// A span in unit-shape space: entry and exit parameters with their faces
+/// ([`unit_normal`]).
+type UnitSpan = ((f32, u32), (f32, u32));
 
 /// The roots of `a·t² + 2·b·t + c`, smaller first, if real.
 fn roots(a: f32, b: f32, c: f32) -> Option<(f32, f32)> {
@@ -561,7 +669,7 @@ fn roots(a: f32, b: f32, c: f32) -> Option<(f32, f32)> {
 /// The unit sphere.
 fn sphere(o: Vec3, d: Vec3) -> Option<UnitSpan> {
     let (t0, t1) = roots(d.dot(d), o.dot(d), o.dot(o) - 1.0)?;
-    Some(((t0, o + d * t0), (t1, o + d * t1)))
+    Some(((t0, 0), (t1, 0)))
 }
 
 /// The frustum `0 ≤ z ≤ 1`, `x² + y² ≤ r(z)²`, `r(z) = bottom + (top − bottom)·z`:
@@ -577,10 +685,6 @@ fn frustum(bottom: f32, top: f32, o: Vec3, d: Vec3) -> Option<UnitSpan> {
         o.x * d.x + o.y * d.y - k * d.z * r_o,
         o.x * o.x + o.y * o.y - r_o * r_o,
     );
-    let lateral = |t: f32| {
-        let p = o + d * t;
-        Vec3::new(p.x, p.y, -k * (bottom + k * p.z))
-    };
     const ALL: (f32, f32) = (f32::NEG_INFINITY, f32::INFINITY);
     const NONE: (f32, f32) = (f32::INFINITY, f32::NEG_INFINITY);
     let inside: [(f32, f32); 2] = match roots(a, b, c) {
@@ -600,8 +704,8 @@ fn frustum(bottom: f32, top: f32, o: Vec3, d: Vec3) -> Option<UnitSpan> {
     let ((s0, n0), (s1, n1)) = slab;
     let mut best: Option<UnitSpan> = None;
     for (q0, q1) in inside {
-        let enter = if q0 > s0 { (q0, lateral(q0)) } else { (s0, n0) };
-        let exit = if q1 < s1 { (q1, lateral(q1)) } else { (s1, n1) };
+        let enter = if q0 > s0 { (q0, SIDE) } else { (s0, n0) };
+        let exit = if q1 < s1 { (q1, SIDE) } else { (s1, n1) };
         if enter.0 < exit.0 {
             best = Some(match best {
                 None => (enter, exit),
@@ -612,19 +716,19 @@ fn frustum(bottom: f32, top: f32, o: Vec3, d: Vec3) -> Option<UnitSpan> {
     best
 }
 
-/// The slab `0 ≤ z ≤ 1` with its caps' normals.
+/// The slab `0 ≤ z ≤ 1` with its caps.
 fn slab_z(o: Vec3, d: Vec3) -> Option<UnitSpan> {
     if d.z == 0.0 {
-        return (0.0..=1.0).contains(&o.z).then_some(((f32::NEG_INFINITY, Vec3::NEG_Z), (f32::INFINITY, Vec3::Z)));
+        return (0.0..=1.0).contains(&o.z).then_some(((f32::NEG_INFINITY, BOTTOM), (f32::INFINITY, TOP)));
     }
     let (ta, tb) = (-o.z / d.z, (1.0 - o.z) / d.z);
-    Some(if d.z > 0.0 { ((ta, Vec3::NEG_Z), (tb, Vec3::Z)) } else { ((tb, Vec3::Z), (ta, Vec3::NEG_Z)) })
+    Some(if d.z > 0.0 { ((ta, BOTTOM), (tb, TOP)) } else { ((tb, TOP), (ta, BOTTOM)) })
 }
 
 /// A convex polyhedron: the ray clipped by every face plane.
 fn polyhedron(poly: &ConvexPolyhedron, o: Vec3, d: Vec3) -> Option<UnitSpan> {
-    let (mut enter, mut exit) = ((f32::NEG_INFINITY, Vec3::ZERO), (f32::INFINITY, Vec3::ZERO));
-    for plane in &poly.planes {
+    let (mut enter, mut exit) = ((f32::NEG_INFINITY, 0), (f32::INFINITY, 0));
+    for (face, plane) in (0..).zip(&poly.planes) {
         let n = plane.truncate();
         let (along, gap) = (n.dot(d), plane.w - n.dot(o));
         if along == 0.0 {
@@ -636,10 +740,10 @@ fn polyhedron(poly: &ConvexPolyhedron, o: Vec3, d: Vec3) -> Option<UnitSpan> {
         let t = gap / along;
         if along > 0.0 {
             if t < exit.0 {
-                exit = (t, n);
+                exit = (t, face);
             }
         } else if t > enter.0 {
-            enter = (t, n);
+            enter = (t, face);
         }
     }
     (enter.0 < exit.0 && enter.0.is_finite() && exit.0.is_finite()).then_some((enter, exit))

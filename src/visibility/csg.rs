@@ -37,7 +37,7 @@ use glam::{DVec2, Mat4, Vec2, Vec3, Vec4};
 use rayon::iter::IndexedParallelIterator;
 use rayon::prelude::*;
 
-use crate::raytrace::csg::{Crossing, CsgCaster, Span, SpanScratch};
+use crate::raytrace::csg::{Crossing, CsgCaster, Hit, Interval, SpanScratch};
 use crate::scene::camera::PixelRays;
 use crate::scene::camera::RowLine;
 use crate::scene::csg::{CsgSolid, Primitive, Shape};
@@ -112,13 +112,12 @@ pub fn scan_solid_into(
     let walker = RowWalker::new(solid, method)?;
     out.resize(w * height as usize, None);
     let bands = out.par_chunks_mut(w * BAND_ROWS);
-    scan_bands(solid, &walker, camera, (width, height), bands, |band, dy, line, row| {
+    scan_bands(solid, &walker, camera, (width, height), bands, |band, dy, row| {
         let out = &mut band[dy * w..(dy + 1) * w];
-        out.copy_from_slice(row);
-        // Distances along the unnormalised row line become distances along
-        // the unit pixel ray.
-        for (x, c) in out.iter_mut().enumerate().filter_map(|(x, c)| Some((x, c.as_mut()?))) {
-            c.t *= line.at(x as f32).dir.length();
+        for (x, (px, hit)) in out.iter_mut().zip(row.hits).enumerate() {
+            // Distances along the unnormalised row line become distances
+            // along the unit pixel ray.
+            *px = hit.map(|h| Crossing { t: h.t * row.line.at(x as f32).dir.length(), ..row.crossing(x, h) });
         }
     });
     Ok(())
@@ -166,16 +165,17 @@ pub fn draw_solids(scene: &Scene, camera: &Camera, vb: &mut VisibilityBuffer) ->
             .collect();
         let bands = bands.into_par_iter().enumerate();
         let walker = RowWalker::new(&world, CsgMethod::Segments).expect("segments need no expansion");
-        scan_bands(&world, &walker, camera, (width, height), bands, |(_, (depth, items, normals)), dy, _, row| {
-            for (x, c) in row.iter().enumerate().filter_map(|(x, c)| Some((x, c.as_ref()?))) {
-                // A crossing's `t` along its row line is its distance along the view axis.
-                let z = camera.depth_at_view_distance(c.t);
+        scan_bands(&world, &walker, camera, (width, height), bands, |(_, (depth, items, normals)), dy, row| {
+            for (x, h) in row.hits.iter().enumerate().filter_map(|(x, h)| Some((x, (*h)?))) {
+                // A hit's `t` along its row line is its distance along the view axis.
+                let z = camera.depth_at_view_distance(h.t);
                 let i = dy * w + x;
                 if z > depth[i] && z >= far && z <= 1.0 {
                     depth[i] = z;
+                    // A depth map needs no item or normal.
                     if !items.is_empty() {
-                        items[i] = ItemId::primitive_of(object as u32, c.primitive);
-                        normals[i] = c.normal;
+                        items[i] = ItemId::primitive_of(object as u32, h.primitive);
+                        normals[i] = row.crossing(x, h).normal;
                     }
                 }
             }
@@ -185,17 +185,34 @@ pub fn draw_solids(scene: &Scene, camera: &Camera, vb: &mut VisibilityBuffer) ->
     drawn
 }
 
+/// One scanned row as the walk hands it on: each pixel's visible [`Hit`], its
+/// `t` counted along the row's rays `line` (the distance along the view
+/// axis), and what gives a hit its normal.
+struct ScannedRow<'a> {
+    hits: &'a [Option<Hit>],
+    line: &'a RowLine,
+    /// The row's rays in each occupant's unit space.
+    units: &'a [RowLine],
+    caster: &'a CsgCaster,
+}
+
+impl ScannedRow<'_> {
+    /// Pixel `x`'s `hit` with its outward normal.
+    fn crossing(&self, x: usize, hit: Hit) -> Crossing {
+        self.caster.crossing_on_line(hit, &self.units[hit.primitive as usize], x as f32)
+    }
+}
+
 /// The walk itself: for each band of [`BAND_ROWS`] rows (in parallel, `bands`
-/// gives each its output), `visit(band, row_in_band, line, crossings)` with
-/// the row's visible crossings, their `t` counted along the row's rays
-/// `line` ([`RowLine`]: the distance along the view axis).
+/// gives each its output), `visit(band, row_in_band, row)` with the row's
+/// visible hits ([`ScannedRow`]).
 fn scan_bands<B: Send>(
     solid: &CsgSolid,
     walker: &RowWalker,
     camera: &Camera,
     (width, height): (u32, u32),
     bands: impl IndexedParallelIterator<Item = B>,
-    visit: impl Fn(&mut B, usize, &RowLine, &[Option<Crossing>]) + Sync,
+    visit: impl Fn(&mut B, usize, &ScannedRow) + Sync,
 ) {
     let (w, h) = (width as usize, height as usize);
     if matches!(walker, RowWalker::Empty) {
@@ -218,9 +235,9 @@ fn scan_bands<B: Send>(
                 RowWalker::Segments(tree) => Occupied::new(tree),
                 _ => Occupied::default(),
             };
-            (vec![None; w], vec![RowLine::default(); solid.primitives.len()], counts)
+            (vec![None; w], vec![RowLine::default(); solid.primitives.len()], counts, SpanScratch::default())
         },
-        |(row, lines, counts), (band, mut out)| {
+        |(row, lines, counts, scratch), (band, mut out)| {
             let first = (band * BAND_ROWS) as i64;
             // The y-occupancy list as the band's first scanline finds it, then kept
             // row by row.
@@ -245,11 +262,11 @@ fn scan_bands<B: Send>(
                 ends.iter().for_each(|&(i, _, _)| lines[i] = caster.unit_line(i, &line));
                 let span = |i: usize, x: usize| caster.span_on(i, &lines[i], x as f32);
                 match walker {
-                    RowWalker::Segments(tree) => scan_row(&caster, (tree, counts), &ends, &span, near, row),
+                    RowWalker::Segments(tree) => scan_row(&caster, (tree, counts), &ends, &span, near, (row, scratch)),
                     RowWalker::Pattern(matrix) => matrix.walk_row(&caster, &ends, &span, near, row),
                     RowWalker::Empty => {}
                 }
-                visit(&mut out, dy, &line, row);
+                visit(&mut out, dy, &ScannedRow { hits: row, line: &line, units: lines, caster: &caster });
             }
         },
     );
@@ -276,13 +293,12 @@ fn scan_row(
     caster: &CsgCaster,
     (tree, counts): (&OccupancyTree, &mut Occupied),
     ends: &[(usize, i64, i64)],
-    span: &impl Fn(usize, usize) -> Option<Span>,
+    span: &impl Fn(usize, usize) -> Option<Interval>,
     near: f32,
-    row: &mut [Option<Crossing>],
+    (row, scratch): (&mut [Option<Hit>], &mut SpanScratch),
 ) {
     let (entry, exit) = x_order(ends.iter().copied());
     let (mut next_in, mut next_out) = (0, 0);
-    let mut scratch = SpanScratch::default();
     let Some(first) = entry.first().map(|e| e.1.max(0) as usize) else { return };
     for (x, px) in row.iter_mut().enumerate().skip(first) {
         while next_in < entry.len() && entry[next_in].1 <= x as i64 {
@@ -290,7 +306,7 @@ fn scan_row(
             next_in += 1;
         }
         if let Some(root) = counts.root(tree) {
-            *px = caster.first_hit_in_by([root], &|i| span(i, x), near, &mut scratch);
+            *px = caster.first_hit_in_by([root], &|i| span(i, x), near, scratch);
         }
         // Primitives whose right end is this pixel leave the x-occupancy list.
         while next_out < exit.len() && exit[next_out].2 <= x as i64 {

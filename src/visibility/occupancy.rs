@@ -341,11 +341,12 @@ impl<'a> Booleans for OccupiedNode<'a> {
 
 #[cfg(test)]
 mod tests {
-    use glam::Vec3;
+    use glam::{Affine3A, Vec3};
     use proptest::prelude::*;
 
     use super::*;
-    use crate::raytrace::csg::{combine, Crossing, Span, SpanScratch};
+    use crate::raytrace::csg::{combine, CsgCaster, Interval, SpanScratch};
+    use crate::scene::csg::{ConvexPolyhedron, CsgSolid, Primitive, Shape};
 
     /// Random trees over primitives `0..n`, up to three levels deep.
     fn tree(n: usize) -> impl Strategy<Value = CsgTree> {
@@ -371,9 +372,24 @@ mod tests {
         }
     }
 
-    fn span(i: usize, t0: f32, t1: f32) -> Span {
-        let at = |t| Crossing { t, normal: Vec3::Z, primitive: i as u32, cut: false };
-        Span { enter: at(t0.min(t1)), exit: at(t0.max(t1) + 0.01) }
+    /// Primitive `i`'s interval along a ray down the z axis: a unit cube
+    /// stretched over `t0..t1` (and a hair), as a caster finds it.
+    fn span(i: usize, t0: f32, t1: f32) -> Interval {
+        let (lo, hi) = (t0.min(t1), t0.max(t1) + 0.01);
+        let cube =
+            Affine3A::from_translation(Vec3::new(-0.5, -0.5, lo)) * Affine3A::from_scale(Vec3::new(1.0, 1.0, hi - lo));
+        let primitives = (0..=i)
+            .map(|_| Primitive {
+                shape: Shape::Polyhedron(ConvexPolyhedron::unit_cube()),
+                transform: cube,
+                color: None,
+                source: 0..0,
+            })
+            .collect();
+        let caster = CsgCaster::new(&CsgSolid { primitives, tree: Some(CsgTree::Leaf(i)) });
+        caster
+            .interval(i, &crate::scene::Ray { origin: Vec3::ZERO, dir: Vec3::Z })
+            .expect("the ray runs through the cube")
     }
 
     const N: usize = 8;
@@ -391,7 +407,7 @@ mod tests {
             let shape = OccupancyTree::new(&t, N);
             let mut counts = Occupied::new(&shape);
             let mut on = [false; N];
-            let spans: Vec<Span> = ends.iter().enumerate().map(|(i, &(a, b))| span(i, a, b)).collect();
+            let spans: Vec<Interval> = ends.iter().enumerate().map(|(i, &(a, b))| span(i, a, b)).collect();
             for (i, present) in changes {
                 counts.set(&shape, i, present);
                 on[i] = present;

@@ -23,7 +23,7 @@
 //! of its positive primitives' intervals minus its flagged negative ones', and the
 //! pixel's surface is the nearest over the visible segments.
 
-use crate::raytrace::csg::{Crossing, CsgCaster, Span, SpanScratch};
+use crate::raytrace::csg::{CsgCaster, Hit, Interval, SpanScratch};
 use crate::scene::csg::CsgTree;
 use crate::visibility::csg::x_order;
 use crate::visibility::occupancy::PlacedSet;
@@ -78,9 +78,9 @@ impl PatternMatrix {
         &self,
         caster: &CsgCaster,
         ends: &[(usize, i64, i64)],
-        span: &impl Fn(usize, usize) -> Option<Span>,
+        span: &impl Fn(usize, usize) -> Option<Interval>,
         near: f32,
-        row: &mut [Option<Crossing>],
+        row: &mut [Option<Hit>],
     ) {
         let n = self.positive_in.len();
         // RCy: positive members not on this scanline.
@@ -147,7 +147,7 @@ impl PatternMatrix {
 /// paper's own named defect, paid for here by a per-pixel cache).
 struct PixelSpans {
     stamp: Vec<u32>,
-    spans: Vec<Option<Span>>,
+    spans: Vec<Option<Interval>>,
     pixel: u32,
 }
 
@@ -160,7 +160,7 @@ impl PixelSpans {
         self.pixel += 1;
     }
 
-    fn get(&mut self, i: usize, span: impl FnOnce() -> Option<Span>) -> Option<Span> {
+    fn get(&mut self, i: usize, span: impl FnOnce() -> Option<Interval>) -> Option<Interval> {
         if self.stamp[i] != self.pixel {
             self.stamp[i] = self.pixel;
             self.spans[i] = span();
