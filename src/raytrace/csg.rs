@@ -459,7 +459,7 @@ pub trait Booleans: Copy {
 }
 
 impl Booleans for &CsgTree {
-    #[inline]
+    #[inline(always)]
     fn parts(self) -> Parts<Self, impl Iterator<Item = Self>> {
         let (operation, first, others): (_, _, &[CsgTree]) = match self {
             CsgTree::Leaf(i) => (Operation::Leaf(*i), None, &[]),

@@ -319,7 +319,7 @@ pub struct OccupiedNode<'a> {
 }
 
 impl<'a> Booleans for OccupiedNode<'a> {
-    #[inline]
+    #[inline(always)]
     fn parts(self) -> Parts<Self, impl Iterator<Item = Self>> {
         let (t, c, n) = (self.tree, self.counts, self.node as usize);
         let node = t.nodes[n];
