@@ -113,6 +113,9 @@ pub struct CsgCaster {
     solid: CsgSolid,
     /// Per primitive: solid space → unit shape, and the normal matrix back.
     frames: Vec<(Affine3A, Mat3A)>,
+    /// Per primitive: whether it is a box (the unit cube's polyhedron), cut
+    /// by slabs ([`unit_cube`]) rather than plane by plane.
+    boxes: Vec<bool>,
     /// Over the primitives' boxes, from [`CsgCaster::BVH_PRIMITIVES`] up,
     /// with the tree's shape for counting the primitives a ray's boxes cross.
     bvh: Option<(Bvh, OccupancyTree)>,
@@ -143,12 +146,18 @@ impl CsgCaster {
     /// enough of them.
     fn prepared(solid: CsgSolid, bvh: bool) -> Self {
         let frames = solid.primitives.iter().map(|p| (p.transform.inverse(), normal_matrix(&p.transform))).collect();
+        let cube = ConvexPolyhedron::unit_cube();
+        let boxes = solid
+            .primitives
+            .iter()
+            .map(|p| matches!(&p.shape, Shape::Polyhedron(q) if q.planes == cube.planes))
+            .collect();
         let n = solid.primitives.len();
         let bvh = solid.tree.as_ref().filter(|_| bvh && n >= Self::BVH_PRIMITIVES).map(|tree| {
             let boxes: Vec<Aabb> = solid.primitives.iter().map(|p| Aabb::around(&p.corners())).collect();
             (Bvh::build(&boxes), OccupancyTree::new(tree, n))
         });
-        CsgCaster { solid, frames, bvh }
+        CsgCaster { solid, frames, boxes, bvh }
     }
 
     /// Primitives from which [`CsgCaster::first_hit`] culls by a BVH.
@@ -194,7 +203,8 @@ impl CsgCaster {
 
     /// The interval of primitive `i` along `o + t·d` in its unit shape's space.
     fn unit_interval(&self, i: usize, o: Vec3, d: Vec3) -> Option<Interval> {
-        let ((t0, f0), (t1, f1)) = unit_span(&self.solid.primitives[i].shape, o, d)?;
+        let span = if self.boxes[i] { unit_cube(o, d) } else { unit_span(&self.solid.primitives[i].shape, o, d) };
+        let ((t0, f0), (t1, f1)) = span?;
         Some(Interval { enter: Hit::new(t0, i, f0), exit: Hit::new(t1, i, f1) })
     }
 
@@ -725,6 +735,36 @@ fn slab_z(o: Vec3, d: Vec3) -> Option<UnitSpan> {
     Some(if d.z > 0.0 { ((ta, BOTTOM), (tb, TOP)) } else { ((tb, TOP), (ta, BOTTOM)) })
 }
 
+/// The unit cube ([`ConvexPolyhedron::unit_cube`]) by slabs: per axis, the
+/// planes at 0 and 1, one entering and one leaving, each `t` found as
+/// [`polyhedron`] finds it from the cube's planes (so the same to the bit, with
+/// the same faces), without the dot products.
+fn unit_cube(o: Vec3, d: Vec3) -> Option<UnitSpan> {
+    let (mut enter, mut exit) = ((f32::NEG_INFINITY, 0), (f32::INFINITY, 0));
+    for axis in 0..3 {
+        // Faces 2·axis (the plane at 1, outward +axis) and 2·axis + 1 (at 0).
+        let (o, d, face) = (o[axis], d[axis], 2 * axis as u32);
+        if d == 0.0 {
+            // Parallel to both planes: outside one of them (as the plane
+            // clipping tests it: a NaN passes) misses.
+            if 1.0 - o < 0.0 || o < 0.0 {
+                return None;
+            }
+            continue;
+        }
+        let (at_one, at_zero) = ((1.0 - o) / d, -o / d);
+        let (inward, outward) =
+            if d > 0.0 { ((at_zero, face + 1), (at_one, face)) } else { ((at_one, face), (at_zero, face + 1)) };
+        if outward.0 < exit.0 {
+            exit = outward;
+        }
+        if inward.0 > enter.0 {
+            enter = inward;
+        }
+    }
+    (enter.0 < exit.0 && enter.0.is_finite() && exit.0.is_finite()).then_some((enter, exit))
+}
+
 /// A convex polyhedron: the ray clipped by every face plane.
 fn polyhedron(poly: &ConvexPolyhedron, o: Vec3, d: Vec3) -> Option<UnitSpan> {
     let (mut enter, mut exit) = ((f32::NEG_INFINITY, 0), (f32::INFINITY, 0));
@@ -747,4 +787,31 @@ fn polyhedron(poly: &ConvexPolyhedron, o: Vec3, d: Vec3) -> Option<UnitSpan> {
         }
     }
     (enter.0 < exit.0 && enter.0.is_finite() && exit.0.is_finite()).then_some((enter, exit))
+}
+
+#[cfg(test)]
+mod tests {
+    use proptest::prelude::*;
+
+    use super::*;
+
+    /// A coordinate, sometimes exactly on one of the cube's planes.
+    fn coordinate(range: std::ops::Range<f32>) -> impl Strategy<Value = f32> {
+        prop_oneof![4 => range, 1 => Just(0.0f32), 1 => Just(1.0f32)]
+    }
+
+    fn vector(range: std::ops::Range<f32>) -> impl Strategy<Value = Vec3> {
+        (coordinate(range.clone()), coordinate(range.clone()), coordinate(range))
+            .prop_map(|(x, y, z)| Vec3::new(x, y, z))
+    }
+
+    proptest! {
+        /// The slab test of a box gives what clipping by the unit cube's
+        /// planes gives: the same parameters to the bit and the same faces,
+        /// rays parallel to a face and rays along one included.
+        #[test]
+        fn a_box_by_slabs_is_the_cube_by_planes(o in vector(-2.0..3.0), d in vector(-2.0..2.0)) {
+            prop_assert_eq!(unit_cube(o, d), polyhedron(&ConvexPolyhedron::unit_cube(), o, d));
+        }
+    }
 }
