@@ -302,3 +302,45 @@ fn jittered_passes_share_the_maps_fitted_to_the_view() {
     let aliased = renderer.render(&scene).unwrap().image.clone();
     assert!(aliased.pixels() == render(&scene, &RenderOptions::default()).unwrap().image.pixels());
 }
+
+/// A wide floor that casts no shadow under a small box, lit by a point light
+/// above: the light's map is fitted to the box alone.
+fn box_on_a_shadowless_floor() -> Scene {
+    let camera = kage::scene::Camera {
+        eye: Vec3::new(0.0, 6.0, 8.0),
+        target: Vec3::ZERO,
+        up: Vec3::Y,
+        near: 0.1,
+        far: 50.0,
+        projection: kage::scene::Projection::Perspective { fov_y_deg: 40.0 },
+        shift: Vec2::ZERO,
+    };
+    let mut scene = common::scene_with(shapes::plane(), camera, 160, 120, false);
+    scene.objects[0].transform = Affine3A::from_scale(Vec3::splat(40.0));
+    scene.objects[0].casts_shadows = false;
+    let lifted = Affine3A::from_translation(Vec3::new(0.0, 0.6, 0.0)) * Affine3A::from_scale(Vec3::splat(0.5));
+    scene.objects.push(Object::mesh("box", Arc::new(shapes::cube()), lifted, 0));
+    scene.lights[0].kind = LightKind::Point { position: Vec3::new(0.5, 4.0, 0.8) };
+    scene.lights[0].shadow = ShadowSettings { samples: 1, ..ShadowSettings::default() };
+    scene
+}
+
+#[test]
+fn a_floor_that_casts_no_shadow_leaves_the_map_to_the_casters_and_still_receives() {
+    let mut scene = box_on_a_shadowless_floor();
+    // Fitted to the box, the point light's map is one cone; were the floor a
+    // caster, the light would lie inside its bounds and need six cube faces.
+    assert!(matches!(ShadowTerm::build(&scene, &scene.lights[0]), ShadowTerm::Map(..)), "a cone around the box");
+    // The floor still receives the box's shadow: the map agrees with shadow
+    // rays, which pass through the floor as the map leaves it out.
+    let (wrong, total) = map_vs_rays(&scene);
+    assert!(total > 5_000, "only {total} tests");
+    assert!((wrong as f64) < 0.005 * total as f64, "{wrong} of {total} shadow-map tests disagree with shadow rays");
+    let under_box = Vec3::new(0.0, 0.0, 0.0);
+    assert!(
+        ShadowTerm::build(&scene, &scene.lights[0]).lit(under_box, 1.0) < 0.5,
+        "the floor under the box is shadowed"
+    );
+    scene.objects[0].casts_shadows = true;
+    assert!(matches!(ShadowTerm::build(&scene, &scene.lights[0]), ShadowTerm::Cube(..)), "the floor widens the map");
+}

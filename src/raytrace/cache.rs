@@ -1,6 +1,7 @@
 //! A [`TraceScene`] kept from frame to frame. An interactive preview re-renders the
 //! same geometry from new viewpoints, under new lights and materials; only a change
-//! of geometry (a mesh or an object's transform) needs a new BVH. Jittered passes of
+//! of geometry (a mesh or an object's transform, or whether it casts shadows)
+//! needs a new BVH. Jittered passes of
 //! one frame (seed 002 §4) share it too.
 //!
 //! The key holds a clone of every object's body (its `Arc<Mesh>` or
@@ -15,7 +16,7 @@ use crate::scene::{Body, Scene};
 /// The BVH of the last scene traced, and what it was built from.
 #[derive(Debug, Default)]
 pub struct TraceCache {
-    key: Vec<(Body, Affine3A)>,
+    key: Vec<(Body, Affine3A, bool)>,
     trace: Option<TraceScene>,
     builds: usize,
 }
@@ -25,9 +26,13 @@ impl TraceCache {
     /// from the last call's.
     pub fn get(&mut self, scene: &Scene) -> &TraceScene {
         let same = self.key.len() == scene.objects.len()
-            && self.key.iter().zip(&scene.objects).all(|((b, t), o)| b.same(&o.body) && *t == o.transform);
+            && self
+                .key
+                .iter()
+                .zip(&scene.objects)
+                .all(|((b, t, c), o)| b.same(&o.body) && *t == o.transform && *c == o.casts_shadows);
         if !same || self.trace.is_none() {
-            self.key = scene.objects.iter().map(|o| (o.body.clone(), o.transform)).collect();
+            self.key = scene.objects.iter().map(|o| (o.body.clone(), o.transform, o.casts_shadows)).collect();
             self.builds += 1;
             self.trace = None;
         }

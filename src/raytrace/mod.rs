@@ -50,6 +50,11 @@ pub struct TraceScene {
     /// The solids' leaves, sorted, with their object and caster.
     solids: Vec<(u32, u32, CsgCaster)>,
     bvh: Bvh,
+    /// Per object, whether it stops shadow rays ([`Object::casts_shadows`]);
+    /// empty when every object does.
+    ///
+    /// [`Object::casts_shadows`]: crate::scene::Object::casts_shadows
+    casters: Vec<bool>,
 }
 
 impl TraceScene {
@@ -57,6 +62,16 @@ impl TraceScene {
     /// the BVH.
     #[must_use]
     pub fn new(scene: &Scene) -> TraceScene {
+        let casters = if scene.objects.iter().all(|o| o.casts_shadows) {
+            Vec::new()
+        } else {
+            scene.objects.iter().map(|o| o.casts_shadows).collect()
+        };
+        TraceScene { casters, ..Self::built(scene) }
+    }
+
+    /// [`TraceScene::new`] but for which objects cast shadows.
+    fn built(scene: &Scene) -> TraceScene {
         let (triangles, items) = Self::mesh_triangles(scene);
         let solids: Vec<(u32, CsgSolid, Aabb)> = scene
             .objects
@@ -78,7 +93,8 @@ impl TraceScene {
         let mut bvh = Bvh::build(&bounds);
         let order = bvh.renumber();
         let mut solids: Vec<Option<(u32, CsgSolid)>> = solids.into_iter().map(|(o, s, _)| Some((o, s))).collect();
-        let mut trace = TraceScene { triangles: Vec::new(), items: Vec::new(), solids: Vec::new(), bvh };
+        let mut trace =
+            TraceScene { triangles: Vec::new(), items: Vec::new(), solids: Vec::new(), bvh, casters: Vec::new() };
         for (leaf, &i) in order.iter().enumerate() {
             let i = i as usize;
             if i < n {
@@ -119,7 +135,7 @@ impl TraceScene {
         let order = bvh.renumber();
         let triangles = order.iter().map(|&i| triangles[i as usize]).collect();
         let items = order.iter().map(|&i| items[i as usize]).collect();
-        TraceScene { triangles, items, solids: Vec::new(), bvh }
+        TraceScene { triangles, items, solids: Vec::new(), bvh, casters: Vec::new() }
     }
 
     /// The solid at leaf `i`, if that leaf is one.
@@ -150,11 +166,13 @@ impl TraceScene {
         Some(Hit { t, ..hit })
     }
 
-    /// Whether anything lies along `ray` in `(0, t_max)` (shadow rays).
+    /// Whether anything that casts shadows lies along `ray` in `(0, t_max)`
+    /// (shadow rays).
     #[must_use]
     pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
         let sr = ShearedRay::new(ray);
         self.bvh.occluded(ray, t_max, |i, t_max| match self.solid_at(i) {
+            _ if !self.casters.is_empty() && !self.casters[self.items[i as usize].object as usize] => None,
             Some((_, _, caster)) => caster.first_hit(ray, 0.0, t_max).map(|c| c.t),
             None => sr.intersect(&self.triangles[i as usize], 0.0, t_max).map(|h| h.0),
         })

@@ -870,7 +870,7 @@ pub fn add_model(scene: &mut Scene, model: &LoadedModel, label: &str, transform:
             label.to_string()
         };
         let body = Body::Solid { solid: Arc::clone(&part.solid), materials };
-        scene.objects.push(Object { name, body, transform, material: own });
+        scene.objects.push(Object { name, body, transform, material: own, casts_shadows: true });
     }
 }
 
@@ -892,7 +892,10 @@ fn add_ground(scene: &mut Scene, (lo, hi): (Vec3, Vec3)) {
         ks: Vec3::ZERO,
         ..Material::default()
     });
-    scene.objects.push(Object::mesh("ground", Arc::new(shapes::plane()), placed, scene.materials.len() - 1));
+    let ground = Object::mesh("ground", Arc::new(shapes::plane()), placed, scene.materials.len() - 1);
+    // It lies under the model: its shadows fall on nothing, and in the key
+    // light's map it would widen the map fourfold around the model.
+    scene.objects.push(Object { casts_shadows: false, ..ground });
 }
 
 /// Reads and builds a scene file from disk.
@@ -944,10 +947,12 @@ pub fn scene_for_model_with(path: &Path, width: u32, height: u32, csg: &CsgOptio
             * Affine3A::from_translation(-centre);
         lights.iter_mut().for_each(|l| l.kind = l.kind.transformed(&z_up));
         // Shadow maps are drawn by the same scanline walk as the view, texel by
-        // texel: the key light's four jittered maps at 512² (their average hides
-        // the coarser texels) and none for the fill light, whose map fitted to
-        // the whole view would cost more than the rest of the frame.
-        lights[0].shadow.resolution = 1024;
+        // texel: the key light's four jittered maps at 256², fitted to the
+        // model alone (the ground casts nothing), so the model spans the map
+        // (their average hides the coarser texels), and none for the fill
+        // light, whose map fitted to the whole view would cost more than the
+        // rest of the frame.
+        lights[0].shadow.resolution = 512;
         lights.iter_mut().skip(1).for_each(|l| l.shadow = ShadowSettings::NONE);
         add_ground(&mut scene, bounds);
     }

@@ -73,13 +73,17 @@ pub struct Object {
     pub transform: Affine3A,
     /// Index into [`Scene::materials`] (a solid's primitives name their own).
     pub material: usize,
+    /// Whether it is drawn into shadow maps. A floor under everything casts
+    /// no shadow onto anything; leaving it out lets a light's map fit the
+    /// objects that do ([`Scene::caster_bounds`]) rather than the floor.
+    pub casts_shadows: bool,
 }
 
 impl Object {
     /// A mesh object.
     #[must_use]
     pub fn mesh(name: impl Into<String>, mesh: Arc<Mesh>, transform: Affine3A, material: usize) -> Object {
-        Object { name: name.into(), body: Body::Mesh(mesh), transform, material }
+        Object { name: name.into(), body: Body::Mesh(mesh), transform, material, casts_shadows: true }
     }
 
     /// The triangles, if the object is a mesh.
@@ -197,7 +201,19 @@ impl Scene {
     /// World-space bounds `(min, max)` of all objects (`None` if there are none).
     #[must_use]
     pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
-        self.objects.iter().filter_map(Object::world_bounds).reduce(|(a, b), (c, d)| (a.min(c), b.max(d)))
+        Self::union_of(self.objects.iter())
+    }
+
+    /// World-space bounds of the objects that cast shadows: what a light's
+    /// shadow map must hold (a receiver outside it is lit, as nothing between
+    /// it and the light is outside it either).
+    #[must_use]
+    pub fn caster_bounds(&self) -> Option<(Vec3, Vec3)> {
+        Self::union_of(self.objects.iter().filter(|o| o.casts_shadows))
+    }
+
+    fn union_of<'a>(objects: impl Iterator<Item = &'a Object>) -> Option<(Vec3, Vec3)> {
+        objects.filter_map(Object::world_bounds).reduce(|(a, b), (c, d)| (a.min(c), b.max(d)))
     }
 
     /// What a ray leaving the scene along `dir` sees: the environment if it is

@@ -76,10 +76,12 @@ pub struct FrameLight {
 /// The lights a frame is shaded with: the scene's, each with its shadow samples.
 #[must_use]
 pub fn frame_lights(scene: &Scene) -> Vec<FrameLight> {
-    frame_lights_within(scene, scene.bounds().unwrap_or_default())
+    frame_lights_within(scene, scene.caster_bounds().unwrap_or_default())
 }
 
-/// [`frame_lights`] with the scene's bounds already known.
+/// [`frame_lights`] with the bounds of the scene's shadow casters already
+/// known ([`Scene::caster_bounds`]: what the maps are fitted to, and what an
+/// area light's samples face).
 fn frame_lights_within(scene: &Scene, (lo, hi): (Vec3, Vec3)) -> Vec<FrameLight> {
     let centre = (lo + hi) * 0.5;
     scene.lights.iter().map(|l| FrameLight { light: l.clone(), samples: l.jittered(centre) }).collect()
@@ -130,7 +132,7 @@ pub fn shade_lit_while(
     let mut stats = PassStats::default();
     pool.begin_frame(scene);
     let mut budget = FUSED_SHADOW_BUDGET;
-    let bounds = scene.bounds().unwrap_or_default();
+    let bounds = scene.caster_bounds().unwrap_or_default();
     let lights = frame_lights_within(scene, bounds);
     let (mut fused, mut own) = (Vec::new(), Vec::new());
     for light in &lights {

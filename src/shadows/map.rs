@@ -12,7 +12,7 @@ use glam::{Mat4, Vec3};
 use wide::f32x8;
 
 use crate::scene::{Camera, Projection, Scene, ShadowSettings};
-use crate::visibility::{rasterize_from, Faces, VisibilityBuffer};
+use crate::visibility::{rasterize_casters, Faces, VisibilityBuffer};
 
 /// Largest tan θ the slope bias uses (θ ≈ 84°); beyond it the bias would push
 /// shadows off their casters.
@@ -35,12 +35,13 @@ pub struct DepthMap {
 }
 
 impl DepthMap {
-    /// Renders the depth of every object of `scene` seen by `camera` into a square
-    /// map of `resolution` texels, held in `depth` (a depth-only buffer, resized).
+    /// Renders the depth of every object of `scene` that casts shadows seen by
+    /// `camera` into a square map of `resolution` texels, held in `depth` (a
+    /// depth-only buffer, resized).
     #[must_use]
     pub fn render(scene: &Scene, camera: &Camera, resolution: u32, mut depth: VisibilityBuffer) -> DepthMap {
         depth.resize(resolution, resolution);
-        rasterize_from(scene, camera, Faces::All, &mut depth);
+        rasterize_casters(scene, camera, Faces::All, &mut depth);
         let (ortho, texel) = match camera.projection {
             Projection::Perspective { fov_y_deg } => (false, 2.0 * (fov_y_deg.to_radians() * 0.5).tan()),
             Projection::Orthographic { height } => (true, height),

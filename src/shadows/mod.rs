@@ -38,13 +38,13 @@ impl ShadowTerm {
     /// Builds the term of `light` in `scene`, rendering its maps.
     #[must_use]
     pub fn build(scene: &Scene, light: &Light) -> ShadowTerm {
-        match scene.bounds() {
+        match scene.caster_bounds() {
             Some(bounds) => ShadowTerm::build_within(scene, light, bounds, &mut MapPool::default()),
             None => ShadowTerm::Unshadowed,
         }
     }
 
-    /// [`ShadowTerm::build`] with the scene's bounds already known, its maps in
+    /// [`ShadowTerm::build`] with the casters' bounds already known, its maps in
     /// buffers taken from `pool` (give them back with [`MapPool::recycle`]).
     #[must_use]
     pub fn build_within(scene: &Scene, light: &Light, bounds: (Vec3, Vec3), pool: &mut MapPool) -> ShadowTerm {
@@ -213,8 +213,9 @@ pub struct MapPool {
     kept: Vec<(MapKey, ShadowTerm)>,
     /// Terms of the last frame not yet taken by this one.
     previous: Vec<(MapKey, ShadowTerm)>,
-    /// The geometry the kept terms saw: every object's body and transform.
-    geometry: Vec<(Body, Affine3A)>,
+    /// The geometry the kept terms saw: every object's body, transform and
+    /// whether it casts shadows.
+    geometry: Vec<(Body, Affine3A, bool)>,
     /// Terms reused since [`MapPool::begin_frame`].
     reused: usize,
     /// The view directional lights' maps are fitted to (`None`: each scene's
@@ -243,9 +244,13 @@ impl MapPool {
     /// an object's body or transform changed, which drops them all.
     pub fn begin_frame(&mut self, scene: &Scene) {
         let same = self.geometry.len() == scene.objects.len()
-            && self.geometry.iter().zip(&scene.objects).all(|((b, t), o)| b.same(&o.body) && *t == o.transform);
+            && self
+                .geometry
+                .iter()
+                .zip(&scene.objects)
+                .all(|((b, t, c), o)| b.same(&o.body) && *t == o.transform && *c == o.casts_shadows);
         if !same {
-            self.geometry = scene.objects.iter().map(|o| (o.body.clone(), o.transform)).collect();
+            self.geometry = scene.objects.iter().map(|o| (o.body.clone(), o.transform, o.casts_shadows)).collect();
             let stale: Vec<_> = self.kept.drain(..).chain(self.previous.drain(..)).collect();
             stale.into_iter().for_each(|(_, term)| self.recycle(term));
         }

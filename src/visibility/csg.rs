@@ -41,7 +41,7 @@ use crate::raytrace::csg::{Crossing, CsgCaster, Hit, Interval, SpanScratch};
 use crate::scene::camera::PixelRays;
 use crate::scene::camera::RowLine;
 use crate::scene::csg::{CsgSolid, Primitive, Shape};
-use crate::scene::{Camera, Scene};
+use crate::scene::{Camera, Object, Scene};
 use crate::visibility::occupancy::{OccupancyTree, Occupied};
 use crate::visibility::pattern::{PatternMatrix, TooManySegments};
 use crate::visibility::{ItemId, VisibilityBuffer};
@@ -142,17 +142,22 @@ impl RowWalker {
     }
 }
 
-/// Draws every solid of `scene` seen by `camera` into `vb` (after its
-/// polygons): where a solid's visible surface lies nearer than what the pixel
+/// Draws every solid of `scene` that `include` takes seen by `camera` into
+/// `vb` (after its polygons): where a solid's visible surface lies nearer than what the pixel
 /// holds and between the near and far planes, the pixel takes its depth, its
 /// item (object + primitive) and its outward normal. A depth-only buffer (a
 /// shadow map) takes the depth alone. Returns the number of solids drawn.
-pub fn draw_solids(scene: &Scene, camera: &Camera, vb: &mut VisibilityBuffer) -> usize {
+pub fn draw_solids(
+    scene: &Scene,
+    camera: &Camera,
+    include: impl Fn(&Object) -> bool,
+    vb: &mut VisibilityBuffer,
+) -> usize {
     let (width, height) = (vb.width(), vb.height());
     let w = width as usize;
     let far = camera.far_plane_factor();
     let mut drawn = 0;
-    for (object, o) in scene.objects.iter().enumerate() {
+    for (object, o) in scene.objects.iter().enumerate().filter(|(_, o)| include(o)) {
         let Some(solid) = o.solid() else { continue };
         let world = solid.transformed(&o.transform);
         let (depth, items, normals) = vb.solid_parts_mut();

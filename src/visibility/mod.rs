@@ -17,7 +17,7 @@ pub mod scan;
 
 use glam::Vec3;
 
-pub use raster::{fragments, rasterize, rasterize_from, Faces, Fragment, RasterStats};
+pub use raster::{fragments, rasterize, rasterize_casters, Faces, Fragment, RasterStats};
 
 /// What a pixel sees: an object and one of its triangles, or one primitive of a
 /// CSG solid (seed 003: item id = object + primitive).

@@ -14,7 +14,7 @@ use rayon::prelude::*;
 use super::clip::{ClipPlanes, MAX_CLIPPED};
 use super::scan::{column_range, row_range, scan_triangle, signed_area2, FixedPoint, SpanSink, ONE};
 use super::{ItemId, VisibilityBuffer};
-use crate::scene::{Camera, Material, Scene};
+use crate::scene::{Camera, Material, Object, Scene};
 
 /// Rows per band: the unit of parallel work and of binning.
 pub const BAND_ROWS: usize = 16;
@@ -121,16 +121,17 @@ pub enum Faces {
 /// material). Translucent meshes are left to [`fragments`].
 pub fn rasterize(scene: &Scene, vb: &mut VisibilityBuffer) -> RasterStats {
     let pass = PolygonPass::new(scene, &scene.camera, Faces::AsMaterials, vb.width(), vb.height());
-    let stats = pass.draw(&chunks(scene, |m| !m.translucent()), vb);
-    RasterStats { solids: super::csg::draw_solids(scene, &scene.camera, vb), ..stats }
+    let stats = pass.draw(&chunks(scene, |_, m| !m.translucent()), vb);
+    RasterStats { solids: super::csg::draw_solids(scene, &scene.camera, |_| true, vb), ..stats }
 }
 
-/// Draws every object of `scene`, opaque or not, seen by `camera` (a light's, for
-/// a shadow map), drawing `faces`, into `vb`.
-pub fn rasterize_from(scene: &Scene, camera: &Camera, faces: Faces, vb: &mut VisibilityBuffer) -> RasterStats {
+/// Draws every object of `scene` that casts shadows ([`Object::casts_shadows`]),
+/// opaque or not, seen by `camera` (a light's, for a shadow map), drawing
+/// `faces`, into `vb`.
+pub fn rasterize_casters(scene: &Scene, camera: &Camera, faces: Faces, vb: &mut VisibilityBuffer) -> RasterStats {
     let pass = PolygonPass::new(scene, camera, faces, vb.width(), vb.height());
-    let stats = pass.draw(&chunks(scene, |_| true), vb);
-    RasterStats { solids: super::csg::draw_solids(scene, camera, vb), ..stats }
+    let stats = pass.draw(&chunks(scene, |o, _| o.casts_shadows), vb);
+    RasterStats { solids: super::csg::draw_solids(scene, camera, |o| o.casts_shadows, vb), ..stats }
 }
 
 /// A sample of a translucent surface at a pixel centre.
@@ -150,7 +151,7 @@ pub struct Fragment {
 /// come band by band, and within a pixel in scene order (object, triangle).
 #[must_use]
 pub fn fragments(scene: &Scene, opaque: &VisibilityBuffer) -> Vec<Fragment> {
-    let chunks = chunks(scene, |m| m.translucent());
+    let chunks = chunks(scene, |_, m| m.translucent());
     if chunks.is_empty() {
         return Vec::new();
     }
@@ -256,9 +257,9 @@ fn project(
 }
 
 /// The objects whose material `include` accepts, cut into chunks.
-fn chunks(scene: &Scene, include: impl Fn(&Material) -> bool) -> Vec<Chunk> {
+fn chunks(scene: &Scene, include: impl Fn(&Object, &Material) -> bool) -> Vec<Chunk> {
     let mut out = Vec::new();
-    for (object, o) in scene.objects.iter().enumerate().filter(|(_, o)| include(&scene.materials[o.material])) {
+    for (object, o) in scene.objects.iter().enumerate().filter(|(_, o)| include(o, &scene.materials[o.material])) {
         let Some(mesh) = o.triangles() else { continue };
         let n = mesh.triangles.len() as u32;
         out.extend(
