@@ -132,6 +132,51 @@ pub enum CsgTree {
 }
 
 impl CsgTree {
+    /// The same solid with nested booleans of one kind merged: a union's
+    /// union operands and an intersection's intersection operands are spliced
+    /// into it, a difference's union cutters become its own cutters
+    /// (`A − (B ∪ C) = A − B − C`), and a difference whose first operand is a
+    /// difference takes over its cutters (`(A − B) − C = A − B − C`). OpenSCAD
+    /// files nest a group per module call; flat, the span combiner cuts by
+    /// each cutter in turn instead of sorting a union of them at every pixel.
+    #[must_use]
+    pub fn flattened(self) -> CsgTree {
+        /// `kids` flattened, with the operands of those `open` opens spliced in.
+        fn splice(kids: Vec<CsgTree>, open: fn(CsgTree) -> Result<Vec<CsgTree>, CsgTree>) -> Vec<CsgTree> {
+            let mut out = Vec::with_capacity(kids.len());
+            for kid in kids.into_iter().map(CsgTree::flattened) {
+                match open(kid) {
+                    Ok(inner) => out.extend(inner),
+                    Err(kid) => out.push(kid),
+                }
+            }
+            out
+        }
+        let unions = |t| match t {
+            CsgTree::Union(kids) => Ok(kids),
+            t => Err(t),
+        };
+        let intersections = |t| match t {
+            CsgTree::Intersection(kids) => Ok(kids),
+            t => Err(t),
+        };
+        match self {
+            CsgTree::Leaf(_) => self,
+            CsgTree::Union(kids) => CsgTree::Union(splice(kids, unions)),
+            CsgTree::Intersection(kids) => CsgTree::Intersection(splice(kids, intersections)),
+            CsgTree::Difference(first, cutters) => {
+                let cutters = splice(cutters, unions);
+                match first.flattened() {
+                    CsgTree::Difference(first, mut earlier) => {
+                        earlier.extend(cutters);
+                        CsgTree::Difference(first, earlier)
+                    }
+                    first => CsgTree::Difference(Box::new(first), cutters),
+                }
+            }
+        }
+    }
+
     /// Whether `p` is inside, given which primitives contain it.
     #[must_use]
     pub fn contains(&self, inside: &impl Fn(usize) -> bool) -> bool {
@@ -192,5 +237,49 @@ impl CsgSolid {
     pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
         let boxes: Vec<(Vec3, Vec3)> = self.primitives.iter().map(Primitive::bounds).collect();
         self.tree.as_ref()?.bounds(&|i| boxes[i])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use proptest::prelude::*;
+
+    use super::*;
+
+    /// Random trees over primitives `0..8`, nested up to four levels.
+    fn tree() -> impl Strategy<Value = CsgTree> {
+        (0..8usize).prop_map(CsgTree::Leaf).prop_recursive(4, 32, 4, |inner| {
+            prop_oneof![
+                prop::collection::vec(inner.clone(), 1..4).prop_map(CsgTree::Union),
+                prop::collection::vec(inner.clone(), 1..4).prop_map(CsgTree::Intersection),
+                (inner.clone(), prop::collection::vec(inner, 1..4))
+                    .prop_map(|(a, cut)| CsgTree::Difference(Box::new(a), cut)),
+            ]
+        })
+    }
+
+    /// Whether a boolean of one kind is left nested in its own kind.
+    fn nested(t: &CsgTree) -> bool {
+        match t {
+            CsgTree::Leaf(_) => false,
+            CsgTree::Union(k) => k.iter().any(|k| matches!(k, CsgTree::Union(_)) || nested(k)),
+            CsgTree::Intersection(k) => k.iter().any(|k| matches!(k, CsgTree::Intersection(_)) || nested(k)),
+            CsgTree::Difference(a, k) => {
+                matches!(**a, CsgTree::Difference(..))
+                    || nested(a)
+                    || k.iter().any(|k| matches!(k, CsgTree::Union(_)) || nested(k))
+            }
+        }
+    }
+
+    proptest! {
+        /// Flattening keeps the solid (the same inside for every set of
+        /// primitives containing a point) and leaves nothing to flatten.
+        #[test]
+        fn flattening_keeps_the_solid(t in tree(), inside in prop::collection::vec(any::<bool>(), 8)) {
+            let flat = t.clone().flattened();
+            prop_assert!(!nested(&flat), "{flat:?}");
+            prop_assert_eq!(flat.contains(&|i| inside[i]), t.contains(&|i| inside[i]));
+        }
     }
 }

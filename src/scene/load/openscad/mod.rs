@@ -174,7 +174,7 @@ pub fn load_csg(path: &Path, text: Arc<str>, options: &CsgOptions) -> Result<Loa
     let mut b =
         Builder { path: path.to_path_buf(), text, options: *options, solid: CsgSolid::default(), warnings: Vec::new() };
     let tree = b.union(&nodes, Affine3A::IDENTITY, None)?;
-    b.solid.tree = tree.into_tree();
+    b.solid.tree = tree.into_tree().map(CsgTree::flattened);
     Ok(LoadedCsg { solid: b.solid, warnings: b.warnings })
 }
 
