@@ -17,7 +17,8 @@
 //! widened by a hair ([`TIE`]), so a cut face exactly on a solid face removes it
 //! instead of speckling.
 
-use glam::{Affine3A, Mat3A, Vec3, Vec3A};
+use glam::{Affine3A, Mat3A, Vec3, Vec3A, Vec4};
+use wide::f32x8;
 
 use super::bvh::{Aabb, Bvh};
 use crate::scene::camera::RowLine;
@@ -113,9 +114,10 @@ pub struct CsgCaster {
     solid: CsgSolid,
     /// Per primitive: solid space → unit shape, and the normal matrix back.
     frames: Vec<(Affine3A, Mat3A)>,
-    /// Per primitive: whether it is a box (the unit cube's polyhedron), cut
-    /// by slabs ([`unit_cube`]) rather than plane by plane.
-    boxes: Vec<bool>,
+    /// Per primitive: how its unit shape is cut when it is not the generic
+    /// procedure's ([`unit_span`]): a box by slabs, a polyhedron of many
+    /// planes eight planes at a time.
+    clipping: Vec<Clipping>,
     /// Over the primitives' boxes, from [`CsgCaster::BVH_PRIMITIVES`] up,
     /// with the tree's shape for counting the primitives a ray's boxes cross.
     bvh: Option<(Bvh, OccupancyTree)>,
@@ -147,17 +149,23 @@ impl CsgCaster {
     fn prepared(solid: CsgSolid, bvh: bool) -> Self {
         let frames = solid.primitives.iter().map(|p| (p.transform.inverse(), normal_matrix(&p.transform))).collect();
         let cube = ConvexPolyhedron::unit_cube();
-        let boxes = solid
+        let clipping = solid
             .primitives
             .iter()
-            .map(|p| matches!(&p.shape, Shape::Polyhedron(q) if q.planes == cube.planes))
+            .map(|p| match &p.shape {
+                Shape::Polyhedron(q) if q.planes == cube.planes => Clipping::Box,
+                Shape::Polyhedron(q) if q.planes.len() >= PlaneLanes::MIN_PLANES => {
+                    Clipping::Lanes(Box::new(PlaneLanes::new(q)))
+                }
+                _ => Clipping::Shape,
+            })
             .collect();
         let n = solid.primitives.len();
         let bvh = solid.tree.as_ref().filter(|_| bvh && n >= Self::BVH_PRIMITIVES).map(|tree| {
             let boxes: Vec<Aabb> = solid.primitives.iter().map(|p| Aabb::around(&p.corners())).collect();
             (Bvh::build(&boxes), OccupancyTree::new(tree, n))
         });
-        CsgCaster { solid, frames, boxes, bvh }
+        CsgCaster { solid, frames, clipping, bvh }
     }
 
     /// Primitives from which [`CsgCaster::first_hit`] culls by a BVH.
@@ -203,7 +211,11 @@ impl CsgCaster {
 
     /// The interval of primitive `i` along `o + t·d` in its unit shape's space.
     fn unit_interval(&self, i: usize, o: Vec3, d: Vec3) -> Option<Interval> {
-        let span = if self.boxes[i] { unit_cube(o, d) } else { unit_span(&self.solid.primitives[i].shape, o, d) };
+        let span = match &self.clipping[i] {
+            Clipping::Box => unit_cube(o, d),
+            Clipping::Lanes(planes) => planes.clip(o, d),
+            Clipping::Shape => unit_span(&self.solid.primitives[i].shape, o, d),
+        };
         let ((t0, f0), (t1, f1)) = span?;
         Some(Interval { enter: Hit::new(t0, i, f0), exit: Hit::new(t1, i, f1) })
     }
@@ -813,6 +825,90 @@ fn unit_cube(o: Vec3, d: Vec3) -> Option<UnitSpan> {
     (enter.0 < exit.0 && enter.0.is_finite() && exit.0.is_finite()).then_some((enter, exit))
 }
 
+/// How a caster cuts a primitive's unit shape.
+#[derive(Debug, Clone)]
+enum Clipping {
+    /// The shape's own procedure ([`unit_span`]).
+    Shape,
+    /// The unit cube, by slabs ([`unit_cube`]).
+    Box,
+    /// A convex polyhedron of many planes, eight planes at a time.
+    Lanes(Box<PlaneLanes>),
+}
+
+/// A convex polyhedron's planes in lanes of eight (structure of arrays): a
+/// ray is clipped by eight planes with one division. Lanes past the last plane
+/// hold `0·p ≤ 1`, which clips nothing.
+#[derive(Debug, Clone)]
+struct PlaneLanes {
+    normal: [Vec<f32x8>; 3],
+    w: Vec<f32x8>,
+}
+
+impl PlaneLanes {
+    /// Planes from which lanes pay: below, a plane-by-plane loop is as quick
+    /// as one pass of lanes and the reduction of their answers (measured: a
+    /// pyramid's five planes, bevel gears' teeth of eight: 10–15% slower in
+    /// lanes; the hull of eight faceted balls, hundreds of planes: 3x faster).
+    const MIN_PLANES: usize = 16;
+
+    fn new(poly: &ConvexPolyhedron) -> PlaneLanes {
+        let lanes = |f: fn(&Vec4) -> f32, pad: f32| -> Vec<f32x8> {
+            poly.planes.chunks(8).map(|c| f32x8::new(std::array::from_fn(|j| c.get(j).map_or(pad, f)))).collect()
+        };
+        PlaneLanes { normal: [lanes(|p| p.x, 0.0), lanes(|p| p.y, 0.0), lanes(|p| p.z, 0.0)], w: lanes(|p| p.w, 1.0) }
+    }
+
+    /// What [`polyhedron`] gives for the same planes, the same `t` to the bit
+    /// and the same faces: each lane keeps the first of its planes with the
+    /// latest entry (earliest exit), and of the lanes tied at the end the one
+    /// with the first plane wins. Never inlined: it is for polyhedra of many
+    /// planes, and inlined into the per-pixel interval it slowed the boxes'
+    /// and small polyhedra's path by 10%.
+    #[inline(never)]
+    fn clip(&self, o: Vec3, d: Vec3) -> Option<UnitSpan> {
+        let s = f32x8::splat;
+        let ([ox, oy, oz], [dx, dy, dz]) = (o.to_array().map(s), d.to_array().map(s));
+        let zero = f32x8::ZERO;
+        let (mut enter, mut exit) = ((s(f32::NEG_INFINITY), zero), (s(f32::INFINITY), zero));
+        let mut miss = zero;
+        let mut face = f32x8::new(std::array::from_fn(|j| j as f32));
+        for (k, &w) in self.w.iter().enumerate() {
+            let [nx, ny, nz] = [self.normal[0][k], self.normal[1][k], self.normal[2][k]];
+            let along = nx * dx + ny * dy + nz * dz;
+            let gap = w - (nx * ox + ny * oy + nz * oz);
+            // Parallel to a plane and outside it: the ray misses.
+            miss |= along.simd_eq(zero) & gap.simd_lt(zero);
+            let t = gap / along;
+            let leaves = along.simd_gt(zero) & t.simd_lt(exit.0);
+            exit = (leaves.select(t, exit.0), leaves.select(face, exit.1));
+            let enters = along.simd_lt(zero) & t.simd_gt(enter.0);
+            enter = (enters.select(t, enter.0), enters.select(face, enter.1));
+            face += s(8.0);
+        }
+        if miss.any() {
+            return None;
+        }
+        let (enter, exit) = (first_of_lanes(enter, |a, b| a > b), first_of_lanes(exit, |a, b| a < b));
+        (enter.0 < exit.0 && enter.0.is_finite() && exit.0.is_finite()).then_some((enter, exit))
+    }
+}
+
+/// Of eight lanes' `(t, face)`, the `t` no other is `later` than, on a tie
+/// the one with the first face.
+#[inline(always)]
+fn first_of_lanes((t, face): (f32x8, f32x8), later: impl Fn(f32, f32) -> bool) -> (f32, u32) {
+    let (t, face) = (t.to_array(), face.to_array());
+    let mut best = (t[0], face[0] as u32);
+    for j in 1..8 {
+        let f = face[j] as u32;
+        if later(t[j], best.0) || (t[j] == best.0 && f < best.1) {
+            best = (t[j], f);
+        }
+    }
+    best
+}
+
 /// A convex polyhedron: the ray clipped by every face plane.
 fn polyhedron(poly: &ConvexPolyhedron, o: Vec3, d: Vec3) -> Option<UnitSpan> {
     let (mut enter, mut exit) = ((f32::NEG_INFINITY, 0), (f32::INFINITY, 0));
@@ -880,6 +976,23 @@ mod tests {
             stack.extend_from_slice(&a);
             cut(&mut stack, kept, &y);
             prop_assert_eq!(stack, expected);
+        }
+
+        /// Eight planes at a time clip as plane by plane does: the same `t`
+        /// to the bit and the same faces, for random planes (some axis
+        /// aligned, some repeated so that faces tie) and rays (some parallel
+        /// to a plane), any number of planes (lanes left over included).
+        #[test]
+        fn planes_in_lanes_clip_as_plane_by_plane(
+            normals in prop::collection::vec(vector(-1.0..1.0), 1..40),
+            offsets in prop::collection::vec(prop_oneof![0.2f32..2.0, Just(1.0f32)], 40),
+            o in vector(-1.0..1.0),
+            d in vector(-2.0..2.0),
+        ) {
+            let mut planes: Vec<Vec4> = normals.iter().zip(&offsets).map(|(n, &w)| n.extend(w)).collect();
+            planes.extend_from_within(..planes.len() / 3);
+            let poly = ConvexPolyhedron { planes, vertices: Vec::new() };
+            prop_assert_eq!(PlaneLanes::new(&poly).clip(o, d), polyhedron(&poly, o, d));
         }
 
         /// The slab test of a box gives what clipping by the unit cube's
