@@ -344,3 +344,20 @@ fn a_floor_that_casts_no_shadow_leaves_the_map_to_the_casters_and_still_receives
     scene.objects[0].casts_shadows = true;
     assert!(matches!(ShadowTerm::build(&scene, &scene.lights[0]), ShadowTerm::Cube(..)), "the floor widens the map");
 }
+
+#[test]
+fn scene_files_and_the_model_rig_say_which_objects_cast_shadows() {
+    let text = "[[object]]\nname = \"floor\"\nshape = \"plane\"\nscale = 40\ncasts_shadows = false\n\n\
+                [[object]]\nname = \"box\"\nshape = \"cube\"\n";
+    let fs = kage::scene::load::FileSystem { base: std::env::temp_dir() };
+    let scene = kage::scene::file::SceneFile::parse(text, Path::new("floor.toml")).unwrap().build(&fs).unwrap();
+    let casts: Vec<(&str, bool)> = scene.objects.iter().map(|o| (o.name.as_str(), o.casts_shadows)).collect();
+    assert_eq!(casts, [("floor", false), ("box", true)]);
+    assert_eq!(scene.caster_bounds(), scene.objects[1].world_bounds(), "the maps fit the box");
+    // The ground a `.csg` model stands on casts nothing; the model does.
+    let model = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/csg/ex004_cube_minus_sphere.csg");
+    let rig = kage::scene::file::scene_for_model(&model, 320, 240).unwrap();
+    let ground: Vec<bool> = rig.objects.iter().filter(|o| o.name == "ground").map(|o| o.casts_shadows).collect();
+    assert_eq!(ground, [false]);
+    assert!(rig.objects.iter().filter(|o| o.name != "ground").all(|o| o.casts_shadows));
+}

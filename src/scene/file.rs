@@ -428,6 +428,9 @@ struct ObjectRec {
     /// A `.csg` model: skip nodes kage cannot render, with a warning.
     #[serde(default)]
     skip_unsupported: bool,
+    /// Whether it is drawn into shadow maps ([`Object::casts_shadows`]).
+    #[serde(default = "yes")]
+    casts_shadows: bool,
 }
 
 impl SceneFile {
@@ -810,7 +813,9 @@ impl SceneFile {
             .clone()
             .or_else(|| r.mesh.as_ref().map(|m| m.get_ref().clone()))
             .unwrap_or_else(|| format!("{:?}", r.shape).to_lowercase());
+        let first = scene.objects.len();
         add_model(scene, &model, &label, transform, material);
+        scene.objects[first..].iter_mut().for_each(|o| o.casts_shadows = r.casts_shadows);
         Ok(model)
     }
 
