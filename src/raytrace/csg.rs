@@ -969,7 +969,9 @@ mod tests {
             let y = Interval { enter: Hit::new(cutter.0, 1, 2), exit: Hit::new(cutter.0 + cutter.1, 1, 3) };
             let a = spans(ts);
             // Spans below `kept` belong to an operand further down the stack.
-            let below: Vec<Interval> = (0..kept).map(|k| Interval { enter: Hit::new(-100.0 + k as f32, 2, 0), exit: Hit::new(-99.5 + k as f32, 2, 1) }).collect();
+            let below: Vec<Interval> = (0..kept)
+                .map(|k| Interval { enter: Hit::new(-100.0 + k as f32, 2, 0), exit: Hit::new(-99.5 + k as f32, 2, 1) })
+                .collect();
             let mut expected = below.clone();
             difference(&a, &[y], &mut expected);
             let mut stack = below;

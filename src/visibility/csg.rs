@@ -142,11 +142,12 @@ impl RowWalker {
     }
 }
 
-/// Draws every solid of `scene` that `include` takes seen by `camera` into
-/// `vb` (after its polygons): where a solid's visible surface lies nearer than what the pixel
-/// holds and between the near and far planes, the pixel takes its depth, its
-/// item (object + primitive) and its outward normal. A depth-only buffer (a
-/// shadow map) takes the depth alone. Returns the number of solids drawn.
+/// Draws every solid of `scene` that `include` takes, seen by `camera`, into
+/// `vb` (after its polygons): where a solid's visible surface lies nearer than
+/// what the pixel holds and between the near and far planes, the pixel takes
+/// its depth, its item (object + primitive) and its outward normal. A
+/// depth-only buffer (a shadow map) takes the depth alone. Returns the number
+/// of solids drawn.
 pub fn draw_solids(
     scene: &Scene,
     camera: &Camera,
