@@ -1,22 +1,16 @@
 //! A [`TraceScene`] kept from frame to frame. An interactive preview re-renders the
 //! same geometry from new viewpoints, under new lights and materials; only a change
-//! of geometry (a mesh or an object's transform, or whether it casts shadows)
-//! needs a new BVH. Jittered passes of
-//! one frame (seed 002 §4) share it too.
-//!
-//! The key holds a clone of every object's body (its `Arc<Mesh>` or
-//! `Arc<CsgSolid>`): while the cache holds it, no one can change that geometry in place (`Arc::get_mut` fails and `Arc::make_mut`
-//! copies), so pointer equality is a sound test of "the same geometry".
-
-use glam::Affine3A;
+//! of geometry (a mesh, an object's transform, or whether it casts shadows:
+//! [`GeometryKey`]) needs a new BVH. Jittered passes of one frame (seed 002 §4)
+//! share it too.
 
 use super::TraceScene;
-use crate::scene::{Body, Scene};
+use crate::scene::{GeometryKey, Scene};
 
 /// The BVH of the last scene traced, and what it was built from.
 #[derive(Debug, Default)]
 pub struct TraceCache {
-    key: Vec<(Body, Affine3A, bool)>,
+    key: GeometryKey,
     trace: Option<TraceScene>,
     builds: usize,
 }
@@ -25,14 +19,8 @@ impl TraceCache {
     /// The trace scene of `scene`'s geometry, built only if the geometry differs
     /// from the last call's.
     pub fn get(&mut self, scene: &Scene) -> &TraceScene {
-        let same = self.key.len() == scene.objects.len()
-            && self
-                .key
-                .iter()
-                .zip(&scene.objects)
-                .all(|((b, t, c), o)| b.same(&o.body) && *t == o.transform && *c == o.casts_shadows);
-        if !same || self.trace.is_none() {
-            self.key = scene.objects.iter().map(|o| (o.body.clone(), o.transform, o.casts_shadows)).collect();
+        if !self.key.matches(scene) || self.trace.is_none() {
+            self.key = GeometryKey::of(scene);
             self.builds += 1;
             self.trace = None;
         }
@@ -61,7 +49,7 @@ mod tests {
         scene.lights.clear();
         cache.get(&scene);
         assert_eq!(cache.builds(), 1, "a new viewpoint and lights keep the BVH");
-        scene.objects[0].transform = Affine3A::from_translation(glam::Vec3::X) * scene.objects[0].transform;
+        scene.objects[0].transform = glam::Affine3A::from_translation(glam::Vec3::X) * scene.objects[0].transform;
         cache.get(&scene);
         assert_eq!(cache.builds(), 2, "a moved object needs a new BVH");
         let crate::scene::Body::Mesh(mesh) = &mut scene.objects[0].body else {

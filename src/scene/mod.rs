@@ -62,6 +62,33 @@ impl Body {
     }
 }
 
+/// What a scene's geometry was when a cache was filled: every object's body
+/// (a clone of its `Arc`: while held, no one can change that geometry in
+/// place, so pointer equality is a sound test), transform and whether it
+/// casts shadows. Caches of the BVH and of shadow maps keep one and rebuild
+/// when the scene no longer [`GeometryKey::matches`] it.
+#[derive(Debug, Clone, Default)]
+pub struct GeometryKey(Vec<(Body, Affine3A, bool)>);
+
+impl GeometryKey {
+    /// The key of `scene`'s geometry.
+    #[must_use]
+    pub fn of(scene: &Scene) -> GeometryKey {
+        GeometryKey(scene.objects.iter().map(|o| (o.body.clone(), o.transform, o.casts_shadows)).collect())
+    }
+
+    /// Whether `scene` has the same geometry.
+    #[must_use]
+    pub fn matches(&self, scene: &Scene) -> bool {
+        self.0.len() == scene.objects.len()
+            && self
+                .0
+                .iter()
+                .zip(&scene.objects)
+                .all(|((b, t, c), o)| b.same(&o.body) && *t == o.transform && *c == o.casts_shadows)
+    }
+}
+
 /// A mesh or a CSG solid placed in the world with a material.
 #[derive(Debug, Clone)]
 pub struct Object {

@@ -10,12 +10,12 @@
 
 pub mod map;
 
-use glam::{Affine3A, Vec2, Vec3};
+use glam::{Vec2, Vec3};
 use wide::f32x8;
 
 pub use map::DepthMap;
 
-use crate::scene::{Body, Camera, Light, LightKind, Projection, Scene, ShadowMethod, ShadowSettings};
+use crate::scene::{Camera, GeometryKey, Light, LightKind, Projection, Scene, ShadowMethod, ShadowSettings};
 use crate::visibility::VisibilityBuffer;
 
 /// Widest spot cone (half-angle, degrees) one perspective map covers; wider spots
@@ -215,7 +215,7 @@ pub struct MapPool {
     previous: Vec<(MapKey, ShadowTerm)>,
     /// The geometry the kept terms saw: every object's body, transform and
     /// whether it casts shadows.
-    geometry: Vec<(Body, Affine3A, bool)>,
+    geometry: GeometryKey,
     /// Terms reused since [`MapPool::begin_frame`].
     reused: usize,
     /// The view directional lights' maps are fitted to (`None`: each scene's
@@ -243,14 +243,8 @@ impl MapPool {
     /// Starts a frame of `scene`: last frame's terms become reusable, unless
     /// an object's body or transform changed, which drops them all.
     pub fn begin_frame(&mut self, scene: &Scene) {
-        let same = self.geometry.len() == scene.objects.len()
-            && self
-                .geometry
-                .iter()
-                .zip(&scene.objects)
-                .all(|((b, t, c), o)| b.same(&o.body) && *t == o.transform && *c == o.casts_shadows);
-        if !same {
-            self.geometry = scene.objects.iter().map(|o| (o.body.clone(), o.transform, o.casts_shadows)).collect();
+        if !self.geometry.matches(scene) {
+            self.geometry = GeometryKey::of(scene);
             let stale: Vec<_> = self.kept.drain(..).chain(self.previous.drain(..)).collect();
             stale.into_iter().for_each(|(_, term)| self.recycle(term));
         }
