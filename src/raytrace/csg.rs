@@ -239,8 +239,8 @@ impl CsgCaster {
     /// (unnormalised) direction.
     #[must_use]
     pub fn span_on(&self, i: usize, unit: &RowLine, x: f32) -> Option<Interval> {
-        let (o, d) = unit_ray_on(unit, x);
-        self.unit_interval(i, o, d)
+        let ray = unit.at(x);
+        self.unit_interval(i, ray.origin, ray.dir)
     }
 
     /// The crossing `hit` of `ray` with its unit outward normal (solid space).
@@ -255,8 +255,7 @@ impl CsgCaster {
     /// (solid space).
     #[must_use]
     pub fn crossing_on_line(&self, hit: Hit, unit: &RowLine, x: f32) -> Crossing {
-        let (o, d) = unit_ray_on(unit, x);
-        self.finish(hit, o + d * hit.t)
+        self.finish(hit, unit.at(x).at(hit.t))
     }
 
     /// `hit` with the unit outward normal (solid space) of its face at `p`
@@ -671,11 +670,6 @@ pub fn primitive_span(p: &Primitive, index: usize, ray: &Ray) -> Option<Span> {
         cut: false,
     };
     Some(Span { enter: crossing(t0, f0), exit: crossing(t1, f1) })
-}
-
-/// Pixel `x`'s ray of a row line: origin and (unnormalised) direction.
-fn unit_ray_on(unit: &RowLine, x: f32) -> (Vec3, Vec3) {
-    (unit.origin + unit.origin_step * x, unit.dir + unit.dir_step * x)
 }
 
 /// The (unnormalised) outward normal of a unit shape's face `face` at its

@@ -241,7 +241,8 @@ impl MapKey {
 
 impl MapPool {
     /// Starts a frame of `scene`: last frame's terms become reusable, unless
-    /// an object's body or transform changed, which drops them all.
+    /// the geometry changed ([`GeometryKey`]: an object's body, transform or
+    /// whether it casts shadows), which drops them all.
     pub fn begin_frame(&mut self, scene: &Scene) {
         if !self.geometry.matches(scene) {
             self.geometry = GeometryKey::of(scene);
