@@ -37,7 +37,9 @@ use glam::{DVec2, Mat4, Vec2, Vec3, Vec4};
 use rayon::iter::IndexedParallelIterator;
 use rayon::prelude::*;
 
-use crate::raytrace::csg::{Crossing, CsgCaster, Hit, Interval, SpanScratch};
+use std::cell::RefCell;
+
+use crate::raytrace::csg::{Crossing, CsgCaster, Hit, Interval, IntervalLanes, SpanScratch};
 use crate::scene::camera::PixelRays;
 use crate::scene::camera::RowLine;
 use crate::scene::csg::{CsgSolid, Primitive, Shape};
@@ -241,9 +243,10 @@ fn scan_bands<B: Send>(
                 RowWalker::Segments(tree) => Occupied::new(tree),
                 _ => Occupied::default(),
             };
-            (vec![None; w], vec![RowLine::default(); solid.primitives.len()], counts, SpanScratch::default())
+            let n = solid.primitives.len();
+            (vec![None; w], vec![RowLine::default(); n], counts, SpanScratch::default(), BlockSpans::new(n))
         },
-        |(row, lines, counts, scratch), (band, mut out)| {
+        |(row, lines, counts, scratch, blocks), (band, mut out)| {
             let first = (band * BAND_ROWS) as i64;
             // The y-occupancy list as the band's first scanline finds it, then kept
             // row by row.
@@ -266,7 +269,8 @@ fn scan_bands<B: Send>(
                 // The row's rays, carried into each occupant's unit space once.
                 let line = rays.row_line(y as usize);
                 ends.iter().for_each(|&(i, _, _)| lines[i] = caster.unit_line(i, &line));
-                let span = |i: usize, x: usize| caster.span_on(i, &lines[i], x as f32);
+                blocks.begin_row(ends.iter().map(|e| e.0));
+                let span = |i: usize, x: usize| blocks.span(&caster, i, &lines[i], x);
                 match walker {
                     RowWalker::Segments(tree) => scan_row(&caster, (tree, counts), &ends, &span, near, (row, scratch)),
                     RowWalker::Pattern(matrix) => matrix.walk_row(&caster, &ends, &span, near, row),
@@ -276,6 +280,39 @@ fn scan_bands<B: Send>(
             }
         },
     );
+}
+
+/// Each occupant's intervals at the eight-pixel block of the scanline last
+/// asked of it: the first pixel of a block that needs a primitive's interval
+/// gets all eight in one SIMD pass ([`CsgCaster::spans_on_eight`], each the
+/// same to the bit as one pixel's), and its neighbours read theirs.
+struct BlockSpans {
+    /// Per primitive: the block (`x / 8`) its lanes hold, and the lanes.
+    cached: RefCell<Vec<(usize, IntervalLanes)>>,
+}
+
+impl BlockSpans {
+    fn new(primitives: usize) -> Self {
+        BlockSpans { cached: RefCell::new(vec![(usize::MAX, IntervalLanes::default()); primitives]) }
+    }
+
+    /// A new scanline: the occupants' lanes (of the row before) are stale.
+    fn begin_row(&mut self, occupants: impl Iterator<Item = usize>) {
+        let cached = self.cached.get_mut();
+        occupants.for_each(|i| cached[i].0 = usize::MAX);
+    }
+
+    /// Primitive `i`'s interval at pixel `x` of its row line `unit`.
+    #[inline]
+    fn span(&self, caster: &CsgCaster, i: usize, unit: &RowLine, x: usize) -> Option<Interval> {
+        let mut cached = self.cached.borrow_mut();
+        let (block, lanes) = &mut cached[i];
+        if *block != x / 8 {
+            *block = x / 8;
+            *lanes = caster.spans_on_eight(i, unit, (x / 8 * 8) as f32);
+        }
+        lanes.get(x % 8)
+    }
 }
 
 /// An occupant of a scanline: primitive, left end, right end (columns).
