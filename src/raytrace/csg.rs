@@ -523,6 +523,9 @@ pub struct Parts<B, I> {
 pub trait Booleans: Copy {
     /// The node's operation and operands.
     fn parts(self) -> Parts<Self, impl Iterator<Item = Self>>;
+
+    /// The primitive, if the node is a leaf (what `parts` says, more cheaply).
+    fn leaf(self) -> Option<usize>;
 }
 
 impl Booleans for &CsgTree {
@@ -538,6 +541,14 @@ impl Booleans for &CsgTree {
             CsgTree::Difference(a, kids) => (Operation::Difference, Some(&**a), kids),
         };
         Parts { operation, first, others: others.iter() }
+    }
+
+    #[inline(always)]
+    fn leaf(self) -> Option<usize> {
+        match self {
+            CsgTree::Leaf(i) => Some(*i),
+            _ => None,
+        }
     }
 }
 
@@ -560,7 +571,10 @@ pub fn combine<B: Booleans>(tree: B, leaf: &impl Fn(usize) -> Option<Interval>, 
         Operation::Union => {
             let mut parts = 0;
             for k in others {
-                combine(k, leaf, scratch);
+                match k.leaf() {
+                    Some(i) => scratch.stack.extend(leaf(i)),
+                    None => _ = combine(k, leaf, scratch),
+                }
                 parts += 1;
             }
             // One operand's spans are already sorted and disjoint.
@@ -574,6 +588,16 @@ pub fn combine<B: Booleans>(tree: B, leaf: &impl Fn(usize) -> Option<Interval>, 
             for k in others {
                 if scratch.stack.len() == base {
                     break; // nothing left to intersect with or cut from
+                }
+                if let Some(i) = k.leaf() {
+                    // One interval or none: narrow or cut in place.
+                    match (leaf(i), op) {
+                        (Some(y), Operation::Difference) => cut(&mut scratch.stack, base, &y),
+                        (Some(y), _) => clip(&mut scratch.stack, base, &y),
+                        (None, Operation::Difference) => {}
+                        (None, _) => scratch.stack.truncate(base),
+                    }
+                    continue;
                 }
                 let mid = combine(k, leaf, scratch);
                 if op == Operation::Difference && scratch.stack.len() <= mid + 1 {
@@ -658,6 +682,24 @@ fn difference(a: &[Interval], b: &[Interval], out: &mut Vec<Interval>) {
         }
         out.extend(rest);
     }
+}
+
+/// [`intersection`] with one interval `y`, in place on the sorted disjoint
+/// spans of `stack` from `base`: each span narrowed to `y`, the empty ones
+/// dropped.
+#[inline]
+fn clip(stack: &mut Vec<Interval>, base: usize, y: &Interval) {
+    let mut kept = base;
+    for k in base..stack.len() {
+        let x = stack[k];
+        let enter = if x.enter.t >= y.enter.t { x.enter } else { y.enter };
+        let exit = if x.exit.t <= y.exit.t { x.exit } else { y.exit };
+        if enter.t < exit.t {
+            stack[kept] = Interval { enter, exit };
+            kept += 1;
+        }
+    }
+    stack.truncate(kept);
 }
 
 /// [`difference`] by one interval `y`, in place on the sorted disjoint spans
@@ -1017,6 +1059,27 @@ mod tests {
             let mut stack = below;
             stack.extend_from_slice(&a);
             cut(&mut stack, kept, &y);
+            prop_assert_eq!(stack, expected);
+        }
+
+        /// Narrowing to one interval in place leaves what [`intersection`]
+        /// with it leaves: the same spans with the same crossings.
+        #[test]
+        fn a_clip_in_place_is_the_intersection_with_one_interval(
+            ts in prop::collection::vec(prop_oneof![-5.0f32..5.0, (-5i32..5).prop_map(|k| k as f32)], 0..12),
+            other in (prop_oneof![-6.0f32..6.0, (-5i32..5).prop_map(|k| k as f32)], 0.0f32..6.0),
+            kept in 0usize..3,
+        ) {
+            let y = Interval { enter: Hit::new(other.0, 1, 2), exit: Hit::new(other.0 + other.1, 1, 3) };
+            let a = spans(ts);
+            let below: Vec<Interval> = (0..kept)
+                .map(|k| Interval { enter: Hit::new(-100.0 + k as f32, 2, 0), exit: Hit::new(-99.5 + k as f32, 2, 1) })
+                .collect();
+            let mut expected = below.clone();
+            intersection(&a, &[y], &mut expected);
+            let mut stack = below;
+            stack.extend_from_slice(&a);
+            clip(&mut stack, kept, &y);
             prop_assert_eq!(stack, expected);
         }
 

@@ -303,15 +303,20 @@ impl BlockSpans {
     }
 
     /// Primitive `i`'s interval at pixel `x` of its row line `unit`.
-    #[inline]
+    #[inline(always)]
     fn span(&self, caster: &CsgCaster, i: usize, unit: &RowLine, x: usize) -> Option<Interval> {
         let mut cached = self.cached.borrow_mut();
         let (block, lanes) = &mut cached[i];
         if *block != x / 8 {
-            *block = x / 8;
-            *lanes = caster.spans_on_eight(i, unit, (x / 8 * 8) as f32);
+            (*block, *lanes) = Self::fill(caster, i, unit, x / 8);
         }
         lanes.get(x % 8)
+    }
+
+    /// Primitive `i`'s lanes for `block`: once per eight pixels, not inlined.
+    #[inline(never)]
+    fn fill(caster: &CsgCaster, i: usize, unit: &RowLine, block: usize) -> (usize, IntervalLanes) {
+        (block, caster.spans_on_eight(i, unit, (block * 8) as f32))
     }
 }
 

@@ -337,6 +337,14 @@ impl<'a> Booleans for OccupiedNode<'a> {
         let at = move |node| OccupiedNode { tree: t, counts: c, node };
         Parts { operation: node.operation, first: first.map(at), others: others.iter().map(move |&n| at(n)) }
     }
+
+    #[inline(always)]
+    fn leaf(self) -> Option<usize> {
+        match self.tree.nodes[self.node as usize].operation {
+            Operation::Leaf(i) => Some(i),
+            _ => None,
+        }
+    }
 }
 
 #[cfg(test)]
