@@ -105,6 +105,37 @@ fn spans_agree_with_point_membership_on_random_solids() {
 }
 
 #[test]
+fn a_union_seen_from_inside_one_part_is_left_where_the_union_ends() {
+    // Two overlapping unit balls at x = 0 and x = 1.5, and a third apart at
+    // x = 6: from inside the first, the union's first surface is where the
+    // second ends (x = 2.5), not where the first does; from outside, the
+    // nearest entry.
+    let ball = |x: f32| Primitive {
+        shape: Shape::Sphere,
+        transform: Affine3A::from_translation(Vec3::new(x, 0.0, 0.0)),
+        color: None,
+        source: 0..0,
+    };
+    let union = |order: [usize; 3]| CsgSolid {
+        primitives: vec![ball(0.0), ball(1.5), ball(6.0)],
+        tree: Some(CsgTree::Union(order.iter().map(|&i| CsgTree::Leaf(i)).collect())),
+    };
+    let near = |a: f32, b: f32| (a - b).abs() < 1e-5;
+    for order in [[0, 1, 2], [2, 1, 0], [1, 2, 0]] {
+        let solid = union(order);
+        let inside = Ray { origin: Vec3::new(0.2, 0.0, 0.0), dir: Vec3::X };
+        let hit = first_hit(&solid, &inside, 0.0, f32::INFINITY).unwrap();
+        assert!(near(hit.t, 2.3) && hit.primitive == 1, "{order:?}: {hit:?}");
+        let outside = Ray { origin: Vec3::new(-3.0, 0.0, 0.0), dir: Vec3::X };
+        let hit = first_hit(&solid, &outside, 0.0, f32::INFINITY).unwrap();
+        assert!(near(hit.t, 2.0) && hit.primitive == 0, "{order:?}: {hit:?}");
+        let between = Ray { origin: Vec3::new(3.0, 0.0, 0.0), dir: Vec3::X };
+        let hit = first_hit(&solid, &between, 0.0, f32::INFINITY).unwrap();
+        assert!(near(hit.t, 2.0) && hit.primitive == 2, "{order:?}: {hit:?}");
+    }
+}
+
+#[test]
 fn normals_point_out_of_the_solid_and_hole_walls_are_marked_cut() {
     // A unit ball with a cylinder bored along z: a ray along x through the centre
     // enters the ball (normal −x), leaves into the hole through its wall (normal

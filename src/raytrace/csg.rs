@@ -332,31 +332,41 @@ impl CsgCaster {
     /// buffers reused from pixel to pixel.
     #[must_use]
     pub fn first_hit_with(&self, tree: &CsgTree, ray: &Ray, t_min: f32, scratch: &mut SpanScratch) -> Option<Crossing> {
-        self.first_hit_in_by([tree], &|i| self.interval(i, ray), t_min, scratch).map(|h| self.crossing_on_ray(h, ray))
+        self.first_hit_in_by(tree, &|i| self.interval(i, ray), t_min, scratch).map(|h| self.crossing_on_ray(h, ray))
     }
 
-    /// The first surface at `t > t_min` of the union of the parts `trees`
-    /// describe (seed 003's nearest surface over segments), each primitive's
-    /// interval from `leaf` — e.g. [`CsgCaster::span_on`] — with buffers
-    /// reused from pixel to pixel. Its normal is found by the caller, who
-    /// knows the ray ([`CsgCaster::crossing_on_line`]).
+    /// The first surface at `t > t_min` of the solid `tree` describes (seed
+    /// 003's nearest surface over segments), each primitive's interval from
+    /// `leaf` — e.g. [`CsgCaster::span_on`] — with buffers reused from pixel
+    /// to pixel. Its normal is found by the caller, who knows the ray
+    /// ([`CsgCaster::crossing_on_line`]).
+    ///
+    /// A union's operands are not merged when they need not be: where `t_min`
+    /// lies outside every operand, the union's first surface is the nearest
+    /// of the operands' first entries (the first operand's on a tie, as the
+    /// merge would give it), so each operand is combined on its own and only
+    /// its first entry kept. An operand holding `t_min` (the near plane inside
+    /// the solid) sends the pixel to the full merge.
     pub fn first_hit_in_by<B: Booleans>(
         &self,
-        trees: impl IntoIterator<Item = B>,
+        tree: B,
         leaf: &impl Fn(usize) -> Option<Interval>,
         t_min: f32,
         scratch: &mut SpanScratch,
     ) -> Option<Hit> {
-        scratch.stack.clear();
-        let mut parts = 0;
-        for tree in trees {
-            combine(tree, leaf, scratch);
-            parts += 1;
+        let Parts { operation, others, .. } = tree.parts();
+        if operation == Operation::Union {
+            let mut nearest: Option<Hit> = None;
+            for k in others {
+                match first_entry(k, leaf, t_min, scratch) {
+                    Ok(Some(h)) if nearest.is_none_or(|n| h.t < n.t) => nearest = Some(h),
+                    Ok(_) => {}
+                    Err(Inside) => return first_of_all(tree, leaf, t_min, scratch),
+                }
+            }
+            return nearest;
         }
-        if parts > 1 {
-            union(&mut scratch.stack, 0);
-        }
-        scratch.stack.iter().flat_map(|s| [s.enter, s.exit]).find(|c| c.t > t_min)
+        first_of_all(tree, leaf, t_min, scratch)
     }
 
     /// The first surface beyond `t_min` of a union of pattern-matrix segments
@@ -438,7 +448,7 @@ impl CsgCaster {
                 counts.fit(shape);
                 met.iter().for_each(|&i| counts.set(shape, i as usize, true));
                 let root = counts.root(shape);
-                let hit = root.and_then(|root| self.first_hit_in_by([root], &|i| self.interval(i, ray), t_min, s));
+                let hit = root.and_then(|root| self.first_hit_in_by(root, &|i| self.interval(i, ray), t_min, s));
                 counts.clear(shape);
                 s.counts = counts;
                 hit
@@ -448,7 +458,7 @@ impl CsgCaster {
                 crossed.resize(self.frames.len(), false);
                 met.iter().for_each(|&i| crossed[i as usize] = true);
                 let leaf = |i: usize| if crossed[i] { self.interval(i, ray) } else { None };
-                let hit = self.first_hit_in_by([tree], &leaf, t_min, s);
+                let hit = self.first_hit_in_by(tree, &leaf, t_min, s);
                 met.iter().for_each(|&i| crossed[i as usize] = false);
                 s.crossed = crossed;
                 hit
@@ -466,7 +476,7 @@ impl CsgCaster {
     pub fn first_hit_every_primitive(&self, ray: &Ray, t_min: f32) -> Option<Crossing> {
         let tree = self.solid.tree.as_ref()?;
         let all: Vec<Option<Interval>> = (0..self.frames.len()).map(|i| self.interval(i, ray)).collect();
-        self.first_hit_in_by([tree], &|i| all[i], t_min, &mut SpanScratch::default())
+        self.first_hit_in_by(tree, &|i| all[i], t_min, &mut SpanScratch::default())
             .map(|h| self.crossing_on_ray(h, ray))
     }
 }
@@ -622,6 +632,45 @@ pub fn combine<B: Booleans>(tree: B, leaf: &impl Fn(usize) -> Option<Interval>, 
         }
     }
     base
+}
+
+/// `t_min` lies inside a part of the solid.
+struct Inside;
+
+/// The first crossing beyond `t_min` of the subtree `tree` if it is an entry
+/// (`None` if there is none); [`Inside`] if it is an exit.
+fn first_entry<B: Booleans>(
+    tree: B,
+    leaf: &impl Fn(usize) -> Option<Interval>,
+    t_min: f32,
+    scratch: &mut SpanScratch,
+) -> Result<Option<Hit>, Inside> {
+    scratch.stack.clear();
+    match tree.leaf() {
+        Some(i) => scratch.stack.extend(leaf(i)),
+        None => _ = combine(tree, leaf, scratch),
+    }
+    for s in &scratch.stack {
+        if s.enter.t > t_min {
+            return Ok(Some(s.enter));
+        }
+        if s.exit.t > t_min {
+            return Err(Inside);
+        }
+    }
+    Ok(None)
+}
+
+/// The first crossing beyond `t_min` of the spans of the whole of `tree`.
+fn first_of_all<B: Booleans>(
+    tree: B,
+    leaf: &impl Fn(usize) -> Option<Interval>,
+    t_min: f32,
+    scratch: &mut SpanScratch,
+) -> Option<Hit> {
+    scratch.stack.clear();
+    combine(tree, leaf, scratch);
+    scratch.stack.iter().flat_map(|s| [s.enter, s.exit]).find(|c| c.t > t_min)
 }
 
 /// Merges the spans on `stack` from `base` into sorted disjoint spans covering

@@ -354,7 +354,7 @@ fn scan_row(
             next_in += 1;
         }
         if let Some(root) = counts.root(tree) {
-            *px = caster.first_hit_in_by([root], &|i| span(i, x), near, scratch);
+            *px = caster.first_hit_in_by(root, &|i| span(i, x), near, scratch);
         }
         // Primitives whose right end is this pixel leave the x-occupancy list.
         while next_out < exit.len() && exit[next_out].2 <= x as i64 {
