@@ -1088,48 +1088,57 @@ mod tests {
         ts.chunks_exact(2).map(|p| Interval { enter: Hit::new(p[0], 0, 0), exit: Hit::new(p[1], 0, 1) }).collect()
     }
 
+    /// A point where spans start or end, within `±r`, often a whole number
+    /// (so that ends meet and tie).
+    fn cut_point(r: f32) -> impl Strategy<Value = f32> {
+        prop_oneof![-r..r, (-5i32..5).prop_map(|k| k as f32)]
+    }
+
+    /// The spans `a` combined with the interval `(start, length)` of another
+    /// primitive by `in_place` on a stack where `kept` spans of an operand
+    /// further down lie below them, and what `general` leaves after those.
+    fn by_one_interval(
+        a: Vec<Interval>,
+        (start, length): (f32, f32),
+        kept: usize,
+        in_place: fn(&mut Vec<Interval>, usize, &Interval),
+        general: fn(&[Interval], &[Interval], &mut Vec<Interval>),
+    ) -> (Vec<Interval>, Vec<Interval>) {
+        let y = Interval { enter: Hit::new(start, 1, 2), exit: Hit::new(start + length, 1, 3) };
+        let below: Vec<Interval> = (0..kept)
+            .map(|k| Interval { enter: Hit::new(-100.0 + k as f32, 2, 0), exit: Hit::new(-99.5 + k as f32, 2, 1) })
+            .collect();
+        let mut expected = below.clone();
+        general(&a, &[y], &mut expected);
+        let mut stack = below;
+        stack.extend_from_slice(&a);
+        in_place(&mut stack, kept, &y);
+        (stack, expected)
+    }
+
     proptest! {
         /// Cutting by one interval in place leaves what [`difference`] by it
         /// leaves: the same spans, the same crossings, walls included.
         #[test]
         fn a_cut_in_place_is_the_difference_by_one_interval(
-            ts in prop::collection::vec(prop_oneof![-5.0f32..5.0, (-5i32..5).prop_map(|k| k as f32)], 0..12),
-            cutter in (prop_oneof![-6.0f32..6.0, (-5i32..5).prop_map(|k| k as f32)], 0.0f32..6.0),
+            ts in prop::collection::vec(cut_point(5.0), 0..12),
+            other in (cut_point(6.0), 0.0f32..6.0),
             kept in 0usize..3,
         ) {
-            let y = Interval { enter: Hit::new(cutter.0, 1, 2), exit: Hit::new(cutter.0 + cutter.1, 1, 3) };
-            let a = spans(ts);
-            // Spans below `kept` belong to an operand further down the stack.
-            let below: Vec<Interval> = (0..kept)
-                .map(|k| Interval { enter: Hit::new(-100.0 + k as f32, 2, 0), exit: Hit::new(-99.5 + k as f32, 2, 1) })
-                .collect();
-            let mut expected = below.clone();
-            difference(&a, &[y], &mut expected);
-            let mut stack = below;
-            stack.extend_from_slice(&a);
-            cut(&mut stack, kept, &y);
-            prop_assert_eq!(stack, expected);
+            let (in_place, expected) = by_one_interval(spans(ts), other, kept, cut, difference);
+            prop_assert_eq!(in_place, expected);
         }
 
         /// Narrowing to one interval in place leaves what [`intersection`]
         /// with it leaves: the same spans with the same crossings.
         #[test]
         fn a_clip_in_place_is_the_intersection_with_one_interval(
-            ts in prop::collection::vec(prop_oneof![-5.0f32..5.0, (-5i32..5).prop_map(|k| k as f32)], 0..12),
-            other in (prop_oneof![-6.0f32..6.0, (-5i32..5).prop_map(|k| k as f32)], 0.0f32..6.0),
+            ts in prop::collection::vec(cut_point(5.0), 0..12),
+            other in (cut_point(6.0), 0.0f32..6.0),
             kept in 0usize..3,
         ) {
-            let y = Interval { enter: Hit::new(other.0, 1, 2), exit: Hit::new(other.0 + other.1, 1, 3) };
-            let a = spans(ts);
-            let below: Vec<Interval> = (0..kept)
-                .map(|k| Interval { enter: Hit::new(-100.0 + k as f32, 2, 0), exit: Hit::new(-99.5 + k as f32, 2, 1) })
-                .collect();
-            let mut expected = below.clone();
-            intersection(&a, &[y], &mut expected);
-            let mut stack = below;
-            stack.extend_from_slice(&a);
-            clip(&mut stack, kept, &y);
-            prop_assert_eq!(stack, expected);
+            let (in_place, expected) = by_one_interval(spans(ts), other, kept, clip, intersection);
+            prop_assert_eq!(in_place, expected);
         }
 
         /// Eight planes at a time clip as plane by plane does: the same `t`
