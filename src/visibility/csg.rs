@@ -39,7 +39,7 @@ use rayon::prelude::*;
 
 use std::cell::RefCell;
 
-use crate::raytrace::csg::{Crossing, CsgCaster, Hit, Interval, IntervalLanes, SpanScratch};
+use crate::raytrace::csg::{Crossing, CsgCaster, Hit, Interval, IntervalLanes, RowFaces, SpanScratch};
 use crate::scene::camera::PixelRays;
 use crate::scene::camera::RowLine;
 use crate::scene::csg::{CsgSolid, Primitive, Shape};
@@ -269,7 +269,7 @@ fn scan_bands<B: Send>(
                 // The row's rays, carried into each occupant's unit space once.
                 let line = rays.row_line(y as usize);
                 ends.iter().for_each(|&(i, _, _)| lines[i] = caster.unit_line(i, &line));
-                blocks.begin_row(ends.iter().map(|e| e.0));
+                blocks.begin_row(&caster, ends.iter().map(|e| e.0), lines);
                 let span = |i: usize, x: usize| blocks.span(&caster, i, &lines[i], x);
                 match walker {
                     RowWalker::Segments(tree) => scan_row(&caster, (tree, counts), &ends, &span, near, (row, scratch)),
@@ -289,17 +289,28 @@ fn scan_bands<B: Send>(
 struct BlockSpans {
     /// Per primitive: the block (`x / 8`) its lanes hold, and the lanes.
     cached: RefCell<Vec<(usize, IntervalLanes)>>,
+    /// Per primitive: the faces the row's rays can cross (polyhedra of many
+    /// planes).
+    faces: Vec<RowFaces>,
 }
 
 impl BlockSpans {
     fn new(primitives: usize) -> Self {
-        BlockSpans { cached: RefCell::new(vec![(usize::MAX, IntervalLanes::default()); primitives]) }
+        BlockSpans {
+            cached: RefCell::new(vec![(usize::MAX, IntervalLanes::default()); primitives]),
+            faces: vec![RowFaces::default(); primitives],
+        }
     }
 
-    /// A new scanline: the occupants' lanes (of the row before) are stale.
-    fn begin_row(&mut self, occupants: impl Iterator<Item = usize>) {
+    /// A new scanline, its rays `lines` in each occupant's space: the
+    /// occupants' lanes (of the row before) are stale, and their faces
+    /// the row can cross are found.
+    fn begin_row(&mut self, caster: &CsgCaster, occupants: impl Iterator<Item = usize>, lines: &[RowLine]) {
         let cached = self.cached.get_mut();
-        occupants.for_each(|i| cached[i].0 = usize::MAX);
+        for i in occupants {
+            cached[i].0 = usize::MAX;
+            caster.row_faces(i, &lines[i], &mut self.faces[i]);
+        }
     }
 
     /// Primitive `i`'s interval at pixel `x` of its row line `unit`.
@@ -308,15 +319,15 @@ impl BlockSpans {
         let mut cached = self.cached.borrow_mut();
         let (block, lanes) = &mut cached[i];
         if *block != x / 8 {
-            (*block, *lanes) = Self::fill(caster, i, unit, x / 8);
+            (*block, *lanes) = Self::fill(caster, i, unit, x / 8, &self.faces[i]);
         }
         lanes.get(x % 8)
     }
 
     /// Primitive `i`'s lanes for `block`: once per eight pixels, not inlined.
     #[inline(never)]
-    fn fill(caster: &CsgCaster, i: usize, unit: &RowLine, block: usize) -> (usize, IntervalLanes) {
-        (block, caster.spans_on_eight(i, unit, (block * 8) as f32))
+    fn fill(caster: &CsgCaster, i: usize, unit: &RowLine, block: usize, faces: &RowFaces) -> (usize, IntervalLanes) {
+        (block, caster.spans_on_eight(i, unit, (block * 8) as f32, faces))
     }
 }
 

@@ -10,7 +10,7 @@
 //! face: the scanline walk's answer does not depend on which path found it.
 //! The property tests below hold the lanes to that.
 
-use glam::Vec3;
+use glam::{Vec3, Vec4};
 use wide::f32x8;
 
 use super::{BOTTOM, SIDE, TOP};
@@ -161,9 +161,15 @@ pub(super) fn unit_cube(r: &RayLanes) -> SpanLanes {
 
 /// [`super::polyhedron`] in lanes: every plane clips all eight rays.
 pub(super) fn polyhedron(poly: &ConvexPolyhedron, r: &RayLanes) -> SpanLanes {
+    planes((0..).zip(&poly.planes), r)
+}
+
+/// [`polyhedron`] by the planes `faces` (face index and plane, in rising
+/// order of index, so that ties go to the first face as they do there).
+pub(super) fn planes<'a>(faces: impl Iterator<Item = (u32, &'a Vec4)>, r: &RayLanes) -> SpanLanes {
     let (mut enter, mut exit) = ((s(f32::NEG_INFINITY), ZERO), (s(f32::INFINITY), ZERO));
     let mut miss = ZERO;
-    for (face, plane) in poly.planes.iter().enumerate() {
+    for (face, plane) in faces {
         let n = plane.truncate().to_array().map(s);
         let (along, gap) = (dot(n, r.d), s(plane.w) - dot(n, r.o));
         let parallel = along.simd_eq(ZERO);
@@ -175,6 +181,73 @@ pub(super) fn polyhedron(poly: &ConvexPolyhedron, r: &RayLanes) -> SpanLanes {
         enter = pick(!leaving & !parallel & t.simd_gt(enter.0), (t, face), enter);
     }
     finish(enter, exit, miss)
+}
+
+/// Which corners of a convex polyhedron lie on each face, so that a
+/// scanline can leave out the faces its rays cannot cross: the rays of a row
+/// lie in one plane (through the eye, or along the view axis under an
+/// orthographic camera), and a ray in that plane enters and leaves the solid
+/// through faces the plane meets. Clipping by those alone gives the same
+/// interval: a face the plane misses lies farther than [`FaceCorners::margin`]
+/// from every crossing, so its plane never wins, nor ties.
+#[derive(Debug, Clone)]
+pub(super) struct FaceCorners {
+    corners: Vec<Vec3>,
+    /// Face `f`'s corners: `on[start[f]..start[f + 1]]`.
+    on: Vec<u32>,
+    start: Vec<u32>,
+    /// How near the row's plane a face must come to be kept.
+    margin: f32,
+}
+
+impl FaceCorners {
+    /// The faces of `poly` and their corners (within a millionth of its size
+    /// of the face's plane), or `None` if it lists no corners.
+    pub(super) fn new(poly: &ConvexPolyhedron) -> Option<FaceCorners> {
+        let corners = poly.vertices.clone();
+        let (lo, hi) = corners.iter().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(a, b), &c| (a.min(c), b.max(c)));
+        let size = (hi - lo).max_element();
+        if corners.is_empty() || !size.is_finite() || size <= 0.0 {
+            return None;
+        }
+        let (mut on, mut start) = (Vec::new(), vec![0]);
+        for plane in &poly.planes {
+            let n = plane.truncate();
+            on.extend(
+                (0..corners.len() as u32).filter(|&k| (n.dot(corners[k as usize]) - plane.w).abs() <= 1e-5 * size),
+            );
+            start.push(on.len() as u32);
+        }
+        Some(FaceCorners { corners, on, start, margin: 1e-3 * size })
+    }
+
+    /// Into `faces` (cleared), in rising order, the faces that the plane of
+    /// `line`'s rays meets or passes within the margin of; every face when
+    /// the rays span no plane.
+    pub(super) fn met_by(&self, line: &RowLine, distances: &mut Vec<f32>, faces: &mut Vec<u32>) {
+        faces.clear();
+        let all = self.start.len() as u32 - 1;
+        let normal = [line.dir.cross(line.dir_step), line.origin_step.cross(line.dir)]
+            .into_iter()
+            .find_map(|m| m.try_normalize());
+        let Some(m) = normal else {
+            faces.extend(0..all);
+            return;
+        };
+        let offset = m.dot(line.origin);
+        distances.clear();
+        distances.extend(self.corners.iter().map(|&c| m.dot(c) - offset));
+        for f in 0..all as usize {
+            let on = &self.on[self.start[f] as usize..self.start[f + 1] as usize];
+            let (lo, hi) = on.iter().fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), &k| {
+                let d = distances[k as usize];
+                (lo.min(d), hi.max(d))
+            });
+            if on.is_empty() || (lo <= self.margin && hi >= -self.margin) {
+                faces.push(f as u32);
+            }
+        }
+    }
 }
 
 /// A clipped interval's lanes: met where nothing missed, the entry before
