@@ -1,7 +1,7 @@
 //! Eight pixels of a scanline at once (seed 003 §5.2.2's coherence along a
 //! scanline): one primitive's interval at pixels `x0..x0 + 8` of a row, each
-//! of the parent module's closed-form procedures ([`super::sphere`],
-//! [`super::frustum`], [`super::unit_cube`], [`super::polyhedron`]) run in
+//! of the parent module's closed-form procedures ([`super::shapes::sphere`],
+//! [`super::shapes::frustum`], [`super::shapes::unit_cube`], [`super::shapes::polyhedron`]) run in
 //! `f32x8` lanes, one pixel per lane.
 //!
 //! Every lane does the same IEEE operations in the same order as the scalar
@@ -13,7 +13,7 @@
 use glam::{Vec3, Vec4};
 use wide::f32x8;
 
-use super::{BOTTOM, SIDE, TOP};
+use super::shapes::{BOTTOM, SIDE, TOP};
 use crate::scene::camera::RowLine;
 use crate::scene::csg::{ConvexPolyhedron, Shape};
 
@@ -59,7 +59,7 @@ fn dot(a: [f32x8; 3], b: [f32x8; 3]) -> f32x8 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
-/// The interval of a unit shape ([`super::unit_span`]) in eight lanes.
+/// The interval of a unit shape ([`super::shapes::unit_span`]) in eight lanes.
 pub(super) fn shape(shape: &Shape, r: &RayLanes) -> SpanLanes {
     match shape {
         Shape::Sphere => sphere(r),
@@ -68,7 +68,7 @@ pub(super) fn shape(shape: &Shape, r: &RayLanes) -> SpanLanes {
     }
 }
 
-/// [`super::roots`] in lanes: the smaller and larger root, and where they are real.
+/// [`super::shapes::roots`] in lanes: the smaller and larger root, and where they are real.
 fn roots(a: f32x8, b: f32x8, c: f32x8) -> (f32x8, f32x8, f32x8) {
     let disc = b * b - a * c;
     let real = !(disc.simd_lt(ZERO) | a.simd_eq(ZERO));
@@ -79,13 +79,13 @@ fn roots(a: f32x8, b: f32x8, c: f32x8) -> (f32x8, f32x8, f32x8) {
     (lo_first.select(r0, r1), lo_first.select(r1, r0), real)
 }
 
-/// [`super::sphere`] in lanes.
+/// [`super::shapes::sphere`] in lanes.
 fn sphere(r: &RayLanes) -> SpanLanes {
     let (t0, t1, hit) = roots(dot(r.d, r.d), dot(r.o, r.d), dot(r.o, r.o) - s(1.0));
     SpanLanes { enter: (t0, ZERO), exit: (t1, ZERO), hit }
 }
 
-/// [`super::slab_z`] in lanes.
+/// [`super::shapes::slab_z`] in lanes.
 fn slab_z(r: &RayLanes) -> SpanLanes {
     let (oz, dz) = (r.o[2], r.d[2]);
     let flat = dz.simd_eq(ZERO);
@@ -101,7 +101,7 @@ fn slab_z(r: &RayLanes) -> SpanLanes {
     }
 }
 
-/// [`super::frustum`] in lanes: each of the scalar procedure's cases (the
+/// [`super::shapes::frustum`] in lanes: each of the scalar procedure's cases (the
 /// quadric's inside one interval, two half-lines, one half-line, all of the
 /// line, none) chosen by mask, then the same clipping by the slab.
 fn frustum(bottom: f32, top: f32, r: &RayLanes) -> SpanLanes {
@@ -141,7 +141,7 @@ fn frustum(bottom: f32, top: f32, r: &RayLanes) -> SpanLanes {
     SpanLanes { enter, exit, hit: slab.hit & (between | outside | half | all) & (ok1 | ok2) }
 }
 
-/// [`super::unit_cube`] in lanes.
+/// [`super::shapes::unit_cube`] in lanes.
 pub(super) fn unit_cube(r: &RayLanes) -> SpanLanes {
     let (mut enter, mut exit) = ((s(f32::NEG_INFINITY), ZERO), (s(f32::INFINITY), ZERO));
     let mut miss = ZERO;
@@ -159,7 +159,7 @@ pub(super) fn unit_cube(r: &RayLanes) -> SpanLanes {
     finish(enter, exit, miss)
 }
 
-/// [`super::polyhedron`] in lanes: every plane clips all eight rays.
+/// [`super::shapes::polyhedron`] in lanes: every plane clips all eight rays.
 pub(super) fn polyhedron(poly: &ConvexPolyhedron, r: &RayLanes) -> SpanLanes {
     planes((0..).zip(&poly.planes), r)
 }

@@ -1,0 +1,393 @@
+//! The booleans of CSG along a ray (seed 003 §5.2's per-pixel interval
+//! intersection, in tree form): each primitive's interval, combined up the
+//! tree by union, intersection and difference into the spans the ray spends
+//! inside the solid. Shared by the scanline walk and the ray caster.
+//!
+//! Coplanar faces (a cutter flush with the face it cuts, which real models are
+//! full of) are decided one way: a difference removes its cutter's closed interval
+//! widened by a hair ([`TIE`]), so a cut face exactly on a solid face removes it
+//! instead of speckling.
+
+use super::{Hit, Interval};
+use crate::scene::csg::CsgTree;
+use crate::visibility::occupancy::Occupied;
+
+/// Relative width (of `t`) within which a cutter's boundary counts as reaching a
+/// solid's boundary.
+pub const TIE: f32 = 1e-5;
+
+/// Reusable buffers for combining spans along a tree, so a pixel allocates
+/// nothing: each node leaves its spans on top of `stack`.
+#[derive(Debug, Clone, Default)]
+pub struct SpanScratch {
+    pub(super) stack: Vec<Interval>,
+    pub(super) out: Vec<Interval>,
+    /// The primitives whose boxes the ray crosses.
+    pub(super) met: Vec<u32>,
+    /// The same as flags (all false between rays).
+    pub(super) crossed: Vec<bool>,
+    /// The same as counts in the tree (empty between rays).
+    pub(super) counts: Occupied,
+}
+
+/// What a node of a tree of booleans does.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Operation {
+    /// A primitive (its index).
+    Leaf(usize),
+    /// Inside any operand.
+    Union,
+    /// Inside every operand.
+    Intersection,
+    /// Inside the first operand, outside the others.
+    Difference,
+}
+
+/// A node of a tree of booleans, taken apart for the span combiner.
+#[derive(Debug, Clone, Copy)]
+pub struct Parts<B, I> {
+    /// What the node does.
+    pub operation: Operation,
+    /// An intersection's or a difference's first operand (what the others
+    /// narrow or cut); `None` for unions and leaves.
+    pub first: Option<B>,
+    /// The other operands the combiner reads: all of them, or (a view) those
+    /// that can change the result.
+    pub others: I,
+}
+
+/// A tree of booleans the span combiner ([`combine`]) walks: a [`CsgTree`], or
+/// a view of one that leaves out what cannot matter at a pixel
+/// ([`crate::visibility::occupancy`]).
+pub trait Booleans: Copy {
+    /// The node's operation and operands.
+    fn parts(self) -> Parts<Self, impl Iterator<Item = Self>>;
+
+    /// The primitive, if the node is a leaf (what `parts` says, more cheaply).
+    fn leaf(self) -> Option<usize>;
+}
+
+impl Booleans for &CsgTree {
+    #[inline(always)]
+    fn parts(self) -> Parts<Self, impl Iterator<Item = Self>> {
+        let (operation, first, others): (_, _, &[CsgTree]) = match self {
+            CsgTree::Leaf(i) => (Operation::Leaf(*i), None, &[]),
+            CsgTree::Union(kids) => (Operation::Union, None, kids),
+            CsgTree::Intersection(kids) => match kids.split_first() {
+                Some((first, others)) => (Operation::Intersection, Some(first), others),
+                None => (Operation::Intersection, None, &[]),
+            },
+            CsgTree::Difference(a, kids) => (Operation::Difference, Some(&**a), kids),
+        };
+        Parts { operation, first, others: others.iter() }
+    }
+
+    #[inline(always)]
+    fn leaf(self) -> Option<usize> {
+        match self {
+            CsgTree::Leaf(i) => Some(*i),
+            _ => None,
+        }
+    }
+}
+
+impl SpanScratch {
+    /// The intervals on the stack: after one [`combine`] from empty, the tree's.
+    #[must_use]
+    pub fn spans(&self) -> &[Interval] {
+        &self.stack
+    }
+}
+
+/// The intervals of the subtree `tree`, given each leaf's interval (at most
+/// one: a primitive is convex), left on top of `scratch.stack`; returns where
+/// they start.
+pub fn combine<B: Booleans>(tree: B, leaf: &impl Fn(usize) -> Option<Interval>, scratch: &mut SpanScratch) -> usize {
+    let base = scratch.stack.len();
+    let Parts { operation, first, others } = tree.parts();
+    match operation {
+        Operation::Leaf(i) => scratch.stack.extend(leaf(i)),
+        Operation::Union => {
+            let mut parts = 0;
+            for k in others {
+                match k.leaf() {
+                    Some(i) => scratch.stack.extend(leaf(i)),
+                    None => _ = combine(k, leaf, scratch),
+                }
+                parts += 1;
+            }
+            // One operand's spans are already sorted and disjoint.
+            if parts > 1 {
+                union(&mut scratch.stack, base);
+            }
+        }
+        op @ (Operation::Intersection | Operation::Difference) => {
+            let Some(first) = first else { return base };
+            combine(first, leaf, scratch);
+            for k in others {
+                if scratch.stack.len() == base {
+                    break; // nothing left to intersect with or cut from
+                }
+                if let Some(i) = k.leaf() {
+                    // One interval or none: narrow or cut in place.
+                    match (leaf(i), op) {
+                        (Some(y), Operation::Difference) => cut(&mut scratch.stack, base, &y),
+                        (Some(y), _) => clip(&mut scratch.stack, base, &y),
+                        (None, Operation::Difference) => {}
+                        (None, _) => scratch.stack.truncate(base),
+                    }
+                    continue;
+                }
+                let mid = combine(k, leaf, scratch);
+                if op == Operation::Difference && scratch.stack.len() <= mid + 1 {
+                    // No span (the ray misses this cutter) or one: cut in place.
+                    if scratch.stack.len() == mid + 1 {
+                        let y = scratch.stack.pop().expect("the cutter's span");
+                        cut(&mut scratch.stack, base, &y);
+                    }
+                    continue;
+                }
+                let SpanScratch { stack, out, .. } = scratch;
+                out.clear();
+                let (a, b) = stack[base..].split_at(mid - base);
+                if op == Operation::Difference {
+                    difference(a, b, out);
+                } else {
+                    intersection(a, b, out);
+                }
+                stack.truncate(base);
+                stack.extend_from_slice(out);
+            }
+        }
+    }
+    base
+}
+
+/// `t_min` lies inside a part of the solid.
+pub(super) struct Inside;
+
+/// The first crossing beyond `t_min` of the subtree `tree` if it is an entry
+/// (`None` if there is none); [`Inside`] if it is an exit.
+pub(super) fn first_entry<B: Booleans>(
+    tree: B,
+    leaf: &impl Fn(usize) -> Option<Interval>,
+    t_min: f32,
+    scratch: &mut SpanScratch,
+) -> Result<Option<Hit>, Inside> {
+    scratch.stack.clear();
+    match tree.leaf() {
+        Some(i) => scratch.stack.extend(leaf(i)),
+        None => _ = combine(tree, leaf, scratch),
+    }
+    for s in &scratch.stack {
+        if s.enter.t > t_min {
+            return Ok(Some(s.enter));
+        }
+        if s.exit.t > t_min {
+            return Err(Inside);
+        }
+    }
+    Ok(None)
+}
+
+/// The first crossing beyond `t_min` of the spans of the whole of `tree`.
+pub(super) fn first_of_all<B: Booleans>(
+    tree: B,
+    leaf: &impl Fn(usize) -> Option<Interval>,
+    t_min: f32,
+    scratch: &mut SpanScratch,
+) -> Option<Hit> {
+    scratch.stack.clear();
+    combine(tree, leaf, scratch);
+    scratch.stack.iter().flat_map(|s| [s.enter, s.exit]).find(|c| c.t > t_min)
+}
+
+/// Merges the spans on `stack` from `base` into sorted disjoint spans covering
+/// their union.
+pub(super) fn union(stack: &mut Vec<Interval>, base: usize) {
+    stack[base..].sort_unstable_by(|x, y| x.enter.t.total_cmp(&y.enter.t));
+    let mut last = base;
+    for k in base..stack.len() {
+        let s = stack[k];
+        if k > base && s.enter.t <= stack[last].exit.t {
+            if s.exit.t > stack[last].exit.t {
+                stack[last].exit = s.exit;
+            }
+        } else {
+            if k > base {
+                last += 1;
+            }
+            stack[last] = s;
+        }
+    }
+    stack.truncate(last + 1);
+}
+
+/// Sorted disjoint spans covering `a ∩ b`, into `out`.
+fn intersection(a: &[Interval], b: &[Interval], out: &mut Vec<Interval>) {
+    for x in a {
+        for y in b {
+            let enter = if x.enter.t >= y.enter.t { x.enter } else { y.enter };
+            let exit = if x.exit.t <= y.exit.t { x.exit } else { y.exit };
+            if enter.t < exit.t {
+                out.push(Interval { enter, exit });
+            }
+        }
+    }
+    out.sort_unstable_by(|p, q| p.enter.t.total_cmp(&q.enter.t));
+}
+
+/// Sorted disjoint spans covering `a` minus `b`, `b` widened by [`TIE`], into
+/// `out`: where the ray leaves a cutter it enters the remaining solid through the
+/// cutter's wall, whose outward normal (for the solid) is the cutter's, reversed.
+pub(super) fn difference(a: &[Interval], b: &[Interval], out: &mut Vec<Interval>) {
+    for x in a {
+        // `b` is sorted and disjoint: walk it once, cutting `x` from the left.
+        let mut rest = Some(*x);
+        for y in b {
+            let Some(p) = rest else { break };
+            let (lo, hi) = (y.enter.t - TIE * y.enter.t.abs().max(1.0), y.exit.t + TIE * y.exit.t.abs().max(1.0));
+            if hi <= p.enter.t {
+                continue;
+            }
+            if lo >= p.exit.t {
+                break;
+            }
+            if p.enter.t < lo {
+                out.push(Interval { enter: p.enter, exit: wall(y.enter) });
+            }
+            rest = (p.exit.t > hi).then(|| Interval { enter: wall(y.exit), exit: p.exit });
+        }
+        out.extend(rest);
+    }
+}
+
+/// [`intersection`] with one interval `y`, in place on the sorted disjoint
+/// spans of `stack` from `base`: each span narrowed to `y`, the empty ones
+/// dropped.
+#[inline]
+fn clip(stack: &mut Vec<Interval>, base: usize, y: &Interval) {
+    let mut kept = base;
+    for k in base..stack.len() {
+        let x = stack[k];
+        let enter = if x.enter.t >= y.enter.t { x.enter } else { y.enter };
+        let exit = if x.exit.t <= y.exit.t { x.exit } else { y.exit };
+        if enter.t < exit.t {
+            stack[kept] = Interval { enter, exit };
+            kept += 1;
+        }
+    }
+    stack.truncate(kept);
+}
+
+/// [`difference`] by one interval `y`, in place on the sorted disjoint spans
+/// of `stack` from `base`: the run of spans it overlaps gives way to what is
+/// left of the first before it and of the last after it.
+#[inline]
+fn cut(stack: &mut Vec<Interval>, base: usize, y: &Interval) {
+    let (lo, hi) = (y.enter.t - TIE * y.enter.t.abs().max(1.0), y.exit.t + TIE * y.exit.t.abs().max(1.0));
+    let mut i = base;
+    while i < stack.len() && stack[i].exit.t <= lo {
+        i += 1;
+    }
+    if i == stack.len() || stack[i].enter.t >= hi {
+        return; // between spans, or past them all
+    }
+    let mut j = i + 1;
+    while j < stack.len() && stack[j].enter.t < hi {
+        j += 1;
+    }
+    let (first, last) = (stack[i], stack[j - 1]);
+    let mut k = i;
+    if first.enter.t < lo {
+        stack[k] = Interval { enter: first.enter, exit: wall(y.enter) };
+        k += 1;
+    }
+    if last.exit.t > hi {
+        let right = Interval { enter: wall(y.exit), exit: last.exit };
+        if k < j {
+            stack[k] = right;
+        } else {
+            stack.insert(k, right);
+        }
+        k += 1;
+    }
+    if k < j {
+        stack.drain(k..j);
+    }
+}
+
+/// A cutter's crossing seen as the wall of the hole it makes (its normal
+/// will be the cutter's, reversed).
+fn wall(c: Hit) -> Hit {
+    Hit { face: c.face ^ Hit::CUT, ..c }
+}
+
+#[cfg(test)]
+mod tests {
+    use proptest::prelude::*;
+
+    use super::*;
+
+    /// Sorted disjoint spans from cut points (sorted, made distinct) of
+    /// primitive 0, every other gap a span.
+    fn spans(mut ts: Vec<f32>) -> Vec<Interval> {
+        ts.sort_by(f32::total_cmp);
+        ts.dedup();
+        ts.chunks_exact(2).map(|p| Interval { enter: Hit::new(p[0], 0, 0), exit: Hit::new(p[1], 0, 1) }).collect()
+    }
+
+    /// A point where spans start or end, within `±r`, often a whole number
+    /// (so that ends meet and tie).
+    fn cut_point(r: f32) -> impl Strategy<Value = f32> {
+        prop_oneof![-r..r, (-5i32..5).prop_map(|k| k as f32)]
+    }
+
+    /// The spans `a` combined with the interval `(start, length)` of another
+    /// primitive by `in_place` on a stack where `kept` spans of an operand
+    /// further down lie below them, and what `general` leaves after those.
+    fn by_one_interval(
+        a: Vec<Interval>,
+        (start, length): (f32, f32),
+        kept: usize,
+        in_place: fn(&mut Vec<Interval>, usize, &Interval),
+        general: fn(&[Interval], &[Interval], &mut Vec<Interval>),
+    ) -> (Vec<Interval>, Vec<Interval>) {
+        let y = Interval { enter: Hit::new(start, 1, 2), exit: Hit::new(start + length, 1, 3) };
+        let below: Vec<Interval> = (0..kept)
+            .map(|k| Interval { enter: Hit::new(-100.0 + k as f32, 2, 0), exit: Hit::new(-99.5 + k as f32, 2, 1) })
+            .collect();
+        let mut expected = below.clone();
+        general(&a, &[y], &mut expected);
+        let mut stack = below;
+        stack.extend_from_slice(&a);
+        in_place(&mut stack, kept, &y);
+        (stack, expected)
+    }
+
+    proptest! {
+        /// Cutting by one interval in place leaves what [`difference`] by it
+        /// leaves: the same spans, the same crossings, walls included.
+        #[test]
+        fn a_cut_in_place_is_the_difference_by_one_interval(
+            ts in prop::collection::vec(cut_point(5.0), 0..12),
+            other in (cut_point(6.0), 0.0f32..6.0),
+            kept in 0usize..3,
+        ) {
+            let (in_place, expected) = by_one_interval(spans(ts), other, kept, cut, difference);
+            prop_assert_eq!(in_place, expected);
+        }
+
+        /// Narrowing to one interval in place leaves what [`intersection`]
+        /// with it leaves: the same spans with the same crossings.
+        #[test]
+        fn a_clip_in_place_is_the_intersection_with_one_interval(
+            ts in prop::collection::vec(cut_point(5.0), 0..12),
+            other in (cut_point(6.0), 0.0f32..6.0),
+            kept in 0usize..3,
+        ) {
+            let (in_place, expected) = by_one_interval(spans(ts), other, kept, clip, intersection);
+            prop_assert_eq!(in_place, expected);
+        }
+    }
+}
