@@ -7,9 +7,12 @@
 //! and walks its pixels keeping the x-occupancy list. A pixel with occupants gets
 //! its visible surface from the depth intervals of the occupants only (seed
 //! 003's procedure 3 in closed form, [`crate::raytrace::csg`]), clipped at the
-//! near plane as polygons are. [`draw_solids`] writes the result into the frame's
-//! visibility buffer (depth, item = object + primitive, normal) or a light's
-//! depth map, z-tested against the polygons already there.
+//! near plane as polygons are. Intervals come eight pixels of a scanline at a
+//! time (one SIMD pass per occupant and block, `BlockSpans`), and a polyhedron
+//! of many planes is clipped only by the faces the scanline's plane meets.
+//! [`draw_solids`] writes the result into the frame's visibility buffer (depth,
+//! item = object + primitive, normal) or a light's depth map, z-tested against
+//! the polygons already there.
 //!
 //! Segments and reference counts (§5.2.1), in tree form. The paper expands the
 //! expression into a sum of products (its pattern matrix) and keeps, per
@@ -33,11 +36,11 @@
 //! orthographic camera, fall back to their box. A too-wide extent only costs
 //! time: where a primitive does not reach, its interval is empty.
 
+use std::cell::RefCell;
+
 use glam::{DVec2, Mat4, Vec2, Vec3, Vec4};
 use rayon::iter::IndexedParallelIterator;
 use rayon::prelude::*;
-
-use std::cell::RefCell;
 
 use crate::raytrace::csg::{Crossing, CsgCaster, Hit, Interval, IntervalLanes, RowFaces, SpanScratch};
 use crate::scene::camera::PixelRays;
