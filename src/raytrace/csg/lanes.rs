@@ -189,7 +189,9 @@ pub(super) fn planes<'a>(faces: impl Iterator<Item = (u32, &'a Vec4)>, r: &RayLa
 /// orthographic camera), and a ray in that plane enters and leaves the solid
 /// through faces the plane meets. Clipping by those alone gives the same
 /// interval: a face the plane misses lies farther than [`FaceCorners::margin`]
-/// from every crossing, so its plane never wins, nor ties.
+/// from every crossing, so its plane does not win or tie — to the bit, unless
+/// it is within rounding of coplanar with the face that does (then the two
+/// differ in the last bits of `t` and of the normal).
 #[derive(Debug, Clone)]
 pub(super) struct FaceCorners {
     corners: Vec<Vec3>,
