@@ -209,7 +209,7 @@ impl CsgCaster {
     /// Primitives from which [`CsgCaster::first_hit`] culls by a BVH.
     pub const BVH_PRIMITIVES: usize = 8;
 
-    /// A ray's booleans count the primitives it meets ([`Occupied`]) when
+    /// A ray's booleans count the primitives it meets ([`Occupied`](crate::visibility::occupancy::Occupied)) when
     /// they are fewer than the tree's nodes over this, and walk the whole
     /// tree otherwise: counting one costs about as much as walking four nodes
     /// (measured on the Menger sponge, whose rays meet a third of its 221
