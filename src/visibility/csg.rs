@@ -241,15 +241,9 @@ fn scan_bands<B: Send>(
     // near plane lies at t = near, under either projection.
     let near = camera.near;
     bands.enumerate().for_each_init(
-        || {
-            let counts = match walker {
-                RowWalker::Segments(tree) => Occupied::new(tree),
-                _ => Occupied::default(),
-            };
-            let n = solid.primitives.len();
-            (vec![None; w], vec![RowLine::default(); n], counts, SpanScratch::default(), BlockSpans::new(n))
-        },
-        |(row, lines, counts, scratch, blocks), (band, mut out)| {
+        || Lent::fitted(w, solid.primitives.len(), walker),
+        |lent, (band, mut out)| {
+            let RowBuffers { row, lines, counts, scratch, blocks } = &mut lent.0;
             let first = (band * BAND_ROWS) as i64;
             // The y-occupancy list as the band's first scanline finds it, then kept
             // row by row.
@@ -285,10 +279,56 @@ fn scan_bands<B: Send>(
     );
 }
 
+/// One worker's buffers for walking scanlines: the row's hits, each
+/// occupant's row line, the occupancy counts, the booleans' stack and the
+/// eight-pixel blocks. Kept between pieces of work on the worker's thread
+/// ([`Lent`]): a solid of a thousand primitives needs ~250 KB of them, and a
+/// scan hands out ~20 pieces.
+#[derive(Default)]
+struct RowBuffers {
+    row: Vec<Option<Hit>>,
+    lines: Vec<RowLine>,
+    counts: Occupied,
+    scratch: SpanScratch,
+    blocks: BlockSpans,
+}
+
+thread_local! {
+    /// The [`RowBuffers`] the thread's last piece of work gave back.
+    static SPARE_ROWS: RefCell<Option<RowBuffers>> = RefCell::default();
+}
+
+/// [`RowBuffers`] lent to a piece of work, given back to its thread when it
+/// is done.
+struct Lent(RowBuffers);
+
+impl Lent {
+    /// The thread's spare buffers (or new ones) sized for rows `width` wide
+    /// of a solid of `primitives` walked by `walker`.
+    fn fitted(width: usize, primitives: usize, walker: &RowWalker) -> Lent {
+        let mut b = SPARE_ROWS.with_borrow_mut(Option::take).unwrap_or_default();
+        b.row.resize(width, None);
+        b.lines.resize(primitives, RowLine::default());
+        if let RowWalker::Segments(tree) = walker {
+            b.counts.fit(tree);
+        }
+        b.blocks.fit(primitives);
+        Lent(b)
+    }
+}
+
+impl Drop for Lent {
+    fn drop(&mut self) {
+        let buffers = std::mem::take(&mut self.0);
+        SPARE_ROWS.with_borrow_mut(|spare| *spare = Some(buffers));
+    }
+}
+
 /// Each occupant's intervals at the eight-pixel block of the scanline last
 /// asked of it: the first pixel of a block that needs a primitive's interval
 /// gets all eight in one SIMD pass ([`CsgCaster::spans_on_eight`], each the
 /// same to the bit as one pixel's), and its neighbours read theirs.
+#[derive(Default)]
 struct BlockSpans {
     /// Per primitive: the block (`x / 8`) its lanes hold, and the lanes.
     cached: RefCell<Vec<(usize, IntervalLanes)>>,
@@ -298,11 +338,11 @@ struct BlockSpans {
 }
 
 impl BlockSpans {
-    fn new(primitives: usize) -> Self {
-        BlockSpans {
-            cached: RefCell::new(vec![(usize::MAX, IntervalLanes::default()); primitives]),
-            faces: vec![RowFaces::default(); primitives],
-        }
+    /// Room for a solid of `primitives` (what it held before is stale:
+    /// [`BlockSpans::begin_row`] marks each row's occupants so).
+    fn fit(&mut self, primitives: usize) {
+        self.cached.get_mut().resize(primitives, (usize::MAX, IntervalLanes::default()));
+        self.faces.resize(primitives, RowFaces::default());
     }
 
     /// A new scanline, its rays `lines` in each occupant's space: the
