@@ -179,9 +179,32 @@ fn normals_point_out_of_the_solid_and_hole_walls_are_marked_cut() {
     assert!(near(hit.t, 4.0) && hit.cut && hit.normal.abs_diff_eq(Vec3::Z, 1e-5), "the pocket's floor: {hit:?}");
 }
 
+/// A camera looking at the origin from a random direction: every fourth
+/// round orthographic; every fifth from inside the solids' reach, so that
+/// primitives straddle the eye.
+fn random_camera(rng: &mut StdRng, round: usize) -> kage::scene::Camera {
+    use kage::scene::{Camera, Projection};
+    let dir =
+        Vec3::new(rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0)).normalize_or(Vec3::Z);
+    let projection = if round % 4 == 3 {
+        Projection::Orthographic { height: 6.0 }
+    } else {
+        Projection::Perspective { fov_y_deg: rng.gen_range(30.0..70.0) }
+    };
+    let distance = if round % 5 == 4 { 1.0 } else { rng.gen_range(5.0..9.0) };
+    Camera {
+        eye: dir * distance,
+        target: Vec3::ZERO,
+        up: if dir.y.abs() > 0.9 { Vec3::X } else { Vec3::Y },
+        near: 0.05,
+        far: 100.0,
+        projection,
+        shift: glam::Vec2::ZERO,
+    }
+}
+
 #[test]
 fn the_scanline_walk_finds_what_a_ray_per_pixel_finds() {
-    use kage::scene::{Camera, Projection};
     use kage::visibility::csg::scan_solid;
     let mut rng = StdRng::seed_from_u64(3);
     let (w, h) = (96u32, 64u32);
@@ -190,24 +213,7 @@ fn the_scanline_walk_finds_what_a_ray_per_pixel_finds() {
         let mut prims = Vec::new();
         let tree = random_tree(&mut rng, &mut prims, 3);
         let solid = CsgSolid { primitives: prims, tree: Some(tree) };
-        let dir = Vec3::new(rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0))
-            .normalize_or(Vec3::Z);
-        let projection = if round % 4 == 3 {
-            Projection::Orthographic { height: 6.0 }
-        } else {
-            Projection::Perspective { fov_y_deg: rng.gen_range(30.0..70.0) }
-        };
-        // Some eyes sit inside the solid's reach, so primitives straddle the eye.
-        let distance = if round % 5 == 4 { 1.0 } else { rng.gen_range(5.0..9.0) };
-        let camera = Camera {
-            eye: dir * distance,
-            target: Vec3::ZERO,
-            up: if dir.y.abs() > 0.9 { Vec3::X } else { Vec3::Y },
-            near: 0.05,
-            far: 100.0,
-            projection,
-            shift: glam::Vec2::ZERO,
-        };
+        let camera = random_camera(&mut rng, round);
         let scanned = scan_solid(&solid, &camera, w, h);
         // The paper's pattern matrix finds the same surfaces.
         let method = kage::visibility::csg::CsgMethod::PatternMatrix { limit: 100_000 };
@@ -277,4 +283,71 @@ fn culling_primitives_by_their_boxes_changes_no_hit() {
         }
     }
     assert!(rays >= 20_000 && hits * 4 > rays, "{hits} hits of {rays} rays");
+}
+
+/// Seed 003 §5.2.2's coherence (a pixel's answer reused along the scanline
+/// while the occupants and the order of their ends stay) gives the surfaces
+/// the walk finds pixel by pixel, to the bit, on random solids and cameras.
+#[test]
+fn reusing_the_answer_along_a_scanline_changes_no_surface() {
+    use kage::visibility::csg::{scan_solid_with, CsgMethod};
+    let mut rng = StdRng::seed_from_u64(11);
+    let (w, h) = (96u32, 64u32);
+    for round in 0..60 {
+        let mut prims = Vec::new();
+        let tree = random_tree(&mut rng, &mut prims, 3);
+        let solid = CsgSolid { primitives: prims, tree: Some(tree) };
+        let camera = random_camera(&mut rng, round);
+        let each = scan_solid_with(&solid, &camera, w, h, CsgMethod::Segments).unwrap();
+        let reused = scan_solid_with(&solid, &camera, w, h, CsgMethod::SegmentsCoherent).unwrap();
+        for (k, (a, b)) in each.iter().zip(&reused).enumerate() {
+            assert_eq!(a, b, "pixel ({}, {}) round {round}", k as u32 % w, k as u32 / w);
+        }
+    }
+}
+
+/// A cutter whose face leans through a solid's face by a few [`TIE`]s: the
+/// raw depths keep their order across the scanline while the cut's decision
+/// (the cutter's face counts as reaching the solid's within `TIE`) changes
+/// inside the run; the coherent walk must change its answer there too.
+#[test]
+fn reuse_follows_a_cut_decided_within_the_tie() {
+    use kage::raytrace::csg::TIE;
+    use kage::scene::{Camera, Projection};
+    use kage::visibility::csg::{scan_solid_with, CsgMethod};
+    let cube = || Shape::Polyhedron(ConvexPolyhedron::unit_cube());
+    let solid_box = Affine3A::from_scale(Vec3::splat(2.0)) * Affine3A::from_translation(Vec3::splat(-0.5));
+    // The cutter's front face: z = 1 + s·x, from two TIEs (of t ≈ 4) in
+    // front of the solid's face z = 1 at x = 1 to two behind it at x = −1:
+    // the cut takes the face from x = −½ on, the raw depths swap at x = 0.
+    let lean = 2.0 * TIE * 4.0;
+    let shear = Mat3::from_cols(Vec3::new(1.0, 0.0, lean), Vec3::Y, Vec3::Z);
+    let cutter = Affine3A::from_mat3(shear)
+        * Affine3A::from_translation(Vec3::new(-1.5, -0.5, 0.5))
+        * Affine3A::from_scale(Vec3::new(3.0, 1.0, 0.5));
+    let primitives = vec![
+        Primitive { shape: cube(), transform: solid_box, color: None, source: 0..0 },
+        Primitive { shape: cube(), transform: cutter, color: None, source: 0..0 },
+    ];
+    let tree = CsgTree::Difference(Box::new(CsgTree::Leaf(0)), vec![CsgTree::Leaf(1)]);
+    let solid = CsgSolid { primitives, tree: Some(tree) };
+    let camera = Camera {
+        eye: Vec3::new(0.0, 0.0, 5.0),
+        target: Vec3::ZERO,
+        up: Vec3::Y,
+        near: 0.05,
+        far: 100.0,
+        projection: Projection::Orthographic { height: 3.0 },
+        shift: glam::Vec2::ZERO,
+    };
+    let (w, h) = (200u32, 100u32);
+    let each = scan_solid_with(&solid, &camera, w, h, CsgMethod::Segments).unwrap();
+    let reused = scan_solid_with(&solid, &camera, w, h, CsgMethod::SegmentsCoherent).unwrap();
+    // Along the middle row: the solid's face where the cutter's lies behind
+    // it by more than the tie, the hole's floor elsewhere.
+    let row = &each[(h / 2 * w) as usize..((h / 2 + 1) * w) as usize];
+    let face = row.iter().filter(|c| c.is_some_and(|c| c.primitive == 0)).count();
+    let floor = row.iter().filter(|c| c.is_some_and(|c| c.primitive == 1)).count();
+    assert!(face > 10 && floor > 10, "face {face}, floor {floor} pixels of the middle row");
+    assert_eq!(each, reused);
 }

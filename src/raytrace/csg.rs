@@ -28,7 +28,7 @@ mod booleans;
 mod lanes;
 mod shapes;
 
-pub use booleans::{combine, Booleans, Operation, Parts, SpanScratch, TIE};
+pub use booleans::{above, below, combine, Booleans, Operation, Parts, SpanScratch, TIE};
 use booleans::{difference, first_entry, first_of_all, union, Inside};
 use shapes::{normal_matrix, unit_cube, unit_normal, unit_span, Clipping, PlaneLanes};
 
@@ -75,7 +75,8 @@ impl Hit {
     /// The bit of `face` that marks a hole's wall.
     const CUT: u32 = 1 << 31;
 
-    fn new(t: f32, primitive: usize, face: u32) -> Hit {
+    /// A crossing at `t` of face `face` of `primitive`.
+    pub(crate) const fn new(t: f32, primitive: usize, face: u32) -> Hit {
         Hit { t, primitive: primitive as u32, face }
     }
 
@@ -83,6 +84,13 @@ impl Hit {
     #[must_use]
     pub fn cut(&self) -> bool {
         self.face & Self::CUT != 0
+    }
+
+    /// This crossing with its hole-wall bit set to `cut` (what the booleans
+    /// made of the same end of the same primitive at a neighbouring pixel).
+    #[must_use]
+    pub fn with_cut(self, cut: bool) -> Hit {
+        Hit { face: (self.face & !Self::CUT) | if cut { Self::CUT } else { 0 }, ..self }
     }
 }
 
@@ -385,6 +393,11 @@ impl CsgCaster {
         t_min: f32,
         scratch: &mut SpanScratch,
     ) -> Option<Hit> {
+        if let Some(i) = tree.leaf() {
+            // One primitive: its own entry, or its exit from inside it.
+            let s = leaf(i)?;
+            return [s.enter, s.exit].into_iter().find(|c| c.t > t_min);
+        }
         let Parts { operation, others, .. } = tree.parts();
         if operation == Operation::Union {
             let mut nearest: Option<Hit> = None;

@@ -6,9 +6,12 @@
 //! Stages, one file each: [`clip`] (homogeneous clipping), [`scan`] (exact
 //! fixed-point DDA scan conversion, top-left rule) and [`raster`] (projection,
 //! binning into bands and the band-parallel z-buffer). [`csg`] finds the visible
-//! surfaces of CSG solids by seed 003's scanline walk.
+//! surfaces of CSG solids by seed 003's scanline walk, over [`occupancy`] (its
+//! reference counts, in tree form) or [`pattern`] (its pattern matrix), with
+//! [`coherence`] (its reuse of a pixel's answer along the scanline) on request.
 
 pub mod clip;
+pub mod coherence;
 pub mod csg;
 pub mod occupancy;
 pub mod pattern;

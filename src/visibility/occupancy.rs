@@ -168,6 +168,13 @@ impl PlacedSet {
         self.place[id] = NONE;
     }
 
+    /// Where `id` stands in [`PlacedSet::ids`] (`None` when not in the set).
+    #[must_use]
+    pub fn place(&self, id: usize) -> Option<usize> {
+        let k = self.place[id];
+        (k != NONE).then_some(k as usize)
+    }
+
     /// The ids, in no particular order.
     #[must_use]
     pub fn ids(&self) -> &[u32] {
@@ -230,6 +237,13 @@ impl Occupied {
             self.climb(tree, leaf);
             leaf = tree.next_leaf[leaf as usize];
         }
+    }
+
+    /// The primitives present (occupying the pixel), each with its place in
+    /// the list.
+    #[must_use]
+    pub fn present(&self) -> &PlacedSet {
+        &self.present
     }
 
     /// Every primitive leaves.

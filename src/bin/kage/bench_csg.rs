@@ -27,9 +27,9 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     let (w, h) = (args.width, args.height);
     println!(
         "| model | primitives | scanline ms | covered pixels | naive rays ms | ratio | BVH rays ms | ratio | \
-         pattern matrix: segments, ms |"
+         reuse (§5.2.2) ms | pattern matrix: segments, ms |"
     );
-    println!("|---|---:|---:|---:|---:|---:|---:|---:|---|");
+    println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---|");
     let (mut ratios, mut bvh_ratios) = (Vec::new(), Vec::new());
     for path in &files {
         let name = path.file_stem().and_then(|s| s.to_str()).unwrap_or_default();
@@ -42,6 +42,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         };
         let (mut times, covered) = scan_times(&solid, &camera, (w, h), CsgMethod::Segments, args.frames.max(1));
         let scan_ms = median(&mut times);
+        let (mut coherent, _) = scan_times(&solid, &camera, (w, h), CsgMethod::SegmentsCoherent, args.frames.max(1));
         let pattern = pattern_cell(&solid, &camera, w, h, args.frames.max(1));
         let caster = CsgCaster::new(&solid);
         let near = |ray: &kage::scene::Ray| camera.distance_at_depth(ray, 1.0);
@@ -55,17 +56,20 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         ratios.push(naive_ms / scan_ms);
         bvh_ratios.push(bvh_ms / scan_ms);
         println!(
-            "| {name} | {} | {scan_ms:.1} | {covered} | {naive_ms:.0} | {:.1} | {bvh_ms:.0} | {:.1} | {pattern} |",
+            "| {name} | {} | {scan_ms:.1} | {covered} | {naive_ms:.0} | {:.1} | {bvh_ms:.0} | {:.1} | {:.1} | {pattern} |",
             solid.primitives.len(),
             naive_ms / scan_ms,
-            bvh_ms / scan_ms
+            bvh_ms / scan_ms,
+            median(&mut coherent)
         );
     }
     println!(
         "\n{w}x{h}, exact quadrics, each model with its corpus camera; scanline: median of {} frames; rays: one frame \
          each. Naive rays: the paper's baseline, every primitive's interval at every pixel, then combined along the \
          tree. BVH rays: only the primitives whose boxes the ray crosses (a BVH from {} primitives up), combined \
-         along the tree with early exits. {} threads. Median ratios: naive/scanline {:.1}, BVH/scanline {:.1}.",
+         along the tree with early exits. Reuse: the scanline walk keeping a pixel's answer while its occupants \
+         and the depth order of their ends stay (seed 003 §5.2.2; the same surfaces to the bit). {} threads. \
+         Median ratios: naive/scanline {:.1}, BVH/scanline {:.1}.",
         args.frames.max(1),
         CsgCaster::BVH_PRIMITIVES,
         rayon::current_num_threads(),

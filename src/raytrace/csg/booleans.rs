@@ -16,6 +16,21 @@ use crate::visibility::occupancy::Occupied;
 /// solid's boundary.
 pub const TIE: f32 = 1e-5;
 
+/// A cutter's entry `t` as a difference compares it: moved [`TIE`] nearer
+/// (relative to `t`, at least absolute).
+#[inline]
+#[must_use]
+pub fn below(t: f32) -> f32 {
+    t - TIE * t.abs().max(1.0)
+}
+
+/// A cutter's exit `t` as a difference compares it: moved [`TIE`] farther.
+#[inline]
+#[must_use]
+pub fn above(t: f32) -> f32 {
+    t + TIE * t.abs().max(1.0)
+}
+
 /// Reusable buffers for combining spans along a tree, so a pixel allocates
 /// nothing: each node leaves its spans on top of `stack`.
 #[derive(Debug, Clone, Default)]
@@ -246,7 +261,7 @@ pub(super) fn difference(a: &[Interval], b: &[Interval], out: &mut Vec<Interval>
         let mut rest = Some(*x);
         for y in b {
             let Some(p) = rest else { break };
-            let (lo, hi) = (y.enter.t - TIE * y.enter.t.abs().max(1.0), y.exit.t + TIE * y.exit.t.abs().max(1.0));
+            let (lo, hi) = (below(y.enter.t), above(y.exit.t));
             if hi <= p.enter.t {
                 continue;
             }
@@ -285,7 +300,7 @@ fn clip(stack: &mut Vec<Interval>, base: usize, y: &Interval) {
 /// left of the first before it and of the last after it.
 #[inline]
 fn cut(stack: &mut Vec<Interval>, base: usize, y: &Interval) {
-    let (lo, hi) = (y.enter.t - TIE * y.enter.t.abs().max(1.0), y.exit.t + TIE * y.exit.t.abs().max(1.0));
+    let (lo, hi) = (below(y.enter.t), above(y.exit.t));
     let mut i = base;
     while i < stack.len() && stack[i].exit.t <= lo {
         i += 1;

@@ -1,5 +1,6 @@
-//! Eight pixels of a scanline at once (seed 003 §5.2.2's coherence along a
-//! scanline): one primitive's interval at pixels `x0..x0 + 8` of a row, each
+//! Eight pixels of a scanline at once (coherence along a scanline the SIMD
+//! way; seed 003 §5.2.2's own reuse of a pixel's answer is
+//! [`crate::visibility::coherence`]): one primitive's interval at pixels `x0..x0 + 8` of a row, each
 //! of the parent module's closed-form procedures ([`super::shapes::sphere`],
 //! [`super::shapes::frustum`], [`super::shapes::unit_cube`], [`super::shapes::polyhedron`]) run in
 //! `f32x8` lanes, one pixel per lane.
