@@ -458,7 +458,7 @@ impl CsgCaster {
             parts += 1;
         }
         if parts > 1 {
-            union(&mut scratch.stack, 0);
+            union(scratch, 0);
         }
         scratch.stack.iter().flat_map(|s| [s.enter, s.exit]).find(|c| c.t > t_min)
     }
