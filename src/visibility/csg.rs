@@ -131,10 +131,11 @@ pub fn scan_solid_into(
     let bands = out.par_chunks_mut(w * BAND_ROWS);
     scan_bands(solid, &walker, camera, (width, height), bands, |band, dy, row| {
         let out = &mut band[dy * w..(dy + 1) * w];
-        for (x, (px, hit)) in out.iter_mut().zip(row.hits).enumerate() {
+        out.fill(None);
+        for (x, h) in row.hits() {
             // Distances along the unnormalised row line become distances
             // along the unit pixel ray.
-            *px = hit.map(|h| Crossing { t: h.t * row.line.at(x as f32).dir.length(), ..row.crossing(x, h) });
+            out[x] = Some(Crossing { t: h.t * row.line.at(x as f32).dir.length(), ..row.crossing(x, h) });
         }
     });
     Ok(())
@@ -202,7 +203,7 @@ pub fn draw_solids(
         let bands = bands.into_par_iter().enumerate();
         let walker = RowWalker::new(&world, CsgMethod::Segments).expect("segments need no expansion");
         scan_bands(&world, &walker, camera, (width, height), bands, |(_, (depth, items, normals)), dy, row| {
-            for (x, h) in row.hits.iter().enumerate().filter_map(|(x, h)| Some((x, (*h)?))) {
+            for (x, h) in row.hits() {
                 // A hit's `t` along its row line is its distance along the view axis.
                 let z = camera.depth_at_view_distance(h.t);
                 let i = dy * w + x;
@@ -225,7 +226,10 @@ pub fn draw_solids(
 /// `t` counted along the row's rays `line` (the distance along the view
 /// axis), and what gives a hit its normal.
 struct ScannedRow<'a> {
+    /// Every pixel's hit (`None` outside `columns`).
     hits: &'a [Option<Hit>],
+    /// The columns that may hold hits.
+    columns: std::ops::Range<usize>,
     line: &'a RowLine,
     /// The row's rays in each occupant's unit space.
     units: &'a [RowLine],
@@ -233,6 +237,12 @@ struct ScannedRow<'a> {
 }
 
 impl ScannedRow<'_> {
+    /// The hits of the columns that may hold any, with their columns.
+    fn hits(&self) -> impl Iterator<Item = (usize, Hit)> + '_ {
+        let hits = &self.hits[self.columns.clone()];
+        self.columns.clone().zip(hits).filter_map(|(x, h)| Some((x, (*h)?)))
+    }
+
     /// Pixel `x`'s `hit` with its outward normal.
     fn crossing(&self, x: usize, hit: Hit) -> Crossing {
         self.caster.crossing_on_line(hit, &self.units[hit.primitive as usize], x as f32)
@@ -287,7 +297,9 @@ fn scan_bands<B: Send>(
                     .iter()
                     .filter_map(|&(i, _)| outlines[i].as_ref()?.columns(y).map(|(a, b)| (i, a, b)))
                     .collect();
-                row.fill(None);
+                // The columns the occupants may cover: the walk writes no other.
+                let lo = ends.iter().map(|e| e.1).min().unwrap_or(0).clamp(0, w as i64) as usize;
+                let hi = ends.iter().map(|e| e.2 + 1).max().unwrap_or(0).clamp(lo as i64, w as i64) as usize;
                 // The row's rays, carried into each occupant's unit space once.
                 let line = rays.row_line(y as usize);
                 ends.iter().for_each(|&(i, _, _)| lines[i] = caster.unit_line(i, &line));
@@ -300,7 +312,10 @@ fn scan_bands<B: Send>(
                     RowWalker::Pattern(matrix) => matrix.walk_row(&caster, &ends, &span, near, row),
                     RowWalker::Empty => {}
                 }
-                visit(&mut out, dy, &ScannedRow { hits: row, line: &line, units: lines, caster: &caster });
+                let scanned = ScannedRow { hits: row, columns: lo..hi, line: &line, units: lines, caster: &caster };
+                visit(&mut out, dy, &scanned);
+                // Between rows, the row's hits are all None.
+                row[lo..hi].fill(None);
             }
         },
     );
