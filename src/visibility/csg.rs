@@ -298,6 +298,7 @@ fn scan_bands<B: Send>(
                     .filter_map(|&(i, _)| outlines[i].as_ref()?.columns(y).map(|(a, b)| (i, a, b)))
                     .collect();
                 // The columns the occupants may cover: the walk writes no other.
+                debug_assert!(row.iter().all(Option::is_none), "row {y}: hits left from the row before");
                 let lo = ends.iter().map(|e| e.1).min().unwrap_or(0).clamp(0, w as i64) as usize;
                 let hi = ends.iter().map(|e| e.2 + 1).max().unwrap_or(0).clamp(lo as i64, w as i64) as usize;
                 // The row's rays, carried into each occupant's unit space once.
@@ -321,11 +322,11 @@ fn scan_bands<B: Send>(
     );
 }
 
-/// One worker's buffers for walking scanlines: the row's hits, each
-/// occupant's row line, the occupancy counts, the booleans' stack, the
-/// eight-pixel blocks and the reusable answer. Kept between pieces of work on the worker's thread
-/// ([`Lent`]): a solid of a thousand primitives needs ~250 KB of them, and a
-/// scan hands out ~20 pieces.
+/// One worker's buffers for walking scanlines: the row's hits (all `None`
+/// between rows), each occupant's row line, the occupancy counts, the
+/// booleans' stack, the eight-pixel blocks and the reusable answer. Kept
+/// between pieces of work on the worker's thread ([`Lent`]): a solid of a
+/// thousand primitives needs ~250 KB of them, and a scan hands out ~20 pieces.
 #[derive(Default)]
 struct RowBuffers {
     row: Vec<Option<Hit>>,
