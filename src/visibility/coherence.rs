@@ -23,7 +23,7 @@
 //! (`docs/benchmarks.md`), the booleans of the few primitives at a pixel are
 //! cheap beside that pass, and the order of many primitives' ends breaks too
 //! often (any two ends swapping, however far behind the surface): the walk
-//! uses it only when asked (`CsgMethod::SegmentsCoherent`).
+//! uses it only when asked ([`super::csg::CsgMethod::SegmentsCoherent`]).
 
 #[cfg(doc)]
 use crate::raytrace::csg::{above, below};

@@ -154,11 +154,14 @@ impl RowWalker {
         let n = solid.primitives.len();
         let Some(tree) = &solid.tree else { return Ok(RowWalker::Empty) };
         Ok(match method {
-            CsgMethod::Segments | CsgMethod::SegmentsCoherent => RowWalker::Segments(SegmentWalk {
-                tree: OccupancyTree::new(tree, n),
-                cut_with: coherence::cut_with(tree, n),
-                coherent: method == CsgMethod::SegmentsCoherent,
-            }),
+            CsgMethod::Segments | CsgMethod::SegmentsCoherent => {
+                let coherent = method == CsgMethod::SegmentsCoherent;
+                RowWalker::Segments(SegmentWalk {
+                    tree: OccupancyTree::new(tree, n),
+                    cut_with: if coherent { coherence::cut_with(tree, n) } else { Vec::new() },
+                    coherent,
+                })
+            }
             CsgMethod::PatternMatrix { limit } => RowWalker::Pattern(PatternMatrix::expand(tree, n, limit)?),
         })
     }
@@ -167,7 +170,7 @@ impl RowWalker {
 /// The walk of the tree's own segments.
 struct SegmentWalk {
     tree: OccupancyTree,
-    /// Per primitive, whether a difference cuts with it.
+    /// Per primitive, whether a difference cuts with it (when coherent).
     cut_with: Vec<bool>,
     /// Whether a pixel's answer is reused along the scanline (seed 003 §5.2.2).
     coherent: bool,
