@@ -334,7 +334,7 @@ pub struct OccupiedNode<'a> {
 
 impl<'a> Booleans for OccupiedNode<'a> {
     #[inline(always)]
-    fn parts(self) -> Parts<Self, impl Iterator<Item = Self>> {
+    fn parts(self) -> Parts<Self, impl Iterator<Item = Self> + Clone> {
         let (t, c, n) = (self.tree, self.counts, self.node as usize);
         let node = t.nodes[n];
         let start = node.start as usize;
