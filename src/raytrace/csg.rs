@@ -307,9 +307,9 @@ impl CsgCaster {
     /// [`CsgCaster::span_on`] at the eight pixels `x0..x0 + 8` of `unit` at
     /// once, in SIMD lanes: each the same to the bit as `span_on` gives it
     /// (a polyhedron of many planes clipped by the faces `row` keeps, from
-    /// [`CsgCaster::row_faces`] on the same line).
-    #[must_use]
-    pub fn spans_on_eight(&self, i: usize, unit: &RowLine, x0: f32, row: &RowFaces) -> IntervalLanes {
+    /// [`CsgCaster::row_faces`] on the same line), written into `out` (a
+    /// walk's cache of them: 140 bytes not moved twice).
+    pub fn spans_on_eight(&self, i: usize, unit: &RowLine, x0: f32, row: &RowFaces, out: &mut IntervalLanes) {
         let rays = lanes::RayLanes::new(unit, x0);
         let shape = &self.solid.primitives[i].shape;
         let spans = match (&self.clipping[i], shape) {
@@ -320,12 +320,12 @@ impl CsgCaster {
             _ => lanes::shape(shape, &rays),
         };
         let face = |f: wide::f32x8| f.to_array().map(|f| f as u32);
-        IntervalLanes {
+        *out = IntervalLanes {
             t: [spans.enter.0.to_array(), spans.exit.0.to_array()],
             face: [face(spans.enter.1), face(spans.exit.1)],
             hit: spans.hit.to_bitmask() as u8,
             primitive: i as u32,
-        }
+        };
     }
 
     /// The crossing `hit` of `ray` with its unit outward normal (solid space).
@@ -557,7 +557,8 @@ mod tests {
     /// the faces `row` keeps) equal each pixel's alone: the same `t` to the
     /// bit, the same faces.
     fn eight_as_one_by_one(caster: &CsgCaster, line: &RowLine, x0: u32, row: &RowFaces) -> Result<(), TestCaseError> {
-        let eight = caster.spans_on_eight(0, line, x0 as f32, row);
+        let mut eight = IntervalLanes::default();
+        caster.spans_on_eight(0, line, x0 as f32, row, &mut eight);
         let bits =
             |s: Option<Interval>| s.map(|s| (s.enter.t.to_bits(), s.enter.face, s.exit.t.to_bits(), s.exit.face));
         for j in 0..8 {

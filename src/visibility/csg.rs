@@ -409,15 +409,17 @@ impl BlockSpans {
         let mut cached = self.cached.borrow_mut();
         let (block, lanes) = &mut cached[i];
         if *block != x / 8 {
-            (*block, *lanes) = Self::fill(caster, i, unit, x / 8, &self.faces[i]);
+            *block = x / 8;
+            Self::fill(caster, i, unit, *block, &self.faces[i], lanes);
         }
         lanes.get(x % 8)
     }
 
-    /// Primitive `i`'s lanes for `block`: once per eight pixels, not inlined.
+    /// Primitive `i`'s lanes for `block`, into `lanes`: once per eight
+    /// pixels, not inlined.
     #[inline(never)]
-    fn fill(caster: &CsgCaster, i: usize, unit: &RowLine, block: usize, faces: &RowFaces) -> (usize, IntervalLanes) {
-        (block, caster.spans_on_eight(i, unit, (block * 8) as f32, faces))
+    fn fill(caster: &CsgCaster, i: usize, unit: &RowLine, block: usize, faces: &RowFaces, lanes: &mut IntervalLanes) {
+        caster.spans_on_eight(i, unit, (block * 8) as f32, faces, lanes);
     }
 }
 
