@@ -28,7 +28,7 @@ mod booleans;
 mod lanes;
 mod shapes;
 
-pub use booleans::{above, below, combine, Booleans, Operation, Parts, SpanScratch, TIE};
+pub use booleans::{above, below, combine, Booleans, LeafSpans, Operation, Parts, SpanScratch, TIE};
 use booleans::{difference, first_entry, first_of_all, union, Inside};
 use shapes::{normal_matrix, unit_cube, unit_normal, unit_span, Clipping, PlaneLanes};
 
@@ -389,13 +389,13 @@ impl CsgCaster {
     pub fn first_hit_in_by<B: Booleans>(
         &self,
         tree: B,
-        leaf: &impl Fn(usize) -> Option<Interval>,
+        leaf: &impl LeafSpans,
         t_min: f32,
         scratch: &mut SpanScratch,
     ) -> Option<Hit> {
         if let Some(i) = tree.leaf() {
             // One primitive: its own entry, or its exit from inside it.
-            let s = leaf(i)?;
+            let s = leaf.span(i)?;
             return [s.enter, s.exit].into_iter().find(|c| c.t > t_min);
         }
         let Parts { operation, others, .. } = tree.parts();

@@ -49,7 +49,7 @@ use glam::{DVec2, Mat4, Vec2, Vec3, Vec4};
 use rayon::iter::IndexedParallelIterator;
 use rayon::prelude::*;
 
-use crate::raytrace::csg::{Crossing, CsgCaster, Hit, Interval, IntervalLanes, RowFaces, SpanScratch};
+use crate::raytrace::csg::{Crossing, CsgCaster, Hit, Interval, IntervalLanes, LeafSpans, RowFaces, SpanScratch};
 use crate::scene::camera::PixelRays;
 use crate::scene::camera::RowLine;
 use crate::scene::csg::{CsgSolid, Primitive, Shape};
@@ -308,12 +308,12 @@ fn scan_bands<B: Send>(
                 let line = rays.row_line(y as usize);
                 ends.iter().for_each(|&(i, _, _)| lines[i] = caster.unit_line(i, &line));
                 blocks.begin_row(&caster, ends.iter().map(|e| e.0), lines);
-                let span = |i: usize, x: usize| blocks.span(&caster, i, &lines[i], x);
+                let spans = RowSpans { blocks, caster: &caster, lines };
                 match walker {
                     RowWalker::Segments(walk) => {
-                        scan_row(&caster, (walk, counts), &ends, &span, near, (row, scratch, coherence));
+                        scan_row(&caster, (walk, counts), &ends, &spans, near, (row, scratch, coherence));
                     }
-                    RowWalker::Pattern(matrix) => matrix.walk_row(&caster, &ends, &span, near, row),
+                    RowWalker::Pattern(matrix) => matrix.walk_row(&caster, &ends, &|i, x| spans.at(i, x), near, row),
                     RowWalker::Empty => {}
                 }
                 let scanned = ScannedRow { hits: row, columns: lo..hi, line: &line, units: lines, caster: &caster };
@@ -423,6 +423,37 @@ impl BlockSpans {
     }
 }
 
+/// A scanline's intervals as the booleans read them: each occupant's
+/// eight-pixel blocks ([`BlockSpans`]) along its row line.
+struct RowSpans<'a> {
+    blocks: &'a BlockSpans,
+    caster: &'a CsgCaster,
+    lines: &'a [RowLine],
+}
+
+impl RowSpans<'_> {
+    /// Primitive `i`'s interval at pixel `x`.
+    #[inline(always)]
+    fn at(&self, i: usize, x: usize) -> Option<Interval> {
+        self.blocks.span(self.caster, i, &self.lines[i], x)
+    }
+}
+
+/// The intervals at pixel `x` of a scanline: a [`LeafSpans`] whose reading
+/// is inlined into the booleans (a closure of it was not, and its answer
+/// came back through memory, a fifth of a small model's walk).
+struct PixelSpans<'a> {
+    row: &'a RowSpans<'a>,
+    x: usize,
+}
+
+impl LeafSpans for PixelSpans<'_> {
+    #[inline(always)]
+    fn span(&self, i: usize) -> Option<Interval> {
+        self.row.at(i, self.x)
+    }
+}
+
 /// An occupant of a scanline: primitive, left end, right end (columns).
 pub(super) type RowEnds = (usize, i64, i64);
 
@@ -445,7 +476,7 @@ fn scan_row(
     caster: &CsgCaster,
     (walk, counts): (&SegmentWalk, &mut Occupied),
     ends: &[(usize, i64, i64)],
-    span: &impl Fn(usize, usize) -> Option<Interval>,
+    spans: &RowSpans,
     near: f32,
     (row, scratch, coherence): (&mut [Option<Hit>], &mut SpanScratch, &mut PixelCoherence),
 ) {
@@ -463,14 +494,14 @@ fn scan_row(
         if let Some(root) = counts.root(tree) {
             *px = if walk.coherent {
                 let present = counts.present();
-                coherence.look(present, near, |i| span(i, x));
+                coherence.look(present, near, |i| spans.at(i, x));
                 coherence.reused().unwrap_or_else(|| {
                     let hit = caster.first_hit_in_by(root, &|i| coherence.span(present, i), near, scratch);
                     coherence.learn(present, &walk.cut_with, hit);
                     hit
                 })
             } else {
-                caster.first_hit_in_by(root, &|i| span(i, x), near, scratch)
+                caster.first_hit_in_by(root, &PixelSpans { row: spans, x }, near, scratch)
             };
         }
         // Primitives whose right end is this pixel leave the x-occupancy list.

@@ -435,10 +435,10 @@ mod tests {
                 on[i] = present;
                 prop_assert_eq!(counts.is_full(&shape), non_empty(&t, &on));
                 let mut whole = SpanScratch::default();
-                combine(&t, &|k| on[k].then_some(spans[k]), &mut whole);
+                combine(&t, &|k: usize| on[k].then_some(spans[k]), &mut whole);
                 let mut seen = SpanScratch::default();
                 if let Some(root) = counts.root(&shape) {
-                    combine(root, &|k| {
+                    combine(root, &|k: usize| {
                         assert!(on[k], "an absent primitive was read");
                         Some(spans[k])
                     }, &mut seen);

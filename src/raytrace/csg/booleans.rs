@@ -31,6 +31,22 @@ pub fn above(t: f32) -> f32 {
     t + TIE * t.abs().max(1.0)
 }
 
+/// Each leaf's interval along the ray at hand, as the booleans read it: a
+/// closure `Fn(usize) -> Option<Interval>`, or a reader the compiler is
+/// made to inline (the scanline walk's eight-pixel blocks: a closure of it
+/// was left as a call whose 28-byte answer came back through memory).
+pub trait LeafSpans {
+    /// Primitive `i`'s interval, if the ray meets it.
+    fn span(&self, i: usize) -> Option<Interval>;
+}
+
+impl<F: Fn(usize) -> Option<Interval>> LeafSpans for F {
+    #[inline(always)]
+    fn span(&self, i: usize) -> Option<Interval> {
+        self(i)
+    }
+}
+
 /// Reusable buffers for combining spans along a tree, so a pixel allocates
 /// nothing: each node leaves its spans on top of `stack`.
 #[derive(Debug, Clone, Default)]
@@ -119,11 +135,11 @@ impl SpanScratch {
 /// The intervals of the subtree `tree`, given each leaf's interval (at most
 /// one: a primitive is convex), left on top of `scratch.stack`; returns where
 /// they start.
-pub fn combine<B: Booleans>(tree: B, leaf: &impl Fn(usize) -> Option<Interval>, scratch: &mut SpanScratch) -> usize {
+pub fn combine<B: Booleans>(tree: B, leaf: &impl LeafSpans, scratch: &mut SpanScratch) -> usize {
     let base = scratch.stack.len();
     let Parts { operation, first, others } = tree.parts();
     match operation {
-        Operation::Leaf(i) => scratch.stack.extend(leaf(i)),
+        Operation::Leaf(i) => scratch.stack.extend(leaf.span(i)),
         Operation::Union => union_of(others, leaf, |_| true, scratch),
         op @ (Operation::Intersection | Operation::Difference) => {
             let Some(first) = first else { return base };
@@ -140,7 +156,7 @@ pub fn combine<B: Booleans>(tree: B, leaf: &impl Fn(usize) -> Option<Interval>, 
                 }
                 if let Some(i) = k.leaf() {
                     // One interval or none: narrow or cut in place.
-                    match (leaf(i), op) {
+                    match (leaf.span(i), op) {
                         (Some(y), Operation::Difference) => cut(&mut scratch.stack, base, &y),
                         (Some(y), _) => clip(&mut scratch.stack, base, &y),
                         (None, Operation::Difference) => {}
@@ -178,7 +194,7 @@ pub fn combine<B: Booleans>(tree: B, leaf: &impl Fn(usize) -> Option<Interval>, 
 #[inline(always)]
 fn union_of<B: Booleans>(
     operands: impl Iterator<Item = B>,
-    leaf: &impl Fn(usize) -> Option<Interval>,
+    leaf: &impl LeafSpans,
     keep: impl Fn(&Interval) -> bool,
     scratch: &mut SpanScratch,
 ) {
@@ -186,7 +202,7 @@ fn union_of<B: Booleans>(
     let mut parts = 0;
     for k in operands {
         match k.leaf() {
-            Some(i) => scratch.stack.extend(leaf(i).filter(&keep)),
+            Some(i) => scratch.stack.extend(leaf.span(i).filter(&keep)),
             None => _ = combine(k, leaf, scratch),
         }
         parts += 1;
@@ -219,13 +235,10 @@ impl Window {
     /// The window of an intersection whose other operands are `others`: the
     /// common part of the leaves' intervals (the others stay unread), or
     /// `None` when a leaf is missed (the intersection is then empty).
-    fn of_leaves<B: Booleans>(
-        others: impl Iterator<Item = B>,
-        leaf: &impl Fn(usize) -> Option<Interval>,
-    ) -> Option<Window> {
+    fn of_leaves<B: Booleans>(others: impl Iterator<Item = B>, leaf: &impl LeafSpans) -> Option<Window> {
         let mut w = Window { lo: f32::NEG_INFINITY, hi: f32::INFINITY };
         for i in others.filter_map(B::leaf) {
-            let s = leaf(i)?;
+            let s = leaf.span(i)?;
             w = Window { lo: w.lo.max(s.enter.t), hi: w.hi.min(s.exit.t) };
         }
         Some(w)
@@ -237,12 +250,7 @@ impl Window {
 /// that lie wholly outside it (a bevel gear's hundreds of teeth, intersected
 /// with its envelope). The result within the window is [`combine`]'s, to the
 /// bit.
-fn combine_within<B: Booleans>(
-    tree: B,
-    leaf: &impl Fn(usize) -> Option<Interval>,
-    window: Window,
-    scratch: &mut SpanScratch,
-) {
+fn combine_within<B: Booleans>(tree: B, leaf: &impl LeafSpans, window: Window, scratch: &mut SpanScratch) {
     match tree.parts() {
         Parts { operation: Operation::Union, others, .. } => {
             union_of(others, leaf, |s: &Interval| !window.excludes(s), scratch);
@@ -258,13 +266,13 @@ pub(super) struct Inside;
 /// (`None` if there is none); [`Inside`] if it is an exit.
 pub(super) fn first_entry<B: Booleans>(
     tree: B,
-    leaf: &impl Fn(usize) -> Option<Interval>,
+    leaf: &impl LeafSpans,
     t_min: f32,
     scratch: &mut SpanScratch,
 ) -> Result<Option<Hit>, Inside> {
     scratch.stack.clear();
     match tree.leaf() {
-        Some(i) => scratch.stack.extend(leaf(i)),
+        Some(i) => scratch.stack.extend(leaf.span(i)),
         None => _ = combine(tree, leaf, scratch),
     }
     for s in &scratch.stack {
@@ -281,7 +289,7 @@ pub(super) fn first_entry<B: Booleans>(
 /// The first crossing beyond `t_min` of the spans of the whole of `tree`.
 pub(super) fn first_of_all<B: Booleans>(
     tree: B,
-    leaf: &impl Fn(usize) -> Option<Interval>,
+    leaf: &impl LeafSpans,
     t_min: f32,
     scratch: &mut SpanScratch,
 ) -> Option<Hit> {
@@ -572,7 +580,7 @@ mod tests {
             let with = |first: CsgTree| CsgTree::Intersection([vec![first], leaves(n..all.len())].concat());
             let result = |tree: &CsgTree| {
                 let mut scratch = SpanScratch::default();
-                combine(tree, &|i| all[i], &mut scratch);
+                combine(tree, &|i: usize| all[i], &mut scratch);
                 scratch.stack
             };
             prop_assert_eq!(result(&with(union.clone())), result(&with(CsgTree::Union(vec![union]))));
