@@ -295,7 +295,17 @@ pub(super) fn first_of_all<B: Booleans>(
 ) -> Option<Hit> {
     scratch.stack.clear();
     combine(tree, leaf, scratch);
-    scratch.stack.iter().flat_map(|s| [s.enter, s.exit]).find(|c| c.t > t_min)
+    // Each span's entry, then its exit (as a loop: pairs built to be searched
+    // were stored and read back, a stall a pixel).
+    for s in &scratch.stack {
+        if s.enter.t > t_min {
+            return Some(s.enter);
+        }
+        if s.exit.t > t_min {
+            return Some(s.exit);
+        }
+    }
+    None
 }
 
 /// Merges the spans on `scratch.stack` from `base` into sorted disjoint spans
