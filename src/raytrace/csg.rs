@@ -395,8 +395,7 @@ impl CsgCaster {
     ) -> Option<Hit> {
         if let Some(i) = tree.leaf() {
             // One primitive: its own entry, or its exit from inside it.
-            let s = leaf.span(i)?;
-            return [s.enter, s.exit].into_iter().find(|c| c.t > t_min);
+            return booleans::first_crossing(&[leaf.span(i)?], t_min);
         }
         let Parts { operation, others, .. } = tree.parts();
         if operation == Operation::Union {

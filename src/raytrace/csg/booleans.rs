@@ -143,8 +143,10 @@ pub fn combine<B: Booleans>(tree: B, leaf: &impl LeafSpans, scratch: &mut SpanSc
         Operation::Union => union_of(others, leaf, |_| true, scratch),
         op @ (Operation::Intersection | Operation::Difference) => {
             let Some(first) = first else { return base };
-            // A leaf first has one span or none: nothing for a window to drop.
-            if op == Operation::Intersection && first.leaf().is_none() {
+            if let Some(i) = first.leaf() {
+                // One span or none: read directly (nothing for a window to drop).
+                scratch.stack.extend(leaf.span(i));
+            } else if op == Operation::Intersection {
                 let Some(window) = Window::of_leaves(others.clone(), leaf) else { return base };
                 combine_within(first, leaf, window, scratch);
             } else {
@@ -295,9 +297,15 @@ pub(super) fn first_of_all<B: Booleans>(
 ) -> Option<Hit> {
     scratch.stack.clear();
     combine(tree, leaf, scratch);
-    // Each span's entry, then its exit (as a loop: pairs built to be searched
-    // were stored and read back, a stall a pixel).
-    for s in &scratch.stack {
+    first_crossing(&scratch.stack, t_min)
+}
+
+/// The first end beyond `t_min` of sorted disjoint `spans`: each span's entry,
+/// then its exit. (A plain loop: pairs built to be searched were stored and
+/// read back, a stall a pixel.)
+#[inline]
+pub(super) fn first_crossing(spans: &[Interval], t_min: f32) -> Option<Hit> {
+    for s in spans {
         if s.enter.t > t_min {
             return Some(s.enter);
         }
