@@ -272,12 +272,19 @@ pub(super) fn first_entry<B: Booleans>(
     t_min: f32,
     scratch: &mut SpanScratch,
 ) -> Result<Option<Hit>, Inside> {
-    scratch.stack.clear();
-    match tree.leaf() {
-        Some(i) => scratch.stack.extend(leaf.span(i)),
-        None => _ = combine(tree, leaf, scratch),
+    // A leaf's one span is read where it is (not pushed and read back).
+    if let Some(i) = tree.leaf() {
+        return leaf.span(i).map_or(Ok(None), |s| entry_beyond(&[s], t_min));
     }
-    for s in &scratch.stack {
+    scratch.stack.clear();
+    combine(tree, leaf, scratch);
+    entry_beyond(&scratch.stack, t_min)
+}
+
+/// [`first_entry`] of sorted disjoint `spans`.
+#[inline]
+fn entry_beyond(spans: &[Interval], t_min: f32) -> Result<Option<Hit>, Inside> {
+    for s in spans {
         if s.enter.t > t_min {
             return Ok(Some(s.enter));
         }
