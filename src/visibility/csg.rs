@@ -91,7 +91,7 @@ pub enum CsgMethod {
     Segments,
     /// [`CsgMethod::Segments`] with a pixel's answer reused along the
     /// scanline while it holds (seed 003 §5.2.2; [`super::coherence`]): the
-    /// same surfaces to the bit, measured slower on most models.
+    /// same surfaces to the bit, measured slower on every corpus model.
     SegmentsCoherent,
     /// The paper's pattern matrix ([`super::pattern`]), expanded up to `limit`
     /// segments.
