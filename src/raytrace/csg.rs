@@ -459,7 +459,7 @@ impl CsgCaster {
         if parts > 1 {
             union(scratch, 0);
         }
-        scratch.stack.iter().flat_map(|s| [s.enter, s.exit]).find(|c| c.t > t_min)
+        booleans::first_crossing(&scratch.stack, t_min)
     }
 
     /// The spans of `ray` inside the solid.

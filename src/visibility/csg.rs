@@ -313,7 +313,9 @@ fn scan_bands<B: Send>(
                     RowWalker::Segments(walk) => {
                         scan_row(&caster, (walk, counts), &ends, &spans, near, (row, scratch, coherence));
                     }
-                    RowWalker::Pattern(matrix) => matrix.walk_row(&caster, &ends, &|i, x| spans.at(i, x), near, row),
+                    RowWalker::Pattern(matrix) => {
+                        matrix.walk_row(&caster, &ends, &|i, x| blocks.span(&caster, i, &lines[i], x), near, row);
+                    }
                     RowWalker::Empty => {}
                 }
                 let scanned = ScannedRow { hits: row, columns: lo..hi, line: &line, units: lines, caster: &caster };

@@ -162,8 +162,11 @@ impl PixelSpans {
 
     fn get(&mut self, i: usize, span: impl FnOnce() -> Option<Interval>) -> Option<Interval> {
         if self.stamp[i] != self.pixel {
+            // Handed on as computed, not read back from where it is kept.
+            let s = span();
             self.stamp[i] = self.pixel;
-            self.spans[i] = span();
+            self.spans[i] = s;
+            return s;
         }
         self.spans[i]
     }
