@@ -97,7 +97,7 @@ impl PatternMatrix {
         let mut visible = PlacedSet::new(self.segments.len());
         let mut flagged = vec![false; n];
         let (mut next_in, mut next_out) = (0, 0);
-        let mut spans = PixelSpans::new(n);
+        let mut spans = SpanCache::new(n);
         let mut scratch = SpanScratch::default();
         let Some(first) = entry.first().map(|e| e.1.max(0) as usize) else { return };
         for (x, px) in row.iter_mut().enumerate().skip(first) {
@@ -145,15 +145,15 @@ impl PatternMatrix {
 /// Each primitive's span at the current pixel, computed once however many
 /// segments hold the primitive (the pattern matrix repeats primitives: the
 /// paper's own named defect, paid for here by a per-pixel cache).
-struct PixelSpans {
+struct SpanCache {
     stamp: Vec<u32>,
     spans: Vec<Option<Interval>>,
     pixel: u32,
 }
 
-impl PixelSpans {
+impl SpanCache {
     fn new(n: usize) -> Self {
-        PixelSpans { stamp: vec![0; n], spans: vec![None; n], pixel: 0 }
+        SpanCache { stamp: vec![0; n], spans: vec![None; n], pixel: 0 }
     }
 
     fn next_pixel(&mut self) {
