@@ -29,7 +29,7 @@ mod lanes;
 mod shapes;
 
 pub use booleans::{above, below, combine, Booleans, LeafSpans, Operation, Parts, SpanScratch, TIE};
-use booleans::{difference, first_entry, first_of_all, union, Inside};
+use booleans::{difference, first_crossing, first_entry, first_of_all, union, Inside};
 use shapes::{normal_matrix, unit_cube, unit_normal, unit_span, Clipping, PlaneLanes};
 
 /// Where a ray crosses a solid's surface.
@@ -307,8 +307,8 @@ impl CsgCaster {
     /// [`CsgCaster::span_on`] at the eight pixels `x0..x0 + 8` of `unit` at
     /// once, in SIMD lanes: each the same to the bit as `span_on` gives it
     /// (a polyhedron of many planes clipped by the faces `row` keeps, from
-    /// [`CsgCaster::row_faces`] on the same line), written into `out` (a
-    /// walk's cache of them: 140 bytes not moved twice).
+    /// [`CsgCaster::row_faces`] on the same line), written into `out` (the
+    /// walk's cache, so the lanes are not returned and then copied).
     pub fn spans_on_eight(&self, i: usize, unit: &RowLine, x0: f32, row: &RowFaces, out: &mut IntervalLanes) {
         let rays = lanes::RayLanes::new(unit, x0);
         let shape = &self.solid.primitives[i].shape;
@@ -395,7 +395,7 @@ impl CsgCaster {
     ) -> Option<Hit> {
         if let Some(i) = tree.leaf() {
             // One primitive: its own entry, or its exit from inside it.
-            return booleans::first_crossing(&[leaf.span(i)?], t_min);
+            return first_crossing(&[leaf.span(i)?], t_min);
         }
         let Parts { operation, others, .. } = tree.parts();
         if operation == Operation::Union {
@@ -459,7 +459,7 @@ impl CsgCaster {
         if parts > 1 {
             union(scratch, 0);
         }
-        booleans::first_crossing(&scratch.stack, t_min)
+        first_crossing(&scratch.stack, t_min)
     }
 
     /// The spans of `ray` inside the solid.
