@@ -285,25 +285,35 @@ fn culling_primitives_by_their_boxes_changes_no_hit() {
     assert!(rays >= 20_000 && hits * 4 > rays, "{hits} hits of {rays} rays");
 }
 
-/// Seed 003 §5.2.2's coherence (a pixel's answer reused along the scanline
-/// while the occupants and the order of their ends stay) gives the surfaces
-/// the walk finds pixel by pixel, to the bit, on random solids and cameras.
+/// Seed 003 §5.2.2's coherence both ways — a pixel's answer reused along the
+/// scanline while the occupants and the order of their ends stay, and an
+/// eight-pixel block's answer spread from its first pixel (the default) —
+/// gives the surfaces the walk finds pixel by pixel, to the bit, on random
+/// solids and cameras.
 #[test]
 fn reusing_the_answer_along_a_scanline_changes_no_surface() {
     use kage::visibility::csg::{scan_solid_with, CsgMethod};
     let mut rng = StdRng::seed_from_u64(11);
     let (w, h) = (96u32, 64u32);
-    for round in 0..60 {
+    let (mut covered, mut blocks_rounds) = (0, 0);
+    for round in 0..200 {
         let mut prims = Vec::new();
         let tree = random_tree(&mut rng, &mut prims, 3);
         let solid = CsgSolid { primitives: prims, tree: Some(tree) };
         let camera = random_camera(&mut rng, round);
-        let each = scan_solid_with(&solid, &camera, w, h, CsgMethod::Segments).unwrap();
-        let reused = scan_solid_with(&solid, &camera, w, h, CsgMethod::SegmentsCoherent).unwrap();
-        for (k, (a, b)) in each.iter().zip(&reused).enumerate() {
-            assert_eq!(a, b, "pixel ({}, {}) round {round}", k as u32 % w, k as u32 / w);
+        let each = scan_solid_with(&solid, &camera, w, h, CsgMethod::SegmentsEachPixel).unwrap();
+        for method in [CsgMethod::SegmentsCoherent, CsgMethod::Segments] {
+            let reused = scan_solid_with(&solid, &camera, w, h, method).unwrap();
+            for (k, (a, b)) in each.iter().zip(&reused).enumerate() {
+                assert_eq!(a, b, "{method:?}: pixel ({}, {}) round {round}", k as u32 % w, k as u32 / w);
+            }
         }
+        let n = each.iter().flatten().count();
+        covered += n;
+        blocks_rounds += usize::from(n > 256);
     }
+    // Enough surface for whole blocks to be spread.
+    assert!(covered > 60_000 && blocks_rounds > 40, "{covered} pixels covered, {blocks_rounds} rounds of blocks");
 }
 
 /// A cutter whose face leans through a solid's face by a few [`TIE`]s: the
@@ -341,8 +351,9 @@ fn reuse_follows_a_cut_decided_within_the_tie() {
         shift: glam::Vec2::ZERO,
     };
     let (w, h) = (200u32, 100u32);
-    let each = scan_solid_with(&solid, &camera, w, h, CsgMethod::Segments).unwrap();
+    let each = scan_solid_with(&solid, &camera, w, h, CsgMethod::SegmentsEachPixel).unwrap();
     let reused = scan_solid_with(&solid, &camera, w, h, CsgMethod::SegmentsCoherent).unwrap();
+    let spread = scan_solid_with(&solid, &camera, w, h, CsgMethod::Segments).unwrap();
     // Along the middle row: the solid's face where the cutter's lies behind
     // it by more than the tie, the hole's floor elsewhere.
     let row = &each[(h / 2 * w) as usize..((h / 2 + 1) * w) as usize];
@@ -350,4 +361,5 @@ fn reuse_follows_a_cut_decided_within_the_tie() {
     let floor = row.iter().filter(|c| c.is_some_and(|c| c.primitive == 1)).count();
     assert!(face > 10 && floor > 10, "face {face}, floor {floor} pixels of the middle row");
     assert_eq!(each, reused);
+    assert_eq!(each, spread);
 }

@@ -86,6 +86,14 @@ impl Hit {
         self.face & Self::CUT != 0
     }
 
+    /// Whether `other` lies on the same face of the same primitive, on the
+    /// same side (a hole's wall or not).
+    #[inline]
+    #[must_use]
+    pub fn same_face(&self, other: &Hit) -> bool {
+        self.primitive == other.primitive && self.face == other.face
+    }
+
     /// This crossing with its hole-wall bit set to `cut` (what the booleans
     /// made of the same end of the same primitive at a neighbouring pixel).
     #[must_use]
@@ -127,6 +135,28 @@ impl IntervalLanes {
             let hit = |k: usize| Hit { t: self.t[k][j], primitive: self.primitive, face: self.face[k][j] };
             Interval { enter: hit(0), exit: hit(1) }
         })
+    }
+
+    /// Bit `j`: whether pixel `j`'s ray meets the primitive.
+    #[inline]
+    #[must_use]
+    pub fn met(&self) -> u8 {
+        self.hit
+    }
+
+    /// The `t` of end `end` (0 the entry, 1 the exit) at the eight pixels
+    /// (meaningless where the ray misses).
+    #[inline]
+    #[must_use]
+    pub fn ends(&self, end: usize) -> &[f32; 8] {
+        &self.t[end]
+    }
+
+    /// End `end` (0 the entry, 1 the exit) at pixel `j` as a crossing.
+    #[inline]
+    #[must_use]
+    pub fn end_at(&self, end: usize, j: usize) -> Hit {
+        Hit { t: self.t[end][j], primitive: self.primitive, face: self.face[end][j] }
     }
 }
 
@@ -341,6 +371,17 @@ impl CsgCaster {
     #[must_use]
     pub fn crossing_on_line(&self, hit: Hit, unit: &RowLine, x: f32) -> Crossing {
         self.finish(hit, unit.at(x).at(hit.t))
+    }
+
+    /// Whether `hit`'s face is flat (a polyhedron's plane, a frustum's cap):
+    /// its normal is then the same at every point of it.
+    #[must_use]
+    pub fn flat(&self, hit: Hit) -> bool {
+        match &self.solid.primitives[hit.primitive as usize].shape {
+            Shape::Sphere => false,
+            Shape::Frustum { .. } => hit.face & !Hit::CUT != shapes::SIDE,
+            Shape::Polyhedron(_) => true,
+        }
     }
 
     /// `hit` with the unit outward normal (solid space) of its face at `p`

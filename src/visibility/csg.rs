@@ -43,7 +43,7 @@
 //! orthographic camera, fall back to their box. A too-wide extent only costs
 //! time: where a primitive does not reach, its interval is empty.
 
-use std::cell::RefCell;
+use std::cell::{Cell, RefCell};
 
 use glam::{DVec2, Mat4, Vec2, Vec3, Vec4};
 use rayon::iter::IndexedParallelIterator;
@@ -54,6 +54,7 @@ use crate::scene::camera::PixelRays;
 use crate::scene::camera::RowLine;
 use crate::scene::csg::{CsgSolid, Primitive, Shape};
 use crate::scene::{Camera, Object, Scene};
+use crate::visibility::block::BlockOrder;
 use crate::visibility::coherence::{self, PixelCoherence};
 use crate::visibility::occupancy::{OccupancyTree, Occupied};
 use crate::visibility::pattern::{PatternMatrix, TooManySegments};
@@ -86,12 +87,17 @@ pub fn scan_solid(solid: &CsgSolid, camera: &Camera, width: u32, height: u32) ->
 /// How a scanline's pixels find their surface.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum CsgMethod {
-    /// The tree's own segments, cut down to the occupants (the default; no
-    /// expansion).
+    /// The tree's own segments, cut down to the occupants (no expansion),
+    /// an eight-pixel block's answer found at its first pixel and spread to
+    /// the others where it provably holds ([`super::block`]; the default).
     Segments,
-    /// [`CsgMethod::Segments`] with a pixel's answer reused along the
-    /// scanline while it holds (seed 003 §5.2.2; [`super::coherence`]): the
-    /// same surfaces to the bit, measured slower on every corpus model.
+    /// [`CsgMethod::Segments`] with the booleans run at every pixel: the
+    /// same surfaces to the bit (what the spreading is tested against).
+    SegmentsEachPixel,
+    /// [`CsgMethod::SegmentsEachPixel`] with a pixel's answer reused along
+    /// the scanline while the order of every end holds (seed 003 §5.2.2 as
+    /// the paper has it; [`super::coherence`]): the same surfaces to the
+    /// bit, measured slower on every corpus model.
     SegmentsCoherent,
     /// The paper's pattern matrix ([`super::pattern`]), expanded up to `limit`
     /// segments.
@@ -131,11 +137,13 @@ pub fn scan_solid_into(
     let bands = out.par_chunks_mut(w * BAND_ROWS);
     scan_bands(solid, &walker, camera, (width, height), bands, |band, dy, row| {
         let out = &mut band[dy * w..(dy + 1) * w];
-        out.fill(None);
-        for (x, h) in row.hits() {
+        let columns = row.columns.clone();
+        out[..columns.start].fill(None);
+        out[columns.end..].fill(None);
+        for (x, (px, h)) in columns.clone().zip(out[columns].iter_mut().zip(&row.hits[row.columns.clone()])) {
             // Distances along the unnormalised row line become distances
             // along the unit pixel ray.
-            out[x] = Some(Crossing { t: h.t * row.line.at(x as f32).dir.length(), ..row.crossing(x, h) });
+            *px = h.map(|h| Crossing { t: h.t * row.line.at(x as f32).dir.length(), ..row.crossing(x, h) });
         }
     });
     Ok(())
@@ -154,12 +162,16 @@ impl RowWalker {
         let n = solid.primitives.len();
         let Some(tree) = &solid.tree else { return Ok(RowWalker::Empty) };
         Ok(match method {
-            CsgMethod::Segments | CsgMethod::SegmentsCoherent => {
-                let coherent = method == CsgMethod::SegmentsCoherent;
+            CsgMethod::Segments | CsgMethod::SegmentsEachPixel | CsgMethod::SegmentsCoherent => {
+                let reuse = match method {
+                    CsgMethod::Segments => Reuse::Blocks,
+                    CsgMethod::SegmentsCoherent => Reuse::Pixels,
+                    _ => Reuse::Never,
+                };
                 RowWalker::Segments(SegmentWalk {
                     tree: OccupancyTree::new(tree, n),
-                    cut_with: if coherent { coherence::cut_with(tree, n) } else { Vec::new() },
-                    coherent,
+                    cut_with: if reuse == Reuse::Pixels { coherence::cut_with(tree, n) } else { Vec::new() },
+                    reuse,
                 })
             }
             CsgMethod::PatternMatrix { limit } => RowWalker::Pattern(PatternMatrix::expand(tree, n, limit)?),
@@ -170,10 +182,21 @@ impl RowWalker {
 /// The walk of the tree's own segments.
 struct SegmentWalk {
     tree: OccupancyTree,
-    /// Per primitive, whether a difference cuts with it (when coherent).
+    /// Per primitive, whether a difference cuts with it (reusing by pixels).
     cut_with: Vec<bool>,
-    /// Whether a pixel's answer is reused along the scanline (seed 003 §5.2.2).
-    coherent: bool,
+    /// How an answer is reused along the scanline (seed 003 §5.2.2).
+    reuse: Reuse,
+}
+
+/// How the segment walk reuses an answer along a scanline.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Reuse {
+    /// An eight-pixel block's, where it provably holds ([`super::block`]).
+    Blocks,
+    /// A pixel's, while the order of every end holds ([`super::coherence`]).
+    Pixels,
+    /// None: the booleans at every pixel.
+    Never,
 }
 
 /// Draws every solid of `scene` that `include` takes, seen by `camera`, into
@@ -237,6 +260,8 @@ struct ScannedRow<'a> {
     /// The row's rays in each occupant's unit space.
     units: &'a [RowLine],
     caster: &'a CsgCaster,
+    /// The last flat face given a normal: a hit on it, and its crossing.
+    flat: Cell<Option<(Hit, Crossing)>>,
 }
 
 impl ScannedRow<'_> {
@@ -246,9 +271,18 @@ impl ScannedRow<'_> {
         self.columns.clone().zip(hits).filter_map(|(x, h)| Some((x, (*h)?)))
     }
 
-    /// Pixel `x`'s `hit` with its outward normal.
+    /// Pixel `x`'s `hit` with its outward normal (a flat face's computed
+    /// once while pixel after pixel shows it).
+    #[inline]
     fn crossing(&self, x: usize, hit: Hit) -> Crossing {
-        self.caster.crossing_on_line(hit, &self.units[hit.primitive as usize], x as f32)
+        if let Some((_, c)) = self.flat.get().filter(|(h, _)| h.same_face(&hit)) {
+            return Crossing { t: hit.t, ..c };
+        }
+        let c = self.caster.crossing_on_line(hit, &self.units[hit.primitive as usize], x as f32);
+        if self.caster.flat(hit) {
+            self.flat.set(Some((hit, c)));
+        }
+        c
     }
 }
 
@@ -281,7 +315,7 @@ fn scan_bands<B: Send>(
     bands.enumerate().for_each_init(
         || Lent::fitted(w, solid.primitives.len(), walker),
         |lent, (band, mut out)| {
-            let RowBuffers { row, lines, counts, scratch, blocks, coherence } = &mut lent.0;
+            let RowBuffers { row, lines, counts, scratch, blocks, coherence, order } = &mut lent.0;
             let first = (band * BAND_ROWS) as i64;
             // The y-occupancy list as the band's first scanline finds it, then kept
             // row by row.
@@ -311,14 +345,22 @@ fn scan_bands<B: Send>(
                 let spans = RowSpans { blocks, caster: &caster, lines };
                 match walker {
                     RowWalker::Segments(walk) => {
-                        scan_row(&caster, (walk, counts), &ends, &spans, near, (row, scratch, coherence));
+                        let reuse = (&mut *coherence, &mut *order);
+                        scan_row(&caster, (walk, counts), &ends, &spans, near, (row, scratch, reuse));
                     }
                     RowWalker::Pattern(matrix) => {
                         matrix.walk_row(&caster, &ends, &|i, x| blocks.span(&caster, i, &lines[i], x), near, row);
                     }
                     RowWalker::Empty => {}
                 }
-                let scanned = ScannedRow { hits: row, columns: lo..hi, line: &line, units: lines, caster: &caster };
+                let scanned = ScannedRow {
+                    hits: row,
+                    columns: lo..hi,
+                    line: &line,
+                    units: lines,
+                    caster: &caster,
+                    flat: Cell::new(None),
+                };
                 visit(&mut out, dy, &scanned);
                 // Between rows, the row's hits are all None.
                 row[lo..hi].fill(None);
@@ -329,7 +371,7 @@ fn scan_bands<B: Send>(
 
 /// One worker's buffers for walking scanlines: the row's hits (all `None`
 /// between rows), each occupant's row line, the occupancy counts, the
-/// booleans' stack, the eight-pixel blocks and the reusable answer. Kept
+/// booleans' stack, the eight-pixel blocks and the reusable answers. Kept
 /// between pieces of work on the worker's thread ([`Lent`]): a solid of a
 /// thousand primitives needs ~250 KB of them, and a scan hands out ~20 pieces.
 #[derive(Default)]
@@ -340,6 +382,7 @@ struct RowBuffers {
     scratch: SpanScratch,
     blocks: BlockSpans,
     coherence: PixelCoherence,
+    order: BlockOrder,
 }
 
 thread_local! {
@@ -409,12 +452,24 @@ impl BlockSpans {
     #[inline(always)]
     fn span(&self, caster: &CsgCaster, i: usize, unit: &RowLine, x: usize) -> Option<Interval> {
         let mut cached = self.cached.borrow_mut();
-        let (block, lanes) = &mut cached[i];
-        if *block != x / 8 {
-            *block = x / 8;
-            Self::fill(caster, i, unit, *block, &self.faces[i], lanes);
+        self.fill_if_stale(&mut cached[i], caster, i, unit, x / 8);
+        cached[i].1.get(x % 8)
+    }
+
+    /// Primitive `i`'s cache entry `cached` made to hold `block`.
+    #[inline(always)]
+    fn fill_if_stale(
+        &self,
+        (cached, lanes): &mut (usize, IntervalLanes),
+        caster: &CsgCaster,
+        i: usize,
+        unit: &RowLine,
+        block: usize,
+    ) {
+        if *cached != block {
+            *cached = block;
+            Self::fill(caster, i, unit, block, &self.faces[i], lanes);
         }
-        lanes.get(x % 8)
     }
 
     /// Primitive `i`'s lanes for `block`, into `lanes`: once per eight
@@ -438,6 +493,24 @@ impl RowSpans<'_> {
     #[inline(always)]
     fn at(&self, i: usize, x: usize) -> Option<Interval> {
         self.blocks.span(self.caster, i, &self.lines[i], x)
+    }
+
+    /// [`BlockOrder::spread`] of `first`, the answer at pixel `x` (a block's
+    /// first) among the occupants `ids`, into the block's eight pixels `out`.
+    fn spread(
+        &self,
+        order: &mut BlockOrder,
+        ids: &[u32],
+        (x, first): (usize, Option<Hit>),
+        near: f32,
+        out: &mut [Option<Hit>],
+    ) -> bool {
+        let mut cached = self.blocks.cached.borrow_mut();
+        for &i in ids {
+            let i = i as usize;
+            self.blocks.fill_if_stale(&mut cached[i], self.caster, i, &self.lines[i], x / 8);
+        }
+        order.spread(ids, |i| &cached[i].1, near, first, out)
     }
 }
 
@@ -472,29 +545,32 @@ pub(super) fn x_order(ends: impl IntoIterator<Item = RowEnds>) -> (Vec<RowEnds>,
 /// One scanline: the x-entry table of the occupants (sorted by left end), the
 /// x-exit order (by right end), the x-occupancy list as the counts of
 /// `occupied` (empty on entry and on return), and each occupied pixel's
-/// surface from the non-empty part of the tree, reused from the pixel before
-/// while the occupants and their order stay (when the walk is coherent).
+/// surface from the non-empty part of the tree, reused as the walk's
+/// [`Reuse`] says.
 fn scan_row(
     caster: &CsgCaster,
     (walk, counts): (&SegmentWalk, &mut Occupied),
     ends: &[(usize, i64, i64)],
     spans: &RowSpans,
     near: f32,
-    (row, scratch, coherence): (&mut [Option<Hit>], &mut SpanScratch, &mut PixelCoherence),
+    (row, scratch, (coherence, order)): (&mut [Option<Hit>], &mut SpanScratch, (&mut PixelCoherence, &mut BlockOrder)),
 ) {
     let tree = &walk.tree;
     let (entry, exit) = x_order(ends.iter().copied());
     let (mut next_in, mut next_out) = (0, 0);
     let Some(first) = entry.first().map(|e| e.1.max(0) as usize) else { return };
     coherence.forget();
-    for (x, px) in row.iter_mut().enumerate().skip(first) {
+    let mut x = first;
+    while x < row.len() {
         while next_in < entry.len() && entry[next_in].1 <= x as i64 {
             counts.set(tree, entry[next_in].0, true);
             coherence.forget();
             next_in += 1;
         }
+        // The last pixel this step settles: `x`, or its whole block.
+        let mut last = x;
         if let Some(root) = counts.root(tree) {
-            *px = if walk.coherent {
+            let hit = if walk.reuse == Reuse::Pixels {
                 let present = counts.present();
                 coherence.look(present, near, |i| spans.at(i, x));
                 coherence.reused().unwrap_or_else(|| {
@@ -505,9 +581,21 @@ fn scan_row(
             } else {
                 caster.first_hit_in_by(root, &PixelSpans { row: spans, x }, near, scratch)
             };
+            row[x] = hit;
+            // A block nothing enters or leaves inside of (a right end on
+            // its last pixel leaves after it).
+            let block = x + 7;
+            let quiet = walk.reuse == Reuse::Blocks
+                && x % 8 == 0
+                && block < row.len()
+                && entry.get(next_in).is_none_or(|e| e.1 > block as i64)
+                && exit.get(next_out).is_none_or(|e| e.2 >= block as i64);
+            if quiet && spans.spread(order, counts.present().ids(), (x, hit), near, &mut row[x..=block]) {
+                last = block;
+            }
         }
-        // Primitives whose right end is this pixel leave the x-occupancy list.
-        while next_out < exit.len() && exit[next_out].2 <= x as i64 {
+        // Primitives whose right end is passed leave the x-occupancy list.
+        while next_out < exit.len() && exit[next_out].2 <= last as i64 {
             counts.set(tree, exit[next_out].0, false);
             coherence.forget();
             next_out += 1;
@@ -515,6 +603,7 @@ fn scan_row(
         if next_out == exit.len() {
             break;
         }
+        x = last + 1;
     }
     counts.clear(tree);
 }

@@ -10,6 +10,7 @@
 //! reference counts, in tree form) or [`pattern`] (its pattern matrix), with
 //! [`coherence`] (its reuse of a pixel's answer along the scanline) on request.
 
+pub mod block;
 pub mod clip;
 pub mod coherence;
 pub mod csg;

@@ -1,0 +1,151 @@
+//! Eight pixels' surfaces from one pixel's booleans: seed 003 §5.2.2's
+//! coherence, taken a block at a time.
+//!
+//! The scanline walk reads every occupant's intervals eight pixels at a time
+//! (one SIMD pass per occupant and block, `BlockSpans` in [`super::csg`]).
+//! Where no occupant enters or leaves inside a block, the booleans run at its
+//! first pixel only, and [`BlockOrder::spread`] hands their answer to the
+//! other seven when it provably holds there.
+//!
+//! Why it holds. The booleans ([`crate::raytrace::csg`]) build the set of
+//! ray parameters inside the solid out of the occupants' intervals, comparing
+//! ends with each other, with the near plane and — a difference's cutter —
+//! moved by [`TIE`]; their answer is the first end of that set beyond the
+//! near plane, always one occupant's own entry or exit. Call it `E` at the
+//! block's first pixel (`+∞` for a miss). Which part of the set lies before
+//! and just past `E` depends only on the ends before `E` and their order. So
+//! when, over the eight pixels,
+//! - each occupant is met at all eight or missed at all eight,
+//! - the ends lying before `E` at the first pixel, the near plane and `E`
+//!   itself keep one order with room to spare: the greatest value one takes
+//!   over the eight stays below the least of the next by more than any
+//!   [`TIE`] move ([`apart`]), and
+//! - every other end stays beyond `E` by as much,
+//!
+//! every comparison that shapes the set up to just past `E` comes out as at
+//! the first pixel, and pixel `j`'s answer is the same end of the same
+//! occupant read at `j` — its `t` and face there, its hole-wall bit — to the
+//! bit what the booleans would give. Unlike the per-pixel reuse of
+//! [`super::coherence`] (which keeps every end in order, so the booleans take
+//! the same path), ends behind the surface may swap freely; a block where
+//! ends before the surface come close (coplanar faces, a cut decided within
+//! the tie, a surface crossing another) is evaluated pixel by pixel.
+
+use crate::raytrace::csg::{Hit, IntervalLanes, TIE};
+
+/// One end's `t` over a block: least and greatest over the eight pixels,
+/// and at the first.
+#[derive(Debug, Clone, Copy)]
+struct EndRange {
+    lo: f32,
+    hi: f32,
+    first: f32,
+}
+
+impl EndRange {
+    /// The range of `t` over eight pixels.
+    #[inline]
+    fn of(t: &[f32; 8]) -> EndRange {
+        let (lo, hi) = t.iter().fold((t[0], t[0]), |(lo, hi), &v| (lo.min(v), hi.max(v)));
+        EndRange { lo, hi, first: t[0] }
+    }
+
+    /// A value the same at every pixel (the near plane).
+    fn fixed(t: f32) -> EndRange {
+        EndRange { lo: t, hi: t, first: t }
+    }
+}
+
+/// Whether every value of `a` lies below every value of `b` by more than
+/// the largest move a difference makes ([`TIE`] relative to `t`, on both
+/// sides), so that no comparison of theirs, moved or not, can differ.
+#[inline]
+fn apart(a: &EndRange, b: &EndRange) -> bool {
+    b.lo - a.hi > 4.0 * TIE * a.hi.abs().max(b.lo.abs()).max(1.0)
+}
+
+/// Room to order a block's ends in, kept from block to block.
+#[derive(Debug, Clone, Default)]
+pub struct BlockOrder {
+    before: Vec<EndRange>,
+}
+
+impl BlockOrder {
+    /// The surfaces at the eight pixels of a block where no occupant enters or
+    /// leaves, given `first` — the booleans' answer at the block's first
+    /// pixel, beyond the near plane at `near` — and the lanes of the
+    /// occupants `ids` (`lanes`, by primitive): written into `out` (eight
+    /// pixels), or `false` (`out` untouched) when the answer may not hold at
+    /// every pixel (see the module's doc).
+    pub fn spread<'a>(
+        &mut self,
+        ids: &[u32],
+        lanes: impl Fn(usize) -> &'a IntervalLanes,
+        near: f32,
+        first: Option<Hit>,
+        out: &mut [Option<Hit>],
+    ) -> bool {
+        // The answer's lanes, its end and that end's range.
+        let answer = match first {
+            None => None,
+            Some(h) => {
+                let l = lanes(h.primitive as usize);
+                let end = match (h.t == l.ends(0)[0], h.t == l.ends(1)[0]) {
+                    (true, false) => 0,
+                    (false, true) => 1,
+                    _ => return false,
+                };
+                Some((l, end))
+            }
+        };
+        let e = answer.map(|(l, end)| (l.end_at(end, 0).primitive, end, EndRange::of(l.ends(end))));
+        if !self.ordered(ids.iter().map(|&i| lanes(i as usize)), near, e) {
+            return false;
+        }
+        let cut = first.is_some_and(|h| h.cut());
+        for (j, px) in out[..8].iter_mut().enumerate() {
+            *px = answer.map(|(l, end)| l.end_at(end, j).with_cut(cut));
+        }
+        true
+    }
+
+    /// The conditions of the module's doc among the lanes of `occupants`
+    /// for the answer `answer` (its primitive, end and range; `None` a miss).
+    fn ordered<'a>(
+        &mut self,
+        occupants: impl Iterator<Item = &'a IntervalLanes>,
+        near: f32,
+        answer: Option<(u32, usize, EndRange)>,
+    ) -> bool {
+        let e = answer.map(|a| a.2);
+        self.before.clear();
+        self.before.push(EndRange::fixed(near));
+        for l in occupants {
+            match l.met() {
+                0 => continue,
+                u8::MAX => {}
+                _ => return false, // met at some pixels only
+            }
+            let primitive = l.end_at(0, 0).primitive;
+            for end in 0..2 {
+                if answer.is_some_and(|(p, k, _)| p == primitive && k == end) {
+                    continue;
+                }
+                let r = EndRange::of(l.ends(end));
+                match e {
+                    // Beyond the answer: only to stay beyond it.
+                    Some(e) if r.first > e.first => {
+                        if !apart(&e, &r) {
+                            return false;
+                        }
+                    }
+                    Some(e) if r.first == e.first => return false,
+                    _ => self.before.push(r),
+                }
+            }
+        }
+        self.before.sort_unstable_by(|a, b| a.first.total_cmp(&b.first));
+        self.before.extend(e);
+        self.before.windows(2).all(|w| apart(&w[0], &w[1]))
+    }
+}
