@@ -363,3 +363,45 @@ fn reuse_follows_a_cut_decided_within_the_tie() {
     assert_eq!(each, reused);
     assert_eq!(each, spread);
 }
+
+/// Two boxes' faces crossing at a hair's angle, so that along the middle row
+/// the nearer one changes where their depths differ in the last bits only:
+/// spreading a block's answer must not take "nearly equal" for "equal".
+#[test]
+fn spreading_a_block_keeps_faces_that_cross_within_rounding_apart() {
+    use kage::scene::{Camera, Projection};
+    use kage::visibility::csg::{scan_solid_with, CsgMethod};
+    let cube = || Shape::Polyhedron(ConvexPolyhedron::unit_cube());
+    let flat = Affine3A::from_translation(Vec3::new(-1.5, -0.5, 0.0));
+    // The second box's top: z = 1 + s·x, s a few units of the last place of
+    // t (≈ 4) across the image.
+    let shear = Mat3::from_cols(Vec3::new(1.0, 0.0, 4.0 * f32::EPSILON), Vec3::Y, Vec3::Z);
+    let leaning = Affine3A::from_mat3(shear) * flat;
+    let primitives = [flat, leaning]
+        .map(|t| Primitive {
+            shape: cube(),
+            transform: t * Affine3A::from_scale(Vec3::new(3.0, 1.0, 1.0)),
+            color: None,
+            source: 0..0,
+        })
+        .to_vec();
+    let tree = CsgTree::Union(vec![CsgTree::Leaf(0), CsgTree::Leaf(1)]);
+    let solid = CsgSolid { primitives, tree: Some(tree) };
+    let camera = Camera {
+        eye: Vec3::new(0.0, 0.0, 5.0),
+        target: Vec3::ZERO,
+        up: Vec3::Y,
+        near: 0.05,
+        far: 100.0,
+        projection: Projection::Orthographic { height: 3.0 },
+        shift: glam::Vec2::ZERO,
+    };
+    let (w, h) = (200u32, 100u32);
+    let each = scan_solid_with(&solid, &camera, w, h, CsgMethod::SegmentsEachPixel).unwrap();
+    let spread = scan_solid_with(&solid, &camera, w, h, CsgMethod::Segments).unwrap();
+    let row = &each[(h / 2 * w) as usize..((h / 2 + 1) * w) as usize];
+    let firsts = row.iter().flatten().filter(|c| c.primitive == 0).count();
+    let seconds = row.iter().flatten().filter(|c| c.primitive == 1).count();
+    assert!(firsts > 10 && seconds > 10, "{firsts} and {seconds} pixels of the middle row show each box");
+    assert_eq!(each, spread);
+}

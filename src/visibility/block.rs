@@ -14,13 +14,13 @@
 //! near plane, always one occupant's own entry or exit. Call it `E` at the
 //! block's first pixel (`+∞` for a miss). Which part of the set lies before
 //! and just past `E` depends only on the ends before `E` and their order. So
-//! when, over the eight pixels,
-//! - each occupant is met at all eight or missed at all eight,
+//! when, at every one of the eight pixels,
+//! - each occupant is met, or each is missed (the same ones at all eight),
 //! - the ends lying before `E` at the first pixel, the near plane and `E`
-//!   itself keep one order with room to spare: the greatest value one takes
-//!   over the eight stays below the least of the next by more than any
-//!   [`TIE`] move ([`apart`]), and
-//! - every other end stays beyond `E` by as much,
+//!   itself keep the first pixel's order, each beyond the one before by more
+//!   than any [`TIE`] move — or equal to it at all eight pixels, so that
+//!   every comparison of the two, moved or not, comes out alike ([`settled`]),
+//! - and every other end stays beyond `E` in the same way,
 //!
 //! every comparison that shapes the set up to just past `E` comes out as at
 //! the first pixel, and pixel `j`'s answer is the same end of the same
@@ -28,46 +28,30 @@
 //! bit what the booleans would give. Unlike the per-pixel reuse of
 //! [`super::coherence`] (which keeps every end in order, so the booleans take
 //! the same path), ends behind the surface may swap freely; a block where
-//! ends before the surface come close (coplanar faces, a cut decided within
-//! the tie, a surface crossing another) is evaluated pixel by pixel.
+//! ends before the surface come close without being equal (a cut decided
+//! within the tie, a surface crossing another) is evaluated pixel by pixel.
+//! The checks run lane by lane (eight pixels per comparison), once per
+//! block, where the booleans ran at each of its pixels.
 
 use crate::raytrace::csg::{Hit, IntervalLanes, TIE};
 
-/// One end's `t` over a block: least and greatest over the eight pixels,
-/// and at the first.
-#[derive(Debug, Clone, Copy)]
-struct EndRange {
-    lo: f32,
-    hi: f32,
-    first: f32,
-}
-
-impl EndRange {
-    /// The range of `t` over eight pixels.
-    #[inline]
-    fn of(t: &[f32; 8]) -> EndRange {
-        let (lo, hi) = t.iter().fold((t[0], t[0]), |(lo, hi), &v| (lo.min(v), hi.max(v)));
-        EndRange { lo, hi, first: t[0] }
-    }
-
-    /// A value the same at every pixel (the near plane).
-    fn fixed(t: f32) -> EndRange {
-        EndRange { lo: t, hi: t, first: t }
-    }
-}
-
-/// Whether every value of `a` lies below every value of `b` by more than
-/// the largest move a difference makes ([`TIE`] relative to `t`, on both
-/// sides), so that no comparison of theirs, moved or not, can differ.
+/// Whether at every pixel `b` lies beyond `a` by more than the largest move
+/// a difference makes ([`TIE`] relative to `t`, on both sides) — or the two
+/// are the same value at every pixel. Either way no comparison of theirs,
+/// moved or not, comes out differently at one pixel than at another.
 #[inline]
-fn apart(a: &EndRange, b: &EndRange) -> bool {
-    b.lo - a.hi > 4.0 * TIE * a.hi.abs().max(b.lo.abs()).max(1.0)
+fn settled(a: &[f32; 8], b: &[f32; 8]) -> bool {
+    let mut apart = true;
+    for j in 0..8 {
+        apart &= b[j] - a[j] > 4.0 * TIE * a[j].abs().max(b[j].abs()).max(1.0);
+    }
+    apart || a == b
 }
 
 /// Room to order a block's ends in, kept from block to block.
 #[derive(Debug, Clone, Default)]
 pub struct BlockOrder {
-    before: Vec<EndRange>,
+    before: Vec<[f32; 8]>,
 }
 
 impl BlockOrder {
@@ -85,7 +69,7 @@ impl BlockOrder {
         first: Option<Hit>,
         out: &mut [Option<Hit>],
     ) -> bool {
-        // The answer's lanes, its end and that end's range.
+        // The answer's lanes and end.
         let answer = match first {
             None => None,
             Some(h) => {
@@ -98,7 +82,7 @@ impl BlockOrder {
                 Some((l, end))
             }
         };
-        let e = answer.map(|(l, end)| (l.end_at(end, 0).primitive, end, EndRange::of(l.ends(end))));
+        let e = answer.map(|(l, end)| (l.end_at(end, 0).primitive, end, l.ends(end)));
         if !self.ordered(ids.iter().map(|&i| lanes(i as usize)), near, e) {
             return false;
         }
@@ -110,16 +94,15 @@ impl BlockOrder {
     }
 
     /// The conditions of the module's doc among the lanes of `occupants`
-    /// for the answer `answer` (its primitive, end and range; `None` a miss).
+    /// for the answer `answer` (its primitive, end and `t`s; `None` a miss).
     fn ordered<'a>(
         &mut self,
         occupants: impl Iterator<Item = &'a IntervalLanes>,
         near: f32,
-        answer: Option<(u32, usize, EndRange)>,
+        answer: Option<(u32, usize, &[f32; 8])>,
     ) -> bool {
-        let e = answer.map(|a| a.2);
         self.before.clear();
-        self.before.push(EndRange::fixed(near));
+        self.before.push([near; 8]);
         for l in occupants {
             match l.met() {
                 0 => continue,
@@ -128,24 +111,21 @@ impl BlockOrder {
             }
             let primitive = l.end_at(0, 0).primitive;
             for end in 0..2 {
-                if answer.is_some_and(|(p, k, _)| p == primitive && k == end) {
-                    continue;
-                }
-                let r = EndRange::of(l.ends(end));
-                match e {
+                let t = l.ends(end);
+                match answer {
+                    Some((p, k, _)) if p == primitive && k == end => {}
                     // Beyond the answer: only to stay beyond it.
-                    Some(e) if r.first > e.first => {
-                        if !apart(&e, &r) {
+                    Some((_, _, e)) if t[0] > e[0] => {
+                        if !settled(e, t) {
                             return false;
                         }
                     }
-                    Some(e) if r.first == e.first => return false,
-                    _ => self.before.push(r),
+                    _ => self.before.push(*t),
                 }
             }
         }
-        self.before.sort_unstable_by(|a, b| a.first.total_cmp(&b.first));
-        self.before.extend(e);
-        self.before.windows(2).all(|w| apart(&w[0], &w[1]))
+        self.before.sort_unstable_by(|a, b| a[0].total_cmp(&b[0]));
+        self.before.extend(answer.map(|a| *a.2));
+        self.before.windows(2).all(|w| settled(&w[0], &w[1]))
     }
 }
