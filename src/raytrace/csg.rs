@@ -349,7 +349,9 @@ impl CsgCaster {
             }
             _ => lanes::shape(shape, &rays),
         };
-        let face = |f: wide::f32x8| f.to_array().map(|f| f as u32);
+        // Faces are small whole numbers: converted in lanes (one by one, the
+        // saturating `as` was a quarter of the fill).
+        let face = |f: wide::f32x8| f.trunc_int().to_array().map(|f| f as u32);
         *out = IntervalLanes {
             t: [spans.enter.0.to_array(), spans.exit.0.to_array()],
             face: [face(spans.enter.1), face(spans.exit.1)],
