@@ -28,10 +28,15 @@
 //!
 //! Coherence (§5.2.2): the paper reuses a pixel's answer at the next pixel
 //! unless a primitive entered or left or the depth order changed. kage has it
-//! exactly ([`super::coherence`], `CsgMethod::SegmentsCoherent`) but walks
-//! pixel by pixel by default: measured on the corpus, checking the order
-//! costs about what the booleans of the few primitives at a pixel cost, and
-//! the order of many primitives' ends breaks too often to pay.
+//! exactly as the paper puts it ([`super::coherence`],
+//! `CsgMethod::SegmentsCoherent`), but measured on the corpus, checking the
+//! order at every pixel costs about what the booleans of the few primitives
+//! there cost, and the order of many primitives' ends breaks too often to
+//! pay. By default the walk takes it a block at a time instead
+//! ([`super::block`]): in an eight-pixel block no occupant enters or leaves,
+//! the booleans run at its first pixel, and their answer goes to the other
+//! seven when the ends before it keep their order at all eight (checked in
+//! lanes, once per block); ends behind the surface may swap.
 //!
 //! Extents (procedures 1 and 2): an ellipsoid seen in perspective from outside
 //! gets the paper's exact rows (scanline planes through the eye tangent to it)

@@ -64,11 +64,13 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         );
     }
     println!(
-        "\n{w}x{h}, exact quadrics, each model with its corpus camera; scanline: median of {} frames; rays: one frame \
-         each. Naive rays: the paper's baseline, every primitive's interval at every pixel, then combined along the \
+        "\n{w}x{h}, exact quadrics, each model with its corpus camera; scanline: median of {} frames (the default \
+         walk: an eight-pixel block's answer found at its first pixel and spread where it provably holds, seed 003 \
+         §5.2.2 by blocks); rays: one frame each. Naive rays: the paper's baseline, every primitive's interval at every pixel, then combined along the \
          tree. BVH rays: only the primitives whose boxes the ray crosses (a BVH from {} primitives up), combined \
-         along the tree with early exits. Reuse: the scanline walk keeping a pixel's answer while its occupants \
-         and the depth order of their ends stay (seed 003 §5.2.2; the same surfaces to the bit). {} threads. \
+         along the tree with early exits. Reuse: the walk keeping a pixel's answer at the next while its occupants \
+         and the depth order of all their ends stay (§5.2.2 pixel by pixel, as the paper has it; the same surfaces \
+         to the bit). {} threads. \
          Median ratios: naive/scanline {:.1}, BVH/scanline {:.1}.",
         args.frames.max(1),
         CsgCaster::BVH_PRIMITIVES,
