@@ -324,14 +324,39 @@ impl CsgCaster {
     /// [`CsgCaster::spans_on_eight`]; nothing for other primitives. A
     /// scanline's rays lie in one plane, which meets few of a rounded
     /// box's hundreds of faces.
-    pub fn row_faces(&self, i: usize, unit: &RowLine, row: &mut RowFaces) {
+    ///
+    /// `rows`, when given, is [`CsgCaster::face_rows`]'s answer and the
+    /// scanline's coordinate: the faces whose rows take it in are kept,
+    /// without measuring each face's corners against the line's plane.
+    pub fn row_faces(&self, i: usize, unit: &RowLine, rows: Option<(&[(f32, f32)], f32)>, row: &mut RowFaces) {
         row.active = false;
         if let Clipping::Lanes(lanes) = &self.clipping[i] {
             if let Some(corners) = &lanes.corners {
-                corners.met_by(unit, &mut row.distances, &mut row.faces);
+                match rows {
+                    Some((ranges, y)) => {
+                        row.faces.clear();
+                        let met = ranges.iter().map(|&(lo, hi)| lo <= y && y <= hi);
+                        row.faces.extend((0..).zip(met).filter_map(|(f, met)| met.then_some(f)));
+                    }
+                    None => corners.met_by(unit, &mut row.distances, &mut row.faces),
+                }
                 row.active = true;
             }
         }
+    }
+
+    /// For a polyhedron of many planes, each face's least and greatest
+    /// scanline coordinate over its corners, `row` giving a point's (solid
+    /// space; a pixel row's centres at `y + ½`), widened by a pixel each way
+    /// so that rounding loses no face: a scanline whose plane meets the face
+    /// lies between (a face is convex, and a scanline's rays fill the plane
+    /// through the eye that projects onto it). `None` for other primitives,
+    /// or when a corner has no row (at or behind the eye).
+    pub fn face_rows(&self, i: usize, row: impl Fn(Vec3) -> Option<f32>) -> Option<Vec<(f32, f32)>> {
+        let Clipping::Lanes(lanes) = &self.clipping[i] else { return None };
+        let to_solid = self.solid.primitives[i].transform;
+        let rows = lanes.corners.as_ref()?.rows(|c| row(to_solid.transform_point3(c)))?;
+        Some(rows.into_iter().map(|(lo, hi)| (lo - 1.0, hi + 1.0)).collect())
     }
 
     /// [`CsgCaster::span_on`] at the eight pixels `x0..x0 + 8` of `unit` at
@@ -652,9 +677,53 @@ mod tests {
             let caster = CsgCaster::new(&CsgSolid { primitives: vec![primitive], tree: Some(CsgTree::Leaf(0)) });
             let line = RowLine { origin, origin_step, dir, dir_step };
             let mut row = RowFaces::default();
-            caster.row_faces(0, &line, &mut row);
+            caster.row_faces(0, &line, None, &mut row);
             prop_assert!(row.active);
             eight_as_one_by_one(&caster, &line, x0, &row)?;
+        }
+
+        /// The same with the faces picked by their projected rows
+        /// ([`CsgCaster::face_rows`]): a turned, stretched faceted ball seen
+        /// by a random camera, every block of a random scanline.
+        #[test]
+        fn a_row_clipped_by_the_faces_its_row_takes_in_is_clipped_by_all(
+            eye in vector(-4.0..4.0),
+            turn in vector(-3.0..3.0),
+            stretch in vector(0.5..1.5),
+            y in 0usize..120,
+            ortho in any::<bool>(),
+        ) {
+            use crate::scene::{Camera, Projection};
+            let eye = eye + Vec3::new(0.0, 0.0, 4.0);
+            let transform = Affine3A::from_scale_rotation_translation(
+                stretch.max(Vec3::splat(0.5)),
+                glam::Quat::from_euler(glam::EulerRot::XYZ, turn.x, turn.y, turn.z),
+                Vec3::ZERO,
+            );
+            let primitive =
+                Primitive { shape: Shape::Polyhedron(faceted_ball(8, 12)), transform, color: None, source: 0..0 };
+            let caster = CsgCaster::new(&CsgSolid { primitives: vec![primitive], tree: Some(CsgTree::Leaf(0)) });
+            let projection = if ortho {
+                Projection::Orthographic { height: 4.0 }
+            } else {
+                Projection::Perspective { fov_y_deg: 60.0 }
+            };
+            let camera =
+                Camera { eye, target: Vec3::ZERO, up: Vec3::Y, near: 0.05, far: 100.0, projection, shift: glam::Vec2::ZERO };
+            let (w, h) = (160u32, 120u32);
+            let vp = camera.view_projection(w as f32 / h as f32);
+            let rows = caster.face_rows(0, |p| {
+                let c = vp * p.extend(1.0);
+                (c.w > 1e-6).then(|| (0.5 - 0.5 * c.y / c.w) * h as f32)
+            });
+            let Some(rows) = rows else { return Ok(()) }; // the eye inside the ball's hull
+            let line = caster.unit_line(0, &camera.pixel_rays(glam::Vec2::new(w as f32, h as f32)).row_line(y));
+            let mut row = RowFaces::default();
+            caster.row_faces(0, &line, Some((&rows, y as f32 + 0.5)), &mut row);
+            prop_assert!(row.active);
+            for x0 in (0..w).step_by(8) {
+                eight_as_one_by_one(&caster, &line, x0, &row)?;
+            }
         }
     }
 

@@ -314,6 +314,9 @@ fn scan_bands<B: Send>(
         outlines.iter().enumerate().filter_map(|(i, o)| o.as_ref().map(|o| (i, o.rows))).collect();
     entry.sort_by_key(|(_, e)| e.y0);
     let caster = CsgCaster::without_bvh(solid);
+    // Many-planed polyhedra: each face's rows.
+    let face_rows: Vec<FaceRows> =
+        (0..solid.primitives.len()).map(|i| caster.face_rows(i, |p| screen_row(p, vp, height))).collect();
     // Along a row line's direction (unit component along the view axis), the
     // near plane lies at t = near, under either projection.
     let near = camera.near;
@@ -346,7 +349,7 @@ fn scan_bands<B: Send>(
                 // The row's rays, carried into each occupant's unit space once.
                 let line = rays.row_line(y as usize);
                 ends.iter().for_each(|&(i, _, _)| lines[i] = caster.unit_line(i, &line));
-                blocks.begin_row(&caster, ends.iter().map(|e| e.0), lines);
+                blocks.begin_row(&caster, ends.iter().map(|e| e.0), lines, (&face_rows, y as f32 + 0.5));
                 let spans = RowSpans { blocks, caster: &caster, lines };
                 match walker {
                     RowWalker::Segments(walk) => {
@@ -373,6 +376,10 @@ fn scan_bands<B: Send>(
         },
     );
 }
+
+/// A many-planed polyhedron's faces' rows ([`CsgCaster::face_rows`]; `None`
+/// for other primitives).
+type FaceRows = Option<Vec<(f32, f32)>>;
 
 /// One worker's buffers for walking scanlines: the row's hits (all `None`
 /// between rows), each occupant's row line, the occupancy counts, the
@@ -445,11 +452,20 @@ impl BlockSpans {
     /// A new scanline, its rays `lines` in each occupant's space: the
     /// occupants' lanes (of the row before) are stale, and their faces
     /// the row can cross are found.
-    fn begin_row(&mut self, caster: &CsgCaster, occupants: impl Iterator<Item = usize>, lines: &[RowLine]) {
+    /// `face_rows` holds [`CsgCaster::face_rows`] per primitive, `y` is the
+    /// scanline's coordinate.
+    fn begin_row(
+        &mut self,
+        caster: &CsgCaster,
+        occupants: impl Iterator<Item = usize>,
+        lines: &[RowLine],
+        (face_rows, y): (&[FaceRows], f32),
+    ) {
         let cached = self.cached.get_mut();
         for i in occupants {
             cached[i].0 = usize::MAX;
-            caster.row_faces(i, &lines[i], &mut self.faces[i]);
+            let rows = face_rows[i].as_deref().map(|r| (r, y));
+            caster.row_faces(i, &lines[i], rows, &mut self.faces[i]);
         }
     }
 
@@ -719,6 +735,14 @@ impl EllipsoidView {
         let (p, q) = (o.dot(d0), o.dot(d1));
         inside_quadratic(q * q - k * d1.dot(d1), p * q - k * d0.dot(d1), p * p - k * d0.dot(d0))
     }
+}
+
+/// The vertical pixel coordinate (row `y` has its centres at `y + ½`) of
+/// world point `p` seen through `vp` in an image `height` rows high, or
+/// `None` at or behind the eye.
+fn screen_row(p: Vec3, vp: Mat4, height: u32) -> Option<f32> {
+    let c: Vec4 = vp * p.extend(1.0);
+    (c.w > 1e-6).then(|| (0.5 - 0.5 * c.y / c.w) * height as f32)
 }
 
 /// Where `a·s² + 2·b·s + c ≥ 0`: the interval between the roots when `a < 0`;

@@ -224,6 +224,24 @@ impl FaceCorners {
         Some(FaceCorners { corners, on, start, margin: 1e-3 * size })
     }
 
+    /// Per face, the least and greatest `row` of its corners (`row`: a
+    /// corner's scanline coordinate); a face without corners spans every row.
+    /// `None` if some corner has no row (lies behind the eye).
+    pub(super) fn rows(&self, row: impl Fn(Vec3) -> Option<f32>) -> Option<Vec<(f32, f32)>> {
+        let at: Vec<f32> = self.corners.iter().map(|&c| row(c)).collect::<Option<_>>()?;
+        let face = |f: usize| {
+            let on = &self.on[self.start[f] as usize..self.start[f + 1] as usize];
+            if on.is_empty() {
+                return (f32::NEG_INFINITY, f32::INFINITY);
+            }
+            on.iter().fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), &k| {
+                let y = at[k as usize];
+                (lo.min(y), hi.max(y))
+            })
+        };
+        Some((0..self.start.len() - 1).map(face).collect())
+    }
+
     /// Into `faces` (cleared), in rising order, the faces that the plane of
     /// `line`'s rays meets or passes within the margin of; every face when
     /// the rays span no plane.
