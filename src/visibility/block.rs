@@ -19,7 +19,7 @@
 //! - the ends lying before `E` at the first pixel, the near plane and `E`
 //!   itself keep the first pixel's order, each beyond the one before by more
 //!   than any [`TIE`] move — or equal to it at all eight pixels, so that
-//!   every comparison of the two, moved or not, comes out alike ([`settled`]),
+//!   every comparison of the two, moved or not, comes out alike,
 //! - and every other end stays beyond `E` in the same way,
 //!
 //! every comparison that shapes the set up to just past `E` comes out as at
