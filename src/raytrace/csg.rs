@@ -168,6 +168,20 @@ pub struct RowFaces {
     active: bool,
     faces: Vec<u32>,
     distances: Vec<f32>,
+    /// Per face of `faces`, the columns it shows in, when known
+    /// ([`FaceExtent`]; empty otherwise).
+    columns: Vec<(f32, f32)>,
+}
+
+/// Where a face of a many-planed polyhedron shows on the screen
+/// ([`CsgCaster::face_extents`]): pixel coordinates, a pixel's centre at
+/// `x + ½, y + ½`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FaceExtent {
+    /// Least and greatest x.
+    pub columns: (f32, f32),
+    /// Least and greatest y.
+    pub rows: (f32, f32),
 }
 
 /// The spans of `ray` inside `solid`, sorted and disjoint (empty if it misses).
@@ -325,18 +339,22 @@ impl CsgCaster {
     /// scanline's rays lie in one plane, which meets few of a rounded
     /// box's hundreds of faces.
     ///
-    /// `rows`, when given, is [`CsgCaster::face_rows`]'s answer and the
-    /// scanline's coordinate: the faces whose rows take it in are kept,
-    /// without measuring each face's corners against the line's plane.
-    pub fn row_faces(&self, i: usize, unit: &RowLine, rows: Option<(&[(f32, f32)], f32)>, row: &mut RowFaces) {
+    /// `extents`, when given, is [`CsgCaster::face_extents`]'s answer and
+    /// the scanline's coordinate: the faces whose rows take it in are kept
+    /// (without measuring each face's corners against the line's plane), with
+    /// their columns, so that a block clips by the faces over it alone.
+    pub fn row_faces(&self, i: usize, unit: &RowLine, extents: Option<(&[FaceExtent], f32)>, row: &mut RowFaces) {
         row.active = false;
+        row.columns.clear();
         if let Clipping::Lanes(lanes) = &self.clipping[i] {
             if let Some(corners) = &lanes.corners {
-                match rows {
-                    Some((ranges, y)) => {
+                match extents {
+                    Some((faces, y)) => {
                         row.faces.clear();
-                        let met = ranges.iter().map(|&(lo, hi)| lo <= y && y <= hi);
-                        row.faces.extend((0..).zip(met).filter_map(|(f, met)| met.then_some(f)));
+                        for (f, e) in (0..).zip(faces).filter(|(_, e)| e.rows.0 <= y && y <= e.rows.1) {
+                            row.faces.push(f);
+                            row.columns.push(e.columns);
+                        }
                     }
                     None => corners.met_by(unit, &mut row.distances, &mut row.faces),
                 }
@@ -345,32 +363,44 @@ impl CsgCaster {
         }
     }
 
-    /// For a polyhedron of many planes, each face's least and greatest
-    /// scanline coordinate over its corners, `row` giving a point's (solid
-    /// space; a pixel row's centres at `y + ½`), widened by a pixel each way
-    /// so that rounding loses no face: a scanline whose plane meets the face
-    /// lies between (a face is convex, and a scanline's rays fill the plane
-    /// through the eye that projects onto it). `None` for other primitives,
-    /// or when a corner has no row (at or behind the eye).
-    pub fn face_rows(&self, i: usize, row: impl Fn(Vec3) -> Option<f32>) -> Option<Vec<(f32, f32)>> {
+    /// For a polyhedron of many planes, where each face shows: the columns
+    /// and rows its corners' projections span (`project` gives a solid-space
+    /// point's pixel coordinates, a pixel's centre at `x + ½, y + ½`), a
+    /// pixel wider each way so that rounding loses no face. A scanline whose
+    /// plane meets the face lies within its rows (a face is convex, and a
+    /// scanline's rays fill the plane through the eye that projects onto
+    /// it), and a pixel whose ray crosses the face within its columns.
+    /// `None` for other primitives, or when a corner has no projection (at
+    /// or behind the eye).
+    pub fn face_extents(&self, i: usize, project: impl Fn(Vec3) -> Option<glam::Vec2>) -> Option<Vec<FaceExtent>> {
         let Clipping::Lanes(lanes) = &self.clipping[i] else { return None };
         let to_solid = self.solid.primitives[i].transform;
-        let rows = lanes.corners.as_ref()?.rows(|c| row(to_solid.transform_point3(c)))?;
-        Some(rows.into_iter().map(|(lo, hi)| (lo - 1.0, hi + 1.0)).collect())
+        let boxes = lanes.corners.as_ref()?.projected(|c| project(to_solid.transform_point3(c)))?;
+        let extent = |b: [f32; 4]| FaceExtent { columns: (b[0] - 1.0, b[1] + 1.0), rows: (b[2] - 1.0, b[3] + 1.0) };
+        Some(boxes.into_iter().map(extent).collect())
     }
 
     /// [`CsgCaster::span_on`] at the eight pixels `x0..x0 + 8` of `unit` at
     /// once, in SIMD lanes: each the same to the bit as `span_on` gives it
     /// (a polyhedron of many planes clipped by the faces `row` keeps, from
-    /// [`CsgCaster::row_faces`] on the same line), written into `out` (the
-    /// walk's cache, so the lanes are not returned and then copied).
+    /// [`CsgCaster::row_faces`] on the same line, and of those, when their
+    /// columns are known, by the ones over the block's pixels: property
+    /// tests hold both to every face), written into `out` (the walk's
+    /// cache, so the lanes are not returned and then copied).
     pub fn spans_on_eight(&self, i: usize, unit: &RowLine, x0: f32, row: &RowFaces, out: &mut IntervalLanes) {
         let rays = lanes::RayLanes::new(unit, x0);
         let shape = &self.solid.primitives[i].shape;
         let spans = match (&self.clipping[i], shape) {
             (Clipping::Box, _) => lanes::unit_cube(&rays),
             (Clipping::Lanes(_), Shape::Polyhedron(poly)) if row.active => {
-                lanes::planes(row.faces.iter().map(|&f| (f, &poly.planes[f as usize])), &rays)
+                let faces = row.faces.iter().map(|&f| (f, &poly.planes[f as usize]));
+                if row.columns.is_empty() {
+                    lanes::planes(faces, &rays)
+                } else {
+                    // The faces over the block's pixel centres.
+                    let over = row.columns.iter().map(|c| c.0 <= x0 + 7.5 && c.1 >= x0 + 0.5);
+                    lanes::planes(faces.zip(over).filter_map(|(f, over)| over.then_some(f)), &rays)
+                }
             }
             _ => lanes::shape(shape, &rays),
         };
@@ -682,11 +712,12 @@ mod tests {
             eight_as_one_by_one(&caster, &line, x0, &row)?;
         }
 
-        /// The same with the faces picked by their projected rows
-        /// ([`CsgCaster::face_rows`]): a turned, stretched faceted ball seen
+        /// The same with the faces picked by where they show
+        /// ([`CsgCaster::face_extents`]: a row's faces by their rows, a
+        /// block's by their columns): a turned, stretched faceted ball seen
         /// by a random camera, every block of a random scanline.
         #[test]
-        fn a_row_clipped_by_the_faces_its_row_takes_in_is_clipped_by_all(
+        fn a_block_clipped_by_the_faces_over_it_is_clipped_by_all(
             eye in vector(-4.0..4.0),
             turn in vector(-3.0..3.0),
             stretch in vector(0.5..1.5),
@@ -712,14 +743,14 @@ mod tests {
                 Camera { eye, target: Vec3::ZERO, up: Vec3::Y, near: 0.05, far: 100.0, projection, shift: glam::Vec2::ZERO };
             let (w, h) = (160u32, 120u32);
             let vp = camera.view_projection(w as f32 / h as f32);
-            let rows = caster.face_rows(0, |p| {
+            let extents = caster.face_extents(0, |p| {
                 let c = vp * p.extend(1.0);
-                (c.w > 1e-6).then(|| (0.5 - 0.5 * c.y / c.w) * h as f32)
+                (c.w > 1e-6).then(|| glam::Vec2::new((0.5 + 0.5 * c.x / c.w) * w as f32, (0.5 - 0.5 * c.y / c.w) * h as f32))
             });
-            let Some(rows) = rows else { return Ok(()) }; // the eye inside the ball's hull
+            let Some(extents) = extents else { return Ok(()) }; // the eye inside the ball's hull
             let line = caster.unit_line(0, &camera.pixel_rays(glam::Vec2::new(w as f32, h as f32)).row_line(y));
             let mut row = RowFaces::default();
-            caster.row_faces(0, &line, Some((&rows, y as f32 + 0.5)), &mut row);
+            caster.row_faces(0, &line, Some((&extents, y as f32 + 0.5)), &mut row);
             prop_assert!(row.active);
             for x0 in (0..w).step_by(8) {
                 eight_as_one_by_one(&caster, &line, x0, &row)?;

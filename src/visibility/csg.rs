@@ -54,7 +54,9 @@ use glam::{DVec2, Mat4, Vec2, Vec3, Vec4};
 use rayon::iter::IndexedParallelIterator;
 use rayon::prelude::*;
 
-use crate::raytrace::csg::{Crossing, CsgCaster, Hit, Interval, IntervalLanes, LeafSpans, RowFaces, SpanScratch};
+use crate::raytrace::csg::{
+    Crossing, CsgCaster, FaceExtent, Hit, Interval, IntervalLanes, LeafSpans, RowFaces, SpanScratch,
+};
 use crate::scene::camera::PixelRays;
 use crate::scene::camera::RowLine;
 use crate::scene::csg::{CsgSolid, Primitive, Shape};
@@ -314,9 +316,9 @@ fn scan_bands<B: Send>(
         outlines.iter().enumerate().filter_map(|(i, o)| o.as_ref().map(|o| (i, o.rows))).collect();
     entry.sort_by_key(|(_, e)| e.y0);
     let caster = CsgCaster::without_bvh(solid);
-    // Many-planed polyhedra: each face's rows.
-    let face_rows: Vec<FaceRows> =
-        (0..solid.primitives.len()).map(|i| caster.face_rows(i, |p| screen_row(p, vp, height))).collect();
+    // Many-planed polyhedra: where each face shows.
+    let face_extents: Vec<FaceExtents> =
+        (0..solid.primitives.len()).map(|i| caster.face_extents(i, |p| screen_point(p, vp, (width, height)))).collect();
     // Along a row line's direction (unit component along the view axis), the
     // near plane lies at t = near, under either projection.
     let near = camera.near;
@@ -349,7 +351,7 @@ fn scan_bands<B: Send>(
                 // The row's rays, carried into each occupant's unit space once.
                 let line = rays.row_line(y as usize);
                 ends.iter().for_each(|&(i, _, _)| lines[i] = caster.unit_line(i, &line));
-                blocks.begin_row(&caster, ends.iter().map(|e| e.0), lines, (&face_rows, y as f32 + 0.5));
+                blocks.begin_row(&caster, ends.iter().map(|e| e.0), lines, (&face_extents, y as f32 + 0.5));
                 let spans = RowSpans { blocks, caster: &caster, lines };
                 match walker {
                     RowWalker::Segments(walk) => {
@@ -377,9 +379,9 @@ fn scan_bands<B: Send>(
     );
 }
 
-/// A many-planed polyhedron's faces' rows ([`CsgCaster::face_rows`]; `None`
-/// for other primitives).
-type FaceRows = Option<Vec<(f32, f32)>>;
+/// A many-planed polyhedron's faces' extents ([`CsgCaster::face_extents`];
+/// `None` for other primitives).
+type FaceExtents = Option<Vec<FaceExtent>>;
 
 /// One worker's buffers for walking scanlines: the row's hits (all `None`
 /// between rows), each occupant's row line, the occupancy counts, the
@@ -452,20 +454,20 @@ impl BlockSpans {
     /// A new scanline, its rays `lines` in each occupant's space: the
     /// occupants' lanes (of the row before) are stale, and their faces
     /// the row can cross are found.
-    /// `face_rows` holds [`CsgCaster::face_rows`] per primitive, `y` is the
-    /// scanline's coordinate.
+    /// `face_extents` holds [`CsgCaster::face_extents`] per primitive, `y`
+    /// is the scanline's coordinate.
     fn begin_row(
         &mut self,
         caster: &CsgCaster,
         occupants: impl Iterator<Item = usize>,
         lines: &[RowLine],
-        (face_rows, y): (&[FaceRows], f32),
+        (face_extents, y): (&[FaceExtents], f32),
     ) {
         let cached = self.cached.get_mut();
         for i in occupants {
             cached[i].0 = usize::MAX;
-            let rows = face_rows[i].as_deref().map(|r| (r, y));
-            caster.row_faces(i, &lines[i], rows, &mut self.faces[i]);
+            let extents = face_extents[i].as_deref().map(|e| (e, y));
+            caster.row_faces(i, &lines[i], extents, &mut self.faces[i]);
         }
     }
 
@@ -737,12 +739,12 @@ impl EllipsoidView {
     }
 }
 
-/// The vertical pixel coordinate (row `y` has its centres at `y + ½`) of
-/// world point `p` seen through `vp` in an image `height` rows high, or
+/// The pixel coordinates (pixel `(x, y)` has its centre at `x + ½, y + ½`)
+/// of world point `p` seen through `vp` in a `width` x `height` image, or
 /// `None` at or behind the eye.
-fn screen_row(p: Vec3, vp: Mat4, height: u32) -> Option<f32> {
+fn screen_point(p: Vec3, vp: Mat4, (width, height): (u32, u32)) -> Option<Vec2> {
     let c: Vec4 = vp * p.extend(1.0);
-    (c.w > 1e-6).then(|| (0.5 - 0.5 * c.y / c.w) * height as f32)
+    (c.w > 1e-6).then(|| Vec2::new((0.5 + 0.5 * c.x / c.w) * width as f32, (0.5 - 0.5 * c.y / c.w) * height as f32))
 }
 
 /// Where `a·s² + 2·b·s + c ≥ 0`: the interval between the roots when `a < 0`;

@@ -224,19 +224,20 @@ impl FaceCorners {
         Some(FaceCorners { corners, on, start, margin: 1e-3 * size })
     }
 
-    /// Per face, the least and greatest `row` of its corners (`row`: a
-    /// corner's scanline coordinate); a face without corners spans every row.
-    /// `None` if some corner has no row (lies behind the eye).
-    pub(super) fn rows(&self, row: impl Fn(Vec3) -> Option<f32>) -> Option<Vec<(f32, f32)>> {
-        let at: Vec<f32> = self.corners.iter().map(|&c| row(c)).collect::<Option<_>>()?;
+    /// Per face, the least and greatest `project`ion of its corners (a
+    /// corner's pixel coordinates): least x, greatest x, least y, greatest
+    /// y; a face without corners spans the whole plane. `None` if some
+    /// corner has no projection (lies behind the eye).
+    pub(super) fn projected(&self, project: impl Fn(Vec3) -> Option<glam::Vec2>) -> Option<Vec<[f32; 4]>> {
+        let at: Vec<glam::Vec2> = self.corners.iter().map(|&c| project(c)).collect::<Option<_>>()?;
         let face = |f: usize| {
             let on = &self.on[self.start[f] as usize..self.start[f + 1] as usize];
             if on.is_empty() {
-                return (f32::NEG_INFINITY, f32::INFINITY);
+                return [f32::NEG_INFINITY, f32::INFINITY, f32::NEG_INFINITY, f32::INFINITY];
             }
-            on.iter().fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), &k| {
-                let y = at[k as usize];
-                (lo.min(y), hi.max(y))
+            on.iter().fold([f32::INFINITY, f32::NEG_INFINITY, f32::INFINITY, f32::NEG_INFINITY], |b, &k| {
+                let p = at[k as usize];
+                [b[0].min(p.x), b[1].max(p.x), b[2].min(p.y), b[3].max(p.y)]
             })
         };
         Some((0..self.start.len() - 1).map(face).collect())
