@@ -7,7 +7,7 @@
 //! "inside the solid" (each primitive's own point test, combined by the tree).
 
 use glam::{Affine3A, Mat3, Vec3, Vec4};
-use kage::raytrace::csg::{first_hit, primitive_span, spans};
+use kage::raytrace::csg::{first_hit, primitive_span, spans, Crossing};
 use kage::scene::csg::{ConvexPolyhedron, CsgSolid, CsgTree, Primitive, Shape};
 use kage::scene::Ray;
 use rand::rngs::StdRng;
@@ -323,8 +323,7 @@ fn reusing_the_answer_along_a_scanline_changes_no_surface() {
 #[test]
 fn reuse_follows_a_cut_decided_within_the_tie() {
     use kage::raytrace::csg::TIE;
-    use kage::scene::{Camera, Projection};
-    use kage::visibility::csg::{scan_solid_with, CsgMethod};
+    use kage::visibility::csg::CsgMethod;
     let cube = || Shape::Polyhedron(ConvexPolyhedron::unit_cube());
     let solid_box = Affine3A::from_scale(Vec3::splat(2.0)) * Affine3A::from_translation(Vec3::splat(-0.5));
     // The cutter's front face: z = 1 + s·x, from two TIEs (of t ≈ 4) in
@@ -341,6 +340,19 @@ fn reuse_follows_a_cut_decided_within_the_tie() {
     ];
     let tree = CsgTree::Difference(Box::new(CsgTree::Leaf(0)), vec![CsgTree::Leaf(1)]);
     let solid = CsgSolid { primitives, tree: Some(tree) };
+    // Along the middle row: the solid's face where the cutter's lies behind
+    // it by more than the tie, the hole's floor elsewhere.
+    let (each, [face, floor]) = down_z(&solid, CsgMethod::SegmentsEachPixel);
+    assert!(face > 10 && floor > 10, "face {face}, floor {floor} pixels of the middle row");
+    assert_eq!(each, down_z(&solid, CsgMethod::SegmentsCoherent).0);
+    assert_eq!(each, down_z(&solid, CsgMethod::Segments).0);
+}
+
+/// `solid` seen straight down the z axis (orthographic, 3 units high) at
+/// 200x100 by `method`, and how many pixels of the middle row show
+/// primitive 0 and primitive 1.
+fn down_z(solid: &CsgSolid, method: kage::visibility::csg::CsgMethod) -> (Vec<Option<Crossing>>, [usize; 2]) {
+    use kage::scene::{Camera, Projection};
     let camera = Camera {
         eye: Vec3::new(0.0, 0.0, 5.0),
         target: Vec3::ZERO,
@@ -351,17 +363,11 @@ fn reuse_follows_a_cut_decided_within_the_tie() {
         shift: glam::Vec2::ZERO,
     };
     let (w, h) = (200u32, 100u32);
-    let each = scan_solid_with(&solid, &camera, w, h, CsgMethod::SegmentsEachPixel).unwrap();
-    let reused = scan_solid_with(&solid, &camera, w, h, CsgMethod::SegmentsCoherent).unwrap();
-    let spread = scan_solid_with(&solid, &camera, w, h, CsgMethod::Segments).unwrap();
-    // Along the middle row: the solid's face where the cutter's lies behind
-    // it by more than the tie, the hole's floor elsewhere.
-    let row = &each[(h / 2 * w) as usize..((h / 2 + 1) * w) as usize];
-    let face = row.iter().filter(|c| c.is_some_and(|c| c.primitive == 0)).count();
-    let floor = row.iter().filter(|c| c.is_some_and(|c| c.primitive == 1)).count();
-    assert!(face > 10 && floor > 10, "face {face}, floor {floor} pixels of the middle row");
-    assert_eq!(each, reused);
-    assert_eq!(each, spread);
+    let scan = kage::visibility::csg::scan_solid_with(solid, &camera, w, h, method).unwrap();
+    let row = &scan[(h / 2 * w) as usize..((h / 2 + 1) * w) as usize];
+    let shows = |p: u32| row.iter().flatten().filter(|c| c.primitive == p).count();
+    let counts = [shows(0), shows(1)];
+    (scan, counts)
 }
 
 /// Two boxes' faces crossing at a hair's angle, so that along the middle row
@@ -369,8 +375,7 @@ fn reuse_follows_a_cut_decided_within_the_tie() {
 /// spreading a block's answer must not take "nearly equal" for "equal".
 #[test]
 fn spreading_a_block_keeps_faces_that_cross_within_rounding_apart() {
-    use kage::scene::{Camera, Projection};
-    use kage::visibility::csg::{scan_solid_with, CsgMethod};
+    use kage::visibility::csg::CsgMethod;
     let cube = || Shape::Polyhedron(ConvexPolyhedron::unit_cube());
     let flat = Affine3A::from_translation(Vec3::new(-1.5, -0.5, 0.0));
     // The second box's top: z = 1 + s·x, s a few units of the last place of
@@ -387,21 +392,7 @@ fn spreading_a_block_keeps_faces_that_cross_within_rounding_apart() {
         .to_vec();
     let tree = CsgTree::Union(vec![CsgTree::Leaf(0), CsgTree::Leaf(1)]);
     let solid = CsgSolid { primitives, tree: Some(tree) };
-    let camera = Camera {
-        eye: Vec3::new(0.0, 0.0, 5.0),
-        target: Vec3::ZERO,
-        up: Vec3::Y,
-        near: 0.05,
-        far: 100.0,
-        projection: Projection::Orthographic { height: 3.0 },
-        shift: glam::Vec2::ZERO,
-    };
-    let (w, h) = (200u32, 100u32);
-    let each = scan_solid_with(&solid, &camera, w, h, CsgMethod::SegmentsEachPixel).unwrap();
-    let spread = scan_solid_with(&solid, &camera, w, h, CsgMethod::Segments).unwrap();
-    let row = &each[(h / 2 * w) as usize..((h / 2 + 1) * w) as usize];
-    let firsts = row.iter().flatten().filter(|c| c.primitive == 0).count();
-    let seconds = row.iter().flatten().filter(|c| c.primitive == 1).count();
+    let (each, [firsts, seconds]) = down_z(&solid, CsgMethod::SegmentsEachPixel);
     assert!(firsts > 10 && seconds > 10, "{firsts} and {seconds} pixels of the middle row show each box");
-    assert_eq!(each, spread);
+    assert_eq!(each, down_z(&solid, CsgMethod::Segments).0);
 }
