@@ -453,9 +453,9 @@ impl BlockSpans {
 
     /// A new scanline, its rays `lines` in each occupant's space: the
     /// occupants' lanes (of the row before) are stale, and their faces
-    /// the row can cross are found.
-    /// `face_extents` holds [`CsgCaster::face_extents`] per primitive, `y`
-    /// is the scanline's coordinate.
+    /// the row can cross are found (`face_extents` holds
+    /// [`CsgCaster::face_extents`] per primitive, `y` is the scanline's
+    /// coordinate).
     fn begin_row(
         &mut self,
         caster: &CsgCaster,
