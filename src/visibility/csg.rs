@@ -144,13 +144,13 @@ pub fn scan_solid_into(
     let bands = out.par_chunks_mut(w * BAND_ROWS);
     scan_bands(solid, &walker, camera, (width, height), bands, |band, dy, row| {
         let out = &mut band[dy * w..(dy + 1) * w];
-        let columns = row.columns.clone();
-        out[..columns.start].fill(None);
-        out[columns.end..].fill(None);
-        for (x, (px, h)) in columns.clone().zip(out[columns].iter_mut().zip(&row.hits[row.columns.clone()])) {
+        out[..row.columns.start].fill(None);
+        out[row.columns.end..].fill(None);
+        for x in row.columns.clone() {
             // Distances along the unnormalised row line become distances
             // along the unit pixel ray.
-            *px = h.map(|h| Crossing { t: h.t * row.line.at(x as f32).dir.length(), ..row.crossing(x, h) });
+            out[x] =
+                row.hits[x].map(|h| Crossing { t: h.t * row.line.at(x as f32).dir.length(), ..row.crossing(x, h) });
         }
     });
     Ok(())
