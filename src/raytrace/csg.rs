@@ -616,9 +616,15 @@ impl CsgCaster {
     #[must_use]
     pub fn first_hit_every_primitive(&self, ray: &Ray, t_min: f32) -> Option<Crossing> {
         let tree = self.solid.tree.as_ref()?;
-        let all: Vec<Option<Interval>> = (0..self.frames.len()).map(|i| self.interval(i, ray)).collect();
-        self.first_hit_in_by(tree, &|i| all[i], t_min, &mut SpanScratch::default())
-            .map(|h| self.crossing_on_ray(h, ray))
+        SCRATCH.with_borrow_mut(|s| {
+            // The thread's buffers, so the baseline pays for no allocation.
+            let mut all = std::mem::take(&mut s.intervals);
+            all.clear();
+            all.extend((0..self.frames.len()).map(|i| self.interval(i, ray)));
+            let hit = self.first_hit_in_by(tree, &|i| all[i], t_min, s);
+            s.intervals = all;
+            hit.map(|h| self.crossing_on_ray(h, ray))
+        })
     }
 }
 

@@ -10,9 +10,9 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use glam::Vec2;
-use kage::raytrace::csg::CsgCaster;
+use kage::raytrace::csg::{Crossing, CsgCaster};
 use kage::scene::load::openscad::{load_csg, CsgOptions, Geometry};
-use kage::scene::{Camera, CsgSolid};
+use kage::scene::{Camera, CsgSolid, Ray};
 use kage::visibility::csg::{scan_solid_into, CsgMethod};
 use kage::visibility::pattern::PatternMatrix;
 use miette::{miette, Result};
@@ -45,11 +45,9 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         let (mut coherent, _) = scan_times(&solid, &camera, (w, h), CsgMethod::SegmentsCoherent, args.frames.max(1));
         let pattern = pattern_cell(&solid, &camera, w, h, args.frames.max(1));
         let caster = CsgCaster::new(&solid);
-        let near = |ray: &kage::scene::Ray| camera.distance_at_depth(ray, 1.0);
-        let (naive_ms, naive_covered) =
-            timed(|| cast(&camera, w, h, |ray| caster.first_hit_every_primitive(ray, near(ray)).is_some()));
-        let (bvh_ms, bvh_covered) =
-            timed(|| cast(&camera, w, h, |ray| caster.first_hit(ray, near(ray), f32::INFINITY).is_some()));
+        let near = |ray: &Ray| camera.distance_at_depth(ray, 1.0);
+        let (naive_ms, naive_covered) = cast(&camera, w, h, |ray| caster.first_hit_every_primitive(ray, near(ray)));
+        let (bvh_ms, bvh_covered) = cast(&camera, w, h, |ray| caster.first_hit(ray, near(ray), f32::INFINITY));
         if naive_covered != covered || bvh_covered != covered {
             eprintln!("{name}: scanline, naive and BVH rays cover {covered}, {naive_covered}, {bvh_covered} pixels");
         }
@@ -66,7 +64,8 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     println!(
         "\n{w}x{h}, exact quadrics, each model with its corpus camera; scanline: median of {} frames (the default \
          walk: an eight-pixel block's answer found at its first pixel and spread where it provably holds, seed 003 \
-         §5.2.2 by blocks); rays: one frame each. Naive rays: the paper's baseline, every primitive's interval at every pixel, then combined along the \
+         §5.2.2 by blocks); rays: one frame each. Every method writes the same frame: each pixel's visible surface \
+         with its normal, into a buffer allocated beforehand. Naive rays: the paper's baseline, every primitive's interval at every pixel, then combined along the \
          tree. BVH rays: only the primitives whose boxes the ray crosses (a BVH from {} primitives up), combined \
          along the tree with early exits. Reuse: the walk keeping a pixel's answer at the next while its occupants \
          and the depth order of all their ends stay (§5.2.2 pixel by pixel, as the paper has it; the same surfaces \
@@ -143,13 +142,21 @@ fn timed<T>(f: impl FnOnce() -> T) -> (f64, T) {
     (t.elapsed().as_secs_f64() * 1e3, out)
 }
 
-/// Pixels whose centre ray `covers`, every pixel cast in parallel rows.
-fn cast(camera: &Camera, w: u32, h: u32, covers: impl Fn(&kage::scene::Ray) -> bool + Sync) -> usize {
+/// Milliseconds to cast every pixel's centre ray (rows in parallel), writing
+/// each pixel's visible surface `first` (with its normal) into a frame — the
+/// scanline walk's output, into a buffer allocated before the clock starts,
+/// as the scanline's is — and the pixels covered.
+fn cast(camera: &Camera, w: u32, h: u32, first: impl Fn(&Ray) -> Option<Crossing> + Sync) -> (f64, usize) {
     let rays = camera.pixel_rays(Vec2::new(w as f32, h as f32));
-    (0..h)
-        .into_par_iter()
-        .map(|y| (0..w).filter(|&x| covers(&rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5)))).count())
-        .sum()
+    let mut frame: Vec<Option<Crossing>> = vec![None; w as usize * h as usize];
+    let (ms, ()) = timed(|| {
+        frame.par_chunks_mut(w as usize).enumerate().for_each(|(y, row)| {
+            for (x, px) in row.iter_mut().enumerate() {
+                *px = first(&rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5)));
+            }
+        });
+    });
+    (ms, frame.iter().filter(|p| p.is_some()).count())
 }
 
 /// The camera of the corpus sidecar `NAME.camera.txt`.
@@ -223,8 +230,7 @@ pub fn run_random(args: &BenchArgs) -> Result<()> {
                 let scan_ms = best(CsgMethod::Segments);
                 let pattern_ms = best(CsgMethod::PatternMatrix { limit: PATTERN_LIMIT });
                 let caster = CsgCaster::new(&solid);
-                let (naive_ms, _) =
-                    timed(|| cast(&camera, w, h, |ray| caster.first_hit_every_primitive(ray, 0.0).is_some()));
+                let (naive_ms, _) = cast(&camera, w, h, |ray| caster.first_hit_every_primitive(ray, 0.0));
                 println!(
                     "| {} | {segments} | {w}x{h} | {scan_ms:.1} | {naive_ms:.0} | {:.0} | {pattern_ms:.1} |",
                     segments * per,
@@ -235,7 +241,7 @@ pub fn run_random(args: &BenchArgs) -> Result<()> {
     }
     println!(
         "\nScanline: best of {} frames; naive rays: one frame, every sphere's interval at every pixel, then the \
-         booleans. {} threads. The paper (160x100, i80286): 50 spheres 73x, 300 spheres 108x; 120 spheres in 30 \
+         booleans; both write each pixel's surface and normal into a frame. {} threads. The paper (160x100, i80286): 50 spheres 73x, 300 spheres 108x; 120 spheres in 30 \
          segments 225x.",
         args.frames.max(1),
         rayon::current_num_threads()

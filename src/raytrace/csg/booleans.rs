@@ -61,6 +61,8 @@ pub struct SpanScratch {
     pub(super) crossed: Vec<bool>,
     /// The same as counts in the tree (empty between rays).
     pub(super) counts: Occupied,
+    /// Every primitive's interval (the baseline ray caster's).
+    pub(super) intervals: Vec<Option<Interval>>,
 }
 
 /// What a node of a tree of booleans does.
