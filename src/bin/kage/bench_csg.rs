@@ -64,9 +64,9 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     println!(
         "\n{w}x{h}, exact quadrics, each model with its corpus camera; scanline: median of {} frames (the default \
          walk: an eight-pixel block's answer found at its first pixel and spread where it provably holds, seed 003 \
-         §5.2.2 by blocks); rays: one frame each. Every method writes the same frame: each pixel's visible surface \
-         with its normal, into a buffer allocated beforehand. Naive rays: the paper's baseline, every primitive's interval at every pixel, then combined along the \
-         tree. BVH rays: only the primitives whose boxes the ray crosses (a BVH from {} primitives up), combined \
+         §5.2.2 by blocks); rays: one frame each. Every method writes the same frame: each pixel's visible \
+         surface with its normal, into a buffer allocated beforehand. Naive rays: the paper's baseline, every \
+         primitive's interval at every pixel, then combined along the tree. BVH rays: only the primitives whose boxes the ray crosses (a BVH from {} primitives up), combined \
          along the tree with early exits. Reuse: the walk keeping a pixel's answer at the next while its occupants \
          and the depth order of all their ends stay (§5.2.2 pixel by pixel, as the paper has it; the same surfaces \
          to the bit). {} threads. \
@@ -142,10 +142,10 @@ fn timed<T>(f: impl FnOnce() -> T) -> (f64, T) {
     (t.elapsed().as_secs_f64() * 1e3, out)
 }
 
-/// Milliseconds to cast every pixel's centre ray (rows in parallel), writing
-/// each pixel's visible surface `first` (with its normal) into a frame — the
-/// scanline walk's output, into a buffer allocated before the clock starts,
-/// as the scanline's is — and the pixels covered.
+/// Milliseconds to cast every pixel's centre ray (rows in parallel), each
+/// pixel's visible surface `first` (with its normal) written into a frame
+/// allocated before the clock starts, as the scanline walk writes its own;
+/// and the pixels covered.
 fn cast(camera: &Camera, w: u32, h: u32, first: impl Fn(&Ray) -> Option<Crossing> + Sync) -> (f64, usize) {
     let rays = camera.pixel_rays(Vec2::new(w as f32, h as f32));
     let mut frame: Vec<Option<Crossing>> = vec![None; w as usize * h as usize];
@@ -241,8 +241,8 @@ pub fn run_random(args: &BenchArgs) -> Result<()> {
     }
     println!(
         "\nScanline: best of {} frames; naive rays: one frame, every sphere's interval at every pixel, then the \
-         booleans; both write each pixel's surface and normal into a frame. {} threads. The paper (160x100, i80286): 50 spheres 73x, 300 spheres 108x; 120 spheres in 30 \
-         segments 225x.",
+         booleans; both write each pixel's surface and normal into a frame. {} threads. The paper (160x100, \
+         i80286): 50 spheres 73x, 300 spheres 108x; 120 spheres in 30 segments 225x.",
         args.frames.max(1),
         rayon::current_num_threads()
     );
