@@ -304,79 +304,130 @@ fn scan_bands<B: Send>(
     bands: impl IndexedParallelIterator<Item = B>,
     visit: impl Fn(&mut B, usize, &ScannedRow) + Sync,
 ) {
-    let (w, h) = (width as usize, height as usize);
     if matches!(walker, RowWalker::Empty) {
         return;
     }
-    let vp = camera.view_projection(width as f32 / height as f32);
-    let rays = camera.pixel_rays(Vec2::new(width as f32, height as f32));
-    let outlines: Vec<Option<Outline>> = solid.primitives.iter().map(|p| Outline::new(p, vp, &rays)).collect();
-    // The y-entry table: the primitives that show at all, by top scanline.
-    let mut entry: Vec<(usize, Extent)> =
-        outlines.iter().enumerate().filter_map(|(i, o)| o.as_ref().map(|o| (i, o.rows))).collect();
-    entry.sort_by_key(|(_, e)| e.y0);
-    let caster = CsgCaster::without_bvh(solid);
-    // Many-planed polyhedra: where each face shows.
-    let face_extents: Vec<FaceExtents> =
-        (0..solid.primitives.len()).map(|i| caster.face_extents(i, |p| screen_point(p, vp, (width, height)))).collect();
-    // Along a row line's direction (unit component along the view axis), the
-    // near plane lies at t = near, under either projection.
-    let near = camera.near;
+    let frame = FrameWalk::new(solid, walker, camera, (width, height));
+    let h = height as usize;
     bands.enumerate().for_each_init(
-        || Lent::fitted(w, solid.primitives.len(), walker),
+        || Lent::fitted(width as usize, solid.primitives.len(), walker),
         |lent, (band, mut out)| {
-            let RowBuffers { row, lines, counts, scratch, blocks, coherence, order } = &mut lent.0;
-            let first = (band * BAND_ROWS) as i64;
-            // The y-occupancy list as the band's first scanline finds it, then kept
-            // row by row.
-            let mut next = entry.partition_point(|(_, e)| e.y0 <= first);
-            let mut occupied: Vec<(usize, Extent)> =
-                entry[..next].iter().copied().filter(|(_, e)| e.y1 >= first).collect();
-            for dy in 0..BAND_ROWS.min(h - band * BAND_ROWS) {
-                let y = first + dy as i64;
-                while next < entry.len() && entry[next].1.y0 <= y {
-                    occupied.push(entry[next]);
-                    next += 1;
-                }
-                occupied.retain(|(_, e)| e.y1 >= y);
-                // Procedure 2: each occupant's left and right ends on this scanline.
-                let ends: Vec<(usize, i64, i64)> = occupied
-                    .iter()
-                    .filter_map(|&(i, _)| outlines[i].as_ref()?.columns(y).map(|(a, b)| (i, a, b)))
-                    .collect();
-                // The columns the occupants may cover: the walk writes no other.
-                debug_assert!(row.iter().all(Option::is_none), "row {y}: hits left from the row before");
-                let lo = ends.iter().map(|e| e.1).min().unwrap_or(0).clamp(0, w as i64) as usize;
-                let hi = ends.iter().map(|e| e.2 + 1).max().unwrap_or(0).clamp(lo as i64, w as i64) as usize;
-                // The row's rays, carried into each occupant's unit space once.
-                let line = rays.row_line(y as usize);
-                ends.iter().for_each(|&(i, _, _)| lines[i] = caster.unit_line(i, &line));
-                blocks.begin_row(&caster, ends.iter().map(|e| e.0), lines, (&face_extents, y as f32 + 0.5));
-                let spans = RowSpans { blocks, caster: &caster, lines };
-                match walker {
-                    RowWalker::Segments(walk) => {
-                        let reuse = (&mut *coherence, &mut *order);
-                        scan_row(&caster, (walk, counts), &ends, &spans, near, (row, scratch, reuse));
-                    }
-                    RowWalker::Pattern(matrix) => {
-                        matrix.walk_row(&caster, &ends, &|i, x| blocks.span(&caster, i, &lines[i], x), near, row);
-                    }
-                    RowWalker::Empty => {}
-                }
-                let scanned = ScannedRow {
-                    hits: row,
-                    columns: lo..hi,
-                    line: &line,
-                    units: lines,
-                    caster: &caster,
-                    flat: Cell::new(None),
-                };
-                visit(&mut out, dy, &scanned);
-                // Between rows, the row's hits are all None.
-                row[lo..hi].fill(None);
+            let first = band * BAND_ROWS;
+            let mut occupancy = YOccupancy::at(&frame.entry, first as i64);
+            for dy in 0..BAND_ROWS.min(h - first) {
+                let y = first + dy;
+                let occupied = occupancy.advance(y as i64);
+                frame.walk_row(y, occupied, &mut lent.0, |row| visit(&mut out, dy, row));
             }
         },
     );
+}
+
+/// What a frame's walk knows before its first scanline: each primitive's
+/// outline on the screen, the y-entry table, the caster, where each face of a
+/// many-planed polyhedron shows, and the pixels' rays.
+struct FrameWalk<'a> {
+    walker: &'a RowWalker,
+    outlines: Vec<Option<Outline>>,
+    /// The y-entry table (procedure 1): the primitives that show at all, by
+    /// top scanline.
+    entry: Vec<(usize, Extent)>,
+    caster: CsgCaster,
+    face_extents: Vec<FaceExtents>,
+    rays: PixelRays,
+    /// Along a row line's direction (unit component along the view axis),
+    /// the near plane lies at t = near, under either projection.
+    near: f32,
+    width: usize,
+}
+
+impl<'a> FrameWalk<'a> {
+    /// The frame of `solid` seen by `camera` at `width` x `height`, walked by
+    /// `walker`.
+    fn new(solid: &CsgSolid, walker: &'a RowWalker, camera: &Camera, (width, height): (u32, u32)) -> Self {
+        let vp = camera.view_projection(width as f32 / height as f32);
+        let rays = camera.pixel_rays(Vec2::new(width as f32, height as f32));
+        let outlines: Vec<Option<Outline>> = solid.primitives.iter().map(|p| Outline::new(p, vp, &rays)).collect();
+        let mut entry: Vec<(usize, Extent)> =
+            outlines.iter().enumerate().filter_map(|(i, o)| o.as_ref().map(|o| (i, o.rows))).collect();
+        entry.sort_by_key(|(_, e)| e.y0);
+        let caster = CsgCaster::without_bvh(solid);
+        let face_extents = (0..solid.primitives.len())
+            .map(|i| caster.face_extents(i, |p| screen_point(p, vp, (width, height))))
+            .collect();
+        FrameWalk { walker, outlines, entry, caster, face_extents, rays, near: camera.near, width: width as usize }
+    }
+
+    /// Scanline `y`, its y-occupancy list `occupied`, walked with `buffers`:
+    /// `visit` is handed the row's hits.
+    fn walk_row(
+        &self,
+        y: usize,
+        occupied: &[(usize, Extent)],
+        buffers: &mut RowBuffers,
+        visit: impl FnOnce(&ScannedRow),
+    ) {
+        let RowBuffers { row, lines, counts, scratch, blocks, coherence, order } = buffers;
+        let caster = &self.caster;
+        // Procedure 2: each occupant's left and right ends on this scanline.
+        let ends: Vec<(usize, i64, i64)> = occupied
+            .iter()
+            .filter_map(|&(i, _)| self.outlines[i].as_ref()?.columns(y as i64).map(|(a, b)| (i, a, b)))
+            .collect();
+        // The columns the occupants may cover: the walk writes no other.
+        debug_assert!(row.iter().all(Option::is_none), "row {y}: hits left from the row before");
+        let w = self.width as i64;
+        let lo = ends.iter().map(|e| e.1).min().unwrap_or(0).clamp(0, w) as usize;
+        let hi = ends.iter().map(|e| e.2 + 1).max().unwrap_or(0).clamp(lo as i64, w) as usize;
+        // The row's rays, carried into each occupant's unit space once.
+        let line = self.rays.row_line(y);
+        ends.iter().for_each(|&(i, _, _)| lines[i] = caster.unit_line(i, &line));
+        blocks.begin_row(caster, ends.iter().map(|e| e.0), lines, (&self.face_extents, y as f32 + 0.5));
+        let spans = RowSpans { blocks, caster, lines };
+        match self.walker {
+            RowWalker::Segments(walk) => {
+                let reuse = (&mut *coherence, &mut *order);
+                scan_row(caster, (walk, counts), &ends, &spans, self.near, (row, scratch, reuse));
+            }
+            RowWalker::Pattern(matrix) => {
+                matrix.walk_row(caster, &ends, &|i, x| blocks.span(caster, i, &lines[i], x), self.near, row);
+            }
+            RowWalker::Empty => {}
+        }
+        visit(&ScannedRow { hits: row, columns: lo..hi, line: &line, units: lines, caster, flat: Cell::new(None) });
+        // Between rows, the row's hits are all None.
+        row[lo..hi].fill(None);
+    }
+}
+
+/// The y-occupancy list (seed 003 §5): the primitives whose rows take in
+/// the scanline at hand, kept row by row down a band from the y-entry table.
+struct YOccupancy<'a> {
+    entry: &'a [(usize, Extent)],
+    /// The first entry not yet met.
+    next: usize,
+    occupied: Vec<(usize, Extent)>,
+}
+
+impl<'a> YOccupancy<'a> {
+    /// The list as scanline `first` finds it, from the y-entry table `entry`.
+    fn at(entry: &'a [(usize, Extent)], first: i64) -> Self {
+        let next = entry.partition_point(|(_, e)| e.y0 <= first);
+        let occupied = entry[..next].iter().copied().filter(|(_, e)| e.y1 >= first).collect();
+        YOccupancy { entry, next, occupied }
+    }
+
+    /// The list at scanline `y` (the one after the last asked for, or the
+    /// first): those whose top is reached join, those whose bottom is
+    /// passed leave.
+    fn advance(&mut self, y: i64) -> &[(usize, Extent)] {
+        while self.next < self.entry.len() && self.entry[self.next].1.y0 <= y {
+            self.occupied.push(self.entry[self.next]);
+            self.next += 1;
+        }
+        self.occupied.retain(|(_, e)| e.y1 >= y);
+        &self.occupied
+    }
 }
 
 /// A many-planed polyhedron's faces' extents ([`CsgCaster::face_extents`];
