@@ -794,8 +794,16 @@ impl EllipsoidView {
 /// of world point `p` seen through `vp` in a `width` x `height` image, or
 /// `None` at or behind the eye.
 fn screen_point(p: Vec3, vp: Mat4, (width, height): (u32, u32)) -> Option<Vec2> {
-    let c: Vec4 = vp * p.extend(1.0);
-    (c.w > 1e-6).then(|| Vec2::new((0.5 + 0.5 * c.x / c.w) * width as f32, (0.5 - 0.5 * c.y / c.w) * height as f32))
+    pixel_of(vp * p.extend(1.0), DVec2::new(f64::from(width), f64::from(height))).map(DVec2::as_vec2)
+}
+
+/// The pixel coordinates in a `size` image of a point whose clip-space
+/// position is `c`, or `None` at or behind the eye.
+fn pixel_of(c: Vec4, size: DVec2) -> Option<DVec2> {
+    (c.w > 1e-6).then(|| {
+        let ndc = DVec2::new(f64::from(c.x / c.w), f64::from(c.y / c.w));
+        DVec2::new((ndc.x * 0.5 + 0.5) * size.x, (0.5 - ndc.y * 0.5) * size.y)
+    })
 }
 
 /// Where `a·s² + 2·b·s + c ≥ 0`: the interval between the roots when `a < 0`;
@@ -840,16 +848,7 @@ fn outline_points(p: &Primitive) -> Vec<Vec3> {
 /// image (Andrew's monotone chain), or `None` when a point lies at or behind
 /// the eye.
 fn projected_hull(points: &[Vec3], vp: Mat4, size: DVec2) -> Option<Vec<DVec2>> {
-    let mut px: Vec<DVec2> = points
-        .iter()
-        .map(|p| {
-            let c: Vec4 = vp * p.extend(1.0);
-            (c.w > 1e-6).then(|| {
-                let ndc = DVec2::new(f64::from(c.x / c.w), f64::from(c.y / c.w));
-                DVec2::new((ndc.x * 0.5 + 0.5) * size.x, (0.5 - ndc.y * 0.5) * size.y)
-            })
-        })
-        .collect::<Option<_>>()?;
+    let mut px: Vec<DVec2> = points.iter().map(|p| pixel_of(vp * p.extend(1.0), size)).collect::<Option<_>>()?;
     px.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
     px.dedup();
     if px.len() < 3 {
@@ -890,18 +889,16 @@ fn hull_row(hull: &[DVec2], y: f64) -> Option<(f64, f64)> {
 /// image if some point lies at or behind the eye; `None` if off screen or all
 /// behind the eye (the points' hull then lies in the half-space behind it).
 fn extent(points: &[Vec3], vp: Mat4, width: u32, height: u32) -> Option<Extent> {
-    let (w, h) = (f64::from(width), f64::from(height));
+    let size = DVec2::new(f64::from(width), f64::from(height));
     let clip: Vec<Vec4> = points.iter().map(|p| vp * p.extend(1.0)).collect();
     if clip.iter().all(|c| c.w <= 0.0) {
         return None; // wholly behind the eye (a cube-map face looking away)
     }
-    let (mut lo, mut hi) = (glam::DVec2::splat(f64::INFINITY), glam::DVec2::splat(f64::NEG_INFINITY));
+    let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
     for c in clip {
-        if c.w <= 1e-6 {
+        let Some(px) = pixel_of(c, size) else {
             return Some(Extent { x0: 0, x1: i64::from(width) - 1, y0: 0, y1: i64::from(height) - 1 });
-        }
-        let ndc = glam::DVec2::new(f64::from(c.x / c.w), f64::from(c.y / c.w));
-        let px = glam::DVec2::new((ndc.x * 0.5 + 0.5) * w, (0.5 - ndc.y * 0.5) * h);
+        };
         (lo, hi) = (lo.min(px), hi.max(px));
     }
     // Pixel x is covered when its centre x + ½ lies in [lo, hi].
