@@ -240,23 +240,26 @@ impl CsgSolid {
     }
 }
 
+/// Random trees over primitives `0..n`, nested up to `depth` levels (for
+/// property tests of whatever reads trees).
+#[cfg(test)]
+pub(crate) fn random_tree(n: usize, depth: u32) -> impl proptest::strategy::Strategy<Value = CsgTree> {
+    use proptest::prelude::*;
+    (0..n).prop_map(CsgTree::Leaf).prop_recursive(depth, 8 * depth, 4, |inner| {
+        prop_oneof![
+            prop::collection::vec(inner.clone(), 1..4).prop_map(CsgTree::Union),
+            prop::collection::vec(inner.clone(), 1..4).prop_map(CsgTree::Intersection),
+            (inner.clone(), prop::collection::vec(inner, 1..4))
+                .prop_map(|(a, cut)| CsgTree::Difference(Box::new(a), cut)),
+        ]
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use proptest::prelude::*;
 
     use super::*;
-
-    /// Random trees over primitives `0..8`, nested up to four levels.
-    fn tree() -> impl Strategy<Value = CsgTree> {
-        (0..8usize).prop_map(CsgTree::Leaf).prop_recursive(4, 32, 4, |inner| {
-            prop_oneof![
-                prop::collection::vec(inner.clone(), 1..4).prop_map(CsgTree::Union),
-                prop::collection::vec(inner.clone(), 1..4).prop_map(CsgTree::Intersection),
-                (inner.clone(), prop::collection::vec(inner, 1..4))
-                    .prop_map(|(a, cut)| CsgTree::Difference(Box::new(a), cut)),
-            ]
-        })
-    }
 
     /// Whether a boolean of one kind is left nested in its own kind.
     fn nested(t: &CsgTree) -> bool {
@@ -276,7 +279,7 @@ mod tests {
         /// Flattening keeps the solid (the same inside for every set of
         /// primitives containing a point) and leaves nothing to flatten.
         #[test]
-        fn flattening_keeps_the_solid(t in tree(), inside in prop::collection::vec(any::<bool>(), 8)) {
+        fn flattening_keeps_the_solid(t in random_tree(8, 4), inside in prop::collection::vec(any::<bool>(), 8)) {
             let flat = t.clone().flattened();
             prop_assert!(!nested(&flat), "{flat:?}");
             prop_assert_eq!(flat.contains(&|i| inside[i]), t.contains(&|i| inside[i]));

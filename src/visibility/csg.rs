@@ -55,7 +55,7 @@ use rayon::iter::IndexedParallelIterator;
 use rayon::prelude::*;
 
 use crate::raytrace::csg::{
-    Crossing, CsgCaster, FaceExtent, Hit, Interval, IntervalLanes, LeafSpans, RowFaces, SpanScratch,
+    Booleans, Crossing, CsgCaster, FaceExtent, Hit, Interval, IntervalLanes, LeafSpans, RowFaces, SpanScratch,
 };
 use crate::scene::camera::PixelRays;
 use crate::scene::camera::RowLine;
@@ -63,6 +63,7 @@ use crate::scene::csg::{CsgSolid, Primitive, Shape};
 use crate::scene::{Camera, Object, Scene};
 use crate::visibility::block::BlockOrder;
 use crate::visibility::coherence::{self, PixelCoherence};
+use crate::visibility::horizon::Horizon;
 use crate::visibility::occupancy::{OccupancyTree, Occupied};
 use crate::visibility::pattern::{PatternMatrix, TooManySegments};
 use crate::visibility::{ItemId, VisibilityBuffer};
@@ -569,8 +570,47 @@ impl RowSpans<'_> {
         self.blocks.span(self.caster, i, &self.lines[i], x)
     }
 
+    /// The booleans' answer at pixel `x` over the tree `root` (beyond the
+    /// near plane at `near`): first with the occupants beyond `horizon` left
+    /// out ([`super::horizon`]), then, if one was and the answer does not
+    /// clear it, with none left out.
+    #[inline(always)]
+    fn first_hit<B: Booleans>(
+        &self,
+        root: B,
+        x: usize,
+        near: f32,
+        horizon: Horizon,
+        scratch: &mut SpanScratch,
+    ) -> Option<Hit> {
+        let short = PixelSpans { row: self, x, horizon, hid: Cell::new(false) };
+        let hit = self.caster.first_hit_in_by(root, &short, near, scratch);
+        // Nothing left out, or an answer that clears the horizon: the whole
+        // tree's answer.
+        if !short.hid.get() || hit.is_some_and(|h| horizon.clears(h.t)) {
+            return hit;
+        }
+        self.first_hit_everywhere(root, x, near, scratch)
+    }
+
+    /// [`RowSpans::first_hit`] with no occupant left out: the rarer case,
+    /// kept out of line (and read through a closure, so that the booleans
+    /// over [`PixelSpans`] keep one caller and are inlined into it).
+    #[cold]
+    #[inline(never)]
+    fn first_hit_everywhere<B: Booleans>(
+        &self,
+        root: B,
+        x: usize,
+        near: f32,
+        scratch: &mut SpanScratch,
+    ) -> Option<Hit> {
+        self.caster.first_hit_in_by(root, &|i| self.at(i, x), near, scratch)
+    }
+
     /// [`BlockOrder::spread`] of `first`, the answer at pixel `x` (a block's
     /// first) among the occupants `ids`, into the block's eight pixels `out`.
+    /// (All of them: the answer is the whole tree's, however found.)
     fn spread(
         &self,
         order: &mut BlockOrder,
@@ -594,12 +634,21 @@ impl RowSpans<'_> {
 struct PixelSpans<'a> {
     row: &'a RowSpans<'a>,
     x: usize,
+    /// Occupants wholly beyond it read as missed.
+    horizon: Horizon,
+    /// Whether one was.
+    hid: Cell<bool>,
 }
 
 impl LeafSpans for PixelSpans<'_> {
     #[inline(always)]
     fn span(&self, i: usize) -> Option<Interval> {
-        self.row.at(i, self.x)
+        let span = self.row.at(i, self.x)?;
+        if self.horizon.hides(span.enter.t) {
+            self.hid.set(true);
+            return None;
+        }
+        Some(span)
     }
 }
 
@@ -635,6 +684,9 @@ fn scan_row(
     let Some(first) = entry.first().map(|e| e.1.max(0) as usize) else { return };
     coherence.forget();
     let mut x = first;
+    // The last surface found and its rise from the pixel before: where the
+    // next pixel's horizon is guessed.
+    let mut surface: Option<(f32, f32)> = None;
     while x < row.len() {
         while next_in < entry.len() && entry[next_in].1 <= x as i64 {
             counts.set(tree, entry[next_in].0, true);
@@ -653,7 +705,13 @@ fn scan_row(
                     hit
                 })
             } else {
-                caster.first_hit_in_by(root, &PixelSpans { row: spans, x }, near, scratch)
+                // Pixel by pixel (the oracle the tests hold the rest to),
+                // every occupant is read.
+                let horizon = match walk.reuse {
+                    Reuse::Blocks => Horizon::guess(surface, counts.present().ids().len()),
+                    _ => Horizon::EVERYWHERE,
+                };
+                spans.first_hit(root, x, near, horizon, scratch)
             };
             row[x] = hit;
             // A block nothing enters or leaves inside of (a right end on
@@ -666,6 +724,10 @@ fn scan_row(
                 && exit.get(next_out).is_none_or(|e| e.2 >= block as i64);
             if quiet && spans.spread(order, counts.present().ids(), (x, hit), near, &mut row[x..=block]) {
                 last = block;
+            }
+            if let Some(h) = row[last] {
+                let rise = row[last.saturating_sub(1)].map_or(0.0, |p| h.t - p.t);
+                surface = Some((h.t, rise));
             }
         }
         // Primitives whose right end is passed leave the x-occupancy list.

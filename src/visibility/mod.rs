@@ -14,6 +14,7 @@ pub mod block;
 pub mod clip;
 pub mod coherence;
 pub mod csg;
+pub mod horizon;
 pub mod occupancy;
 pub mod pattern;
 pub mod raster;

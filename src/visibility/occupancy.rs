@@ -368,20 +368,7 @@ mod tests {
 
     use super::*;
     use crate::raytrace::csg::{combine, CsgCaster, Interval, SpanScratch};
-    use crate::scene::csg::{ConvexPolyhedron, CsgSolid, Primitive, Shape};
-
-    /// Random trees over primitives `0..n`, up to three levels deep.
-    fn tree(n: usize) -> impl Strategy<Value = CsgTree> {
-        let leaf = (0..n).prop_map(CsgTree::Leaf);
-        leaf.prop_recursive(3, 24, 4, |inner| {
-            prop_oneof![
-                prop::collection::vec(inner.clone(), 1..4).prop_map(CsgTree::Union),
-                prop::collection::vec(inner.clone(), 1..4).prop_map(CsgTree::Intersection),
-                (inner.clone(), prop::collection::vec(inner, 1..4))
-                    .prop_map(|(a, cut)| CsgTree::Difference(Box::new(a), cut)),
-            ]
-        })
-    }
+    use crate::scene::csg::{random_tree, ConvexPolyhedron, CsgSolid, Primitive, Shape};
 
     /// Whether `tree` can be non-empty where only `on` primitives are present
     /// (the counts' meaning, stated recursively).
@@ -422,7 +409,7 @@ mod tests {
         /// as over the whole tree with absent primitives missed.
         #[test]
         fn counts_follow_the_tree(
-            t in tree(N),
+            t in random_tree(N, 3),
             ends in prop::collection::vec((0.0f32..10.0, 0.0f32..10.0), N),
             changes in prop::collection::vec((0..N, any::<bool>()), 1..40),
         ) {
