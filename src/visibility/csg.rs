@@ -38,6 +38,12 @@
 //! seven when the ends before it keep their order at all eight (checked in
 //! lanes, once per block); ends behind the surface may swap.
 //!
+//! Depth (beyond the paper): most of a pixel's occupants on a part of many
+//! features lie behind its surface. Where the booleans run, the occupants
+//! whose interval starts beyond a horizon guessed a little past the surface
+//! of the pixel before are left out, and the answer is kept when it provably
+//! is the whole tree's ([`super::horizon`]).
+//!
 //! Extents (procedures 1 and 2): an ellipsoid seen in perspective from outside
 //! gets the paper's exact rows (scanline planes through the eye tangent to it)
 //! and, per scanline, exact left and right ends (lines through the eye tangent to
