@@ -711,8 +711,8 @@ fn scan_row(
                     hit
                 })
             } else {
-                // Pixel by pixel (the oracle the tests hold the rest to),
-                // every occupant is read.
+                // The walk pixel by pixel (`Reuse::Never`, the oracle the
+                // tests hold the rest to) reads every occupant.
                 let horizon = match walk.reuse {
                     Reuse::Blocks => Horizon::guess(surface, counts.present().ids().len()),
                     _ => Horizon::EVERYWHERE,

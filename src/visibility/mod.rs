@@ -8,9 +8,9 @@
 //! binning into bands and the band-parallel z-buffer). [`csg`] finds the visible
 //! surfaces of CSG solids by seed 003's scanline walk, over [`occupancy`] (its
 //! reference counts, in tree form) or [`pattern`] (its pattern matrix), with
-//! [`block`] (its reuse of an answer, a block of eight pixels at a time),
-//! [`horizon`] (occupants wholly behind the surface left out of the booleans)
-//! and [`coherence`] (its reuse pixel by pixel, as the paper has it) on request.
+//! [`block`] (its reuse of an answer, a block of eight pixels at a time) and
+//! [`horizon`] (occupants wholly behind the surface left out of the booleans),
+//! or [`coherence`] (its reuse pixel by pixel, as the paper has it) on request.
 
 pub mod block;
 pub mod clip;
