@@ -182,8 +182,10 @@ impl RowWalker {
                     CsgMethod::SegmentsCoherent => Reuse::Pixels,
                     _ => Reuse::Never,
                 };
+                let shape = OccupancyTree::new(tree, n);
                 RowWalker::Segments(SegmentWalk {
-                    tree: OccupancyTree::new(tree, n),
+                    horizon: reuse == Reuse::Blocks && !shape.is_union_of_leaves(),
+                    tree: shape,
                     cut_with: if reuse == Reuse::Pixels { coherence::cut_with(tree, n) } else { Vec::new() },
                     reuse,
                 })
@@ -200,6 +202,12 @@ struct SegmentWalk {
     cut_with: Vec<bool>,
     /// How an answer is reused along the scanline (seed 003 §5.2.2).
     reuse: Reuse,
+    /// Whether the booleans leave out occupants beyond a guessed horizon
+    /// ([`super::horizon`]): not pixel by pixel (the tests' oracle), and not
+    /// for a union of primitives, whose booleans read each occupant once
+    /// anyway (where leaving some out saved nothing and the second passes
+    /// at silhouettes cost: the paper's random spheres).
+    horizon: bool,
 }
 
 /// How the segment walk reuses an answer along a scanline.
@@ -589,7 +597,7 @@ impl RowSpans<'_> {
         horizon: Horizon,
         scratch: &mut SpanScratch,
     ) -> Option<Hit> {
-        let short = PixelSpans { row: self, x, horizon, hid: Cell::new(false) };
+        let short = ShortSpans { all: PixelSpans { row: self, x }, horizon, hid: Cell::new(false) };
         let hit = self.caster.first_hit_in_by(root, &short, near, scratch);
         // Nothing left out, or an answer that clears the horizon: the whole
         // tree's answer.
@@ -601,7 +609,8 @@ impl RowSpans<'_> {
 
     /// [`RowSpans::first_hit`] with no occupant left out: the rarer case,
     /// kept out of line (and read through a closure, so that the booleans
-    /// over [`PixelSpans`] keep one caller and are inlined into it).
+    /// over [`ShortSpans`] and [`PixelSpans`] each keep one caller and are
+    /// inlined into it).
     #[cold]
     #[inline(never)]
     fn first_hit_everywhere<B: Booleans>(
@@ -640,16 +649,28 @@ impl RowSpans<'_> {
 struct PixelSpans<'a> {
     row: &'a RowSpans<'a>,
     x: usize,
-    /// Occupants wholly beyond it read as missed.
-    horizon: Horizon,
-    /// Whether one was.
-    hid: Cell<bool>,
 }
 
 impl LeafSpans for PixelSpans<'_> {
     #[inline(always)]
     fn span(&self, i: usize) -> Option<Interval> {
-        let span = self.row.at(i, self.x)?;
+        self.row.at(i, self.x)
+    }
+}
+
+/// [`PixelSpans`] short of a horizon: the occupants whose interval starts
+/// at or beyond it read as missed ([`super::horizon`]).
+struct ShortSpans<'a> {
+    all: PixelSpans<'a>,
+    horizon: Horizon,
+    /// Whether an occupant was left out.
+    hid: Cell<bool>,
+}
+
+impl LeafSpans for ShortSpans<'_> {
+    #[inline(always)]
+    fn span(&self, i: usize) -> Option<Interval> {
+        let span = self.all.span(i)?;
         if self.horizon.hides(span.enter.t) {
             self.hid.set(true);
             return None;
@@ -710,14 +731,10 @@ fn scan_row(
                     coherence.learn(present, &walk.cut_with, hit);
                     hit
                 })
+            } else if walk.horizon {
+                spans.first_hit(root, x, near, Horizon::guess(surface, counts.present().ids().len()), scratch)
             } else {
-                // The walk pixel by pixel (`Reuse::Never`, the oracle the
-                // tests hold the rest to) reads every occupant.
-                let horizon = match walk.reuse {
-                    Reuse::Blocks => Horizon::guess(surface, counts.present().ids().len()),
-                    _ => Horizon::EVERYWHERE,
-                };
-                spans.first_hit(root, x, near, horizon, scratch)
+                caster.first_hit_in_by(root, &PixelSpans { row: spans, x }, near, scratch)
             };
             row[x] = hit;
             // A block nothing enters or leaves inside of (a right end on
@@ -731,7 +748,7 @@ fn scan_row(
             if quiet && spans.spread(order, counts.present().ids(), (x, hit), near, &mut row[x..=block]) {
                 last = block;
             }
-            if let Some(h) = row[last] {
+            if let Some(h) = row[last].filter(|_| walk.horizon) {
                 let rise = row[last.saturating_sub(1)].map_or(0.0, |p| h.t - p.t);
                 surface = Some((h.t, rise));
             }

@@ -100,6 +100,20 @@ impl OccupancyTree {
         self.nodes.is_empty()
     }
 
+    /// Whether the tree is one primitive or a union of primitives: the
+    /// booleans then read each occupant once, on its own, and nothing cuts,
+    /// clips or merges.
+    #[must_use]
+    pub fn is_union_of_leaves(&self) -> bool {
+        let root = &self.nodes[self.root as usize];
+        let leaf = |k: &u32| matches!(self.nodes[*k as usize].operation, Operation::Leaf(_));
+        match root.operation {
+            Operation::Leaf(_) => true,
+            Operation::Union => self.operands_of(root).iter().all(leaf),
+            _ => false,
+        }
+    }
+
     fn operands_of(&self, node: &Node) -> &[u32] {
         &self.operands[node.start as usize..(node.start + node.count) as usize]
     }
