@@ -14,7 +14,9 @@
 //!
 //! The parts: `shapes` (each unit shape's crossings and normals), `booleans`
 //! (the intervals combined along the tree; coplanar cuts decided by [`TIE`]),
-//! and `lanes` (eight pixels of a scanline at once, for the scanline walk).
+//! `lanes` (eight pixels of a scanline at once, for the scanline walk), and
+//! `faces` (which of a many-planed polyhedron's faces a block of eight
+//! pixels can cross).
 
 use glam::{Affine3A, Mat3A, Vec3};
 
@@ -25,11 +27,13 @@ use crate::scene::Ray;
 use crate::visibility::occupancy::OccupancyTree;
 
 mod booleans;
+mod faces;
 mod lanes;
 mod shapes;
 
 pub use booleans::{above, below, combine, Booleans, LeafSpans, Operation, Parts, SpanScratch, TIE};
 use booleans::{difference, first_crossing, first_entry, first_of_all, union, Inside};
+pub use faces::{FacesOnScreen, RowFaces};
 use shapes::{normal_matrix, unit_cube, unit_normal, unit_span, Clipping, PlaneLanes};
 
 /// Where a ray crosses a solid's surface.
@@ -158,30 +162,6 @@ impl IntervalLanes {
     pub fn end_at(&self, end: usize, j: usize) -> Hit {
         Hit { t: self.t[end][j], primitive: self.primitive, face: self.face[end][j] }
     }
-}
-
-/// The faces of a many-planed polyhedron that one scanline's rays can cross
-/// ([`CsgCaster::row_faces`]), with buffers reused from row to row.
-#[derive(Debug, Clone, Default)]
-pub struct RowFaces {
-    /// Whether `faces` applies (the primitive is such a polyhedron).
-    active: bool,
-    faces: Vec<u32>,
-    distances: Vec<f32>,
-    /// Per face of `faces`, the columns it shows in, when known
-    /// ([`FaceExtent`]; empty otherwise).
-    columns: Vec<(f32, f32)>,
-}
-
-/// Where a face of a many-planed polyhedron shows on the screen
-/// ([`CsgCaster::face_extents`]): pixel coordinates, a pixel's centre at
-/// `x + ½, y + ½`.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct FaceExtent {
-    /// Least and greatest x.
-    pub columns: (f32, f32),
-    /// Least and greatest y.
-    pub rows: (f32, f32),
 }
 
 /// The spans of `ray` inside `solid`, sorted and disjoint (empty if it misses).
@@ -339,68 +319,52 @@ impl CsgCaster {
     /// scanline's rays lie in one plane, which meets few of a rounded
     /// box's hundreds of faces.
     ///
-    /// `extents`, when given, is [`CsgCaster::face_extents`]'s answer and
-    /// the scanline's coordinate: the faces whose rows take it in are kept
-    /// (without measuring each face's corners against the line's plane), with
-    /// their columns, so that a block clips by the faces over it alone.
-    pub fn row_faces(&self, i: usize, unit: &RowLine, extents: Option<(&[FaceExtent], f32)>, row: &mut RowFaces) {
-        row.active = false;
-        row.columns.clear();
-        if let Clipping::Lanes(lanes) = &self.clipping[i] {
-            if let Some(corners) = &lanes.corners {
-                match extents {
-                    Some((faces, y)) => {
-                        row.faces.clear();
-                        for (f, e) in (0..).zip(faces).filter(|(_, e)| e.rows.0 <= y && y <= e.rows.1) {
-                            row.faces.push(f);
-                            row.columns.push(e.columns);
-                        }
-                    }
-                    None => corners.met_by(unit, &mut row.distances, &mut row.faces),
-                }
-                row.active = true;
-            }
-        }
+    /// `screen`, when given, is [`CsgCaster::faces_on_screen`]'s answer and
+    /// the scanline's index: the faces that show on the scanline are kept
+    /// (without measuring each face's corners against the line's plane),
+    /// sorted by the blocks of eight pixels their columns reach there, so
+    /// that a block clips by the faces over it alone.
+    pub fn row_faces(&self, i: usize, unit: &RowLine, screen: Option<(&FacesOnScreen, usize)>, row: &mut RowFaces) {
+        row.off();
+        let Clipping::Lanes(lanes) = &self.clipping[i] else { return };
+        let Some(corners) = &lanes.corners else { return };
+        row.find(match screen {
+            Some((screen, y)) => faces::Sieve::Screen(screen, y),
+            None => faces::Sieve::Plane(corners, unit),
+        });
     }
 
-    /// For a polyhedron of many planes, where each face shows: the columns
-    /// and rows its corners' projections span (`project` gives a solid-space
-    /// point's pixel coordinates, a pixel's centre at `x + ½, y + ½`), a
-    /// pixel wider each way so that rounding loses no face. A scanline whose
-    /// plane meets the face lies within its rows (a face is convex, and a
-    /// scanline's rays fill the plane through the eye that projects onto
-    /// it), and a pixel whose ray crosses the face within its columns.
-    /// `None` for other primitives, or when a corner has no projection (at
-    /// or behind the eye).
-    pub fn face_extents(&self, i: usize, project: impl Fn(Vec3) -> Option<glam::Vec2>) -> Option<Vec<FaceExtent>> {
+    /// For a polyhedron of many planes, where each face shows in a `size`
+    /// frame ([`FacesOnScreen`]; `project` gives a solid-space point's pixel
+    /// coordinates, a pixel's centre at `x + ½, y + ½`). `None` for other
+    /// primitives, or when a corner has no projection (at or behind the
+    /// eye).
+    pub fn faces_on_screen(
+        &self,
+        i: usize,
+        project: impl Fn(Vec3) -> Option<glam::Vec2>,
+        size: (usize, usize),
+    ) -> Option<FacesOnScreen> {
         let Clipping::Lanes(lanes) = &self.clipping[i] else { return None };
         let to_solid = self.solid.primitives[i].transform;
-        let boxes = lanes.corners.as_ref()?.projected(|c| project(to_solid.transform_point3(c)))?;
-        let extent = |b: [f32; 4]| FaceExtent { columns: (b[0] - 1.0, b[1] + 1.0), rows: (b[2] - 1.0, b[3] + 1.0) };
-        Some(boxes.into_iter().map(extent).collect())
+        let corners = lanes.corners.as_ref()?;
+        let at = corners.projected(|c| project(to_solid.transform_point3(c)))?;
+        Some(FacesOnScreen::new(corners, &at, size))
     }
 
-    /// [`CsgCaster::span_on`] at the eight pixels `x0..x0 + 8` of `unit` at
-    /// once, in SIMD lanes: each the same to the bit as `span_on` gives it
-    /// (a polyhedron of many planes clipped by the faces `row` keeps, from
-    /// [`CsgCaster::row_faces`] on the same line, and of those, when their
-    /// columns are known, by the ones over the block's pixels: property
-    /// tests hold both to every face), written into `out` (the walk's
-    /// cache, so the lanes are not returned and then copied).
-    pub fn spans_on_eight(&self, i: usize, unit: &RowLine, x0: f32, row: &RowFaces, out: &mut IntervalLanes) {
-        let rays = lanes::RayLanes::new(unit, x0);
+    /// [`CsgCaster::span_on`] at the eight pixels `8·block..8·block + 8` of
+    /// `unit` at once, in SIMD lanes: each the same to the bit as `span_on`
+    /// gives it (a polyhedron of many planes clipped by the faces `row`
+    /// keeps over the block, from [`CsgCaster::row_faces`] on the same line:
+    /// property tests hold both to every face), written into `out` (the
+    /// walk's cache, so the lanes are not returned and then copied).
+    pub fn spans_on_eight(&self, i: usize, unit: &RowLine, block: usize, row: &RowFaces, out: &mut IntervalLanes) {
+        let rays = lanes::RayLanes::new(unit, (block * 8) as f32);
         let shape = &self.solid.primitives[i].shape;
         let spans = match (&self.clipping[i], shape) {
             (Clipping::Box, _) => lanes::unit_cube(&rays),
             (Clipping::Lanes(_), Shape::Polyhedron(poly)) if row.active => {
-                let faces = row.faces.iter().map(|&f| (f, &poly.planes[f as usize]));
-                if row.columns.is_empty() {
-                    lanes::planes(faces, &rays)
-                } else {
-                    // The faces over the block's pixel centres.
-                    let over = row.columns.iter().map(|c| c.0 <= x0 + 7.5 && c.1 >= x0 + 0.5);
-                    lanes::planes(faces.zip(over).filter_map(|(f, over)| over.then_some(f)), &rays)
-                }
+                lanes::planes(row.over(block).iter().map(|&f| (f, &poly.planes[f as usize])), &rays)
             }
             _ => lanes::shape(shape, &rays),
         };
@@ -656,16 +620,21 @@ mod tests {
     use super::shapes::tests::vector;
     use super::*;
 
-    /// Primitive 0's eight pixels from `x0` of `line` in lanes (clipped by
-    /// the faces `row` keeps) equal each pixel's alone: the same `t` to the
-    /// bit, the same faces.
-    fn eight_as_one_by_one(caster: &CsgCaster, line: &RowLine, x0: u32, row: &RowFaces) -> Result<(), TestCaseError> {
+    /// Primitive 0's eight pixels of block `block` of `line` in lanes
+    /// (clipped by the faces `row` keeps) equal each pixel's alone: the same
+    /// `t` to the bit, the same faces.
+    fn eight_as_one_by_one(
+        caster: &CsgCaster,
+        line: &RowLine,
+        block: usize,
+        row: &RowFaces,
+    ) -> Result<(), TestCaseError> {
         let mut eight = IntervalLanes::default();
-        caster.spans_on_eight(0, line, x0 as f32, row, &mut eight);
+        caster.spans_on_eight(0, line, block, row, &mut eight);
         let bits =
             |s: Option<Interval>| s.map(|s| (s.enter.t.to_bits(), s.enter.face, s.exit.t.to_bits(), s.exit.face));
         for j in 0..8 {
-            prop_assert_eq!(bits(eight.get(j)), bits(caster.span_on(0, line, (x0 + j as u32) as f32)), "pixel {}", j);
+            prop_assert_eq!(bits(eight.get(j)), bits(caster.span_on(0, line, (block * 8 + j) as f32)), "pixel {}", j);
         }
         Ok(())
     }
@@ -698,7 +667,7 @@ mod tests {
         #[test]
         fn a_row_clipped_by_the_faces_it_meets_is_clipped_by_all(
             line in (vector(-1.5..1.5), vector(-0.05..0.05), vector(-2.0..2.0), vector(-0.05..0.05)),
-            x0 in 0u32..24,
+            block in 0usize..3,
             ortho in any::<bool>(),
         ) {
             let (origin, mut origin_step, dir, mut dir_step) = line;
@@ -715,11 +684,11 @@ mod tests {
             let mut row = RowFaces::default();
             caster.row_faces(0, &line, None, &mut row);
             prop_assert!(row.active);
-            eight_as_one_by_one(&caster, &line, x0, &row)?;
+            eight_as_one_by_one(&caster, &line, block, &row)?;
         }
 
         /// The same with the faces picked by where they show
-        /// ([`CsgCaster::face_extents`]: a row's faces by their rows, a
+        /// ([`CsgCaster::faces_on_screen`]: a row's faces by their rows, a
         /// block's by their columns): a turned, stretched faceted ball seen
         /// by a random camera, every block of a random scanline.
         #[test]
@@ -749,17 +718,17 @@ mod tests {
                 Camera { eye, target: Vec3::ZERO, up: Vec3::Y, near: 0.05, far: 100.0, projection, shift: glam::Vec2::ZERO };
             let (w, h) = (160u32, 120u32);
             let vp = camera.view_projection(w as f32 / h as f32);
-            let extents = caster.face_extents(0, |p| {
+            let screen = caster.faces_on_screen(0, |p| {
                 let c = vp * p.extend(1.0);
                 (c.w > 1e-6).then(|| glam::Vec2::new((0.5 + 0.5 * c.x / c.w) * w as f32, (0.5 - 0.5 * c.y / c.w) * h as f32))
-            });
-            let Some(extents) = extents else { return Ok(()) }; // the eye inside the ball's hull
+            }, (w as usize, h as usize));
+            let Some(screen) = screen else { return Ok(()) }; // the eye inside the ball's hull
             let line = caster.unit_line(0, &camera.pixel_rays(glam::Vec2::new(w as f32, h as f32)).row_line(y));
             let mut row = RowFaces::default();
-            caster.row_faces(0, &line, Some((&extents, y as f32 + 0.5)), &mut row);
+            caster.row_faces(0, &line, Some((&screen, y)), &mut row);
             prop_assert!(row.active);
-            for x0 in (0..w).step_by(8) {
-                eight_as_one_by_one(&caster, &line, x0, &row)?;
+            for block in 0..w as usize / 8 {
+                eight_as_one_by_one(&caster, &line, block, &row)?;
             }
         }
     }
@@ -779,7 +748,7 @@ mod tests {
             radii in (prop_oneof![0.0f32..2.0, Just(0.0f32), Just(1.0f32)], prop_oneof![0.0f32..2.0, Just(1.0f32)]),
             normals in prop::collection::vec(vector(-1.0..1.0), 8..24),
             line in (vector(-1.5..1.5), vector(-0.05..0.05), vector(-2.0..2.0), vector(-0.05..0.05)),
-            x0 in 0u32..24,
+            block in 0usize..3,
             flat in 0usize..6,
         ) {
             let (origin, origin_step, mut dir, mut dir_step) = line;
@@ -799,7 +768,7 @@ mod tests {
             let primitive = Primitive { shape, transform: Affine3A::IDENTITY, color: None, source: 0..0 };
             let caster = CsgCaster::new(&CsgSolid { primitives: vec![primitive], tree: Some(CsgTree::Leaf(0)) });
             let line = RowLine { origin, origin_step, dir, dir_step };
-            eight_as_one_by_one(&caster, &line, x0, &RowFaces::default())?;
+            eight_as_one_by_one(&caster, &line, block, &RowFaces::default())?;
         }
     }
 }

@@ -61,7 +61,7 @@ use rayon::iter::IndexedParallelIterator;
 use rayon::prelude::*;
 
 use crate::raytrace::csg::{
-    Booleans, Crossing, CsgCaster, FaceExtent, Hit, Interval, IntervalLanes, LeafSpans, RowFaces, SpanScratch,
+    Booleans, Crossing, CsgCaster, FacesOnScreen, Hit, Interval, IntervalLanes, LeafSpans, RowFaces, SpanScratch,
 };
 use crate::scene::camera::PixelRays;
 use crate::scene::camera::RowLine;
@@ -348,7 +348,9 @@ struct FrameWalk<'a> {
     /// top scanline.
     entry: Vec<(usize, Extent)>,
     caster: CsgCaster,
-    face_extents: Vec<FaceExtents>,
+    /// Per primitive, where its faces show ([`CsgCaster::faces_on_screen`]:
+    /// polyhedra of many planes).
+    faces: Vec<Option<FacesOnScreen>>,
     rays: PixelRays,
     /// Along a row line's direction (unit component along the view axis),
     /// the near plane lies at t = near, under either projection.
@@ -367,10 +369,12 @@ impl<'a> FrameWalk<'a> {
             outlines.iter().enumerate().filter_map(|(i, o)| o.as_ref().map(|o| (i, o.rows))).collect();
         entry.sort_by_key(|(_, e)| e.y0);
         let caster = CsgCaster::without_bvh(solid);
-        let face_extents = (0..solid.primitives.len())
-            .map(|i| caster.face_extents(i, |p| screen_point(p, vp, (width, height))))
+        let faces = (0..solid.primitives.len())
+            .map(|i| {
+                caster.faces_on_screen(i, |p| screen_point(p, vp, (width, height)), (width as usize, height as usize))
+            })
             .collect();
-        FrameWalk { walker, outlines, entry, caster, face_extents, rays, near: camera.near, width: width as usize }
+        FrameWalk { walker, outlines, entry, caster, faces, rays, near: camera.near, width: width as usize }
     }
 
     /// Scanline `y`, its y-occupancy list `occupied`, walked with `buffers`:
@@ -397,7 +401,7 @@ impl<'a> FrameWalk<'a> {
         // The row's rays, carried into each occupant's unit space once.
         let line = self.rays.row_line(y);
         ends.iter().for_each(|&(i, _, _)| lines[i] = caster.unit_line(i, &line));
-        blocks.begin_row(caster, ends.iter().map(|e| e.0), lines, (&self.face_extents, y as f32 + 0.5));
+        blocks.begin_row(caster, ends.iter().map(|e| e.0), lines, (&self.faces, y));
         let spans = RowSpans { blocks, caster, lines };
         match self.walker {
             RowWalker::Segments(walk) => {
@@ -444,10 +448,6 @@ impl<'a> YOccupancy<'a> {
         &self.occupied
     }
 }
-
-/// A many-planed polyhedron's faces' extents ([`CsgCaster::face_extents`];
-/// `None` for other primitives).
-type FaceExtents = Option<Vec<FaceExtent>>;
 
 /// One worker's buffers for walking scanlines: the row's hits (all `None`
 /// between rows), each occupant's row line, the occupancy counts, the
@@ -519,21 +519,20 @@ impl BlockSpans {
 
     /// A new scanline, its rays `lines` in each occupant's space: the
     /// occupants' lanes (of the row before) are stale, and their faces
-    /// the row can cross are found (`face_extents` holds
-    /// [`CsgCaster::face_extents`] per primitive, `y` is the scanline's
-    /// coordinate).
+    /// the row can cross are found (`faces` holds
+    /// [`CsgCaster::faces_on_screen`] per primitive, `y` is the scanline).
     fn begin_row(
         &mut self,
         caster: &CsgCaster,
         occupants: impl Iterator<Item = usize>,
         lines: &[RowLine],
-        (face_extents, y): (&[FaceExtents], f32),
+        (faces, y): (&[Option<FacesOnScreen>], usize),
     ) {
         let cached = self.cached.get_mut();
         for i in occupants {
             cached[i].0 = usize::MAX;
-            let extents = face_extents[i].as_deref().map(|e| (e, y));
-            caster.row_faces(i, &lines[i], extents, &mut self.faces[i]);
+            let screen = faces[i].as_ref().map(|s| (s, y));
+            caster.row_faces(i, &lines[i], screen, &mut self.faces[i]);
         }
     }
 
@@ -565,7 +564,7 @@ impl BlockSpans {
     /// pixels, not inlined.
     #[inline(never)]
     fn fill(caster: &CsgCaster, i: usize, unit: &RowLine, block: usize, faces: &RowFaces, lanes: &mut IntervalLanes) {
-        caster.spans_on_eight(i, unit, (block * 8) as f32, faces, lanes);
+        caster.spans_on_eight(i, unit, block, faces, lanes);
     }
 }
 

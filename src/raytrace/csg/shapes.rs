@@ -176,7 +176,7 @@ pub(super) struct PlaneLanes {
     normal: [Vec<f32x8>; 3],
     w: Vec<f32x8>,
     /// Its faces' corners, for leaving out faces a scanline cannot cross.
-    pub(super) corners: Option<super::lanes::FaceCorners>,
+    pub(super) corners: Option<super::faces::FaceCorners>,
 }
 
 impl PlaneLanes {
@@ -193,7 +193,7 @@ impl PlaneLanes {
         PlaneLanes {
             normal: [lanes(|p| p.x, 0.0), lanes(|p| p.y, 0.0), lanes(|p| p.z, 0.0)],
             w: lanes(|p| p.w, 1.0),
-            corners: super::lanes::FaceCorners::new(poly),
+            corners: super::faces::FaceCorners::new(poly),
         }
     }
 
