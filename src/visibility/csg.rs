@@ -68,6 +68,7 @@ use crate::scene::camera::RowLine;
 use crate::scene::csg::{CsgSolid, Primitive, Shape};
 use crate::scene::{Camera, Object, Scene};
 use crate::visibility::block::BlockOrder;
+use crate::visibility::bounds::BoundingLeaves;
 use crate::visibility::coherence::{self, PixelCoherence};
 use crate::visibility::horizon::Horizon;
 use crate::visibility::occupancy::{OccupancyTree, Occupied};
@@ -344,6 +345,9 @@ fn scan_bands<B: Send>(
 struct FrameWalk<'a> {
     walker: &'a RowWalker,
     outlines: Vec<Option<Outline>>,
+    /// Per primitive, the leaves outside whose outlines it cannot change
+    /// the solid ([`super::bounds`]).
+    bounds: BoundingLeaves,
     /// The y-entry table (procedure 1): the primitives that show at all, by
     /// top scanline.
     entry: Vec<(usize, Extent)>,
@@ -364,7 +368,11 @@ impl<'a> FrameWalk<'a> {
     fn new(solid: &CsgSolid, walker: &'a RowWalker, camera: &Camera, (width, height): (u32, u32)) -> Self {
         let vp = camera.view_projection(width as f32 / height as f32);
         let rays = camera.pixel_rays(Vec2::new(width as f32, height as f32));
-        let outlines: Vec<Option<Outline>> = solid.primitives.iter().map(|p| Outline::new(p, vp, &rays)).collect();
+        let mut outlines: Vec<Option<Outline>> = solid.primitives.iter().map(|p| Outline::new(p, vp, &rays)).collect();
+        let bounds = solid.tree.as_ref().map(|t| BoundingLeaves::new(t, outlines.len())).unwrap_or_default();
+        for i in (0..outlines.len()).filter(|&i| !bounds.of(i).is_empty()) {
+            outlines[i] = Outline::within(&outlines, i, &bounds);
+        }
         let mut entry: Vec<(usize, Extent)> =
             outlines.iter().enumerate().filter_map(|(i, o)| o.as_ref().map(|o| (i, o.rows))).collect();
         entry.sort_by_key(|(_, e)| e.y0);
@@ -374,7 +382,32 @@ impl<'a> FrameWalk<'a> {
                 caster.faces_on_screen(i, |p| screen_point(p, vp, (width, height)), (width as usize, height as usize))
             })
             .collect();
-        FrameWalk { walker, outlines, entry, caster, faces, rays, near: camera.near, width: width as usize }
+        FrameWalk { walker, outlines, bounds, entry, caster, faces, rays, near: camera.near, width: width as usize }
+    }
+
+    /// Procedure 2 on row `y` for each of the `occupied`: their ends, each
+    /// clipped to the ends of the leaves that bound it (`own` keeps every
+    /// occupant's unclipped ends, stamped with the row).
+    fn ends(
+        &self,
+        y: usize,
+        occupied: &[(usize, Extent)],
+        own: &mut [(usize, Option<(i64, i64)>)],
+    ) -> Vec<(usize, i64, i64)> {
+        for &(i, _) in occupied {
+            own[i] = (y, self.outlines[i].as_ref().and_then(|o| o.columns(y as i64)));
+        }
+        let clipped = |i: usize| {
+            let (mut a, mut b) = own[i].1?;
+            for &q in self.bounds.of(i) {
+                // A bound that does not occupy the row leaves nothing.
+                let (row, ends) = own[q as usize];
+                let (c, d) = ends.filter(|_| row == y)?;
+                (a, b) = (a.max(c), b.min(d));
+            }
+            (a <= b).then_some((i, a, b))
+        };
+        occupied.iter().filter_map(|&(i, _)| clipped(i)).collect()
     }
 
     /// Scanline `y`, its y-occupancy list `occupied`, walked with `buffers`:
@@ -386,13 +419,10 @@ impl<'a> FrameWalk<'a> {
         buffers: &mut RowBuffers,
         visit: impl FnOnce(&ScannedRow),
     ) {
-        let RowBuffers { row, lines, counts, scratch, blocks, coherence, order } = buffers;
+        let RowBuffers { row, lines, own_ends, counts, scratch, blocks, coherence, order } = buffers;
         let caster = &self.caster;
         // Procedure 2: each occupant's left and right ends on this scanline.
-        let ends: Vec<(usize, i64, i64)> = occupied
-            .iter()
-            .filter_map(|&(i, _)| self.outlines[i].as_ref()?.columns(y as i64).map(|(a, b)| (i, a, b)))
-            .collect();
+        let ends = self.ends(y, occupied, own_ends);
         // The columns the occupants may cover: the walk writes no other.
         debug_assert!(row.iter().all(Option::is_none), "row {y}: hits left from the row before");
         let w = self.width as i64;
@@ -458,6 +488,8 @@ impl<'a> YOccupancy<'a> {
 struct RowBuffers {
     row: Vec<Option<Hit>>,
     lines: Vec<RowLine>,
+    /// Per primitive, the row it last occupied and its unclipped ends there.
+    own_ends: Vec<(usize, Option<(i64, i64)>)>,
     counts: Occupied,
     scratch: SpanScratch,
     blocks: BlockSpans,
@@ -481,6 +513,9 @@ impl Lent {
         let mut b = SPARE_ROWS.with_borrow_mut(Option::take).unwrap_or_default();
         b.row.resize(width, None);
         b.lines.resize(primitives, RowLine::default());
+        // Rows of an earlier frame must not pass for this one's.
+        b.own_ends.clear();
+        b.own_ends.resize(primitives, (usize::MAX, None));
         if let RowWalker::Segments(walk) = walker {
             b.counts.fit(&walk.tree);
         }
@@ -830,6 +865,20 @@ impl Outline {
             }
         }
         Some(Outline { rows, ellipsoid, hull })
+    }
+
+    /// Primitive `i`'s outline among `outlines` with its rows and columns
+    /// narrowed to those of the leaves that `bounds` it; `None` where they
+    /// leave nothing (what [`FrameWalk::ends`] then clips on each row).
+    fn within(outlines: &[Option<Outline>], i: usize, bounds: &BoundingLeaves) -> Option<Outline> {
+        let mut own = outlines[i].clone()?;
+        for &q in bounds.of(i) {
+            let r = outlines[q as usize].as_ref()?.rows;
+            let e = &mut own.rows;
+            (e.x0, e.x1, e.y0, e.y1) = (e.x0.max(r.x0), e.x1.min(r.x1), e.y0.max(r.y0), e.y1.min(r.y1));
+        }
+        let e = own.rows;
+        (e.x0 <= e.x1 && e.y0 <= e.y1).then_some(own)
     }
 
     /// The columns the primitive may cover on row `y`.

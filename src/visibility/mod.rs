@@ -9,10 +9,12 @@
 //! surfaces of CSG solids by seed 003's scanline walk, over [`occupancy`] (its
 //! reference counts, in tree form) or [`pattern`] (its pattern matrix), with
 //! [`block`] (its reuse of an answer, a block of eight pixels at a time) and
-//! [`horizon`] (occupants wholly behind the surface left out of the booleans),
+//! [`horizon`] (occupants wholly behind the surface left out of the booleans)
+//! and [`bounds`] (a primitive's projection clipped to the leaves that bound it),
 //! or [`coherence`] (its reuse pixel by pixel, as the paper has it) on request.
 
 pub mod block;
+pub mod bounds;
 pub mod clip;
 pub mod coherence;
 pub mod csg;
