@@ -68,7 +68,7 @@ use crate::scene::camera::RowLine;
 use crate::scene::csg::{CsgSolid, Primitive, Shape};
 use crate::scene::{Camera, Object, Scene};
 use crate::visibility::block::BlockOrder;
-use crate::visibility::bounds::BoundingLeaves;
+use crate::visibility::bounds::{self, BoundingLeaves, PixelBox};
 use crate::visibility::coherence::{self, PixelCoherence};
 use crate::visibility::horizon::Horizon;
 use crate::visibility::occupancy::{OccupancyTree, Occupied};
@@ -89,6 +89,17 @@ struct Extent {
     x1: i64,
     y0: i64,
     y1: i64,
+}
+
+impl PixelBox for Extent {
+    fn meet(self, o: Extent) -> Option<Extent> {
+        let e = Extent { x0: self.x0.max(o.x0), x1: self.x1.min(o.x1), y0: self.y0.max(o.y0), y1: self.y1.min(o.y1) };
+        (e.x0 <= e.x1 && e.y0 <= e.y1).then_some(e)
+    }
+
+    fn join(self, o: Extent) -> Extent {
+        Extent { x0: self.x0.min(o.x0), x1: self.x1.max(o.x1), y0: self.y0.min(o.y0), y1: self.y1.max(o.y1) }
+    }
 }
 
 /// The visible surface of `solid` (in world space) at each pixel centre of a
@@ -370,8 +381,15 @@ impl<'a> FrameWalk<'a> {
         let rays = camera.pixel_rays(Vec2::new(width as f32, height as f32));
         let mut outlines: Vec<Option<Outline>> = solid.primitives.iter().map(|p| Outline::new(p, vp, &rays)).collect();
         let bounds = solid.tree.as_ref().map(|t| BoundingLeaves::new(t, outlines.len())).unwrap_or_default();
-        for i in (0..outlines.len()).filter(|&i| !bounds.of(i).is_empty()) {
-            outlines[i] = Outline::within(&outlines, i, &bounds);
+        if let Some(tree) = &solid.tree {
+            let mut boxes: Vec<Option<Extent>> = outlines.iter().map(|o| o.as_ref().map(|o| o.rows)).collect();
+            bounds::narrow(tree, &mut boxes);
+            for (o, b) in outlines.iter_mut().zip(boxes) {
+                match (o.as_mut(), b) {
+                    (Some(o), Some(b)) => o.rows = b,
+                    _ => *o = None,
+                }
+            }
         }
         let mut entry: Vec<(usize, Extent)> =
             outlines.iter().enumerate().filter_map(|(i, o)| o.as_ref().map(|o| (i, o.rows))).collect();
@@ -865,20 +883,6 @@ impl Outline {
             }
         }
         Some(Outline { rows, ellipsoid, hull })
-    }
-
-    /// Primitive `i`'s outline among `outlines` with its rows and columns
-    /// narrowed to those of the leaves that `bounds` it; `None` where they
-    /// leave nothing (what [`FrameWalk::ends`] then clips on each row).
-    fn within(outlines: &[Option<Outline>], i: usize, bounds: &BoundingLeaves) -> Option<Outline> {
-        let mut own = outlines[i].clone()?;
-        for &q in bounds.of(i) {
-            let r = outlines[q as usize].as_ref()?.rows;
-            let e = &mut own.rows;
-            (e.x0, e.x1, e.y0, e.y1) = (e.x0.max(r.x0), e.x1.min(r.x1), e.y0.max(r.y0), e.y1.min(r.y1));
-        }
-        let e = own.rows;
-        (e.x0 <= e.x1 && e.y0 <= e.y1).then_some(own)
     }
 
     /// The columns the primitive may cover on row `y`.
