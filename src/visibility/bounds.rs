@@ -37,6 +37,113 @@ use crate::scene::csg::CsgTree;
 /// primitive's ends on every scanline it occupies.
 pub const MOST_BOUNDS: usize = 2;
 
+/// What bounds a node of the tree: meets narrow it (an intersection is
+/// within all its operands), joins widen it (a union is within any).
+trait Bound: Clone {
+    /// No bound at all.
+    fn anywhere() -> Self;
+    /// Within both.
+    fn meet(&self, other: &Self) -> Self;
+    /// Within one or the other.
+    fn join(&self, other: &Self) -> Self;
+}
+
+/// One way of bounding the primitives of a tree ([`BoundingLeaves`] or the
+/// boxes of [`narrow`]), walked by [`bound_leaves`].
+trait Bounding {
+    /// What bounds a node.
+    type Bound: Bound;
+    /// What bounds primitive `p` as it stands.
+    fn own(&self, p: usize) -> Self::Bound;
+    /// Primitive `p` (found in one leaf only) matters only `within`: takes
+    /// note, and returns what bounds it now.
+    fn within(&mut self, p: usize, within: &Self::Bound) -> Self::Bound;
+}
+
+/// What bounds `tree`, from what bounds each of its primitives.
+fn bound_of<T: Bounding>(t: &T, tree: &CsgTree) -> T::Bound {
+    match tree {
+        CsgTree::Leaf(p) => Some(t.own(*p)),
+        CsgTree::Union(kids) => kids.iter().map(|k| bound_of(t, k)).reduce(|a, b| a.join(&b)),
+        CsgTree::Intersection(kids) => kids.iter().map(|k| bound_of(t, k)).reduce(|a, b| a.meet(&b)),
+        CsgTree::Difference(first, _) => Some(bound_of(t, first)),
+    }
+    .unwrap_or_else(T::Bound::anywhere)
+}
+
+/// Hands every primitive of `tree` found in one leaf (`once`) what bounds
+/// it there, the subtree mattering only `within`: an intersection's
+/// operands are within each other, a difference's cutters within the part
+/// they cut. Returns what bounds `tree` afterwards.
+fn bound_leaves<T: Bounding>(t: &mut T, tree: &CsgTree, within: &T::Bound, once: &[bool]) -> T::Bound {
+    match tree {
+        CsgTree::Leaf(p) if once[*p] => t.within(*p, within),
+        CsgTree::Leaf(p) => t.own(*p),
+        CsgTree::Union(kids) => kids
+            .iter()
+            .map(|k| bound_leaves(t, k, within, once))
+            .reduce(|a, b| a.join(&b))
+            .unwrap_or_else(T::Bound::anywhere),
+        CsgTree::Intersection(kids) => {
+            // Operand k matters within the others: those before it (as
+            // bounded) and those after it (as they are).
+            let mut after = vec![T::Bound::anywhere(); kids.len() + 1];
+            for (k, kid) in kids.iter().enumerate().rev() {
+                after[k] = after[k + 1].meet(&bound_of(t, kid));
+            }
+            let mut before = within.clone();
+            for (k, kid) in kids.iter().enumerate() {
+                let own = bound_leaves(t, kid, &before.meet(&after[k + 1]), once);
+                before = before.meet(&own);
+            }
+            before
+        }
+        CsgTree::Difference(first, cutters) => {
+            let part = within.meet(&bound_leaves(t, first, within, once));
+            cutters.iter().for_each(|c| _ = bound_leaves(t, c, &part, once));
+            part
+        }
+    }
+}
+
+/// Whether each of `primitives` primitives is found in exactly one leaf of
+/// `tree` (one found in more may matter wherever any of its places does).
+fn found_once(tree: &CsgTree, primitives: usize) -> Vec<bool> {
+    fn count(tree: &CsgTree, seen: &mut [u8]) {
+        match tree {
+            CsgTree::Leaf(p) => seen[*p] = seen[*p].saturating_add(1),
+            CsgTree::Union(kids) | CsgTree::Intersection(kids) => kids.iter().for_each(|k| count(k, seen)),
+            CsgTree::Difference(first, cutters) => {
+                count(first, seen);
+                cutters.iter().for_each(|k| count(k, seen));
+            }
+        }
+    }
+    let mut seen = vec![0u8; primitives];
+    count(tree, &mut seen);
+    seen.into_iter().map(|n| n == 1).collect()
+}
+
+/// Leaves that bound a node, innermost last (at most [`MOST_BOUNDS`]);
+/// none for a union (a list of leaves cannot say "within one or another").
+#[derive(Debug, Clone, Default)]
+struct LeafList(Vec<u32>);
+
+impl Bound for LeafList {
+    fn anywhere() -> Self {
+        LeafList(Vec::new())
+    }
+
+    fn meet(&self, other: &Self) -> Self {
+        let all: Vec<u32> = self.0.iter().chain(&other.0).copied().collect();
+        LeafList(all[all.len().saturating_sub(MOST_BOUNDS)..].to_vec())
+    }
+
+    fn join(&self, _: &Self) -> Self {
+        LeafList::anywhere()
+    }
+}
+
 /// Per primitive, the leaves (primitives) outside whose outlines it cannot
 /// change the solid.
 #[derive(Debug, Clone, Default)]
@@ -46,25 +153,33 @@ pub struct BoundingLeaves {
     leaves: Vec<u32>,
 }
 
+/// [`BoundingLeaves`] as they are found.
+struct FoundLeaves(Vec<LeafList>);
+
+impl Bounding for FoundLeaves {
+    type Bound = LeafList;
+
+    fn own(&self, p: usize) -> LeafList {
+        LeafList(vec![p as u32])
+    }
+
+    fn within(&mut self, p: usize, within: &LeafList) -> LeafList {
+        self.0[p] = LeafList(within.0.iter().copied().filter(|&q| q as usize != p).collect());
+        self.own(p)
+    }
+}
+
 impl BoundingLeaves {
-    /// The bounding leaves of each of `primitives` primitives of `tree`. A
-    /// primitive found in more than one leaf of the tree gets none (it may
-    /// matter wherever any of its places does).
+    /// The bounding leaves of each of `primitives` primitives of `tree` (none
+    /// for a primitive found in more than one leaf).
     #[must_use]
     pub fn new(tree: &CsgTree, primitives: usize) -> BoundingLeaves {
-        let mut found: Vec<Option<Vec<u32>>> = vec![None; primitives];
-        let mut twice = vec![false; primitives];
-        visit(tree, &mut Vec::new(), &mut |p, bounds| {
-            twice[p] |= found[p].is_some();
-            let own: Vec<u32> = bounds.iter().rev().copied().filter(|&q| q as usize != p).take(MOST_BOUNDS).collect();
-            found[p] = Some(own);
-        });
+        let mut found = FoundLeaves(vec![LeafList::default(); primitives]);
+        bound_leaves(&mut found, tree, &LeafList::anywhere(), &found_once(tree, primitives));
         let mut out = BoundingLeaves { start: Vec::with_capacity(primitives + 1), leaves: Vec::new() };
-        for (p, bounds) in found.into_iter().enumerate() {
+        for bounds in found.0 {
             out.start.push(out.leaves.len() as u32);
-            if !twice[p] {
-                out.leaves.extend(bounds.unwrap_or_default());
-            }
+            out.leaves.extend(bounds.0);
         }
         out.start.push(out.leaves.len() as u32);
         out
@@ -78,46 +193,6 @@ impl BoundingLeaves {
             _ => &[],
         }
     }
-}
-
-/// Calls `leaf(p, bounds)` for every leaf of `tree`, `bounds` the leaves that
-/// bound it (outermost first), `outer` those of the tree itself.
-fn visit(tree: &CsgTree, outer: &mut Vec<u32>, leaf: &mut impl FnMut(usize, &[u32])) {
-    match tree {
-        CsgTree::Leaf(p) => leaf(*p, outer),
-        CsgTree::Union(kids) => kids.iter().for_each(|k| visit(k, outer, leaf)),
-        CsgTree::Intersection(kids) => {
-            let each: Vec<Vec<u32>> = kids.iter().map(bounded_by).collect();
-            for (k, kid) in kids.iter().enumerate() {
-                let depth = outer.len();
-                let others = each.iter().enumerate().filter(|&(j, _)| j != k).flat_map(|(_, b)| b);
-                outer.extend(others.take(MOST_BOUNDS));
-                visit(kid, outer, leaf);
-                outer.truncate(depth);
-            }
-        }
-        CsgTree::Difference(first, cutters) => {
-            visit(first, outer, leaf);
-            let depth = outer.len();
-            outer.extend(bounded_by(first));
-            cutters.iter().for_each(|c| visit(c, outer, leaf));
-            outer.truncate(depth);
-        }
-    }
-}
-
-/// Leaves (at most [`MOST_BOUNDS`]) whose volumes contain the whole of
-/// `tree`: a leaf itself, an intersection's operands', a difference's first
-/// operand's; none for a union.
-fn bounded_by(tree: &CsgTree) -> Vec<u32> {
-    let mut out = match tree {
-        CsgTree::Leaf(p) => vec![*p as u32],
-        CsgTree::Union(_) => Vec::new(),
-        CsgTree::Intersection(kids) => kids.iter().flat_map(bounded_by).collect(),
-        CsgTree::Difference(first, _) => bounded_by(first),
-    };
-    out.truncate(MOST_BOUNDS);
-    out
 }
 
 /// A box of pixels (a primitive's or a node's reach on the screen), as
@@ -139,24 +214,49 @@ enum Reach<B> {
 }
 
 impl<B: PixelBox> Reach<B> {
-    fn meet(self, other: Reach<B>) -> Reach<B> {
-        match (self, other) {
+    fn of(b: Option<B>) -> Reach<B> {
+        b.map_or(Reach::Nowhere, Reach::Within)
+    }
+}
+
+impl<B: PixelBox> Bound for Reach<B> {
+    fn anywhere() -> Self {
+        Reach::Anywhere
+    }
+
+    fn meet(&self, other: &Self) -> Self {
+        match (*self, *other) {
             (Reach::Nowhere, _) | (_, Reach::Nowhere) => Reach::Nowhere,
             (Reach::Anywhere, r) | (r, Reach::Anywhere) => r,
-            (Reach::Within(a), Reach::Within(b)) => a.meet(b).map_or(Reach::Nowhere, Reach::Within),
+            (Reach::Within(a), Reach::Within(b)) => Reach::of(a.meet(b)),
         }
     }
 
-    fn join(self, other: Reach<B>) -> Reach<B> {
-        match (self, other) {
+    fn join(&self, other: &Self) -> Self {
+        match (*self, *other) {
             (Reach::Anywhere, _) | (_, Reach::Anywhere) => Reach::Anywhere,
             (Reach::Nowhere, r) | (r, Reach::Nowhere) => r,
             (Reach::Within(a), Reach::Within(b)) => Reach::Within(a.join(b)),
         }
     }
+}
 
-    fn of(b: Option<B>) -> Reach<B> {
-        b.map_or(Reach::Nowhere, Reach::Within)
+/// Each primitive's box of pixels, as [`narrow`] cuts them.
+struct Boxes<'a, B>(&'a mut [Option<B>]);
+
+impl<B: PixelBox> Bounding for Boxes<'_, B> {
+    type Bound = Reach<B>;
+
+    fn own(&self, p: usize) -> Reach<B> {
+        Reach::of(self.0[p])
+    }
+
+    fn within(&mut self, p: usize, within: &Reach<B>) -> Reach<B> {
+        self.0[p] = match self.own(p).meet(within) {
+            Reach::Within(b) => Some(b),
+            _ => None,
+        };
+        self.own(p)
     }
 }
 
@@ -169,68 +269,8 @@ impl<B: PixelBox> Reach<B> {
 /// boxes, drilled by long cylinders). A primitive found in more than one
 /// leaf is left as it is.
 pub fn narrow<B: PixelBox>(tree: &CsgTree, boxes: &mut [Option<B>]) {
-    let mut leaves = vec![0u8; boxes.len()];
-    count_leaves(tree, &mut leaves);
-    narrow_within(tree, Reach::Anywhere, boxes, &leaves);
-}
-
-/// How many leaves name each primitive (2 for two or more).
-fn count_leaves(tree: &CsgTree, leaves: &mut [u8]) {
-    match tree {
-        CsgTree::Leaf(p) => leaves[*p] = (leaves[*p] + 1).min(2),
-        CsgTree::Union(kids) | CsgTree::Intersection(kids) => kids.iter().for_each(|k| count_leaves(k, leaves)),
-        CsgTree::Difference(first, cutters) => {
-            count_leaves(first, leaves);
-            cutters.iter().for_each(|k| count_leaves(k, leaves));
-        }
-    }
-}
-
-/// Where `tree` may be non-empty, from its primitives' `boxes`.
-fn reach<B: PixelBox>(tree: &CsgTree, boxes: &[Option<B>]) -> Reach<B> {
-    match tree {
-        CsgTree::Leaf(p) => Reach::of(boxes[*p]),
-        CsgTree::Union(kids) => kids.iter().fold(Reach::Nowhere, |r, k| r.join(reach(k, boxes))),
-        CsgTree::Intersection(kids) => kids.iter().fold(Reach::Anywhere, |r, k| r.meet(reach(k, boxes))),
-        CsgTree::Difference(first, _) => reach(first, boxes),
-    }
-}
-
-/// [`narrow`] of the subtree `tree`, whose result matters only `within`;
-/// returns where the subtree may be non-empty afterwards.
-fn narrow_within<B: PixelBox>(tree: &CsgTree, within: Reach<B>, boxes: &mut [Option<B>], leaves: &[u8]) -> Reach<B> {
-    match tree {
-        CsgTree::Leaf(p) => {
-            if leaves[*p] == 1 {
-                boxes[*p] = match Reach::of(boxes[*p]).meet(within) {
-                    Reach::Within(b) => Some(b),
-                    _ => None,
-                };
-            }
-            Reach::of(boxes[*p])
-        }
-        CsgTree::Union(kids) => {
-            kids.iter().fold(Reach::Nowhere, |r, k| r.join(narrow_within(k, within, boxes, leaves)))
-        }
-        CsgTree::Intersection(kids) => {
-            // Operand k matters within the others: those before it (as
-            // narrowed) and those after it (as they are).
-            let mut after = vec![Reach::Anywhere; kids.len() + 1];
-            for (k, kid) in kids.iter().enumerate().rev() {
-                after[k] = after[k + 1].meet(reach(kid, boxes));
-            }
-            let mut before = within;
-            for (k, kid) in kids.iter().enumerate() {
-                before = before.meet(narrow_within(kid, before.meet(after[k + 1]), boxes, leaves));
-            }
-            before
-        }
-        CsgTree::Difference(first, cutters) => {
-            let part = narrow_within(first, within, boxes, leaves);
-            cutters.iter().for_each(|c| _ = narrow_within(c, part, boxes, leaves));
-            part
-        }
-    }
+    let once = found_once(tree, boxes.len());
+    bound_leaves(&mut Boxes(boxes), tree, &Reach::Anywhere, &once);
 }
 
 #[cfg(test)]
