@@ -316,6 +316,48 @@ fn reusing_the_answer_along_a_scanline_changes_no_surface() {
     assert!(covered > 60_000 && blocks_rounds > 40, "{covered} pixels covered, {blocks_rounds} rounds of blocks");
 }
 
+/// A union of primitives takes each pixel's nearest entry occupant by
+/// occupant along the scanline (a z-buffer; the default walk): the same
+/// surfaces, to the bit, as the booleans pixel by pixel, with twin primitives
+/// (exact ties: the one first in the file shows) and cameras inside a
+/// primitive (the rows where a ray starts inside go to the booleans).
+#[test]
+fn a_union_of_primitives_walked_as_a_z_buffer_finds_what_the_booleans_find() {
+    use kage::visibility::csg::{scan_solid_with, CsgMethod};
+    let mut rng = StdRng::seed_from_u64(23);
+    let (w, h) = (96u32, 64u32);
+    let (mut covered, mut twins_seen) = (0, 0);
+    for round in 0..120 {
+        let mut primitives: Vec<Primitive> = (0..rng.gen_range(2..12))
+            .map(|_| Primitive {
+                shape: random_shape(&mut rng),
+                transform: random_transform(&mut rng),
+                color: None,
+                source: 0..0,
+            })
+            .collect();
+        // A twin of one primitive, later in the file: every face of the pair ties.
+        let twin = rng.gen_range(0..primitives.len());
+        primitives.push(primitives[twin].clone());
+        let tree = CsgTree::Union((0..primitives.len()).map(CsgTree::Leaf).collect());
+        let solid = CsgSolid { primitives, tree: Some(tree) };
+        let camera = random_camera(&mut rng, round);
+        let each = scan_solid_with(&solid, &camera, w, h, CsgMethod::SegmentsEachPixel).unwrap();
+        let nearest = scan_solid_with(&solid, &camera, w, h, CsgMethod::Segments).unwrap();
+        for (k, (a, b)) in each.iter().zip(&nearest).enumerate() {
+            assert_eq!(a, b, "pixel ({}, {}) round {round}", k as u32 % w, k as u32 / w);
+            let last = solid.primitives.len() as u32 - 1;
+            twins_seen += usize::from(b.is_some_and(|c| c.primitive == twin as u32));
+            // (From inside, the first surface is an exit the full merge finds,
+            // whose ties are not ordered.)
+            let outside = round % 5 != 4;
+            assert!(!outside || b.is_none_or(|c| c.primitive != last), "round {round}: the later twin shows");
+        }
+        covered += each.iter().flatten().count();
+    }
+    assert!(covered > 60_000 && twins_seen > 5_000, "{covered} pixels covered, {twins_seen} of twins");
+}
+
 /// A cutter whose face leans through a solid's face by a few [`TIE`]s: the
 /// raw depths keep their order across the scanline while the cut's decision
 /// (the cutter's face counts as reaching the solid's within `TIE`) changes

@@ -98,6 +98,16 @@ impl Hit {
         self.primitive == other.primitive && self.face == other.face
     }
 
+    /// Whether this crossing comes before `other` along the ray: nearer, or
+    /// as near and of a primitive earlier in the file (a union's coplanar
+    /// faces show the first part's at every pixel, whatever order a walk
+    /// met them in).
+    #[inline]
+    #[must_use]
+    pub fn nearer_than(&self, other: &Hit) -> bool {
+        self.t < other.t || (self.t == other.t && self.primitive < other.primitive)
+    }
+
     /// This crossing with its hole-wall bit set to `cut` (what the booleans
     /// made of the same end of the same primitive at a neighbouring pixel).
     #[must_use]
@@ -444,8 +454,10 @@ impl CsgCaster {
     ///
     /// A union's operands are not merged when they need not be: where `t_min`
     /// lies outside every operand, the union's first surface is the nearest
-    /// of the operands' first entries (the first operand's on a tie, as the
-    /// merge would give it), so each operand is combined on its own and only
+    /// of the operands' first entries (on a tie, the one of the primitive
+    /// first in the file: [`Hit::nearer_than`]; the scanline walk meets a
+    /// union's operands in the order they came to occupy the row, the ray
+    /// caster in the tree's), so each operand is combined on its own and only
     /// its first entry kept. An operand holding `t_min` (the near plane inside
     /// the solid) sends the pixel to the full merge.
     pub fn first_hit_in_by<B: Booleans>(
@@ -464,7 +476,7 @@ impl CsgCaster {
             let mut nearest: Option<Hit> = None;
             for k in others {
                 match first_entry(k, leaf, t_min, scratch) {
-                    Ok(Some(h)) if nearest.is_none_or(|n| h.t < n.t) => nearest = Some(h),
+                    Ok(Some(h)) if nearest.is_none_or(|n| h.nearer_than(&n)) => nearest = Some(h),
                     Ok(_) => {}
                     Err(Inside) => return first_of_all(tree, leaf, t_min, scratch),
                 }

@@ -195,8 +195,10 @@ impl RowWalker {
                     _ => Reuse::Never,
                 };
                 let shape = OccupancyTree::new(tree, n);
+                let union = shape.is_union_of_leaves();
                 RowWalker::Segments(SegmentWalk {
-                    horizon: reuse == Reuse::Blocks && !shape.is_union_of_leaves(),
+                    horizon: reuse == Reuse::Blocks && !union,
+                    nearest_entries: reuse == Reuse::Blocks && union,
                     tree: shape,
                     cut_with: if reuse == Reuse::Pixels { coherence::cut_with(tree, n) } else { Vec::new() },
                     reuse,
@@ -220,6 +222,10 @@ struct SegmentWalk {
     /// anyway (where leaving some out saved nothing and the second passes
     /// at silhouettes cost: the paper's random spheres).
     horizon: bool,
+    /// Whether a row's pixels take the nearest entry of their occupants,
+    /// found occupant by occupant ([`RowSpans::nearest_entries`]): a union
+    /// of primitives, not pixel by pixel (the tests' oracle).
+    nearest_entries: bool,
 }
 
 /// How the segment walk reuses an answer along a scanline.
@@ -589,6 +595,20 @@ impl BlockSpans {
         }
     }
 
+    /// `read` of primitive `i`'s intervals at the eight pixels of `block` of
+    /// its row line `unit`.
+    #[inline(always)]
+    fn lanes<R>(
+        &self,
+        (caster, i, unit): (&CsgCaster, usize, &RowLine),
+        block: usize,
+        read: impl FnOnce(&IntervalLanes) -> R,
+    ) -> R {
+        let mut cached = self.cached.borrow_mut();
+        self.fill_if_stale(&mut cached[i], caster, i, unit, block);
+        read(&cached[i].1)
+    }
+
     /// Primitive `i`'s interval at pixel `x` of its row line `unit`.
     #[inline(always)]
     fn span(&self, caster: &CsgCaster, i: usize, unit: &RowLine, x: usize) -> Option<Interval> {
@@ -630,6 +650,46 @@ struct RowSpans<'a> {
 }
 
 impl RowSpans<'_> {
+    /// A union of primitives' row (the paper's Table 1): each pixel's
+    /// nearest entry beyond `near` over the occupants `ends`, found occupant
+    /// by occupant a block of eight pixels at a time, as a z-buffer would
+    /// (seed 003 §5.2's nearest surface over the segments, each segment one
+    /// primitive; what the booleans give a union, ties included:
+    /// [`Hit::nearer_than`]). `false`, the row half written,
+    /// where a ray starts inside an occupant: the union's first surface
+    /// there may be an exit, which the booleans find.
+    fn nearest_entries(&self, ends: &[(usize, i64, i64)], near: f32, row: &mut [Option<Hit>]) -> bool {
+        let last = row.len() as i64 - 1;
+        for &(i, a, b) in ends {
+            let (a, b) = (a.max(0), b.min(last));
+            if a > b {
+                continue;
+            }
+            let (a, b) = (a as usize, b as usize);
+            let primitive = (self.caster, i, &self.lines[i]);
+            for block in a / 8..=b / 8 {
+                let pixels = a.max(block * 8)..=b.min(block * 8 + 7);
+                let inside = self.blocks.lanes(primitive, block, |lanes| {
+                    for x in pixels {
+                        let Some(s) = lanes.get(x % 8) else { continue };
+                        if s.enter.t > near {
+                            if row[x].is_none_or(|h| s.enter.nearer_than(&h)) {
+                                row[x] = Some(s.enter);
+                            }
+                        } else if s.exit.t > near {
+                            return true;
+                        }
+                    }
+                    false
+                });
+                if inside {
+                    return false;
+                }
+            }
+        }
+        true
+    }
+
     /// Primitive `i`'s interval at pixel `x`.
     #[inline(always)]
     fn at(&self, i: usize, x: usize) -> Option<Interval> {
@@ -757,6 +817,12 @@ fn scan_row(
     near: f32,
     (row, scratch, (coherence, order)): (&mut [Option<Hit>], &mut SpanScratch, (&mut PixelCoherence, &mut BlockOrder)),
 ) {
+    if walk.nearest_entries {
+        if spans.nearest_entries(ends, near, row) {
+            return;
+        }
+        row.fill(None);
+    }
     let tree = &walk.tree;
     let (entry, exit) = x_order(ends.iter().copied());
     let (mut next_in, mut next_out) = (0, 0);
