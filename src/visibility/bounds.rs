@@ -126,17 +126,40 @@ fn found_once(tree: &CsgTree, primitives: usize) -> Vec<bool> {
 
 /// Leaves that bound a node, innermost last (at most [`MOST_BOUNDS`]);
 /// none for a union (a list of leaves cannot say "within one or another").
-#[derive(Debug, Clone, Default)]
-struct LeafList(Vec<u32>);
+#[derive(Debug, Clone, Copy, Default)]
+struct LeafList {
+    leaves: [u32; MOST_BOUNDS],
+    len: usize,
+}
+
+impl LeafList {
+    fn of(p: usize) -> LeafList {
+        LeafList::anywhere().with(p as u32)
+    }
+
+    /// These and `q`, the oldest dropped past [`MOST_BOUNDS`].
+    fn with(mut self, q: u32) -> LeafList {
+        if self.len == MOST_BOUNDS {
+            self.leaves.rotate_left(1);
+            self.len -= 1;
+        }
+        self.leaves[self.len] = q;
+        self.len += 1;
+        self
+    }
+
+    fn leaves(&self) -> &[u32] {
+        &self.leaves[..self.len]
+    }
+}
 
 impl Bound for LeafList {
     fn anywhere() -> Self {
-        LeafList(Vec::new())
+        LeafList { leaves: [0; MOST_BOUNDS], len: 0 }
     }
 
     fn meet(&self, other: &Self) -> Self {
-        let all: Vec<u32> = self.0.iter().chain(&other.0).copied().collect();
-        LeafList(all[all.len().saturating_sub(MOST_BOUNDS)..].to_vec())
+        other.leaves().iter().fold(*self, |list, &q| list.with(q))
     }
 
     fn join(&self, _: &Self) -> Self {
@@ -160,11 +183,12 @@ impl Bounding for FoundLeaves {
     type Bound = LeafList;
 
     fn own(&self, p: usize) -> LeafList {
-        LeafList(vec![p as u32])
+        LeafList::of(p)
     }
 
     fn within(&mut self, p: usize, within: &LeafList) -> LeafList {
-        self.0[p] = LeafList(within.0.iter().copied().filter(|&q| q as usize != p).collect());
+        let others = within.leaves().iter().filter(|&&q| q as usize != p);
+        self.0[p] = others.fold(LeafList::anywhere(), |list, &q| list.with(q));
         self.own(p)
     }
 }
@@ -179,7 +203,7 @@ impl BoundingLeaves {
         let mut out = BoundingLeaves { start: Vec::with_capacity(primitives + 1), leaves: Vec::new() };
         for bounds in found.0 {
             out.start.push(out.leaves.len() as u32);
-            out.leaves.extend(bounds.0);
+            out.leaves.extend_from_slice(bounds.leaves());
         }
         out.start.push(out.leaves.len() as u32);
         out

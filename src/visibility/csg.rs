@@ -917,9 +917,9 @@ struct EllipsoidView {
 impl Outline {
     fn new(p: &Primitive, vp: Mat4, rays: &PixelRays) -> Option<Outline> {
         let (width, height) = (rays.size.x as u32, rays.size.y as u32);
-        let points = outline_points(p);
-        let mut rows = extent(&points, vp, width, height)?;
-        let hull = projected_hull(&points, vp, rays.size.as_dvec2()).unwrap_or_default();
+        let clip: Vec<Vec4> = outline_points(p).into_iter().map(|q| vp * q.extend(1.0)).collect();
+        let mut rows = extent(&clip, width, height)?;
+        let hull = projected_hull(&clip, rays.size.as_dvec2()).unwrap_or_default();
         let ellipsoid = (p.shape == Shape::Sphere && !rays.ortho)
             .then(|| {
                 let to_unit = p.transform.inverse();
@@ -1047,11 +1047,11 @@ fn outline_points(p: &Primitive) -> Vec<Vec3> {
     }
 }
 
-/// The convex hull of `points` projected to pixel coordinates of a `size`
-/// image (Andrew's monotone chain), or `None` when a point lies at or behind
-/// the eye.
-fn projected_hull(points: &[Vec3], vp: Mat4, size: DVec2) -> Option<Vec<DVec2>> {
-    let mut px: Vec<DVec2> = points.iter().map(|p| pixel_of(vp * p.extend(1.0), size)).collect::<Option<_>>()?;
+/// The convex hull of points projected to pixel coordinates of a `size`
+/// image, given their clip-space positions `clip` (Andrew's monotone chain),
+/// or `None` when a point lies at or behind the eye.
+fn projected_hull(clip: &[Vec4], size: DVec2) -> Option<Vec<DVec2>> {
+    let mut px: Vec<DVec2> = clip.iter().map(|&c| pixel_of(c, size)).collect::<Option<_>>()?;
     px.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
     px.dedup();
     if px.len() < 3 {
@@ -1059,9 +1059,11 @@ fn projected_hull(points: &[Vec3], vp: Mat4, size: DVec2) -> Option<Vec<DVec2>> 
     }
     let turn = |o: DVec2, a: DVec2, b: DVec2| (a - o).perp_dot(b - o);
     let mut hull: Vec<DVec2> = Vec::with_capacity(px.len() * 2);
-    for pass in [&px[..], &px.iter().rev().copied().collect::<Vec<_>>()[..]] {
+    // The lower chain left to right, then the upper chain back.
+    for pass in 0..2 {
         let start = hull.len();
-        for &p in pass {
+        for k in 0..px.len() {
+            let p = px[if pass == 0 { k } else { px.len() - 1 - k }];
             while hull.len() >= start + 2 && turn(hull[hull.len() - 2], hull[hull.len() - 1], p) <= 0.0 {
                 hull.pop();
             }
@@ -1088,17 +1090,17 @@ fn hull_row(hull: &[DVec2], y: f64) -> Option<(f64, f64)> {
     (lo <= hi).then_some((lo, hi))
 }
 
-/// The pixels whose centres the projection of `points` can cover; the whole
-/// image if some point lies at or behind the eye; `None` if off screen or all
-/// behind the eye (the points' hull then lies in the half-space behind it).
-fn extent(points: &[Vec3], vp: Mat4, width: u32, height: u32) -> Option<Extent> {
+/// The pixels whose centres the projection of points (their clip-space
+/// positions `clip`) can cover; the whole image if some point lies at or
+/// behind the eye; `None` if off screen or all behind the eye (the points'
+/// hull then lies in the half-space behind it).
+fn extent(clip: &[Vec4], width: u32, height: u32) -> Option<Extent> {
     let size = DVec2::new(f64::from(width), f64::from(height));
-    let clip: Vec<Vec4> = points.iter().map(|p| vp * p.extend(1.0)).collect();
     if clip.iter().all(|c| c.w <= 0.0) {
         return None; // wholly behind the eye (a cube-map face looking away)
     }
     let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
-    for c in clip {
+    for &c in clip {
         let Some(px) = pixel_of(c, size) else {
             return Some(Extent { x0: 0, x1: i64::from(width) - 1, y0: 0, y1: i64::from(height) - 1 });
         };
