@@ -317,7 +317,8 @@ fn reusing_the_answer_along_a_scanline_changes_no_surface() {
 }
 
 /// A union of primitives takes each pixel's nearest entry occupant by
-/// occupant along the scanline (a z-buffer; the default walk): the same
+/// occupant along the scanline (a z-buffer, nearest occupants first, a block
+/// left unsolved for one wholly behind what it shows; the default walk): the same
 /// surfaces, to the bit, as the booleans pixel by pixel, with twin primitives
 /// (exact ties: the one first in the file shows) and cameras inside a
 /// primitive (the rows where a ray starts inside go to the booleans).

@@ -78,6 +78,11 @@ use crate::visibility::{ItemId, VisibilityBuffer};
 /// Rows scanned by one worker in turn.
 const BAND_ROWS: usize = 16;
 
+/// Relative depth by which a primitive must lie behind a pixel's surface
+/// for the union's z-buffer to leave it unsolved there (far above the
+/// rounding of a computed interval).
+const DEPTH_MARGIN: f32 = 1e-4;
+
 /// How far (in pixels) an exact extent is widened, so that rounding never drops
 /// a pixel whose ray grazes the primitive.
 const ROUNDING_PX: f64 = 1e-3;
@@ -434,6 +439,20 @@ impl<'a> FrameWalk<'a> {
         occupied.iter().filter_map(|&(i, _)| clipped(i)).collect()
     }
 
+    /// A union's row by [`RowSpans::nearest_entries`], the occupants `ends`
+    /// taken nearest first; `false`, the row left empty, where the booleans
+    /// must find it.
+    fn nearest_entries(&self, ends: &[(usize, i64, i64)], spans: &RowSpans, row: &mut [Option<Hit>]) -> bool {
+        let nearest = |i: usize| self.outlines[i].as_ref().map_or(f32::MIN, |o| o.nearest);
+        let mut by_depth: Vec<_> = ends.iter().map(|&(i, a, b)| (i, a, b, nearest(i))).collect();
+        by_depth.sort_unstable_by(|p, q| p.3.total_cmp(&q.3));
+        let found = spans.nearest_entries(&by_depth, self.near, row);
+        if !found {
+            row.fill(None);
+        }
+        found
+    }
+
     /// Scanline `y`, its y-occupancy list `occupied`, walked with `buffers`:
     /// `visit` is handed the row's hits.
     fn walk_row(
@@ -459,8 +478,10 @@ impl<'a> FrameWalk<'a> {
         let spans = RowSpans { blocks, caster, lines };
         match self.walker {
             RowWalker::Segments(walk) => {
-                let reuse = (&mut *coherence, &mut *order);
-                scan_row(caster, (walk, counts), &ends, &spans, self.near, (row, scratch, reuse));
+                if !(walk.nearest_entries && self.nearest_entries(&ends, &spans, row)) {
+                    let reuse = (&mut *coherence, &mut *order);
+                    scan_row(caster, (walk, counts), &ends, &spans, self.near, (row, scratch, reuse));
+                }
             }
             RowWalker::Pattern(matrix) => {
                 matrix.walk_row(caster, &ends, &|i, x| blocks.span(caster, i, &lines[i], x), self.near, row);
@@ -655,20 +676,29 @@ impl RowSpans<'_> {
     /// by occupant a block of eight pixels at a time, as a z-buffer would
     /// (seed 003 §5.2's nearest surface over the segments, each segment one
     /// primitive; what the booleans give a union, ties included:
-    /// [`Hit::nearer_than`]). `false`, the row half written,
+    /// [`Hit::nearer_than`]), nearest occupants first (`ends` holds each
+    /// one's least depth), so that a block the row already shows nearer
+    /// surfaces at is not solved for the ones behind. `false`, the row half written,
     /// where a ray starts inside an occupant: the union's first surface
     /// there may be an exit, which the booleans find.
-    fn nearest_entries(&self, ends: &[(usize, i64, i64)], near: f32, row: &mut [Option<Hit>]) -> bool {
+    fn nearest_entries(&self, ends: &[(usize, i64, i64, f32)], near: f32, row: &mut [Option<Hit>]) -> bool {
         let last = row.len() as i64 - 1;
-        for &(i, a, b) in ends {
+        for &(i, a, b, nearest) in ends {
             let (a, b) = (a.max(0), b.min(last));
             if a > b {
                 continue;
             }
             let (a, b) = (a as usize, b as usize);
+            // A block whose pixels all hold a surface nearer than any point
+            // of the primitive (by a margin over the lanes' rounding) keeps
+            // them unread; not where the near plane may cut the primitive.
+            let behind = if nearest > near * (1.0 + DEPTH_MARGIN) { nearest * (1.0 - DEPTH_MARGIN) } else { f32::MIN };
             let primitive = (self.caster, i, &self.lines[i]);
             for block in a / 8..=b / 8 {
                 let pixels = a.max(block * 8)..=b.min(block * 8 + 7);
+                if row[pixels.clone()].iter().all(|h| h.is_some_and(|h| h.t < behind)) {
+                    continue;
+                }
                 let inside = self.blocks.lanes(primitive, block, |lanes| {
                     for x in pixels {
                         let Some(s) = lanes.get(x % 8) else { continue };
@@ -817,12 +847,6 @@ fn scan_row(
     near: f32,
     (row, scratch, (coherence, order)): (&mut [Option<Hit>], &mut SpanScratch, (&mut PixelCoherence, &mut BlockOrder)),
 ) {
-    if walk.nearest_entries {
-        if spans.nearest_entries(ends, near, row) {
-            return;
-        }
-        row.fill(None);
-    }
     let tree = &walk.tree;
     let (entry, exit) = x_order(ends.iter().copied());
     let (mut next_in, mut next_out) = (0, 0);
@@ -897,6 +921,9 @@ struct Outline {
     /// corners of a convex solid around the primitive, when all lie in front of
     /// the eye: a polyhedron's own (exact), a frustum's circumscribed prism's.
     hull: Vec<DVec2>,
+    /// The least distance along the view axis of those corners: no ray meets
+    /// the primitive nearer (a row line's `t` counts that distance).
+    nearest: f32,
 }
 
 /// An ellipsoid `{M·q + c : |q| ≤ 1}` seen from an eye outside it, in the unit
@@ -917,7 +944,10 @@ struct EllipsoidView {
 impl Outline {
     fn new(p: &Primitive, vp: Mat4, rays: &PixelRays) -> Option<Outline> {
         let (width, height) = (rays.size.x as u32, rays.size.y as u32);
-        let clip: Vec<Vec4> = outline_points(p).into_iter().map(|q| vp * q.extend(1.0)).collect();
+        let points = outline_points(p);
+        let depth = |q: &Vec3| (*q - rays.origin).dot(rays.forward) / rays.forward.length_squared();
+        let nearest = points.iter().map(depth).fold(f32::INFINITY, f32::min);
+        let clip: Vec<Vec4> = points.into_iter().map(|q| vp * q.extend(1.0)).collect();
         let mut rows = extent(&clip, width, height)?;
         let hull = projected_hull(&clip, rays.size.as_dvec2()).unwrap_or_default();
         let ellipsoid = (p.shape == Shape::Sphere && !rays.ortho)
@@ -948,7 +978,7 @@ impl Outline {
                 return None;
             }
         }
-        Some(Outline { rows, ellipsoid, hull })
+        Some(Outline { rows, ellipsoid, hull, nearest })
     }
 
     /// The columns the primitive may cover on row `y`.
