@@ -45,9 +45,13 @@ fn random_transform(rng: &mut StdRng) -> Affine3A {
     Affine3A::from_mat3_translation(rotation * shear * scale, offset)
 }
 
+fn random_primitive(rng: &mut StdRng) -> Primitive {
+    Primitive { shape: random_shape(rng), transform: random_transform(rng), color: None, source: 0..0 }
+}
+
 fn random_tree(rng: &mut StdRng, prims: &mut Vec<Primitive>, depth: u32) -> CsgTree {
     if depth == 0 || rng.gen_bool(0.3) {
-        prims.push(Primitive { shape: random_shape(rng), transform: random_transform(rng), color: None, source: 0..0 });
+        prims.push(random_primitive(rng));
         return CsgTree::Leaf(prims.len() - 1);
     }
     let kids: Vec<CsgTree> = (0..rng.gen_range(2..4)).map(|_| random_tree(rng, prims, depth - 1)).collect();
@@ -329,14 +333,7 @@ fn a_union_of_primitives_walked_as_a_z_buffer_finds_what_the_booleans_find() {
     let (w, h) = (96u32, 64u32);
     let (mut covered, mut twins_seen) = (0, 0);
     for round in 0..120 {
-        let mut primitives: Vec<Primitive> = (0..rng.gen_range(2..12))
-            .map(|_| Primitive {
-                shape: random_shape(&mut rng),
-                transform: random_transform(&mut rng),
-                color: None,
-                source: 0..0,
-            })
-            .collect();
+        let mut primitives: Vec<Primitive> = (0..rng.gen_range(2..12)).map(|_| random_primitive(&mut rng)).collect();
         // A twin of one primitive, later in the file: every face of the pair ties.
         let twin = rng.gen_range(0..primitives.len());
         primitives.push(primitives[twin].clone());
