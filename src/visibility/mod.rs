@@ -20,6 +20,7 @@ pub mod coherence;
 pub mod csg;
 pub mod horizon;
 pub mod occupancy;
+mod outline;
 pub mod pattern;
 pub mod raster;
 pub mod scan;
