@@ -6,12 +6,13 @@
 //! Stages, one file each: [`clip`] (homogeneous clipping), [`scan`] (exact
 //! fixed-point DDA scan conversion, top-left rule) and [`raster`] (projection,
 //! binning into bands and the band-parallel z-buffer). [`csg`] finds the visible
-//! surfaces of CSG solids by seed 003's scanline walk, over [`occupancy`] (its
-//! reference counts, in tree form) or [`pattern`] (its pattern matrix), with
-//! [`block`] (its reuse of an answer, a block of eight pixels at a time) and
-//! [`horizon`] (occupants wholly behind the surface left out of the booleans)
-//! and [`bounds`] (a primitive's projection clipped to the leaves that bound it),
-//! or [`coherence`] (its reuse pixel by pixel, as the paper has it) on request.
+//! surfaces of CSG solids by seed 003's scanline walk, from each primitive's
+//! outline on the screen (`outline.rs`: its procedures 1 and 2) clipped by
+//! [`bounds`] (to the nodes that bound it), over [`occupancy`] (its reference
+//! counts, in tree form) or [`pattern`] (its pattern matrix), with [`block`]
+//! (its reuse of an answer, a block of eight pixels at a time) and [`horizon`]
+//! (occupants wholly behind the surface left out of the booleans), or
+//! [`coherence`] (its reuse pixel by pixel, as the paper has it) on request.
 
 pub mod block;
 pub mod bounds;
