@@ -653,11 +653,11 @@ impl RowSpans<'_> {
     /// by occupant a block of eight pixels at a time, as a z-buffer would
     /// (seed 003 §5.2's nearest surface over the segments, each segment one
     /// primitive; what the booleans give a union, ties included:
-    /// [`Hit::nearer_than`]), nearest occupants first (`ends` holds each
-    /// one's least depth), so that a block the row already shows nearer
-    /// surfaces at is not solved for the ones behind. `false`, the row half written,
-    /// where a ray starts inside an occupant: the union's first surface
-    /// there may be an exit, which the booleans find.
+    /// [`Hit::nearer_than`]). The occupants come nearest first, each with its
+    /// least depth, so that a block already showing nearer surfaces is not
+    /// solved for the ones behind. `false`, the row half written, where a ray
+    /// starts inside an occupant: the union's first surface there may be an
+    /// exit, which the booleans find.
     fn nearest_entries(&self, ends: &[(usize, i64, i64, f32)], near: f32, row: &mut [Option<Hit>]) -> bool {
         let last = row.len() as i64 - 1;
         for &(i, a, b, nearest) in ends {
