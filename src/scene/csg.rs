@@ -188,22 +188,112 @@ impl CsgTree {
         }
     }
 
-    /// Axis-aligned bounds of the tree given each primitive's: unions join
-    /// them, intersections overlap them, a difference keeps its first part's.
+    /// What bounds the tree, given what bounds each primitive (`leaf`):
+    /// unions join their operands' bounds, intersections meet them, a
+    /// difference keeps its first part's.
+    #[must_use]
+    pub fn bound<B: Bound>(&self, leaf: &impl Fn(usize) -> B) -> B {
+        match self {
+            CsgTree::Leaf(i) => leaf(*i),
+            CsgTree::Union(kids) => kids.iter().fold(B::nowhere(), |b, k| b.join(&k.bound(leaf))),
+            CsgTree::Intersection(kids) => kids.iter().fold(B::anywhere(), |b, k| b.meet(&k.bound(leaf))),
+            CsgTree::Difference(a, _) => a.bound(leaf),
+        }
+    }
+
+    /// Axis-aligned bounds of the tree given each primitive's ([`CsgTree::bound`]).
     /// `None` when the bounds show the tree empty.
     #[must_use]
     pub fn bounds(&self, leaf: &impl Fn(usize) -> (Vec3, Vec3)) -> Option<(Vec3, Vec3)> {
-        let join = |a: (Vec3, Vec3), b: (Vec3, Vec3)| (a.0.min(b.0), a.1.max(b.1));
-        let meet = |a: (Vec3, Vec3), b: (Vec3, Vec3)| (a.0.max(b.0), a.1.min(b.1));
-        let b = match self {
-            CsgTree::Leaf(i) => leaf(*i),
-            CsgTree::Union(kids) => kids.iter().filter_map(|k| k.bounds(leaf)).reduce(join)?,
-            CsgTree::Intersection(kids) => {
-                kids.iter().map(|k| k.bounds(leaf)).collect::<Option<Vec<_>>>()?.into_iter().reduce(meet)?
-            }
-            CsgTree::Difference(a, _) => a.bounds(leaf)?,
-        };
-        (b.0.cmple(b.1).all()).then_some(b)
+        match self.bound(&|i| Reach::Within(Aabb(leaf(i)))) {
+            Reach::Within(Aabb(b)) => Some(b),
+            Reach::Anywhere | Reach::Nowhere => None,
+        }
+    }
+}
+
+/// What bounds a node of a [`CsgTree`] ([`CsgTree::bound`]): meets narrow it
+/// (an intersection lies within all its operands), joins widen it (a union
+/// within any).
+pub trait Bound: Clone {
+    /// No bound at all (what meets start from).
+    fn anywhere() -> Self;
+    /// Nothing inside (what joins start from), or the nearest bound that
+    /// can say so.
+    fn nowhere() -> Self;
+    /// Within both.
+    #[must_use]
+    fn meet(&self, other: &Self) -> Self;
+    /// Within one or the other.
+    #[must_use]
+    fn join(&self, other: &Self) -> Self;
+}
+
+/// A box (of space, of pixels) as a [`Reach`] meets and joins them.
+pub trait BoxBound: Copy {
+    /// What lies in both, `None` if nothing.
+    fn meet(self, other: Self) -> Option<Self>;
+    /// A box holding both.
+    fn join(self, other: Self) -> Self;
+}
+
+/// Where a node of a tree may be non-empty: anywhere, within a box, or
+/// nowhere.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Reach<B> {
+    /// Anywhere.
+    Anywhere,
+    /// Within the box.
+    Within(B),
+    /// Nowhere.
+    Nowhere,
+}
+
+impl<B> Reach<B> {
+    /// Within `b`, or nowhere for `None`.
+    pub fn of(b: Option<B>) -> Reach<B> {
+        b.map_or(Reach::Nowhere, Reach::Within)
+    }
+}
+
+impl<B: BoxBound> Bound for Reach<B> {
+    fn anywhere() -> Self {
+        Reach::Anywhere
+    }
+
+    fn nowhere() -> Self {
+        Reach::Nowhere
+    }
+
+    fn meet(&self, other: &Self) -> Self {
+        match (*self, *other) {
+            (Reach::Nowhere, _) | (_, Reach::Nowhere) => Reach::Nowhere,
+            (Reach::Anywhere, r) | (r, Reach::Anywhere) => r,
+            (Reach::Within(a), Reach::Within(b)) => Reach::of(a.meet(b)),
+        }
+    }
+
+    fn join(&self, other: &Self) -> Self {
+        match (*self, *other) {
+            (Reach::Anywhere, _) | (_, Reach::Anywhere) => Reach::Anywhere,
+            (Reach::Nowhere, r) | (r, Reach::Nowhere) => r,
+            (Reach::Within(a), Reach::Within(b)) => Reach::Within(a.join(b)),
+        }
+    }
+}
+
+/// An axis-aligned box `(min, max)` of solid space.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Aabb((Vec3, Vec3));
+
+impl BoxBound for Aabb {
+    fn meet(self, Aabb(b): Aabb) -> Option<Aabb> {
+        let m = (self.0 .0.max(b.0), self.0 .1.min(b.1));
+        m.0.cmple(m.1).all().then_some(Aabb(m))
+    }
+
+    fn join(self, Aabb(b): Aabb) -> Aabb {
+        Aabb((self.0 .0.min(b.0), self.0 .1.max(b.1)))
     }
 }
 

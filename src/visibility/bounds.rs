@@ -30,23 +30,12 @@
 //! lose 60% of theirs but the frame only 4%: the ring's outline still takes
 //! in the axis, where they all meet.
 
-use crate::scene::csg::CsgTree;
+use crate::scene::csg::{Bound, BoxBound, CsgTree, Reach};
 
 /// Most bounding leaves kept per primitive (the innermost ones, nearest the
 /// primitive in the tree and usually the tightest): each costs a clip of the
 /// primitive's ends on every scanline it occupies.
 pub const MOST_BOUNDS: usize = 2;
-
-/// What bounds a node of the tree: meets narrow it (an intersection is
-/// within all its operands), joins widen it (a union is within any).
-trait Bound: Clone {
-    /// No bound at all.
-    fn anywhere() -> Self;
-    /// Within both.
-    fn meet(&self, other: &Self) -> Self;
-    /// Within one or the other.
-    fn join(&self, other: &Self) -> Self;
-}
 
 /// One way of bounding the primitives of a tree ([`BoundingLeaves`] or the
 /// boxes of [`narrow`]), walked by [`bound_leaves`].
@@ -60,17 +49,6 @@ trait Bounding {
     fn within(&mut self, p: usize, within: &Self::Bound) -> Self::Bound;
 }
 
-/// What bounds `tree`, from what bounds each of its primitives.
-fn bound_of<T: Bounding>(t: &T, tree: &CsgTree) -> T::Bound {
-    match tree {
-        CsgTree::Leaf(p) => Some(t.own(*p)),
-        CsgTree::Union(kids) => kids.iter().map(|k| bound_of(t, k)).reduce(|a, b| a.join(&b)),
-        CsgTree::Intersection(kids) => kids.iter().map(|k| bound_of(t, k)).reduce(|a, b| a.meet(&b)),
-        CsgTree::Difference(first, _) => Some(bound_of(t, first)),
-    }
-    .unwrap_or_else(T::Bound::anywhere)
-}
-
 /// Hands every primitive of `tree` found in one leaf (`once`) what bounds
 /// it there, the subtree mattering only `within`: an intersection's
 /// operands are within each other, a difference's cutters within the part
@@ -79,17 +57,13 @@ fn bound_leaves<T: Bounding>(t: &mut T, tree: &CsgTree, within: &T::Bound, once:
     match tree {
         CsgTree::Leaf(p) if once[*p] => t.within(*p, within),
         CsgTree::Leaf(p) => t.own(*p),
-        CsgTree::Union(kids) => kids
-            .iter()
-            .map(|k| bound_leaves(t, k, within, once))
-            .reduce(|a, b| a.join(&b))
-            .unwrap_or_else(T::Bound::anywhere),
+        CsgTree::Union(kids) => kids.iter().fold(T::Bound::nowhere(), |b, k| b.join(&bound_leaves(t, k, within, once))),
         CsgTree::Intersection(kids) => {
             // Operand k matters within the others: those before it (as
             // bounded) and those after it (as they are).
             let mut after = vec![T::Bound::anywhere(); kids.len() + 1];
             for (k, kid) in kids.iter().enumerate().rev() {
-                after[k] = after[k + 1].meet(&bound_of(t, kid));
+                after[k] = after[k + 1].meet(&kid.bound(&|p| t.own(p)));
             }
             let mut before = within.clone();
             for (k, kid) in kids.iter().enumerate() {
@@ -162,6 +136,11 @@ impl Bound for LeafList {
         other.leaves().iter().fold(*self, |list, &q| list.with(q))
     }
 
+    /// A list cannot say "nothing inside": no bound, which holds too.
+    fn nowhere() -> Self {
+        LeafList::anywhere()
+    }
+
     fn join(&self, _: &Self) -> Self {
         LeafList::anywhere()
     }
@@ -219,56 +198,10 @@ impl BoundingLeaves {
     }
 }
 
-/// A box of pixels (a primitive's or a node's reach on the screen), as
-/// [`narrow`] meets and joins them.
-pub trait PixelBox: Copy {
-    /// The pixels in both, `None` if none.
-    fn meet(self, other: Self) -> Option<Self>;
-    /// A box holding the pixels of both.
-    fn join(self, other: Self) -> Self;
-}
-
-/// Where a node of the tree may be non-empty: anywhere, within a box, or
-/// nowhere on the screen.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Reach<B> {
-    Anywhere,
-    Within(B),
-    Nowhere,
-}
-
-impl<B: PixelBox> Reach<B> {
-    fn of(b: Option<B>) -> Reach<B> {
-        b.map_or(Reach::Nowhere, Reach::Within)
-    }
-}
-
-impl<B: PixelBox> Bound for Reach<B> {
-    fn anywhere() -> Self {
-        Reach::Anywhere
-    }
-
-    fn meet(&self, other: &Self) -> Self {
-        match (*self, *other) {
-            (Reach::Nowhere, _) | (_, Reach::Nowhere) => Reach::Nowhere,
-            (Reach::Anywhere, r) | (r, Reach::Anywhere) => r,
-            (Reach::Within(a), Reach::Within(b)) => Reach::of(a.meet(b)),
-        }
-    }
-
-    fn join(&self, other: &Self) -> Self {
-        match (*self, *other) {
-            (Reach::Anywhere, _) | (_, Reach::Anywhere) => Reach::Anywhere,
-            (Reach::Nowhere, r) | (r, Reach::Nowhere) => r,
-            (Reach::Within(a), Reach::Within(b)) => Reach::Within(a.join(b)),
-        }
-    }
-}
-
 /// Each primitive's box of pixels, as [`narrow`] cuts them.
 struct Boxes<'a, B>(&'a mut [Option<B>]);
 
-impl<B: PixelBox> Bounding for Boxes<'_, B> {
+impl<B: BoxBound> Bounding for Boxes<'_, B> {
     type Bound = Reach<B>;
 
     fn own(&self, p: usize) -> Reach<B> {
@@ -292,7 +225,7 @@ impl<B: PixelBox> Bounding for Boxes<'_, B> {
 /// [`BoundingLeaves`] this reaches through unions (a part made of many
 /// boxes, drilled by long cylinders). A primitive found in more than one
 /// leaf is left as it is.
-pub fn narrow<B: PixelBox>(tree: &CsgTree, boxes: &mut [Option<B>]) {
+pub fn narrow<B: BoxBound>(tree: &CsgTree, boxes: &mut [Option<B>]) {
     let once = found_once(tree, boxes.len());
     bound_leaves(&mut Boxes(boxes), tree, &Reach::Anywhere, &once);
 }
@@ -340,7 +273,7 @@ mod tests {
     #[derive(Debug, Clone, Copy, PartialEq, Eq)]
     struct Span(i64, i64);
 
-    impl PixelBox for Span {
+    impl BoxBound for Span {
         fn meet(self, o: Span) -> Option<Span> {
             let s = Span(self.0.max(o.0), self.1.min(o.1));
             (s.0 <= s.1).then_some(s)

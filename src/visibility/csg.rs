@@ -368,8 +368,9 @@ impl<'a> FrameWalk<'a> {
         let vp = camera.view_projection(width as f32 / height as f32);
         let rays = camera.pixel_rays(Vec2::new(width as f32, height as f32));
         let mut outlines: Vec<Option<Outline>> = solid.primitives.iter().map(|p| Outline::new(p, vp, &rays)).collect();
-        let bounds = solid.tree.as_ref().map(|t| BoundingLeaves::new(t, outlines.len())).unwrap_or_default();
+        let mut bounds = BoundingLeaves::default();
         if let Some(tree) = &solid.tree {
+            bounds = BoundingLeaves::new(tree, outlines.len());
             let mut boxes: Vec<Option<Extent>> = outlines.iter().map(|o| o.as_ref().map(|o| o.rows)).collect();
             bounds::narrow(tree, &mut boxes);
             for (o, b) in outlines.iter_mut().zip(boxes) {

@@ -9,8 +9,7 @@
 use glam::{DVec2, Mat4, Vec2, Vec3, Vec4};
 
 use crate::scene::camera::PixelRays;
-use crate::scene::csg::{Primitive, Shape};
-use crate::visibility::bounds::PixelBox;
+use crate::scene::csg::{BoxBound, Primitive, Shape};
 
 /// How far (in pixels) an exact extent is widened, so that rounding never drops
 /// a pixel whose ray grazes the primitive.
@@ -25,7 +24,7 @@ pub(super) struct Extent {
     pub(super) y1: i64,
 }
 
-impl PixelBox for Extent {
+impl BoxBound for Extent {
     fn meet(self, o: Extent) -> Option<Extent> {
         let e = Extent { x0: self.x0.max(o.x0), x1: self.x1.min(o.x1), y0: self.y0.max(o.y0), y1: self.y1.min(o.y1) };
         (e.x0 <= e.x1 && e.y0 <= e.y1).then_some(e)
