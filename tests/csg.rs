@@ -356,6 +356,38 @@ fn a_union_of_primitives_walked_as_a_z_buffer_finds_what_the_booleans_find() {
     assert!(covered > 60_000 && twins_seen > 5_000, "{covered} pixels covered, {twins_seen} of twins");
 }
 
+/// A viewer's frame scanned again and again (other solids, other cameras,
+/// now and then an empty solid or another size) holds, after each scan, just
+/// what a fresh scan finds: what the last scan wrote and this one does not is
+/// cleared.
+#[test]
+fn a_frame_scanned_again_holds_only_the_last_scan() {
+    use kage::visibility::csg::{scan_solid_into, scan_solid_with, CsgMethod};
+    use kage::visibility::surface_frame::SurfaceFrame;
+    let mut rng = StdRng::seed_from_u64(29);
+    let mut frame = SurfaceFrame::new();
+    let (mut stale, mut covered) = (0, 0);
+    for round in 0..60 {
+        let (w, h) = if round % 13 == 12 { (40u32, 24u32) } else { (96, 64) };
+        let mut primitives = Vec::new();
+        let tree = random_tree(&mut rng, &mut primitives, 2);
+        let solid = CsgSolid { primitives, tree: (round % 11 != 10).then_some(tree) };
+        let camera = random_camera(&mut rng, round);
+        let before: Vec<bool> = frame.pixels().iter().map(Option::is_some).collect();
+        scan_solid_into(&solid, &camera, (w, h), CsgMethod::Segments, &mut frame).unwrap();
+        let fresh = scan_solid_with(&solid, &camera, w, h, CsgMethod::Segments).unwrap();
+        assert_eq!(frame.pixels().len(), fresh.len(), "round {round}");
+        for (k, (a, b)) in frame.pixels().iter().zip(&fresh).enumerate() {
+            assert_eq!(a, b, "pixel ({}, {}) round {round}", k as u32 % w, k as u32 / w);
+        }
+        let same_size = before.len() == fresh.len();
+        stale += fresh.iter().zip(&before).filter(|(f, &b)| same_size && b && f.is_none()).count();
+        covered += fresh.iter().flatten().count();
+    }
+    // Enough pixels held a surface before and none after for the test to bite.
+    assert!(stale > 10_000 && covered > 20_000, "{stale} pixels cleared, {covered} covered");
+}
+
 /// A cutter whose face leans through a solid's face by a few [`TIE`]s: the
 /// raw depths keep their order across the scanline while the cut's decision
 /// (the cutter's face counts as reaching the solid's within `TIE`) changes

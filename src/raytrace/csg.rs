@@ -404,6 +404,25 @@ impl CsgCaster {
         self.finish(hit, unit.at(x).at(hit.t))
     }
 
+    /// [`CsgCaster::crossing_on_line`] at the eight pixels `x0..x0 + 8` of
+    /// `unit`, each showing `hit`'s face (its primitive, face and hole-wall
+    /// bit) at its own `t`: in lanes, each the scalar crossing to the bit.
+    #[must_use]
+    pub fn crossings_on_eight(&self, hit: Hit, t: [f32; 8], unit: &RowLine, x0: usize) -> [Crossing; 8] {
+        let i = hit.primitive as usize;
+        let rays = lanes::RayLanes::new(unit, x0 as f32);
+        let shape = &self.solid.primitives[i].shape;
+        let cut = hit.cut();
+        let n = lanes::normals(shape, hit.face & !Hit::CUT, &rays, wide::f32x8::new(t), &self.frames[i].1)
+            .map(|c| if cut { -c } else { c }.to_array());
+        std::array::from_fn(|j| Crossing {
+            t: t[j],
+            normal: Vec3::new(n[0][j], n[1][j], n[2][j]),
+            primitive: hit.primitive,
+            cut,
+        })
+    }
+
     /// Whether `hit`'s face is flat (a polyhedron's plane, a frustum's cap):
     /// its normal is then the same at every point of it.
     #[must_use]
@@ -741,6 +760,52 @@ mod tests {
             prop_assert!(row.active);
             for block in 0..w as usize / 8 {
                 eight_as_one_by_one(&caster, &line, block, &row)?;
+            }
+        }
+    }
+
+    proptest! {
+        /// Eight crossings of one face given their normals in lanes
+        /// ([`CsgCaster::crossings_on_eight`]) are each pixel's alone
+        /// ([`CsgCaster::crossing_on_line`]) to the bit: spheres and frustums
+        /// (side and caps) under random turns and stretches, hole walls, rays
+        /// of a perspective or an orthographic row, zero normals included
+        /// (a cone's apex, `t` where the sphere's centre lies).
+        #[test]
+        fn crossings_in_lanes_are_each_pixel_alone(
+            kind in 0usize..3,
+            radii in (prop_oneof![0.0f32..2.0, Just(0.0f32)], 0.0f32..2.0),
+            turn in vector(-3.0..3.0),
+            stretch in vector(0.2..3.0),
+            line in (vector(-1.5..1.5), vector(-0.05..0.05), vector(-2.0..2.0), vector(-0.05..0.05)),
+            t in prop::array::uniform8(prop_oneof![0.0f32..4.0, Just(0.0f32)]),
+            block in 0usize..3,
+            cut in any::<bool>(),
+            from_centre in any::<bool>(),
+        ) {
+            let (shape, face) = match kind {
+                0 => (Shape::Sphere, 0),
+                k => (Shape::Frustum { bottom: radii.0, top: radii.1 }, if k == 1 { shapes::SIDE } else { shapes::TOP }),
+            };
+            let transform = Affine3A::from_scale_rotation_translation(
+                stretch,
+                glam::Quat::from_euler(glam::EulerRot::XYZ, turn.x, turn.y, turn.z),
+                turn,
+            );
+            let primitive = Primitive { shape, transform, color: None, source: 0..0 };
+            let caster = CsgCaster::new(&CsgSolid { primitives: vec![primitive], tree: Some(CsgTree::Leaf(0)) });
+            let (mut origin, mut origin_step, dir, dir_step) = line;
+            if from_centre {
+                // Rays from the unit shape's origin: at t = 0, a zero normal.
+                (origin, origin_step) = (Vec3::ZERO, Vec3::ZERO);
+            }
+            let line = RowLine { origin, origin_step, dir, dir_step };
+            let hit = Hit::new(0.0, 0, face).with_cut(cut);
+            let eight = caster.crossings_on_eight(hit, t, &line, block * 8);
+            let bits = |c: Crossing| (c.t.to_bits(), c.normal.to_array().map(f32::to_bits), c.primitive, c.cut);
+            for (j, lane) in eight.into_iter().enumerate() {
+                let one = caster.crossing_on_line(Hit { t: t[j], ..hit }, &line, (block * 8 + j) as f32);
+                prop_assert_eq!(bits(lane), bits(one), "pixel {}", j);
             }
         }
     }

@@ -225,6 +225,16 @@ impl RowLine {
     pub fn at(&self, x: f32) -> Ray {
         Ray { origin: self.origin + self.origin_step * x, dir: self.dir + self.dir_step * x }
     }
+
+    /// `at(x).dir.length()` of the eight columns `x0..x0 + 8`, in lanes (each
+    /// to the bit).
+    #[must_use]
+    pub fn dir_lengths(&self, x0: usize) -> [f32; 8] {
+        let x = wide::f32x8::new(std::array::from_fn(|j| (x0 + j) as f32));
+        let d: [wide::f32x8; 3] =
+            std::array::from_fn(|k| wide::f32x8::splat(self.dir[k]) + wide::f32x8::splat(self.dir_step[k]) * x);
+        (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt().to_array()
+    }
 }
 
 /// Rays through the pixels of one image (see [`Camera::pixel_rays`]).
@@ -306,6 +316,24 @@ mod tests {
                 assert!(ndc.z > 0.0 && ndc.z <= 1.0, "depth {}", ndc.z);
                 let t = c.distance_at_depth(&r, ndc.z);
                 assert!((t - 3.0).abs() < 1e-3, "{p:?} {pix}: depth {} back to distance {t}, not 3", ndc.z);
+            }
+        }
+    }
+
+    /// The lengths of eight columns' directions in lanes are each column's
+    /// `at(x).dir.length()` to the bit, on every row of both projections.
+    #[test]
+    fn eight_direction_lengths_are_each_columns() {
+        let size = Vec2::new(100.0, 30.0);
+        for p in [Projection::Perspective { fov_y_deg: 50.0 }, Projection::Orthographic { height: 4.0 }] {
+            let rays = cam(p).pixel_rays(size);
+            for y in 0..30 {
+                let line = rays.row_line(y);
+                for x0 in (0..100).step_by(8) {
+                    let lanes = line.dir_lengths(x0).map(f32::to_bits);
+                    let one: [u32; 8] = std::array::from_fn(|j| line.at((x0 + j) as f32).dir.length().to_bits());
+                    assert_eq!(lanes, one, "{p:?} row {y} columns {x0}..");
+                }
             }
         }
     }

@@ -74,6 +74,7 @@ use crate::visibility::horizon::Horizon;
 use crate::visibility::occupancy::{OccupancyTree, Occupied};
 use crate::visibility::outline::{screen_point, Extent, Outline};
 use crate::visibility::pattern::{PatternMatrix, TooManySegments};
+use crate::visibility::surface_frame::{row_to_write, SurfaceFrame};
 use crate::visibility::{ItemId, VisibilityBuffer};
 
 /// Rows scanned by one worker in turn.
@@ -124,35 +125,39 @@ pub fn scan_solid_with(
     height: u32,
     method: CsgMethod,
 ) -> Result<Vec<Option<Crossing>>, TooManySegments> {
-    let mut out = Vec::new();
+    let mut out = SurfaceFrame::new();
     scan_solid_into(solid, camera, (width, height), method, &mut out)?;
-    Ok(out)
+    Ok(out.into_pixels())
 }
 
-/// [`scan_solid_with`] into `out` (resized to the image), so a viewer
+/// [`scan_solid_with`] into `out` (made the image's size), so a viewer
 /// re-scanning frame after frame reuses one buffer, as the frame's
-/// visibility buffer is reused.
+/// visibility buffer is reused, and clears only what the last scan wrote.
 pub fn scan_solid_into(
     solid: &CsgSolid,
     camera: &Camera,
     (width, height): (u32, u32),
     method: CsgMethod,
-    out: &mut Vec<Option<Crossing>>,
+    out: &mut SurfaceFrame,
 ) -> Result<(), TooManySegments> {
     let w = width as usize;
     let walker = RowWalker::new(solid, method)?;
-    out.resize(w * height as usize, None);
-    let bands = out.par_chunks_mut(w * BAND_ROWS);
-    scan_bands(solid, &walker, camera, (width, height), bands, |band, dy, row| {
-        let out = &mut band[dy * w..(dy + 1) * w];
-        out[..row.columns.start].fill(None);
-        out[row.columns.end..].fill(None);
-        for x in row.columns.clone() {
+    out.fit(w, height as usize);
+    if matches!(walker, RowWalker::Empty) {
+        out.clear();
+        return Ok(());
+    }
+    let bands = out.bands_mut(BAND_ROWS);
+    scan_bands(solid, &walker, camera, (width, height), bands, |(pixels, written), dy, row| {
+        let out = row_to_write(&mut pixels[dy * w..(dy + 1) * w], &mut written[dy], row.blocks());
+        row.crossings_by_eight(|x0, found| {
             // Distances along the unnormalised row line become distances
             // along the unit pixel ray.
-            out[x] =
-                row.hits[x].map(|h| Crossing { t: h.t * row.line.at(x as f32).dir.length(), ..row.crossing(x, h) });
-        }
+            let lengths = row.line.dir_lengths(x0);
+            for ((px, c), length) in out[x0..].iter_mut().zip(found).zip(lengths) {
+                *px = c.map(|c| Crossing { t: c.t * length, ..c });
+            }
+        });
     });
     Ok(())
 }
@@ -291,6 +296,44 @@ impl ScannedRow<'_> {
     fn hits(&self) -> impl Iterator<Item = (usize, Hit)> + '_ {
         let hits = &self.hits[self.columns.clone()];
         self.columns.clone().zip(hits).filter_map(|(x, h)| Some((x, (*h)?)))
+    }
+
+    /// The columns of the eight-pixel blocks that take in [`Self::columns`]
+    /// (the last cut short by the row's end).
+    fn blocks(&self) -> std::ops::Range<usize> {
+        if self.columns.is_empty() {
+            return 0..0;
+        }
+        self.columns.start / 8 * 8..self.columns.end.next_multiple_of(8).min(self.hits.len())
+    }
+
+    /// Each pixel of [`Self::blocks`] with its crossing ([`Self::crossing`]),
+    /// eight at a time: `visit(x0, crossings)` for pixels `x0..x0 + 8`. A
+    /// block showing one curved face at all eight pixels finds their normals
+    /// in lanes, one showing a flat face shares one normal.
+    fn crossings_by_eight(&self, mut visit: impl FnMut(usize, &[Option<Crossing>])) {
+        for x0 in self.blocks().step_by(8) {
+            let hits = &self.hits[x0..(x0 + 8).min(self.hits.len())];
+            if let (Ok(hits), Some(first)) = (<&[Option<Hit>; 8]>::try_from(hits), hits[0]) {
+                if hits.iter().all(|h| h.is_some_and(|h| h.same_face(&first))) {
+                    let t = hits.map(|h| h.map_or(0.0, |h| h.t));
+                    let found = if self.caster.flat(first) {
+                        let c = self.crossing(x0, first);
+                        t.map(|t| Some(Crossing { t, ..c }))
+                    } else {
+                        let unit = &self.units[first.primitive as usize];
+                        self.caster.crossings_on_eight(first, t, unit, x0).map(Some)
+                    };
+                    visit(x0, &found);
+                    continue;
+                }
+            }
+            let mut found = [None; 8];
+            for ((f, h), x) in found.iter_mut().zip(hits).zip(x0..) {
+                *f = h.map(|h| self.crossing(x, h));
+            }
+            visit(x0, &found[..hits.len()]);
+        }
     }
 
     /// Pixel `x`'s `hit` with its outward normal (a flat face's computed

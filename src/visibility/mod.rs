@@ -25,6 +25,7 @@ mod outline;
 pub mod pattern;
 pub mod raster;
 pub mod scan;
+pub mod surface_frame;
 
 use glam::Vec3;
 

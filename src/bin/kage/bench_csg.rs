@@ -15,6 +15,7 @@ use kage::scene::load::openscad::{load_csg, CsgOptions, Geometry};
 use kage::scene::{Camera, CsgSolid, Ray};
 use kage::visibility::csg::{scan_solid_into, CsgMethod};
 use kage::visibility::pattern::PatternMatrix;
+use kage::visibility::surface_frame::SurfaceFrame;
 use miette::{miette, Result};
 use rayon::prelude::*;
 
@@ -122,11 +123,11 @@ fn scan_times(
     method: CsgMethod,
     frames: usize,
 ) -> (Vec<f64>, usize) {
-    let mut out = Vec::new();
-    let scan = |out: &mut Vec<_>| scan_solid_into(solid, camera, size, method, out).expect("expanded before");
+    let mut out = SurfaceFrame::new();
+    let scan = |out: &mut SurfaceFrame| scan_solid_into(solid, camera, size, method, out).expect("expanded before");
     scan(&mut out);
     let times = (0..frames).map(|_| timed(|| scan(&mut out)).0).collect();
-    (times, out.iter().filter(|p| p.is_some()).count())
+    (times, out.pixels().iter().filter(|p| p.is_some()).count())
 }
 
 /// The median of `v` (0 when empty).

@@ -11,7 +11,7 @@
 //! face: the scanline walk's answer does not depend on which path found it.
 //! The property tests below hold the lanes to that.
 
-use glam::{Vec3, Vec4};
+use glam::{Mat3A, Vec3, Vec4};
 use wide::f32x8;
 
 use super::shapes::{BOTTOM, SIDE, TOP};
@@ -182,6 +182,29 @@ pub(super) fn planes<'a>(faces: impl Iterator<Item = (u32, &'a Vec4)>, r: &RayLa
         enter = pick(!leaving & !parallel & t.simd_gt(enter.0), (t, face), enter);
     }
     finish(enter, exit, miss)
+}
+
+/// The unit outward normals, in solid space, where the rays `r` cross
+/// `face` of the unit `shape` at `t` (eight crossings of one face): the shape's
+/// normal ([`super::shapes::unit_normal`]) carried by the normal matrix `m`,
+/// then normalised or zero, as the scalar `(m * n).normalize_or_zero()` does.
+pub(super) fn normals(shape: &Shape, face: u32, r: &RayLanes, t: f32x8, m: &Mat3A) -> [f32x8; 3] {
+    let p: [f32x8; 3] = std::array::from_fn(|k| r.o[k] + r.d[k] * t);
+    let n = match shape {
+        Shape::Sphere => p,
+        Shape::Frustum { bottom, top } if face == SIDE => {
+            let k = top - bottom;
+            [p[0], p[1], s(-k) * (s(*bottom) + s(k) * p[2])]
+        }
+        // A flat face: one normal.
+        _ => super::shapes::unit_normal(shape, face, Vec3::ZERO).to_array().map(s),
+    };
+    // `Mat3A * v`: the columns scaled by v's components, summed left to right.
+    let (cx, cy, cz) = (m.x_axis, m.y_axis, m.z_axis);
+    let v: [f32x8; 3] = std::array::from_fn(|k| s(cx[k]) * n[0] + s(cy[k]) * n[1] + s(cz[k]) * n[2]);
+    let rcp = s(1.0) / dot(v, v).sqrt();
+    let finite = rcp.simd_gt(ZERO) & rcp.simd_lt(s(f32::INFINITY));
+    v.map(|c| finite.select(c * rcp, ZERO))
 }
 
 /// A clipped interval's lanes: met where nothing missed, the entry before
