@@ -786,23 +786,27 @@ impl RowSpans<'_> {
         self.caster.first_hit_in_by(root, &|i| self.at(i, x), near, scratch)
     }
 
-    /// [`BlockOrder::spread`] of `first`, the answer at pixel `x` (a block's
-    /// first) among the occupants `ids`, into the block's eight pixels `out`.
-    /// (All of them: the answer is the whole tree's, however found.)
+    /// [`BlockOrder::spread`] of `first`, the answer at pixel `x`, among the
+    /// occupants `ids`, over the pixels after it up to `upto` (in its block):
+    /// `row`'s pixels written as far as the answer holds, the last returned.
+    /// (All occupants: the answer is the whole tree's, however found.)
     fn spread(
         &self,
         order: &mut BlockOrder,
         ids: &[u32],
         (x, first): (usize, Option<Hit>),
         near: f32,
-        out: &mut [Option<Hit>],
-    ) -> bool {
+        (row, upto): (&mut [Option<Hit>], usize),
+    ) -> usize {
         let mut cached = self.blocks.cached.borrow_mut();
         for &i in ids {
             let i = i as usize;
             self.blocks.fill_if_stale(&mut cached[i], self.caster, i, &self.lines[i], x / 8);
         }
-        order.spread(ids, |i| &cached[i].1, near, first, out)
+        let x0 = x / 8 * 8;
+        let end = (x0 + 8).min(row.len());
+        let block = &mut row[x0..end];
+        x0 + order.spread(ids, |i| &cached[i].1, near, (x - x0, first), (block, upto - x0))
     }
 }
 
@@ -900,16 +904,16 @@ fn scan_row(
                 caster.first_hit_in_by(root, &PixelSpans { row: spans, x }, near, scratch)
             };
             row[x] = hit;
-            // A block nothing enters or leaves inside of (a right end on
-            // its last pixel leaves after it).
-            let block = x + 7;
-            let quiet = walk.reuse == Reuse::Blocks
-                && x % 8 == 0
-                && block < row.len()
-                && entry.get(next_in).is_none_or(|e| e.1 > block as i64)
-                && exit.get(next_out).is_none_or(|e| e.2 >= block as i64);
-            if quiet && spans.spread(order, counts.present().ids(), (x, hit), near, &mut row[x..=block]) {
-                last = block;
+            if walk.reuse == Reuse::Blocks && x % 8 == 0 {
+                // The run from a block's first pixel that nothing enters or
+                // leaves inside of (a right end leaves after its pixel).
+                let mut upto = (x + 7).min(row.len() - 1) as i64;
+                upto = entry.get(next_in).map_or(upto, |e| upto.min(e.1 - 1));
+                upto = exit.get(next_out).map_or(upto, |e| upto.min(e.2));
+                if upto > x as i64 {
+                    let ids = counts.present().ids();
+                    last = spans.spread(order, ids, (x, hit), near, (row, upto as usize));
+                }
             }
             if let Some(h) = row[last].filter(|_| walk.horizon) {
                 let rise = row[last.saturating_sub(1)].map_or(0.0, |p| h.t - p.t);
