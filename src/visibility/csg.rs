@@ -140,26 +140,54 @@ pub fn scan_solid_into(
     method: CsgMethod,
     out: &mut SurfaceFrame,
 ) -> Result<(), TooManySegments> {
-    let w = width as usize;
-    let walker = RowWalker::new(solid, method)?;
-    out.fit(w, height as usize);
-    if matches!(walker, RowWalker::Empty) {
-        out.clear();
-        return Ok(());
-    }
-    let bands = out.bands_mut(BAND_ROWS);
-    scan_bands(solid, &walker, camera, (width, height), bands, |(pixels, written), dy, row| {
-        let out = row_to_write(&mut pixels[dy * w..(dy + 1) * w], &mut written[dy], row.blocks());
-        row.crossings_by_eight(|x0, found| {
-            // Distances along the unnormalised row line become distances
-            // along the unit pixel ray.
-            let lengths = row.line.dir_lengths(x0);
-            for ((px, c), length) in out[x0..].iter_mut().zip(found).zip(lengths) {
-                *px = c.map(|c| Crossing { t: c.t * length, ..c });
-            }
-        });
-    });
+    PreparedSolid::new(solid, method)?.scan_into(camera, (width, height), out);
     Ok(())
+}
+
+/// A solid made ready for seed 003's scanline walk frame after frame, as a
+/// viewer keeps it while only the camera moves: its primitives prepared for
+/// casting (inverse transforms, normal matrices, a polyhedron's faces and
+/// their corners), its tree for the walk (the occupancy tree, or the pattern
+/// matrix expanded) and each primitive's bounding leaves.
+pub struct PreparedSolid {
+    caster: CsgCaster,
+    walker: RowWalker,
+    /// Per primitive, the leaves outside whose outlines it cannot change
+    /// the solid ([`super::bounds`]).
+    bounds: BoundingLeaves,
+}
+
+impl PreparedSolid {
+    /// `solid` made ready to be walked by `method`; fails when the pattern
+    /// matrix would pass its limit.
+    pub fn new(solid: &CsgSolid, method: CsgMethod) -> Result<PreparedSolid, TooManySegments> {
+        let bounds = solid.tree.as_ref().map(|t| BoundingLeaves::new(t, solid.primitives.len())).unwrap_or_default();
+        Ok(PreparedSolid { caster: CsgCaster::without_bvh(solid), walker: RowWalker::new(solid, method)?, bounds })
+    }
+
+    /// The visible surface at each pixel centre of a `width` x `height`
+    /// image seen by `camera`, into `out` (made the image's size), as
+    /// [`scan_solid_with`] finds it.
+    pub fn scan_into(&self, camera: &Camera, (width, height): (u32, u32), out: &mut SurfaceFrame) {
+        let w = width as usize;
+        out.fit(w, height as usize);
+        if matches!(self.walker, RowWalker::Empty) {
+            out.clear();
+            return;
+        }
+        let bands = out.bands_mut(BAND_ROWS);
+        scan_bands(self, camera, (width, height), bands, |(pixels, written), dy, row| {
+            let out = row_to_write(&mut pixels[dy * w..(dy + 1) * w], &mut written[dy], row.blocks());
+            row.crossings_by_eight(|x0, found| {
+                // Distances along the unnormalised row line become distances
+                // along the unit pixel ray.
+                let lengths = row.line.dir_lengths(x0);
+                for ((px, c), length) in out[x0..].iter_mut().zip(found).zip(lengths) {
+                    *px = c.map(|c| Crossing { t: c.t * length, ..c });
+                }
+            });
+        });
+    }
 }
 
 /// What walks a scanline's pixels.
@@ -254,8 +282,8 @@ pub fn draw_solids(
             .map(|d| (d, items.next().unwrap_or(&mut []), normals.next().unwrap_or(&mut [])))
             .collect();
         let bands = bands.into_par_iter().enumerate();
-        let walker = RowWalker::new(&world, CsgMethod::Segments).expect("segments need no expansion");
-        scan_bands(&world, &walker, camera, (width, height), bands, |(_, (depth, items, normals)), dy, row| {
+        let prepared = PreparedSolid::new(&world, CsgMethod::Segments).expect("segments need no expansion");
+        scan_bands(&prepared, camera, (width, height), bands, |(_, (depth, items, normals)), dy, row| {
             for (x, h) in row.hits() {
                 // A hit's `t` along its row line is its distance along the view axis.
                 let z = camera.depth_at_view_distance(h.t);
@@ -355,20 +383,20 @@ impl ScannedRow<'_> {
 /// gives each its output), `visit(band, row_in_band, row)` with the row's
 /// visible hits ([`ScannedRow`]).
 fn scan_bands<B: Send>(
-    solid: &CsgSolid,
-    walker: &RowWalker,
+    prepared: &PreparedSolid,
     camera: &Camera,
     (width, height): (u32, u32),
     bands: impl IndexedParallelIterator<Item = B>,
     visit: impl Fn(&mut B, usize, &ScannedRow) + Sync,
 ) {
+    let walker = &prepared.walker;
     if matches!(walker, RowWalker::Empty) {
         return;
     }
-    let frame = FrameWalk::new(solid, walker, camera, (width, height));
+    let frame = FrameWalk::new(prepared, camera, (width, height));
     let h = height as usize;
     bands.enumerate().for_each_init(
-        || Lent::fitted(width as usize, solid.primitives.len(), walker),
+        || Lent::fitted(width as usize, prepared.caster.solid().primitives.len(), walker),
         |lent, (band, mut out)| {
             let first = band * BAND_ROWS;
             let mut occupancy = YOccupancy::at(&frame.entry, first as i64);
@@ -389,11 +417,11 @@ struct FrameWalk<'a> {
     outlines: Vec<Option<Outline>>,
     /// Per primitive, the leaves outside whose outlines it cannot change
     /// the solid ([`super::bounds`]).
-    bounds: BoundingLeaves,
+    bounds: &'a BoundingLeaves,
     /// The y-entry table (procedure 1): the primitives that show at all, by
     /// top scanline.
     entry: Vec<(usize, Extent)>,
-    caster: CsgCaster,
+    caster: &'a CsgCaster,
     /// Per primitive, where its faces show ([`CsgCaster::faces_on_screen`]:
     /// polyhedra of many planes).
     faces: Vec<Option<FacesOnScreen>>,
@@ -407,13 +435,12 @@ struct FrameWalk<'a> {
 impl<'a> FrameWalk<'a> {
     /// The frame of `solid` seen by `camera` at `width` x `height`, walked by
     /// `walker`.
-    fn new(solid: &CsgSolid, walker: &'a RowWalker, camera: &Camera, (width, height): (u32, u32)) -> Self {
+    fn new(prepared: &'a PreparedSolid, camera: &Camera, (width, height): (u32, u32)) -> Self {
+        let (caster, solid) = (&prepared.caster, prepared.caster.solid());
         let vp = camera.view_projection(width as f32 / height as f32);
         let rays = camera.pixel_rays(Vec2::new(width as f32, height as f32));
         let mut outlines: Vec<Option<Outline>> = solid.primitives.iter().map(|p| Outline::new(p, vp, &rays)).collect();
-        let mut bounds = BoundingLeaves::default();
         if let Some(tree) = &solid.tree {
-            bounds = BoundingLeaves::new(tree, outlines.len());
             let mut boxes: Vec<Option<Extent>> = outlines.iter().map(|o| o.as_ref().map(|o| o.rows)).collect();
             bounds::narrow(tree, &mut boxes);
             for (o, b) in outlines.iter_mut().zip(boxes) {
@@ -426,13 +453,22 @@ impl<'a> FrameWalk<'a> {
         let mut entry: Vec<(usize, Extent)> =
             outlines.iter().enumerate().filter_map(|(i, o)| o.as_ref().map(|o| (i, o.rows))).collect();
         entry.sort_by_key(|(_, e)| e.y0);
-        let caster = CsgCaster::without_bvh(solid);
         let faces = (0..solid.primitives.len())
             .map(|i| {
                 caster.faces_on_screen(i, |p| screen_point(p, vp, (width, height)), (width as usize, height as usize))
             })
             .collect();
-        FrameWalk { walker, outlines, bounds, entry, caster, faces, rays, near: camera.near, width: width as usize }
+        FrameWalk {
+            walker: &prepared.walker,
+            outlines,
+            bounds: &prepared.bounds,
+            entry,
+            caster,
+            faces,
+            rays,
+            near: camera.near,
+            width: width as usize,
+        }
     }
 
     /// Procedure 2 on row `y` for each of the `occupied`: their ends, each
@@ -484,7 +520,7 @@ impl<'a> FrameWalk<'a> {
         visit: impl FnOnce(&ScannedRow),
     ) {
         let RowBuffers { row, lines, own_ends, counts, scratch, blocks, coherence, order } = buffers;
-        let caster = &self.caster;
+        let caster = self.caster;
         // Procedure 2: each occupant's left and right ends on this scanline.
         let ends = self.ends(y, occupied, own_ends);
         // The columns the occupants may cover: the walk writes no other.
