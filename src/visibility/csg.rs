@@ -178,13 +178,14 @@ impl PreparedSolid {
         let bands = out.bands_mut(BAND_ROWS);
         scan_bands(self, camera, (width, height), bands, |(pixels, written), dy, row| {
             let out = row_to_write(&mut pixels[dy * w..(dy + 1) * w], &mut written[dy], row.blocks());
-            row.crossings_by_eight(|x0, found| {
-                // Distances along the unnormalised row line become distances
-                // along the unit pixel ray.
-                let lengths = row.line.dir_lengths(x0);
-                for ((px, c), length) in out[x0..].iter_mut().zip(found).zip(lengths) {
-                    *px = c.map(|c| Crossing { t: c.t * length, ..c });
+            // Distances along the unnormalised row line become distances
+            // along the unit pixel ray (a block's eight lengths at its first).
+            let mut lengths = [0.0; 8];
+            row.crossings_by_eight(|x0, j, c| {
+                if j == 0 {
+                    lengths = row.line.dir_lengths(x0);
                 }
+                out[x0 + j] = c.map(|c| Crossing { t: c.t * lengths[j], ..c });
             });
         });
     }
@@ -336,31 +337,30 @@ impl ScannedRow<'_> {
     }
 
     /// Each pixel of [`Self::blocks`] with its crossing ([`Self::crossing`]),
-    /// eight at a time: `visit(x0, crossings)` for pixels `x0..x0 + 8`. A
-    /// block showing one curved face at all eight pixels finds their normals
-    /// in lanes, one showing a flat face shares one normal.
-    fn crossings_by_eight(&self, mut visit: impl FnMut(usize, &[Option<Crossing>])) {
+    /// eight at a time: `visit(x0, j, crossing)` for pixel `x0 + j` of the
+    /// block at `x0`, `j` from 0. A block showing one curved face at all
+    /// eight pixels finds their normals in lanes, one showing a flat face
+    /// shares one normal.
+    fn crossings_by_eight(&self, mut visit: impl FnMut(usize, usize, Option<Crossing>)) {
         for x0 in self.blocks().step_by(8) {
             let hits = &self.hits[x0..(x0 + 8).min(self.hits.len())];
             if let (Ok(hits), Some(first)) = (<&[Option<Hit>; 8]>::try_from(hits), hits[0]) {
                 if hits.iter().all(|h| h.is_some_and(|h| h.same_face(&first))) {
                     let t = hits.map(|h| h.map_or(0.0, |h| h.t));
-                    let found = if self.caster.flat(first) {
+                    if self.caster.flat(first) {
                         let c = self.crossing(x0, first);
-                        t.map(|t| Some(Crossing { t, ..c }))
+                        (0..8).for_each(|j| visit(x0, j, Some(Crossing { t: t[j], ..c })));
                     } else {
                         let unit = &self.units[first.primitive as usize];
-                        self.caster.crossings_on_eight(first, t, unit, x0).map(Some)
-                    };
-                    visit(x0, &found);
+                        let found = self.caster.crossings_on_eight(first, t, unit, x0);
+                        (0..8).for_each(|j| visit(x0, j, Some(found[j])));
+                    }
                     continue;
                 }
             }
-            let mut found = [None; 8];
-            for ((f, h), x) in found.iter_mut().zip(hits).zip(x0..) {
-                *f = h.map(|h| self.crossing(x, h));
+            for (j, h) in hits.iter().enumerate() {
+                visit(x0, j, h.map(|h| self.crossing(x0 + j, h)));
             }
-            visit(x0, &found[..hits.len()]);
         }
     }
 
