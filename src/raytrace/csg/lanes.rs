@@ -106,6 +106,9 @@ fn slab_z(r: &RayLanes) -> SpanLanes {
 /// quadric's inside one interval, two half-lines, one half-line, all of the
 /// line, none) chosen by mask, then the same clipping by the slab.
 fn frustum(bottom: f32, top: f32, r: &RayLanes) -> SpanLanes {
+    if bottom == top {
+        return cylinder(bottom, r);
+    }
     let (o, d) = (r.o, r.d);
     let k = s(top - bottom);
     let slab = slab_z(r);
@@ -140,6 +143,24 @@ fn frustum(bottom: f32, top: f32, r: &RayLanes) -> SpanLanes {
     let enter = pick(ok1 & ok2, pick(e1.0.simd_le(e2.0), e1, e2), pick(ok1, e1, e2));
     let exit = pick(ok1 & ok2, pick(x1.0.simd_ge(x2.0), x1, x2), pick(ok1, x1, x2));
     SpanLanes { enter, exit, hit: slab.hit & (between | outside | half | all) & (ok1 | ok2) }
+}
+
+/// [`super::shapes::cylinder`] in lanes: between the roots, all of a line
+/// within the radius, or none; then clipped by the slab.
+fn cylinder(radius: f32, r: &RayLanes) -> SpanLanes {
+    let (o, d) = (r.o, r.d);
+    let slab = slab_z(r);
+    let a = d[0] * d[0] + d[1] * d[1];
+    let b = o[0] * d[0] + o[1] * d[1];
+    let c = (o[0] * o[0] + o[1] * o[1]) - s(radius) * s(radius);
+    let (r0, r1, real) = roots(a, b, c);
+    let all = !real & c.simd_le(ZERO);
+    let (inf, neg_inf) = (s(f32::INFINITY), s(f32::NEG_INFINITY));
+    let (q0, q1) = pick(real, (r0, r1), pick(all, (neg_inf, inf), (inf, neg_inf)));
+    let ((s0, n0), (s1, n1)) = (slab.enter, slab.exit);
+    let enter = pick(q0.simd_gt(s0), (q0, s(SIDE as f32)), (s0, n0));
+    let exit = pick(q1.simd_lt(s1), (q1, s(SIDE as f32)), (s1, n1));
+    SpanLanes { enter, exit, hit: slab.hit & (real | all) & enter.0.simd_lt(exit.0) }
 }
 
 /// [`super::shapes::unit_cube`] in lanes.

@@ -75,6 +75,9 @@ pub(super) fn sphere(o: Vec3, d: Vec3) -> Option<UnitSpan> {
 /// the slab between the caps intersected with the quadric's inside, which within
 /// the slab is one convex piece (the apex of a cone lies on a cap).
 pub(super) fn frustum(bottom: f32, top: f32, o: Vec3, d: Vec3) -> Option<UnitSpan> {
+    if bottom == top {
+        return cylinder(bottom, o, d);
+    }
     let k = top - bottom;
     let slab = slab_z(o, d)?;
     let r_o = bottom + k * o.z;
@@ -113,6 +116,23 @@ pub(super) fn frustum(bottom: f32, top: f32, o: Vec3, d: Vec3) -> Option<UnitSpa
         }
     }
     best
+}
+
+/// [`frustum`] of one radius, a cylinder: the same equations with the
+/// cone's slope `k` zero, so the quadric's inside along a line is the one
+/// stretch between its roots, or all of a line parallel to the axis within
+/// the radius, or nothing.
+fn cylinder(radius: f32, o: Vec3, d: Vec3) -> Option<UnitSpan> {
+    let ((s0, n0), (s1, n1)) = slab_z(o, d)?;
+    let (a, b, c) = (d.x * d.x + d.y * d.y, o.x * d.x + o.y * d.y, o.x * o.x + o.y * o.y - radius * radius);
+    let (q0, q1) = match roots(a, b, c) {
+        Some(r) => r,
+        None if c <= 0.0 => (f32::NEG_INFINITY, f32::INFINITY),
+        None => return None,
+    };
+    let enter = if q0 > s0 { (q0, SIDE) } else { (s0, n0) };
+    let exit = if q1 < s1 { (q1, SIDE) } else { (s1, n1) };
+    (enter.0 < exit.0).then_some((enter, exit))
 }
 
 /// The slab `0 ≤ z ≤ 1` with its caps.
