@@ -639,8 +639,10 @@ impl Drop for Lent {
 /// same to the bit as one pixel's), and its neighbours read theirs.
 #[derive(Default)]
 struct BlockSpans {
-    /// Per primitive: the block (`x / 8`) its lanes hold, and the lanes.
-    cached: RefCell<Vec<(usize, IntervalLanes)>>,
+    /// Per primitive, two slots (even blocks, odd blocks): the block
+    /// (`x / 8`) its lanes hold, and the lanes — a block's and the one
+    /// before it.
+    cached: RefCell<Vec<[(usize, IntervalLanes); 2]>>,
     /// Per primitive: the faces the row's rays can cross (polyhedra of many
     /// planes).
     faces: Vec<RowFaces>,
@@ -650,7 +652,7 @@ impl BlockSpans {
     /// Room for a solid of `primitives` (what it held before is stale:
     /// [`BlockSpans::begin_row`] marks each row's occupants so).
     fn fit(&mut self, primitives: usize) {
-        self.cached.get_mut().resize(primitives, (usize::MAX, IntervalLanes::default()));
+        self.cached.get_mut().resize(primitives, [(usize::MAX, IntervalLanes::default()); 2]);
         self.faces.resize(primitives, RowFaces::default());
     }
 
@@ -667,7 +669,7 @@ impl BlockSpans {
     ) {
         let cached = self.cached.get_mut();
         for i in occupants {
-            cached[i].0 = usize::MAX;
+            cached[i].iter_mut().for_each(|c| c.0 = usize::MAX);
             let screen = faces[i].as_ref().map(|s| (s, y));
             caster.row_faces(i, &lines[i], screen, &mut self.faces[i]);
         }
@@ -683,16 +685,17 @@ impl BlockSpans {
         read: impl FnOnce(&IntervalLanes) -> R,
     ) -> R {
         let mut cached = self.cached.borrow_mut();
-        self.fill_if_stale(&mut cached[i], caster, i, unit, block);
-        read(&cached[i].1)
+        self.fill_if_stale(&mut cached[i][block % 2], caster, i, unit, block);
+        read(&cached[i][block % 2].1)
     }
 
     /// Primitive `i`'s interval at pixel `x` of its row line `unit`.
     #[inline(always)]
     fn span(&self, caster: &CsgCaster, i: usize, unit: &RowLine, x: usize) -> Option<Interval> {
         let mut cached = self.cached.borrow_mut();
-        self.fill_if_stale(&mut cached[i], caster, i, unit, x / 8);
-        cached[i].1.get(x % 8)
+        let slot = &mut cached[i][x / 8 % 2];
+        self.fill_if_stale(slot, caster, i, unit, x / 8);
+        slot.1.get(x % 8)
     }
 
     /// Primitive `i`'s cache entry `cached` made to hold `block`.
@@ -837,12 +840,41 @@ impl RowSpans<'_> {
         let mut cached = self.blocks.cached.borrow_mut();
         for &i in ids {
             let i = i as usize;
-            self.blocks.fill_if_stale(&mut cached[i], self.caster, i, &self.lines[i], x / 8);
+            self.blocks.fill_if_stale(&mut cached[i][x / 8 % 2], self.caster, i, &self.lines[i], x / 8);
         }
-        let x0 = x / 8 * 8;
+        let (x0, slot) = (x / 8 * 8, x / 8 % 2);
         let end = (x0 + 8).min(row.len());
-        let block = &mut row[x0..end];
-        x0 + order.spread(ids, |i| &cached[i].1, near, (x - x0, first), (block, upto - x0))
+        let at = |i: usize| (&cached[i][slot].1, x - x0);
+        let run = (x - x0 + 1, upto - x0);
+        x0 + order.spread(ids, (at, |i| &cached[i][slot].1), near, first, (&mut row[x0..end], run)).unwrap_or(x - x0)
+    }
+
+    /// The answer of pixel `x − 1` (the last of the block before, found with
+    /// the same occupants `ids`) carried on into `x`'s block, up to `upto`,
+    /// as [`RowSpans::spread`] hands an answer on inside a block: `row`'s
+    /// pixels written from `x` as far as it holds, the last returned (`None`
+    /// when it does not hold at `x`, or the lanes of `x − 1` are gone).
+    fn carry(
+        &self,
+        order: &mut BlockOrder,
+        ids: &[u32],
+        x: usize,
+        near: f32,
+        (row, upto): (&mut [Option<Hit>], usize),
+    ) -> Option<usize> {
+        let (block, before) = (x / 8, x / 8 - 1);
+        let mut cached = self.blocks.cached.borrow_mut();
+        if ids.iter().any(|&i| cached[i as usize][before % 2].0 != before) {
+            return None;
+        }
+        for &i in ids {
+            let i = i as usize;
+            self.blocks.fill_if_stale(&mut cached[i][block % 2], self.caster, i, &self.lines[i], block);
+        }
+        let end = (x + 8).min(row.len());
+        let at = |i: usize| (&cached[i][before % 2].1, 7);
+        let (first, out) = (row[x - 1], &mut row[x..end]);
+        order.spread(ids, (at, |i| &cached[i][block % 2].1), near, first, (out, (0, upto - x))).map(|last| x + last)
     }
 }
 
@@ -917,49 +949,63 @@ fn scan_row(
     // The last surface found and its rise from the pixel before: where the
     // next pixel's horizon is guessed.
     let mut surface: Option<(f32, f32)> = None;
+    // Whether the pixel before `x` was settled with the occupants `x` has.
+    let mut steady = false;
     while x < row.len() {
         while next_in < entry.len() && entry[next_in].1 <= x as i64 {
             counts.set(tree, entry[next_in].0, true);
             coherence.forget();
+            steady = false;
             next_in += 1;
         }
         // The last pixel this step settles: `x`, or its whole block.
         let mut last = x;
         if let Some(root) = counts.root(tree) {
-            let hit = if walk.reuse == Reuse::Pixels {
-                let present = counts.present();
-                coherence.look(present, near, |i| spans.at(i, x));
-                coherence.reused().unwrap_or_else(|| {
-                    let hit = caster.first_hit_in_by(root, &|i| coherence.span(present, i), near, scratch);
-                    coherence.learn(present, &walk.cut_with, hit);
-                    hit
-                })
-            } else if walk.horizon {
-                spans.first_hit(root, x, near, Horizon::guess(surface, counts.present().ids().len()), scratch)
+            // The run from a block's first pixel that nothing enters or
+            // leaves inside of (a right end leaves after its pixel).
+            let by_blocks = walk.reuse == Reuse::Blocks && x % 8 == 0;
+            let mut upto = (x + 7).min(row.len() - 1) as i64;
+            upto = entry.get(next_in).map_or(upto, |e| upto.min(e.1 - 1));
+            upto = exit.get(next_out).map_or(upto, |e| upto.min(e.2)).max(x as i64);
+            let upto = upto as usize;
+            // The answer of the pixel before carried on where it holds, or
+            // the booleans' at `x` spread along the run.
+            let ids = counts.present().ids();
+            let carried = (by_blocks && steady).then(|| spans.carry(order, ids, x, near, (row, upto))).flatten();
+            if let Some(l) = carried {
+                last = l;
             } else {
-                caster.first_hit_in_by(root, &PixelSpans { row: spans, x }, near, scratch)
-            };
-            row[x] = hit;
-            if walk.reuse == Reuse::Blocks && x % 8 == 0 {
-                // The run from a block's first pixel that nothing enters or
-                // leaves inside of (a right end leaves after its pixel).
-                let mut upto = (x + 7).min(row.len() - 1) as i64;
-                upto = entry.get(next_in).map_or(upto, |e| upto.min(e.1 - 1));
-                upto = exit.get(next_out).map_or(upto, |e| upto.min(e.2));
-                if upto > x as i64 {
-                    let ids = counts.present().ids();
-                    last = spans.spread(order, ids, (x, hit), near, (row, upto as usize));
+                let hit = if walk.reuse == Reuse::Pixels {
+                    let present = counts.present();
+                    coherence.look(present, near, |i| spans.at(i, x));
+                    coherence.reused().unwrap_or_else(|| {
+                        let hit = caster.first_hit_in_by(root, &|i| coherence.span(present, i), near, scratch);
+                        coherence.learn(present, &walk.cut_with, hit);
+                        hit
+                    })
+                } else if walk.horizon {
+                    spans.first_hit(root, x, near, Horizon::guess(surface, ids.len()), scratch)
+                } else {
+                    caster.first_hit_in_by(root, &PixelSpans { row: spans, x }, near, scratch)
+                };
+                row[x] = hit;
+                if by_blocks && upto > x {
+                    last = spans.spread(order, ids, (x, hit), near, (row, upto));
                 }
             }
             if let Some(h) = row[last].filter(|_| walk.horizon) {
                 let rise = row[last.saturating_sub(1)].map_or(0.0, |p| h.t - p.t);
                 surface = Some((h.t, rise));
             }
+            steady = true;
+        } else {
+            steady = false;
         }
         // Primitives whose right end is passed leave the x-occupancy list.
         while next_out < exit.len() && exit[next_out].2 <= last as i64 {
             counts.set(tree, exit[next_out].0, false);
             coherence.forget();
+            steady = false;
             next_out += 1;
         }
         if next_out == exit.len() {
