@@ -142,8 +142,8 @@ impl BlockOrder {
             }
             held &= met;
             let primitive = l.end_at(0, 0).primitive;
-            for end in 0..2 {
-                let (t, r) = (l.ends(end), was[end]);
+            for (end, r) in was.into_iter().enumerate() {
+                let t = l.ends(end);
                 match answer {
                     Some((p, k, _, _)) if p == primitive && k == end => {}
                     // Beyond the answer: only to stay beyond it.
