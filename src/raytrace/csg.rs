@@ -374,7 +374,7 @@ impl CsgCaster {
         let spans = match (&self.clipping[i], shape) {
             (Clipping::Box, _) => lanes::unit_cube(&rays),
             (Clipping::Lanes(_), Shape::Polyhedron(poly)) if row.active => {
-                lanes::planes(row.over(block).iter().map(|&f| (f, &poly.planes[f as usize])), &rays)
+                lanes::planes(row.over(block).map(|f| (f, &poly.planes[f as usize])), &rays)
             }
             _ => lanes::shape(shape, &rays),
         };

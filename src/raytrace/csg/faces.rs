@@ -128,6 +128,9 @@ struct BandFace {
 /// crosses the face within its columns on the scanline.
 #[derive(Debug, Clone)]
 pub struct FacesOnScreen {
+    /// This frame's own number (a row's table of faces by block, built
+    /// once per band, is this frame's only if it carries it).
+    frame: u64,
     /// Per face, its least and greatest y.
     rows: Vec<(f32, f32)>,
     /// The frame's width in pixels, and its bands of eight rows.
@@ -177,12 +180,16 @@ impl FacesOnScreen {
         }
         let mut bands = Cells::default();
         bands.sort(&shown);
-        FacesOnScreen { rows, size: (width, count), bands }
+        static FRAMES: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+        let frame = FRAMES.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+        FacesOnScreen { frame, rows, size: (width, count), bands }
     }
 
     /// Into `row`, scanline `y`'s faces: those whose rows take in its
     /// centre, and of those (when there are many) the ones over each block
-    /// of eight pixels; every face for a scanline past the frame.
+    /// of eight pixels; every face for a scanline past the frame. (The
+    /// band's faces are sorted by block once for its eight rows, each row
+    /// reading the ones whose rows take it in.)
     fn on_row(&self, y: usize, row: &mut RowFaces) {
         row.faces.clear();
         let (width, bands) = self.size;
@@ -192,19 +199,24 @@ impl FacesOnScreen {
         }
         let centre = y as f32 + 0.5;
         let band = self.bands.get(y / 8);
-        let shown = band.iter().filter(|b| {
-            let (top, bottom) = self.rows[b.face as usize];
+        let on = |f: u32| {
+            let (top, bottom) = self.rows[f as usize];
             top <= centre && centre <= bottom
-        });
-        row.faces.extend(shown.clone().map(|b| b.face));
+        };
+        row.faces.extend(band.iter().map(|b| b.face).filter(|&f| on(f)));
         if row.faces.len() < Self::SORT_FROM {
             return;
         }
-        row.entries.clear();
-        for b in shown {
-            row.entries.extend(cells_over(b.columns, width.div_ceil(8)).map(|c| (c, b.face)));
+        if row.band != (self.frame, y / 8) {
+            row.entries.clear();
+            for b in band {
+                let face = BlockFace { face: b.face, rows: self.rows[b.face as usize] };
+                row.entries.extend(cells_over(b.columns, width.div_ceil(8)).map(|c| (c, face)));
+            }
+            row.blocks.sort(&row.entries);
+            row.band = (self.frame, y / 8);
         }
-        row.blocks.sort(&row.entries);
+        row.centre = centre;
         row.by_block = true;
     }
 }
@@ -220,11 +232,23 @@ pub struct RowFaces {
     faces: Vec<u32>,
     distances: Vec<f32>,
     /// Whether the faces' columns are known ([`FacesOnScreen`]), and
-    /// `blocks` holds the faces over each block of eight pixels.
+    /// `blocks` holds the faces over each block of eight pixels of the
+    /// band: those whose rows take in `centre` are the row's.
     by_block: bool,
-    blocks: Cells<u32>,
+    blocks: Cells<BlockFace>,
+    /// The frame and band of eight rows `blocks` was sorted for.
+    band: (u64, usize),
+    /// The row's centre.
+    centre: f32,
     /// Each face with each block it is over, while sorting.
-    entries: Vec<(usize, u32)>,
+    entries: Vec<(usize, BlockFace)>,
+}
+
+/// A face in a band's table by block, with its rows.
+#[derive(Debug, Clone, Copy, Default)]
+struct BlockFace {
+    face: u32,
+    rows: (f32, f32),
 }
 
 impl RowFaces {
@@ -247,12 +271,12 @@ impl RowFaces {
 
     /// The faces that the rays of pixels `8·block..8·block + 8` can cross,
     /// in rising order.
-    pub(super) fn over(&self, block: usize) -> &[u32] {
-        if self.by_block {
-            self.blocks.get(block)
-        } else {
-            &self.faces
-        }
+    pub(super) fn over(&self, block: usize) -> impl Iterator<Item = u32> + '_ {
+        let centre = self.centre;
+        let (by_block, all) =
+            if self.by_block { (self.blocks.get(block), &[][..]) } else { (&[][..], &self.faces[..]) };
+        let on_row = by_block.iter().filter(move |f| f.rows.0 <= centre && centre <= f.rows.1).map(|f| f.face);
+        on_row.chain(all.iter().copied())
     }
 }
 
