@@ -236,8 +236,9 @@ fn projected_hull(clip: &[Vec4], size: DVec2) -> Option<Vec<DVec2>> {
 /// the smallest and largest x, or `None` if it misses.
 fn hull_row(hull: &[DVec2], y: f64) -> Option<(f64, f64)> {
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-    for (k, &a) in hull.iter().enumerate() {
-        let b = hull[(k + 1) % hull.len()];
+    // Each side: a corner and the next, the last closing on the first.
+    let next = hull.iter().skip(1).chain(hull.first());
+    for (&a, &b) in hull.iter().zip(next) {
         if (a.y - y) * (b.y - y) > 0.0 {
             continue; // both ends on one side
         }
