@@ -63,8 +63,8 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         );
     }
     println!(
-        "\n{w}x{h}, exact quadrics, each model with its corpus camera; scanline: median of {} frames (the default \
-         walk: an eight-pixel block's answer found at its first pixel and spread where it provably holds, seed 003 \
+        "\n{w}x{h}, exact quadrics, each model with its corpus camera; scanline: the solid prepared once (as the \
+         rays' caster is), median of {} frames (the default walk: an eight-pixel block's answer found at its first pixel and spread where it provably holds, seed 003 \
          §5.2.2 by blocks); rays: one frame each. Every method writes the same frame: each pixel's visible \
          surface with its normal, into a buffer allocated beforehand. Naive rays: the paper's baseline, every \
          primitive's interval at every pixel, then combined along the tree. BVH rays: only the primitives whose boxes the ray crosses (a BVH from {} primitives up), combined \
