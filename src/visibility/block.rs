@@ -2,7 +2,7 @@
 //! coherence, taken a block at a time.
 //!
 //! The scanline walk reads every occupant's intervals eight pixels at a time
-//! (one SIMD pass per occupant and block, `BlockSpans` in [`super::csg`]).
+//! (one SIMD pass per occupant and block, `BlockSpans` in `spans.rs`).
 //! The booleans run at a block's first pixel, and [`BlockOrder::spread`]
 //! hands their answer on along the run of pixels after it that no occupant
 //! enters or leaves inside of (the whole block, or up to the next left or

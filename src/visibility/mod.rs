@@ -8,11 +8,13 @@
 //! binning into bands and the band-parallel z-buffer). [`csg`] finds the visible
 //! surfaces of CSG solids by seed 003's scanline walk, from each primitive's
 //! outline on the screen (`outline.rs`: its procedures 1 and 2) clipped by
-//! [`bounds`] (to the nodes that bound it), over [`occupancy`] (its reference
+//! [`bounds`] (to the nodes that bound it), each occupant's intervals found eight
+//! pixels at a time (`spans.rs`), over [`occupancy`] (its reference
 //! counts, in tree form) or [`pattern`] (its pattern matrix), with [`block`]
 //! (its reuse of an answer, a block of eight pixels at a time) and [`horizon`]
 //! (occupants wholly behind the surface left out of the booleans), or
-//! [`coherence`] (its reuse pixel by pixel, as the paper has it) on request.
+//! [`coherence`] (its reuse pixel by pixel, as the paper has it) on request,
+//! into a [`surface_frame`] kept from scan to scan.
 
 pub mod block;
 pub mod bounds;
@@ -25,6 +27,7 @@ mod outline;
 pub mod pattern;
 pub mod raster;
 pub mod scan;
+mod spans;
 pub mod surface_frame;
 
 use glam::Vec3;
