@@ -18,7 +18,7 @@
 //! `faces` (which of a many-planed polyhedron's faces a block of eight
 //! pixels can cross).
 
-use glam::{Affine3A, Mat3A, Vec3};
+use glam::{Affine3A, Mat3A, Vec3, Vec3A};
 
 use super::bvh::{Aabb, Bvh};
 use crate::scene::camera::RowLine;
@@ -198,6 +198,8 @@ pub struct CsgCaster {
     /// procedure's ([`unit_span`]): a box by slabs, a polyhedron of many
     /// planes eight planes at a time.
     clipping: Vec<Clipping>,
+    /// Per primitive: the box `(min, max)` around its unit shape.
+    unit_boxes: Vec<(Vec3A, Vec3A)>,
     /// Over the primitives' boxes, from [`CsgCaster::BVH_PRIMITIVES`] up,
     /// with the tree's shape for counting the primitives a ray's boxes cross.
     bvh: Option<(Bvh, OccupancyTree)>,
@@ -240,12 +242,28 @@ impl CsgCaster {
                 _ => Clipping::Shape,
             })
             .collect();
+        let unit_boxes = solid
+            .primitives
+            .iter()
+            .map(|p| {
+                p.unit_corners()
+                    .into_iter()
+                    .fold((Vec3A::INFINITY, Vec3A::NEG_INFINITY), |(lo, hi), c| (lo.min(c.into()), hi.max(c.into())))
+            })
+            .collect();
         let n = solid.primitives.len();
         let bvh = solid.tree.as_ref().filter(|_| bvh && n >= Self::BVH_PRIMITIVES).map(|tree| {
             let boxes: Vec<Aabb> = solid.primitives.iter().map(|p| Aabb::around(&p.corners())).collect();
             (Bvh::build(&boxes), OccupancyTree::new(tree, n))
         });
-        CsgCaster { solid, frames, clipping, bvh }
+        CsgCaster { solid, frames, clipping, unit_boxes, bvh }
+    }
+
+    /// The box `(min, max)` around primitive `i`'s unit shape (the space of
+    /// [`CsgCaster::unit_line`]).
+    #[must_use]
+    pub fn unit_box(&self, i: usize) -> (Vec3A, Vec3A) {
+        self.unit_boxes[i]
     }
 
     /// Primitives from which [`CsgCaster::first_hit`] culls by a BVH.

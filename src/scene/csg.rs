@@ -79,6 +79,13 @@ impl Primitive {
     /// polyhedron's own corners), in solid space.
     #[must_use]
     pub fn corners(&self) -> Vec<Vec3> {
+        self.unit_corners().into_iter().map(|c| self.transform.transform_point3(c)).collect()
+    }
+
+    /// The corners of a box around the unit shape, in its own space (before
+    /// the transform).
+    #[must_use]
+    pub fn unit_corners(&self) -> Vec<Vec3> {
         let unit_box = |z0: f32| -> Vec<Vec3> {
             (0..8)
                 .map(|i| {
@@ -87,12 +94,11 @@ impl Primitive {
                 })
                 .collect()
         };
-        let local = match &self.shape {
+        match &self.shape {
             Shape::Sphere => unit_box(-1.0),
             Shape::Frustum { .. } => unit_box(0.0),
             Shape::Polyhedron(p) => p.vertices.clone(),
-        };
-        local.into_iter().map(|c| self.transform.transform_point3(c)).collect()
+        }
     }
 
     /// Axis-aligned bounds `(min, max)` in solid space.
