@@ -493,11 +493,17 @@ impl<'a> FrameWalk<'a> {
     /// A union's row by [`RowSpans::nearest_entries`], the occupants `ends`
     /// taken nearest first; `false`, the row left empty, where the booleans
     /// must find it.
-    fn nearest_entries(&self, ends: &[(usize, i64, i64)], spans: &RowSpans, row: &mut [Option<Hit>]) -> bool {
+    fn nearest_entries(
+        &self,
+        ends: &[(usize, i64, i64)],
+        spans: &RowSpans,
+        (row, by_depth): (&mut [Option<Hit>], &mut Vec<(usize, i64, i64, f32)>),
+    ) -> bool {
         let nearest = |i: usize| self.outlines[i].as_ref().map_or(f32::MIN, |o| o.nearest);
-        let mut by_depth: Vec<_> = ends.iter().map(|&(i, a, b)| (i, a, b, nearest(i))).collect();
+        by_depth.clear();
+        by_depth.extend(ends.iter().map(|&(i, a, b)| (i, a, b, nearest(i))));
         by_depth.sort_unstable_by(|p, q| p.3.total_cmp(&q.3));
-        let found = spans.nearest_entries(&by_depth, self.near, row);
+        let found = spans.nearest_entries(by_depth, self.near, row);
         if !found {
             row.fill(None);
         }
@@ -513,7 +519,7 @@ impl<'a> FrameWalk<'a> {
         buffers: &mut RowBuffers,
         visit: impl FnOnce(&ScannedRow),
     ) {
-        let RowBuffers { row, lines, own_ends, counts, scratch, blocks, coherence, order } = buffers;
+        let RowBuffers { row, lines, own_ends, counts, scratch, blocks, coherence, order, by_depth } = buffers;
         let caster = self.caster;
         // Procedure 2: each occupant's left and right ends on this scanline.
         let ends = self.ends(y, occupied, own_ends);
@@ -529,7 +535,7 @@ impl<'a> FrameWalk<'a> {
         let spans = RowSpans { blocks, caster, lines };
         match self.walker {
             RowWalker::Segments(walk) => {
-                if !(walk.nearest_entries && self.nearest_entries(&ends, &spans, row)) {
+                if !(walk.nearest_entries && self.nearest_entries(&ends, &spans, (row, by_depth))) {
                     let reuse = (&mut *coherence, &mut *order);
                     scan_row(caster, (walk, counts), &ends, &spans, self.near, (row, scratch, reuse));
                 }
@@ -591,6 +597,8 @@ struct RowBuffers {
     blocks: BlockSpans,
     coherence: PixelCoherence,
     order: BlockOrder,
+    /// A union's occupants, nearest first ([`RowSpans::nearest_entries`]).
+    by_depth: Vec<(usize, i64, i64, f32)>,
 }
 
 thread_local! {
