@@ -147,7 +147,7 @@ impl RowSpans<'_> {
             let primitive = (self.caster, i, &self.lines[i]);
             let (everywhere, floor) = (behind(nearest), BoxFloor::new(&self.lines[i], self.caster.unit_box(i)));
             for block in a / 8..=b / 8 {
-                // Half-open: an inclusive range iterated a fifth slower here.
+                // Half-open: walking an inclusive range cost ex022 4%.
                 let pixels = a.max(block * 8)..b.min(block * 8 + 7) + 1;
                 let far = row[pixels.clone()]
                     .iter()
