@@ -472,8 +472,8 @@ impl<'a> FrameWalk<'a> {
         &self,
         y: usize,
         occupied: &[(usize, Extent)],
-        own: &mut [(usize, Option<(i64, i64)>)],
-    ) -> Vec<(usize, i64, i64)> {
+        (own, ends): (&mut [(usize, Option<(i64, i64)>)], &mut Vec<(usize, i64, i64)>),
+    ) {
         for &(i, _) in occupied {
             own[i] = (y, self.outlines[i].as_ref().and_then(|o| o.columns(y as i64)));
         }
@@ -487,7 +487,8 @@ impl<'a> FrameWalk<'a> {
             }
             (a <= b).then_some((i, a, b))
         };
-        occupied.iter().filter_map(|&(i, _)| clipped(i)).collect()
+        ends.clear();
+        ends.extend(occupied.iter().filter_map(|&(i, _)| clipped(i)));
     }
 
     /// A union's row by [`RowSpans::nearest_entries`], the occupants `ends`
@@ -519,10 +520,12 @@ impl<'a> FrameWalk<'a> {
         buffers: &mut RowBuffers,
         visit: impl FnOnce(&ScannedRow),
     ) {
-        let RowBuffers { row, lines, own_ends, counts, scratch, blocks, coherence, order, by_depth } = buffers;
+        let RowBuffers { row, lines, own_ends, ends, x_order, counts, scratch, blocks, coherence, order, by_depth } =
+            buffers;
         let caster = self.caster;
         // Procedure 2: each occupant's left and right ends on this scanline.
-        let ends = self.ends(y, occupied, own_ends);
+        self.ends(y, occupied, (own_ends, ends));
+        let ends = &*ends;
         // The columns the occupants may cover: the walk writes no other.
         debug_assert!(row.iter().all(Option::is_none), "row {y}: hits left from the row before");
         let w = self.width as i64;
@@ -535,13 +538,13 @@ impl<'a> FrameWalk<'a> {
         let spans = RowSpans { blocks, caster, lines };
         match self.walker {
             RowWalker::Segments(walk) => {
-                if !(walk.nearest_entries && self.nearest_entries(&ends, &spans, (row, by_depth))) {
+                if !(walk.nearest_entries && self.nearest_entries(ends, &spans, (row, by_depth))) {
                     let reuse = (&mut *coherence, &mut *order);
-                    scan_row(caster, (walk, counts), &ends, &spans, self.near, (row, scratch, reuse));
+                    scan_row(caster, (walk, counts), ends, &spans, self.near, (row, scratch, reuse), x_order);
                 }
             }
             RowWalker::Pattern(matrix) => {
-                matrix.walk_row(caster, &ends, &|i, x| blocks.span(caster, i, &lines[i], x), self.near, row);
+                matrix.walk_row(caster, ends, &|i, x| blocks.span(caster, i, &lines[i], x), self.near, row);
             }
             RowWalker::Empty => {}
         }
@@ -592,6 +595,9 @@ struct RowBuffers {
     lines: Vec<RowLine>,
     /// Per primitive, the row it last occupied and its unclipped ends there.
     own_ends: Vec<(usize, Option<(i64, i64)>)>,
+    /// The row's occupants with their ends, clipped by their bounds.
+    ends: Vec<(usize, i64, i64)>,
+    x_order: XOrder,
     counts: Occupied,
     scratch: SpanScratch,
     blocks: BlockSpans,
@@ -640,12 +646,23 @@ pub(super) type RowEnds = (usize, i64, i64);
 
 /// A scanline's x-entry table (occupants by left end) and x-exit order (by
 /// right end).
-pub(super) fn x_order(ends: impl IntoIterator<Item = RowEnds>) -> (Vec<RowEnds>, Vec<RowEnds>) {
-    let mut entry: Vec<RowEnds> = ends.into_iter().collect();
-    entry.sort_by_key(|e| e.1);
-    let mut exit = entry.clone();
-    exit.sort_by_key(|e| e.2);
-    (entry, exit)
+#[derive(Debug, Default)]
+pub(super) struct XOrder {
+    pub(super) entry: Vec<RowEnds>,
+    pub(super) exit: Vec<RowEnds>,
+}
+
+impl XOrder {
+    /// The tables of the occupants `ends` (what they held before dropped).
+    pub(super) fn sort(&mut self, ends: impl IntoIterator<Item = RowEnds>) -> &Self {
+        self.entry.clear();
+        self.entry.extend(ends);
+        self.entry.sort_by_key(|e| e.1);
+        self.exit.clear();
+        self.exit.extend_from_slice(&self.entry);
+        self.exit.sort_by_key(|e| e.2);
+        self
+    }
 }
 
 /// One scanline: the x-entry table of the occupants (sorted by left end), the
@@ -660,9 +677,10 @@ fn scan_row(
     spans: &RowSpans,
     near: f32,
     (row, scratch, (coherence, order)): (&mut [Option<Hit>], &mut SpanScratch, (&mut PixelCoherence, &mut BlockOrder)),
+    tables: &mut XOrder,
 ) {
     let tree = &walk.tree;
-    let (entry, exit) = x_order(ends.iter().copied());
+    let XOrder { entry, exit } = tables.sort(ends.iter().copied());
     let (mut next_in, mut next_out) = (0, 0);
     let Some(first) = entry.first().map(|e| e.1.max(0) as usize) else { return };
     coherence.forget();

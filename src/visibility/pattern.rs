@@ -25,7 +25,7 @@
 
 use crate::raytrace::csg::{CsgCaster, Hit, Interval, SpanScratch};
 use crate::scene::csg::CsgTree;
-use crate::visibility::csg::x_order;
+use crate::visibility::csg::XOrder;
 use crate::visibility::occupancy::PlacedSet;
 
 /// One segment: an intersection of positive primitives and complements of
@@ -91,7 +91,8 @@ impl PatternMatrix {
         // Only positive members of live segments, and negative members of any,
         // need walking.
         let wanted = |i: usize| self.positive_in[i].iter().any(|&s| live[s as usize]) || self.negative_somewhere[i];
-        let (entry, exit) = x_order(ends.iter().copied().filter(|&(i, _, _)| wanted(i)));
+        let mut tables = XOrder::default();
+        let XOrder { entry, exit } = tables.sort(ends.iter().copied().filter(|&(i, _, _)| wanted(i)));
         let mut rcx: Vec<usize> = self.segments.iter().map(|s| s.positive.len()).collect();
         // The visible-segment list (seed 003 §5.2.1).
         let mut visible = PlacedSet::new(self.segments.len());
