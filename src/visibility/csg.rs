@@ -468,12 +468,7 @@ impl<'a> FrameWalk<'a> {
     /// Procedure 2 on row `y` for each of the `occupied`: their ends, each
     /// clipped to the ends of the leaves that bound it (`own` keeps every
     /// occupant's unclipped ends, stamped with the row).
-    fn ends(
-        &self,
-        y: usize,
-        occupied: &[(usize, Extent)],
-        (own, ends): (&mut [(usize, Option<(i64, i64)>)], &mut Vec<(usize, i64, i64)>),
-    ) {
+    fn ends(&self, y: usize, occupied: &[(usize, Extent)], (own, ends): (&mut [OwnEnds], &mut Vec<RowEnds>)) {
         for &(i, _) in occupied {
             own[i] = (y, self.outlines[i].as_ref().and_then(|o| o.columns(y as i64)));
         }
@@ -498,7 +493,7 @@ impl<'a> FrameWalk<'a> {
         &self,
         ends: &[(usize, i64, i64)],
         spans: &RowSpans,
-        (row, by_depth): (&mut [Option<Hit>], &mut Vec<(usize, i64, i64, f32)>),
+        (row, by_depth): (&mut [Option<Hit>], &mut Vec<DepthEnds>),
     ) -> bool {
         let nearest = |i: usize| self.outlines[i].as_ref().map_or(f32::MIN, |o| o.nearest);
         by_depth.clear();
@@ -594,9 +589,9 @@ struct RowBuffers {
     row: Vec<Option<Hit>>,
     lines: Vec<RowLine>,
     /// Per primitive, the row it last occupied and its unclipped ends there.
-    own_ends: Vec<(usize, Option<(i64, i64)>)>,
+    own_ends: Vec<OwnEnds>,
     /// The row's occupants with their ends, clipped by their bounds.
-    ends: Vec<(usize, i64, i64)>,
+    ends: Vec<RowEnds>,
     x_order: XOrder,
     counts: Occupied,
     scratch: SpanScratch,
@@ -604,7 +599,7 @@ struct RowBuffers {
     coherence: PixelCoherence,
     order: BlockOrder,
     /// A union's occupants, nearest first ([`RowSpans::nearest_entries`]).
-    by_depth: Vec<(usize, i64, i64, f32)>,
+    by_depth: Vec<DepthEnds>,
 }
 
 thread_local! {
@@ -643,6 +638,14 @@ impl Drop for Lent {
 
 /// An occupant of a scanline: primitive, left end, right end (columns).
 pub(super) type RowEnds = (usize, i64, i64);
+
+/// A primitive's own ends on the row it last occupied: the row, and its
+/// unclipped ends there (if it shows).
+type OwnEnds = (usize, Option<(i64, i64)>);
+
+/// An occupant of a union's scanline with its least depth
+/// ([`RowSpans::nearest_entries`]).
+type DepthEnds = (usize, i64, i64, f32);
 
 /// A scanline's x-entry table (occupants by left end) and x-exit order (by
 /// right end).
