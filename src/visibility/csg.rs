@@ -63,7 +63,7 @@ use rayon::prelude::*;
 use crate::raytrace::csg::{Crossing, CsgCaster, FacesOnScreen, Hit, SpanScratch};
 use crate::scene::camera::PixelRays;
 use crate::scene::camera::RowLine;
-use crate::scene::csg::CsgSolid;
+use crate::scene::csg::{CsgSolid, Primitive};
 use crate::scene::{Camera, Object, Scene};
 use crate::visibility::block::BlockOrder;
 use crate::visibility::bounds::{self, BoundingLeaves};
@@ -387,20 +387,24 @@ fn scan_bands<B: Send>(
     if matches!(walker, RowWalker::Empty) {
         return;
     }
-    let frame = FrameWalk::new(prepared, camera, (width, height));
-    let h = height as usize;
-    bands.enumerate().for_each_init(
-        || Lent::fitted(width as usize, prepared.caster.solid().primitives.len(), walker),
-        |lent, (band, mut out)| {
-            let first = band * BAND_ROWS;
-            let mut occupancy = YOccupancy::at(&frame.entry, first as i64);
-            for dy in 0..BAND_ROWS.min(h - first) {
-                let y = first + dy;
-                let occupied = occupancy.advance(y as i64);
-                frame.walk_row(y, occupied, &mut lent.0, |row| visit(&mut out, dy, row));
-            }
-        },
-    );
+    // The whole frame in the pool: its preparation's parallel parts and
+    // the bands start no second time from outside it.
+    rayon::scope(|_| {
+        let frame = FrameWalk::new(prepared, camera, (width, height));
+        let h = height as usize;
+        bands.enumerate().for_each_init(
+            || Lent::fitted(width as usize, prepared.caster.solid().primitives.len(), walker),
+            |lent, (band, mut out)| {
+                let first = band * BAND_ROWS;
+                let mut occupancy = YOccupancy::at(&frame.entry, first as i64);
+                for dy in 0..BAND_ROWS.min(h - first) {
+                    let y = first + dy;
+                    let occupied = occupancy.advance(y as i64);
+                    frame.walk_row(y, occupied, &mut lent.0, |row| visit(&mut out, dy, row));
+                }
+            },
+        );
+    });
 }
 
 /// What a frame's walk knows before its first scanline: each primitive's
@@ -427,13 +431,37 @@ struct FrameWalk<'a> {
 }
 
 impl<'a> FrameWalk<'a> {
+    /// Primitives from which a frame's outlines and faces are found in
+    /// parallel.
+    const PARALLEL_FROM: usize = 16;
+
     /// The frame of `solid` seen by `camera` at `width` x `height`, walked by
     /// `walker`.
     fn new(prepared: &'a PreparedSolid, camera: &Camera, (width, height): (u32, u32)) -> Self {
         let (caster, solid) = (&prepared.caster, prepared.caster.solid());
         let vp = camera.view_projection(width as f32 / height as f32);
         let rays = camera.pixel_rays(Vec2::new(width as f32, height as f32));
-        let mut outlines: Vec<Option<Outline>> = solid.primitives.iter().map(|p| Outline::new(p, vp, &rays)).collect();
+        let many = solid.primitives.len() >= Self::PARALLEL_FROM;
+        let outlines = || -> Vec<Option<Outline>> {
+            let outline = |p: &Primitive| Outline::new(p, vp, &rays);
+            if many {
+                solid.primitives.par_iter().map(outline).collect()
+            } else {
+                solid.primitives.iter().map(outline).collect()
+            }
+        };
+        let faces = || -> Vec<Option<FacesOnScreen>> {
+            let size = (width as usize, height as usize);
+            let face = |i: usize| caster.faces_on_screen(i, |p| screen_point(p, vp, (width, height)), size);
+            let n = solid.primitives.len();
+            if many {
+                (0..n).into_par_iter().map(face).collect()
+            } else {
+                (0..n).map(face).collect()
+            }
+        };
+        // Many primitives: each primitive's outline and faces at once.
+        let (mut outlines, faces) = if many { rayon::join(outlines, faces) } else { (outlines(), faces()) };
         if let Some(tree) = &solid.tree {
             let mut boxes: Vec<Option<Extent>> = outlines.iter().map(|o| o.as_ref().map(|o| o.rows)).collect();
             bounds::narrow(tree, &mut boxes);
@@ -447,11 +475,6 @@ impl<'a> FrameWalk<'a> {
         let mut entry: Vec<(usize, Extent)> =
             outlines.iter().enumerate().filter_map(|(i, o)| o.as_ref().map(|o| (i, o.rows))).collect();
         entry.sort_by_key(|(_, e)| e.y0);
-        let faces = (0..solid.primitives.len())
-            .map(|i| {
-                caster.faces_on_screen(i, |p| screen_point(p, vp, (width, height)), (width as usize, height as usize))
-            })
-            .collect();
         FrameWalk {
             walker: &prepared.walker,
             outlines,
