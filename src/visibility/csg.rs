@@ -514,7 +514,7 @@ impl<'a> FrameWalk<'a> {
     /// must find it.
     fn nearest_entries(
         &self,
-        ends: &[(usize, i64, i64)],
+        ends: &[RowEnds],
         spans: &RowSpans,
         (row, by_depth): (&mut [Option<Hit>], &mut Vec<DepthEnds>),
     ) -> bool {

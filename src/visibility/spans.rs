@@ -2,15 +2,17 @@
 //! interval of each occupant): each occupant's eight-pixel blocks of lanes,
 //! found once per block ([`BlockSpans`]), and the readers the booleans, the
 //! block spreading ([`super::block`]) and the union's z-buffer take them
-//! through ([`RowSpans`]), with occupants beyond a [`Horizon`] left out.
+//! through ([`RowSpans`]), with occupants beyond a [`Horizon`] left out;
+//! and the depth below which a block's rays cannot meet a primitive's box
+//! ([`BoxFloor`]), by which the z-buffer leaves blocks unsolved.
 
 use std::cell::{Cell, RefCell};
+
+use glam::{BVec3A, Vec3, Vec3A};
 
 use crate::raytrace::csg::{
     Booleans, CsgCaster, FacesOnScreen, Hit, Interval, IntervalLanes, LeafSpans, RowFaces, SpanScratch,
 };
-use glam::{BVec3A, Vec3, Vec3A};
-
 use crate::scene::camera::RowLine;
 use crate::visibility::block::BlockOrder;
 use crate::visibility::horizon::Horizon;
