@@ -172,15 +172,7 @@ impl PreparedSolid {
         let bands = out.bands_mut(BAND_ROWS);
         scan_bands(self, camera, (width, height), bands, |(pixels, written), dy, row| {
             let out = row_to_write(&mut pixels[dy * w..(dy + 1) * w], &mut written[dy], row.blocks());
-            // Distances along the unnormalised row line become distances
-            // along the unit pixel ray (a block's eight lengths at its first).
-            let mut lengths = [0.0; 8];
-            row.crossings_by_eight(|x0, j, c| {
-                if j == 0 {
-                    lengths = row.line.dir_lengths(x0);
-                }
-                out[x0 + j] = c.map(|c| Crossing { t: c.t * lengths[j], ..c });
-            });
+            row.unit_crossings_into(out);
         });
     }
 }
@@ -330,30 +322,34 @@ impl ScannedRow<'_> {
         self.columns.start / 8 * 8..self.columns.end.next_multiple_of(8).min(self.hits.len())
     }
 
-    /// Each pixel of [`Self::blocks`] with its crossing ([`Self::crossing`]),
-    /// eight at a time: `visit(x0, j, crossing)` for pixel `x0 + j` of the
-    /// block at `x0`, `j` from 0. A block showing one curved face at all
-    /// eight pixels finds their normals in lanes, one showing a flat face
-    /// shares one normal.
-    fn crossings_by_eight(&self, mut visit: impl FnMut(usize, usize, Option<Crossing>)) {
+    /// Into `out` (the row's pixels), each pixel's crossing
+    /// ([`Self::crossing`]) over [`Self::blocks`], eight at a time, `t` taken
+    /// along each pixel's unit ray (the row line's direction is not of unit
+    /// length). A block showing one curved face at all eight pixels finds
+    /// their normals in lanes, one showing a flat face shares one normal.
+    fn unit_crossings_into(&self, out: &mut [Option<Crossing>]) {
         for x0 in self.blocks().step_by(8) {
-            let hits = &self.hits[x0..(x0 + 8).min(self.hits.len())];
+            let end = (x0 + 8).min(self.hits.len());
+            let (hits, out) = (&self.hits[x0..end], &mut out[x0..end]);
+            let lengths = wide::f32x8::new(self.line.dir_lengths(x0));
             if let (Ok(hits), Some(first)) = (<&[Option<Hit>; 8]>::try_from(hits), hits[0]) {
                 if hits.iter().all(|h| h.is_some_and(|h| h.same_face(&first))) {
                     let t = hits.map(|h| h.map_or(0.0, |h| h.t));
+                    let along = (wide::f32x8::new(t) * lengths).to_array();
                     if self.caster.flat(first) {
                         let c = self.crossing(x0, first);
-                        (0..8).for_each(|j| visit(x0, j, Some(Crossing { t: t[j], ..c })));
+                        out.iter_mut().zip(along).for_each(|(o, t)| *o = Some(Crossing { t, ..c }));
                     } else {
                         let unit = &self.units[first.primitive as usize];
                         let found = self.caster.crossings_on_eight(first, t, unit, x0);
-                        (0..8).for_each(|j| visit(x0, j, Some(found[j])));
+                        out.iter_mut().zip(along).zip(found).for_each(|((o, t), c)| *o = Some(Crossing { t, ..c }));
                     }
                     continue;
                 }
             }
-            for (j, h) in hits.iter().enumerate() {
-                visit(x0, j, h.map(|h| self.crossing(x0 + j, h)));
+            let lengths = lengths.to_array();
+            for (j, (o, h)) in out.iter_mut().zip(hits).enumerate() {
+                *o = h.map(|h| Crossing { t: h.t * lengths[j], ..self.crossing(x0 + j, h) });
             }
         }
     }
@@ -392,7 +388,11 @@ fn scan_bands<B: Send>(
     rayon::scope(|_| {
         let frame = FrameWalk::new(prepared, camera, (width, height));
         let h = height as usize;
-        bands.enumerate().for_each_init(
+        // Each band its own piece of work: left to split only where stolen,
+        // rayon hands each thread a quarter of the frame, and a thread done
+        // with its own finds the rest of the other's unsplittable (ex_csg_modules'
+        // second thread sat idle for the last 40% of the frame).
+        bands.enumerate().with_max_len(1).for_each_init(
             || Lent::fitted(width as usize, prepared.caster.solid().primitives.len(), walker),
             |lent, (band, mut out)| {
                 let first = band * BAND_ROWS;

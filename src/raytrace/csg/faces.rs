@@ -110,6 +110,9 @@ fn columns_within(corners: &[Vec2], (top, bottom): (f32, f32)) -> Option<(f32, f
     (lo <= hi).then_some((lo, hi))
 }
 
+/// Faces' rows, and the bands they show in ([`FacesOnScreen::shown`]).
+type FacesShown = (Vec<(f32, f32)>, Vec<(usize, BandFace)>);
+
 /// A face as one band of rows sees it: the face, and the columns it spans
 /// within a pixel of the band's rows (a pixel wider each way).
 #[derive(Debug, Clone, Copy, Default)]
@@ -149,15 +152,39 @@ impl FacesOnScreen {
     /// block clips by them all sooner than the row sorts them.
     const SORT_FROM: usize = 12;
 
+    /// Faces from which [`FacesOnScreen::new`] finds them in two halves at
+    /// once (ex006_hull_dice's 482: its frame 3% sooner).
+    const SPLIT_FROM: usize = 256;
+
     /// The faces of `faces`, whose corners project to `at` (pixel
     /// coordinates, a pixel's centre at `x + ½, y + ½`), in a `width` x
     /// `height` frame.
     pub(super) fn new(faces: &FaceCorners, at: &[Vec2], (width, height): (usize, usize)) -> Self {
         let count = height.div_ceil(8);
+        let n = faces.count();
+        // Many faces (a hull of rounded corners): the two halves at once,
+        // so that the frame's bands, which wait on them, start sooner.
+        let ((mut rows, mut shown), (rows2, shown2)) = if n >= Self::SPLIT_FROM {
+            rayon::join(|| Self::shown(faces, at, count, 0..n / 2), || Self::shown(faces, at, count, n / 2..n))
+        } else {
+            (Self::shown(faces, at, count, 0..n), Default::default())
+        };
+        rows.extend(rows2);
+        shown.extend(shown2);
+        let mut bands = Cells::default();
+        bands.sort(&shown);
+        static FRAMES: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+        let frame = FRAMES.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+        FacesOnScreen { frame, rows, size: (width, count), bands }
+    }
+
+    /// Of the faces `range`: each one's rows, and the bands it shows in with
+    /// its columns there.
+    fn shown(faces: &FaceCorners, at: &[Vec2], count: usize, range: Range<usize>) -> FacesShown {
         let mut corners = Vec::new();
-        let mut rows = Vec::with_capacity(faces.count());
+        let mut rows = Vec::with_capacity(range.len());
         let mut shown: Vec<(usize, BandFace)> = Vec::new();
-        for f in 0..faces.count() {
+        for f in range {
             corners.clear();
             corners.extend(faces.on(f).iter().map(|&k| at[k as usize]));
             let (lo, hi) = corners.iter().fold((Vec2::INFINITY, Vec2::NEG_INFINITY), |(a, b), &p| (a.min(p), b.max(p)));
@@ -178,11 +205,7 @@ impl FacesOnScreen {
                 }
             }
         }
-        let mut bands = Cells::default();
-        bands.sort(&shown);
-        static FRAMES: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
-        let frame = FRAMES.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
-        FacesOnScreen { frame, rows, size: (width, count), bands }
+        (rows, shown)
     }
 
     /// Into `row`, scanline `y`'s faces: those whose rows take in its
