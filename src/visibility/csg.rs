@@ -77,7 +77,7 @@ use crate::visibility::surface_frame::{row_to_write, SurfaceFrame};
 use crate::visibility::{ItemId, VisibilityBuffer};
 
 /// Rows scanned by one worker in turn.
-const BAND_ROWS: usize = 16;
+const BAND_ROWS: usize = 8;
 
 /// The visible surface of `solid` (in world space) at each pixel centre of a
 /// `width` x `height` image seen by `camera`, rows top to bottom: the first
