@@ -146,7 +146,8 @@ fn timed<T>(f: impl FnOnce() -> T) -> (f64, T) {
     (t.elapsed().as_secs_f64() * 1e3, out)
 }
 
-/// Milliseconds to cast every pixel's centre ray (rows in parallel), each
+/// Milliseconds to cast every pixel's centre ray (rows in parallel, four to
+/// a task, so that the rays are shared out as evenly as the walk's bands), each
 /// pixel's visible surface `first` (with its normal) written into a frame
 /// allocated before the clock starts, as the scanline walk writes its own;
 /// and the pixels covered.
@@ -154,7 +155,7 @@ fn cast(camera: &Camera, w: u32, h: u32, first: impl Fn(&Ray) -> Option<Crossing
     let rays = camera.pixel_rays(Vec2::new(w as f32, h as f32));
     let mut frame: Vec<Option<Crossing>> = vec![None; w as usize * h as usize];
     let (ms, ()) = timed(|| {
-        frame.par_chunks_mut(w as usize).enumerate().for_each(|(y, row)| {
+        frame.par_chunks_mut(w as usize).enumerate().with_max_len(4).for_each(|(y, row)| {
             for (x, px) in row.iter_mut().enumerate() {
                 *px = first(&rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5)));
             }
