@@ -76,7 +76,8 @@ use crate::visibility::spans::{BlockSpans, PixelSpans, RowSpans};
 use crate::visibility::surface_frame::{row_to_write, SurfaceFrame};
 use crate::visibility::{ItemId, VisibilityBuffer};
 
-/// Rows scanned by one worker in turn.
+/// Rows scanned by one worker in turn, each band a task of its own
+/// ([`scan_bands`]).
 const BAND_ROWS: usize = 8;
 
 /// The visible surface of `solid` (in world space) at each pixel centre of a
