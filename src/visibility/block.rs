@@ -20,7 +20,11 @@
 //! reference pixel, where the booleans' answer is known (`+∞` for a miss).
 //! Which part of the set lies before and just past `E` depends only on the
 //! ends before `E` and their order. So at a pixel `j` of the run where
-//! - each occupant is met if it is met at the reference pixel, missed if missed,
+//! - each occupant is met if it is met at the reference pixel, missed if
+//!   missed — or, where it is missed or lies wholly beyond `E` there (its
+//!   entry beyond `E` by more than any [`TIE`] move), missed or wholly beyond
+//!   `E` again: such an occupant changes no part of the set short of just
+//!   past `E`, as an occupant beyond a [`super::horizon`] does not,
 //! - the ends lying before `E` at the reference pixel, the near plane and `E`
 //!   itself keep that pixel's order, each beyond the one before by more
 //!   than any [`TIE`] move — or equal to it at both pixels, so that every
@@ -50,15 +54,28 @@ use crate::raytrace::csg::{Hit, IntervalLanes, TIE};
 /// theirs, moved or not, comes out differently from the reference pixel's.
 #[inline]
 fn settled((a, ra): (&[f32; 8], f32), (b, rb): (&[f32; 8], f32)) -> u8 {
-    if rb - ra > 4.0 * TIE * ra.abs().max(rb.abs()).max(1.0) {
-        let (a, b) = (f32x8::new(*a), f32x8::new(*b));
-        let margin = f32x8::splat(4.0 * TIE) * a.abs().max(b.abs()).max(f32x8::splat(1.0));
-        (b - a).simd_gt(margin).to_bitmask() as u8
+    if clear(ra, rb) {
+        clear_lanes(a, b)
     } else if ra == rb {
         f32x8::new(*a).simd_eq(f32x8::new(*b)).to_bitmask() as u8
     } else {
         0
     }
+}
+
+/// Whether `b` lies beyond `a` by more than the largest move a difference
+/// makes ([`TIE`] relative to `t`, on both sides).
+#[inline]
+fn clear(a: f32, b: f32) -> bool {
+    b - a > 4.0 * TIE * a.abs().max(b.abs()).max(1.0)
+}
+
+/// The pixels (bits of lanes) where `b` lies beyond `a` as [`clear`] says.
+#[inline]
+fn clear_lanes(a: &[f32; 8], b: &[f32; 8]) -> u8 {
+    let (a, b) = (f32x8::new(*a), f32x8::new(*b));
+    let margin = f32x8::splat(4.0 * TIE) * a.abs().max(b.abs()).max(f32x8::splat(1.0));
+    (b - a).simd_gt(margin).to_bitmask() as u8
 }
 
 /// An end's lanes in the run's block, and its value at the reference pixel.
@@ -133,14 +150,21 @@ impl BlockOrder {
         self.before.clear();
         self.before.push(([near; 8], near));
         let mut held = u8::MAX;
+        // The pixels where an occupant is missed or lies wholly beyond the
+        // answer, and whether it did at the reference pixel.
+        let aside = |was_met: bool, was: [f32; 2], l: &IntervalLanes| {
+            let Some((_, _, re, e)) = answer else { return (!was_met, !l.met()) };
+            (!was_met || clear(re, was[0]), !l.met() | clear_lanes(e, l.ends(0)))
+        };
         for (was_met, was, l) in occupants {
-            // Missed where it was missed, met where it was met.
-            let met = l.met();
-            if !was_met {
-                held &= !met;
+            // Missed or wholly beyond the answer where it was, met with its
+            // ends in order where it was not.
+            let (was_aside, now_aside) = aside(was_met, was, l);
+            if was_aside {
+                held &= now_aside;
                 continue;
             }
-            held &= met;
+            held &= l.met();
             let primitive = l.end_at(0, 0).primitive;
             for (end, r) in was.into_iter().enumerate() {
                 let t = l.ends(end);
