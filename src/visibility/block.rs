@@ -7,7 +7,9 @@
 //! hands their answer on along the run of pixels after it that no occupant
 //! enters or leaves inside of (the whole block, or up to the next left or
 //! right end), as far as it provably holds; the walk goes on pixel by pixel
-//! from the first pixel where it does not. Where the last pixel of the block
+//! from the first pixel where it does not. The same from the first pixel
+//! after an occupant entered or left inside a block, where at least three
+//! of its pixels follow. Where the last pixel of the block
 //! before was settled with the same occupants, its answer is handed on into
 //! the block the same way (the walk keeps each occupant's lanes of two
 //! blocks), and the booleans do not run at all.

@@ -727,10 +727,14 @@ fn scan_row(
         // The last pixel this step settles: `x`, or its whole block.
         let mut last = x;
         if let Some(root) = counts.root(tree) {
-            // The run from a block's first pixel that nothing enters or
-            // leaves inside of (a right end leaves after its pixel).
-            let by_blocks = walk.reuse == Reuse::Blocks && x % 8 == 0;
-            let mut upto = (x + 7).min(row.len() - 1) as i64;
+            // The run from `x` to its block's end that nothing enters or
+            // leaves inside of (a right end leaves after its pixel). The
+            // booleans' answer is spread along it from a block's first pixel,
+            // and from the first after an occupant entered or left while at
+            // least three of the block's pixels follow it (fewer: the
+            // booleans pixel by pixel cost less than the spreading).
+            let by_blocks = walk.reuse == Reuse::Blocks && (x % 8 == 0 || (!steady && x % 8 <= 4));
+            let mut upto = (x | 7).min(row.len() - 1) as i64;
             upto = entry.get(next_in).map_or(upto, |e| upto.min(e.1 - 1));
             upto = exit.get(next_out).map_or(upto, |e| upto.min(e.2)).max(x as i64);
             let upto = upto as usize;
