@@ -77,8 +77,10 @@ use crate::visibility::surface_frame::{row_to_write, SurfaceFrame};
 use crate::visibility::{ItemId, VisibilityBuffer};
 
 /// Rows scanned by one worker in turn, each band a task of its own
-/// ([`scan_bands`]).
-const BAND_ROWS: usize = 8;
+/// ([`scan_bands`]). Measured with the walk's loops aligned (so that layout
+/// moves no model's time): 16 rows 3-4% sooner than 8 on the median models,
+/// 12 alike, 32 slower.
+const BAND_ROWS: usize = 16;
 
 /// The visible surface of `solid` (in world space) at each pixel centre of a
 /// `width` x `height` image seen by `camera`, rows top to bottom: the first
