@@ -8,8 +8,8 @@
 //! enters or leaves inside of (the whole block, or up to the next left or
 //! right end), as far as it provably holds; the walk goes on pixel by pixel
 //! from the first pixel where it does not. The same from the first pixel
-//! after an occupant entered or left inside a block, where at least three
-//! of its pixels follow. Where the last pixel of the block
+//! after an occupant entered or left inside a block, where that pays
+//! (`EventSpreads` in `csg.rs`). Where the last pixel of the block
 //! before was settled with the same occupants, its answer is handed on into
 //! the block the same way (the walk keeps each occupant's lanes of two
 //! blocks), and the booleans do not run at all.

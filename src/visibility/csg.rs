@@ -694,6 +694,29 @@ impl XOrder {
     }
 }
 
+/// Whether a row's walk spreads the booleans' answer from the first pixel
+/// after an occupant entered or left inside a block (beyond the paper, which
+/// reuses an answer only where nothing entered or left). It pays where at
+/// least three of the block's pixels follow and the answer holds on for two
+/// or more of them; on rows of many small parts (a Menger sponge, a carriage
+/// of 417 primitives) it mostly stops at once, and the booleans pixel by
+/// pixel cost less. A row starts out spreading and stops once such spreads
+/// have failed twice more than they paid (two paid ones at most banked).
+#[derive(Debug, Clone, Copy, Default)]
+struct EventSpreads(i32);
+
+impl EventSpreads {
+    /// Whether to spread from pixel `x` along a run that ends at `upto`.
+    fn worth(self, x: usize, upto: usize) -> bool {
+        upto >= x + 3 && self.0 > -2
+    }
+
+    /// A spread from pixel `x` settled pixels up to `last`.
+    fn paid(&mut self, x: usize, last: usize) {
+        self.0 = if last >= x + 2 { (self.0 + 1).min(2) } else { self.0 - 1 };
+    }
+}
+
 /// One scanline: the x-entry table of the occupants (sorted by left end), the
 /// x-exit order (by right end), the x-occupancy list as the counts of
 /// `occupied` (empty on entry and on return), and each occupied pixel's
@@ -719,6 +742,7 @@ fn scan_row(
     let mut surface: Option<(f32, f32)> = None;
     // Whether the pixel before `x` was settled with the occupants `x` has.
     let mut steady = false;
+    let mut event_spreads = EventSpreads::default();
     while x < row.len() {
         while next_in < entry.len() && entry[next_in].1 <= x as i64 {
             counts.set(tree, entry[next_in].0, true);
@@ -732,14 +756,14 @@ fn scan_row(
             // The run from `x` to its block's end that nothing enters or
             // leaves inside of (a right end leaves after its pixel). The
             // booleans' answer is spread along it from a block's first pixel,
-            // and from the first after an occupant entered or left while at
-            // least three of the block's pixels follow it (fewer: the
-            // booleans pixel by pixel cost less than the spreading).
-            let by_blocks = walk.reuse == Reuse::Blocks && (x % 8 == 0 || (!steady && x % 8 <= 4));
+            // and from the first after an occupant entered or left where
+            // that is worth it ([`EventSpreads`]).
             let mut upto = (x | 7).min(row.len() - 1) as i64;
             upto = entry.get(next_in).map_or(upto, |e| upto.min(e.1 - 1));
             upto = exit.get(next_out).map_or(upto, |e| upto.min(e.2)).max(x as i64);
             let upto = upto as usize;
+            let after_event = !steady && event_spreads.worth(x, upto);
+            let by_blocks = walk.reuse == Reuse::Blocks && (x % 8 == 0 || after_event);
             // The answer of the pixel before carried on where it holds, or
             // the booleans' at `x` spread along the run.
             let ids = counts.present().ids();
@@ -763,6 +787,9 @@ fn scan_row(
                 row[x] = hit;
                 if by_blocks && upto > x {
                     last = spans.spread(order, ids, (x, hit), near, (row, upto));
+                    if x % 8 != 0 {
+                        event_spreads.paid(x, last);
+                    }
                 }
             }
             if let Some(h) = row[last].filter(|_| walk.horizon) {
