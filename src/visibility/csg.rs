@@ -763,11 +763,14 @@ fn scan_row(
             upto = exit.get(next_out).map_or(upto, |e| upto.min(e.2)).max(x as i64);
             let upto = upto as usize;
             let after_event = !steady && event_spreads.worth(x, upto);
-            let by_blocks = walk.reuse == Reuse::Blocks && (x % 8 == 0 || after_event);
+            let spreading = walk.reuse == Reuse::Blocks && (x % 8 == 0 || after_event);
             // The answer of the pixel before carried on where it holds, or
             // the booleans' at `x` spread along the run.
             let ids = counts.present().ids();
-            let carried = (by_blocks && steady).then(|| spans.carry(order, ids, x, near, (row, upto))).flatten();
+            // (Carried only into a block's first pixel: the pixel before is
+            // the last of the block before, whose lanes the walk keeps.)
+            let carry = spreading && steady && x % 8 == 0;
+            let carried = carry.then(|| spans.carry(order, ids, x, near, (row, upto))).flatten();
             if let Some(l) = carried {
                 last = l;
             } else {
@@ -785,7 +788,7 @@ fn scan_row(
                     caster.first_hit_in_by(root, &PixelSpans { row: spans, x }, near, scratch)
                 };
                 row[x] = hit;
-                if by_blocks && upto > x {
+                if spreading && upto > x {
                     last = spans.spread(order, ids, (x, hit), near, (row, upto));
                     if x % 8 != 0 {
                         event_spreads.paid(x, last);
