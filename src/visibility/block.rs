@@ -65,18 +65,22 @@ fn settled((a, ra): (&[f32; 8], f32), (b, rb): (&[f32; 8], f32)) -> u8 {
     }
 }
 
-/// Whether `b` lies beyond `a` by more than the largest move a difference
-/// makes ([`TIE`] relative to `t`, on both sides).
+/// How far apart (relative to the larger `t`, at least absolute) two ends
+/// must lie to stand clear of each other: beyond the largest move a
+/// difference makes ([`TIE`] on both sides), with room for rounding.
+const CLEARANCE: f32 = 4.0 * TIE;
+
+/// Whether `b` lies beyond `a` by more than [`CLEARANCE`].
 #[inline]
 fn clear(a: f32, b: f32) -> bool {
-    b - a > 4.0 * TIE * a.abs().max(b.abs()).max(1.0)
+    b - a > CLEARANCE * a.abs().max(b.abs()).max(1.0)
 }
 
 /// The pixels (bits of lanes) where `b` lies beyond `a` as [`clear`] says.
 #[inline]
 fn clear_lanes(a: &[f32; 8], b: &[f32; 8]) -> u8 {
     let (a, b) = (f32x8::new(*a), f32x8::new(*b));
-    let margin = f32x8::splat(4.0 * TIE) * a.abs().max(b.abs()).max(f32x8::splat(1.0));
+    let margin = f32x8::splat(CLEARANCE) * a.abs().max(b.abs()).max(f32x8::splat(1.0));
     (b - a).simd_gt(margin).to_bitmask() as u8
 }
 

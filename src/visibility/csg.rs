@@ -750,7 +750,8 @@ fn scan_row(
             steady = false;
             next_in += 1;
         }
-        // The last pixel this step settles: `x`, or its whole block.
+        // The last pixel this step settles: `x`, or the last its answer was
+        // spread or carried to.
         let mut last = x;
         if let Some(root) = counts.root(tree) {
             // The run from `x` to its block's end that nothing enters or
