@@ -356,6 +356,49 @@ fn a_union_of_primitives_walked_as_a_z_buffer_finds_what_the_booleans_find() {
     assert!(covered > 60_000 && twins_seen > 5_000, "{covered} pixels covered, {twins_seen} of twins");
 }
 
+/// A union of a crowd of small primitives, most of them on the same rows
+/// (over 64, 128 and 256 occupants to a row: the z-buffer's bits in one, two
+/// and four words, and beyond that the booleans), with twins: the same
+/// surfaces, to the bit, as the booleans pixel by pixel.
+#[test]
+fn a_crowded_union_walked_as_a_z_buffer_finds_what_the_booleans_find() {
+    use kage::scene::{Camera, Projection};
+    use kage::visibility::csg::{scan_solid_with, CsgMethod};
+    let mut rng = StdRng::seed_from_u64(37);
+    let (w, h) = (96u32, 64u32);
+    let mut covered = 0;
+    for (round, n) in [100, 200, 300, 160].into_iter().enumerate() {
+        let mut primitives: Vec<Primitive> = (0..n)
+            .map(|_| {
+                let p = random_primitive(&mut rng);
+                // In a flat band across the view: each row meets most of them.
+                let at = Vec3::new(rng.gen_range(-2.5..2.5), rng.gen_range(-0.2..0.2), rng.gen_range(-2.0..2.0));
+                Primitive { transform: Affine3A::from_mat3_translation(Mat3::from(p.transform.matrix3) * 0.3, at), ..p }
+            })
+            .collect();
+        let twins: Vec<Primitive> = primitives.iter().step_by(7).cloned().collect();
+        primitives.extend(twins);
+        let tree = CsgTree::Union((0..primitives.len()).map(CsgTree::Leaf).collect());
+        let solid = CsgSolid { primitives, tree: Some(tree) };
+        let camera = Camera {
+            eye: Vec3::new(0.4 * round as f32 - 0.6, 0.3, 8.0),
+            target: Vec3::ZERO,
+            up: Vec3::Y,
+            near: 0.05,
+            far: 100.0,
+            projection: Projection::Perspective { fov_y_deg: 40.0 },
+            shift: glam::Vec2::ZERO,
+        };
+        let each = scan_solid_with(&solid, &camera, w, h, CsgMethod::SegmentsEachPixel).unwrap();
+        let nearest = scan_solid_with(&solid, &camera, w, h, CsgMethod::Segments).unwrap();
+        for (k, (a, b)) in each.iter().zip(&nearest).enumerate() {
+            assert_eq!(a, b, "pixel ({}, {}) round {round}", k as u32 % w, k as u32 / w);
+        }
+        covered += each.iter().flatten().count();
+    }
+    assert!(covered > 2_500, "{covered} pixels covered");
+}
+
 /// A viewer's frame scanned again and again (other solids, other cameras,
 /// now and then an empty solid or another size) holds, after each scan, just
 /// what a fresh scan finds: what the last scan wrote and this one does not is

@@ -166,6 +166,14 @@ impl IntervalLanes {
         &self.t[end]
     }
 
+    /// The faces of end `end` (0 the entry, 1 the exit) at the eight pixels
+    /// (meaningless where the ray misses).
+    #[inline]
+    #[must_use]
+    pub fn faces(&self, end: usize) -> &[u32; 8] {
+        &self.face[end]
+    }
+
     /// End `end` (0 the entry, 1 the exit) at pixel `j` as a crossing.
     #[inline]
     #[must_use]

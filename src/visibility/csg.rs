@@ -74,6 +74,7 @@ use crate::visibility::outline::{screen_point, Extent, Outline};
 use crate::visibility::pattern::{PatternMatrix, TooManySegments};
 use crate::visibility::spans::{BlockSpans, PixelSpans, RowSpans};
 use crate::visibility::surface_frame::{row_to_write, SurfaceFrame};
+use crate::visibility::zbuffer::{DepthEnds, UnionRow};
 use crate::visibility::{ItemId, VisibilityBuffer};
 
 /// Rows scanned by one worker in turn, each band a task of its own
@@ -228,7 +229,7 @@ struct SegmentWalk {
     /// at silhouettes cost: the paper's random spheres).
     horizon: bool,
     /// Whether a row's pixels take the nearest entry of their occupants,
-    /// found occupant by occupant ([`RowSpans::nearest_entries`]): a union
+    /// found a block of eight pixels at a time ([`super::zbuffer`]): a union
     /// of primitives, not pixel by pixel (the tests' oracle).
     nearest_entries: bool,
 }
@@ -519,13 +520,13 @@ impl<'a> FrameWalk<'a> {
         &self,
         ends: &[RowEnds],
         spans: &RowSpans,
-        (row, by_depth): (&mut [Option<Hit>], &mut Vec<DepthEnds>),
+        (row, by_depth, union): (&mut [Option<Hit>], &mut Vec<DepthEnds>, &mut UnionRow),
     ) -> bool {
         let nearest = |i: usize| self.outlines[i].as_ref().map_or(f32::MIN, |o| o.nearest);
         by_depth.clear();
         by_depth.extend(ends.iter().map(|&(i, a, b)| (i, a, b, nearest(i))));
         by_depth.sort_unstable_by(|p, q| p.3.total_cmp(&q.3));
-        let found = spans.nearest_entries(by_depth, self.near, row);
+        let found = spans.nearest_entries(by_depth, self.near, (row, union));
         if !found {
             row.fill(None);
         }
@@ -541,8 +542,20 @@ impl<'a> FrameWalk<'a> {
         buffers: &mut RowBuffers,
         visit: impl FnOnce(&ScannedRow),
     ) {
-        let RowBuffers { row, lines, own_ends, ends, x_order, counts, scratch, blocks, coherence, order, by_depth } =
-            buffers;
+        let RowBuffers {
+            row,
+            lines,
+            own_ends,
+            ends,
+            x_order,
+            counts,
+            scratch,
+            blocks,
+            coherence,
+            order,
+            by_depth,
+            union,
+        } = buffers;
         let caster = self.caster;
         // Procedure 2: each occupant's left and right ends on this scanline.
         self.ends(y, occupied, (own_ends, ends));
@@ -559,7 +572,7 @@ impl<'a> FrameWalk<'a> {
         let spans = RowSpans { blocks, caster, lines };
         match self.walker {
             RowWalker::Segments(walk) => {
-                if !(walk.nearest_entries && self.nearest_entries(ends, &spans, (row, by_depth))) {
+                if !(walk.nearest_entries && self.nearest_entries(ends, &spans, (row, by_depth, union))) {
                     let reuse = (&mut *coherence, &mut *order);
                     scan_row(caster, (walk, counts), ends, &spans, self.near, (row, scratch, reuse), x_order);
                 }
@@ -626,6 +639,7 @@ struct RowBuffers {
     order: BlockOrder,
     /// A union's occupants, nearest first ([`RowSpans::nearest_entries`]).
     by_depth: Vec<DepthEnds>,
+    union: UnionRow,
 }
 
 thread_local! {
@@ -668,10 +682,6 @@ pub(super) type RowEnds = (usize, i64, i64);
 /// A primitive's own ends on the row it last occupied: the row, and its
 /// unclipped ends there (if it shows).
 type OwnEnds = (usize, Option<(i64, i64)>);
-
-/// An occupant of a union's scanline with its least depth
-/// ([`RowSpans::nearest_entries`]).
-type DepthEnds = (usize, i64, i64, f32);
 
 /// A scanline's x-entry table (occupants by left end) and x-exit order (by
 /// right end).

@@ -9,7 +9,8 @@
 //! surfaces of CSG solids by seed 003's scanline walk, from each primitive's
 //! outline on the screen (`outline.rs`: its procedures 1 and 2) clipped by
 //! [`bounds`] (to the nodes that bound it), each occupant's intervals found eight
-//! pixels at a time (`spans.rs`), over [`occupancy`] (its reference
+//! pixels at a time (`spans.rs`), a union of primitives as a z-buffer
+//! (`zbuffer.rs`), other trees over [`occupancy`] (its reference
 //! counts, in tree form) or [`pattern`] (its pattern matrix), with [`block`]
 //! (its reuse of an answer, a block of eight pixels at a time) and [`horizon`]
 //! (occupants wholly behind the surface left out of the booleans), or
@@ -29,6 +30,7 @@ pub mod raster;
 pub mod scan;
 mod spans;
 pub mod surface_frame;
+mod zbuffer;
 
 use glam::Vec3;
 
