@@ -2,8 +2,9 @@
 //! interval of each occupant): each occupant's eight-pixel blocks of lanes,
 //! found once per block ([`BlockSpans`]), and the readers the booleans and
 //! the block spreading ([`super::block`]) take them through ([`RowSpans`]),
-//! with occupants beyond a [`Horizon`] left out. (A union's z-buffer reads
-//! its lanes straight from the caster: [`super::zbuffer`].)
+//! with occupants beyond a [`Horizon`] left out. (A union's z-buffer solves
+//! each occupant's block once, uncached: [`BlockSpans::solve`], read by
+//! [`super::zbuffer`].)
 
 use std::cell::{Cell, RefCell};
 

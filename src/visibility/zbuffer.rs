@@ -96,7 +96,8 @@ impl RowSpans<'_> {
     /// The union's row: each pixel's nearest entry beyond `near` over the
     /// occupants `ends` (nearest first), into `row` (all `None` before).
     /// `false`, the row half written, where a ray starts inside an occupant
-    /// (or more than 256 occupants share the row).
+    /// (or more than 256 occupants share the row). Kept out of line, so that
+    /// the booleans' row walk beside it compiles as it did without it.
     #[inline(never)]
     pub(super) fn nearest_entries(
         &self,
