@@ -255,6 +255,126 @@ fn the_scanline_walk_finds_what_a_ray_per_pixel_finds() {
     assert!(covered * 20 > pixels, "only {covered} of {pixels} pixels show a solid");
 }
 
+/// A part of a few primitives cut by many, some far from it, some through it,
+/// some through two of its primitives at once: the walk (which leaves each
+/// cutter out wherever the ray misses the region its box shares with a box of
+/// the part's primitives) shows at every pixel what a ray cast at the whole
+/// solid shows.
+#[test]
+fn a_cutter_left_out_where_it_cannot_meet_its_part_changes_no_pixel() {
+    use kage::visibility::csg::scan_solid;
+    let mut rng = StdRng::seed_from_u64(41);
+    let (w, h) = (96u32, 64u32);
+    let (mut covered, mut cut) = (0, 0);
+    for round in 0..40 {
+        let parts = rng.gen_range(1..4);
+        let cutters = rng.gen_range(4..14);
+        let mut primitives: Vec<Primitive> = (0..parts + cutters).map(|_| random_primitive(&mut rng)).collect();
+        for p in &mut primitives[parts..] {
+            // Smaller, and spread wider than the part.
+            let at = Vec3::new(rng.gen_range(-2.5..2.5), rng.gen_range(-2.5..2.5), rng.gen_range(-2.5..2.5));
+            p.transform = Affine3A::from_mat3_translation(Mat3::from(p.transform.matrix3) * 0.6, at);
+        }
+        let body = CsgTree::Union((0..parts).map(CsgTree::Leaf).collect());
+        let tree = CsgTree::Difference(
+            Box::new(body),
+            vec![CsgTree::Union((parts..parts + cutters).map(CsgTree::Leaf).collect())],
+        );
+        let solid = CsgSolid { primitives, tree: Some(tree) };
+        let camera = random_camera(&mut rng, round);
+        let scanned = scan_solid(&solid, &camera, w, h);
+        let rays = camera.pixel_rays(glam::Vec2::new(w as f32, h as f32));
+        for y in 0..h {
+            for x in 0..w {
+                let ray = rays.ray(glam::Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
+                let near = camera.distance_at_depth(&ray, 1.0);
+                let cast = first_hit(&solid, &ray, near, f32::INFINITY);
+                let got = scanned[(y * w + x) as usize];
+                match (got, cast) {
+                    (None, None) => {}
+                    (Some(a), Some(b)) => {
+                        assert_eq!(a.primitive, b.primitive, "({x}, {y}) round {round}");
+                        assert!((a.t - b.t).abs() <= 1e-4 * b.t.abs().max(1.0), "({x}, {y}): {a:?} vs {b:?}");
+                        covered += 1;
+                        cut += usize::from(a.cut);
+                    }
+                    _ => panic!("({x}, {y}) round {round}: scanline {got:?}, ray {cast:?}"),
+                }
+            }
+        }
+    }
+    // Enough surface, and enough of it hole walls, for the test to bite.
+    assert!(covered > 20_000 && cut > 2_000, "{covered} pixels covered, {cut} of hole walls");
+}
+
+/// Cutters flush with their part, as CAD models have them (a pocket as wide
+/// as the plate, a cutter the part's own size, placed by translations that
+/// do not round exactly): leaving each out where it cannot meet the part
+/// keeps every pixel the rays cover covered, and shows the same primitive
+/// nearly everywhere (a face the cut leaves exactly on the part's may show
+/// either: the order in which the difference meets its cutters decides).
+#[test]
+fn cutters_flush_with_their_part_are_left_out_only_where_they_cannot_meet_it() {
+    use kage::visibility::csg::scan_solid;
+    let mut rng = StdRng::seed_from_u64(43);
+    let (w, h) = (96u32, 64u32);
+    let (mut covered, mut same, mut cut) = (0, 0, 0);
+    let cube = |lo: Vec3, hi: Vec3| Primitive {
+        shape: Shape::Polyhedron(ConvexPolyhedron::unit_cube()),
+        transform: Affine3A::from_scale_rotation_translation(hi - lo, glam::Quat::IDENTITY, lo),
+        color: None,
+        source: 0..0,
+    };
+    for round in 0..40 {
+        // The part: a plate about the origin whose corners do not round exactly.
+        let size = Vec3::new(rng.gen_range(2.1..3.9), rng.gen_range(2.1..3.9), rng.gen_range(0.3..1.7));
+        let (lo, hi) = (-size * 0.5 - Vec3::splat(0.1), size * 0.5 - Vec3::splat(0.1));
+        let mut primitives = vec![cube(lo, hi)];
+        for _ in 0..rng.gen_range(3..9) {
+            // Each side of a cutter on the part's face, or inside, or beyond it.
+            let mut side = |a: f32, b: f32| match rng.gen_range(0..4) {
+                0 => a,
+                1 => b,
+                2 => rng.gen_range(a..b),
+                _ => b + rng.gen_range(0.0..1.0),
+            };
+            let (x0, x1, y0, y1, z0, z1) = (
+                side(lo.x, hi.x),
+                side(lo.x, hi.x),
+                side(lo.y, hi.y),
+                side(lo.y, hi.y),
+                side(lo.z, hi.z),
+                side(lo.z, hi.z),
+            );
+            let (a, b) = (Vec3::new(x0.min(x1), y0.min(y1), z0.min(z1)), Vec3::new(x0.max(x1), y0.max(y1), z0.max(z1)));
+            if (b - a).min_element() > 0.05 {
+                primitives.push(cube(a, b));
+            }
+        }
+        let cutters = CsgTree::Union((1..primitives.len()).map(CsgTree::Leaf).collect());
+        let solid = CsgSolid { primitives, tree: Some(CsgTree::Difference(Box::new(CsgTree::Leaf(0)), vec![cutters])) };
+        let camera = random_camera(&mut rng, round);
+        let scanned = scan_solid(&solid, &camera, w, h);
+        let rays = camera.pixel_rays(glam::Vec2::new(w as f32, h as f32));
+        for y in 0..h {
+            for x in 0..w {
+                let ray = rays.ray(glam::Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
+                let near = camera.distance_at_depth(&ray, 1.0);
+                let cast = first_hit(&solid, &ray, near, f32::INFINITY);
+                let got = scanned[(y * w + x) as usize];
+                assert_eq!(got.is_some(), cast.is_some(), "({x}, {y}) round {round}: scanline {got:?}, ray {cast:?}");
+                if let (Some(a), Some(b)) = (got, cast) {
+                    covered += 1;
+                    same += usize::from(a.primitive == b.primitive);
+                    cut += usize::from(a.cut);
+                }
+            }
+        }
+    }
+    assert!(covered > 20_000 && cut > 2_000, "{covered} pixels covered, {cut} of hole walls");
+    assert!(same * 1000 >= covered * 995, "{same} of {covered} pixels show the ray's primitive");
+}
+
 /// The BVH-culled ray caster (a primitive whose box the ray misses counts as
 /// missed) finds exactly what casting every primitive finds, on random solids
 /// large enough to get a BVH, for rays from inside and outside their reach.

@@ -68,6 +68,7 @@ use crate::scene::{Camera, Object, Scene};
 use crate::visibility::block::BlockOrder;
 use crate::visibility::bounds::{self, BoundingLeaves};
 use crate::visibility::coherence::{self, PixelCoherence};
+use crate::visibility::cut_region::CutRegions;
 use crate::visibility::horizon::Horizon;
 use crate::visibility::occupancy::{OccupancyTree, Occupied};
 use crate::visibility::outline::{screen_point, Extent, Outline};
@@ -153,6 +154,8 @@ pub struct PreparedSolid {
     /// Per primitive, the leaves outside whose outlines it cannot change
     /// the solid ([`super::bounds`]).
     bounds: BoundingLeaves,
+    /// Per cutter, where in space it can change the solid ([`super::cut_region`]).
+    regions: CutRegions,
 }
 
 impl PreparedSolid {
@@ -160,7 +163,13 @@ impl PreparedSolid {
     /// matrix would pass its limit.
     pub fn new(solid: &CsgSolid, method: CsgMethod) -> Result<PreparedSolid, TooManySegments> {
         let bounds = solid.tree.as_ref().map(|t| BoundingLeaves::new(t, solid.primitives.len())).unwrap_or_default();
-        Ok(PreparedSolid { caster: CsgCaster::without_bvh(solid), walker: RowWalker::new(solid, method)?, bounds })
+        let (caster, walker) = (CsgCaster::without_bvh(solid), RowWalker::new(solid, method)?);
+        let regions = match (&walker, &solid.tree) {
+            (RowWalker::Segments(walk), _) => CutRegions::new(solid, &caster, &walk.tree),
+            (_, Some(tree)) => CutRegions::new(solid, &caster, &OccupancyTree::new(tree, solid.primitives.len())),
+            (_, None) => CutRegions::default(),
+        };
+        Ok(PreparedSolid { caster, walker, bounds, regions })
     }
 
     /// The visible surface at each pixel centre of a `width` x `height`
@@ -469,6 +478,9 @@ impl<'a> FrameWalk<'a> {
         if let Some(tree) = &solid.tree {
             let mut boxes: Vec<Option<Extent>> = outlines.iter().map(|o| o.as_ref().map(|o| o.rows)).collect();
             bounds::narrow(tree, &mut boxes);
+            for (i, b) in boxes.iter_mut().enumerate() {
+                *b = prepared.regions.narrow(i, *b, (camera, vp, (width, height)));
+            }
             for (o, b) in outlines.iter_mut().zip(boxes) {
                 match (o.as_mut(), b) {
                     (Some(o), Some(b)) => o.rows = b,

@@ -8,7 +8,8 @@
 //! binning into bands and the band-parallel z-buffer). [`csg`] finds the visible
 //! surfaces of CSG solids by seed 003's scanline walk, from each primitive's
 //! outline on the screen (`outline.rs`: its procedures 1 and 2) clipped by
-//! [`bounds`] (to the nodes that bound it), each occupant's intervals found eight
+//! [`bounds`] (to the nodes that bound it) and by `cut_region.rs` (a cutter to
+//! where in space it meets its part), each occupant's intervals found eight
 //! pixels at a time (`spans.rs`), a union of primitives as a z-buffer
 //! (`zbuffer.rs`), other trees over [`occupancy`] (its reference
 //! counts, in tree form) or [`pattern`] (its pattern matrix), with [`block`]
@@ -22,6 +23,7 @@ pub mod bounds;
 pub mod clip;
 pub mod coherence;
 pub mod csg;
+mod cut_region;
 pub mod horizon;
 pub mod occupancy;
 mod outline;

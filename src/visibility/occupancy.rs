@@ -119,6 +119,91 @@ impl OccupancyTree {
     }
 }
 
+/// The part each cutting primitive cuts (`cut_region.rs` keeps a cutter
+/// to where in space it meets it): per primitive that lies under a cutter of
+/// a difference (the nearest such), the primitives of that difference's
+/// first operand, its body. A difference's set lies within its body's
+/// primitives, and such a primitive changes the set of the cutters it lies
+/// under only within itself (widened by [`crate::raytrace::csg::TIE`]):
+/// where the two do not meet, it changes nothing of the solid.
+#[derive(Debug, Clone, Default)]
+pub struct CutterBodies {
+    /// Per primitive: its body (an index into `bodies`), or none.
+    body: Vec<u32>,
+    /// Per body: its primitives, `primitives[start..end]`.
+    bodies: Vec<(u32, u32)>,
+    primitives: Vec<u32>,
+}
+
+impl CutterBodies {
+    /// The bodies of `tree`'s cutting primitives (a primitive with more
+    /// than one leaf has none).
+    #[must_use]
+    pub fn new(tree: &OccupancyTree) -> CutterBodies {
+        let mut table = CutterBodies { body: vec![NONE; tree.first_leaf.len()], ..CutterBodies::default() };
+        let mut by_node = vec![NONE; tree.nodes.len()];
+        for (i, &leaf) in tree.first_leaf.iter().enumerate() {
+            if leaf == NONE || tree.next_leaf[leaf as usize] != NONE {
+                continue;
+            }
+            let Some(difference) = tree.cutting(leaf) else { continue };
+            if by_node[difference as usize] == NONE {
+                by_node[difference as usize] = table.bodies.len() as u32;
+                let start = table.primitives.len() as u32;
+                let body = tree.operands[tree.nodes[difference as usize].start as usize];
+                tree.leaves_under(body, &mut table.primitives);
+                table.bodies.push((start, table.primitives.len() as u32));
+            }
+            table.body[i] = by_node[difference as usize];
+        }
+        table
+    }
+
+    /// Primitive `i`'s body, if it cuts.
+    #[inline]
+    #[must_use]
+    pub fn body_of(&self, i: usize) -> Option<usize> {
+        let b = *self.body.get(i)?;
+        (b != NONE).then_some(b as usize)
+    }
+
+    /// The primitives of body `b`.
+    #[inline]
+    #[must_use]
+    pub fn primitives(&self, b: usize) -> &[u32] {
+        let (start, end) = self.bodies[b];
+        &self.primitives[start as usize..end as usize]
+    }
+}
+
+impl OccupancyTree {
+    /// The nearest difference above `node` that it lies under a cutter of.
+    fn cutting(&self, mut node: u32) -> Option<u32> {
+        loop {
+            let parent = self.nodes[node as usize].parent;
+            if parent == NONE {
+                return None;
+            }
+            let p = &self.nodes[parent as usize];
+            if p.operation == Operation::Difference && self.operands[p.start as usize] != node {
+                return Some(parent);
+            }
+            node = parent;
+        }
+    }
+
+    /// The primitives of the leaves under `node`, into `out`.
+    fn leaves_under(&self, node: u32, out: &mut Vec<u32>) {
+        let n = &self.nodes[node as usize];
+        if let Operation::Leaf(i) = n.operation {
+            out.push(i as u32);
+        }
+        for &k in self.operands_of(n) {
+            self.leaves_under(k, out);
+        }
+    }
+}
+
 /// The operands of `tree` with nested nodes of the same kind merged in: a
 /// union's unions, an intersection's intersections, and a difference's first
 /// operand when it is itself a difference (`(a − b) − c`).
