@@ -74,8 +74,13 @@ impl CutRegions {
         let region = |i: usize| {
             let b = bodies.body_of(i)?;
             let c = &boxes[i];
+            // A flat box (a transform that cannot be undone) bounds nothing.
+            let parts = bodies.primitives(b).iter().map(|&p| &boxes[p as usize]);
+            if !c.solid() || !parts.clone().all(Parallelepiped::solid) {
+                return None;
+            }
             let mut region = Region { corners: Vec::new(), widened: c.widened as f32, own: c.bounds };
-            for p in bodies.primitives(b).iter().map(|&p| &boxes[p as usize]) {
+            for p in parts {
                 // Boxes apart in space: no corner.
                 if c.bounds.0.max(p.bounds.0).cmpgt(c.bounds.1.min(p.bounds.1)).any() {
                     continue;
@@ -180,6 +185,11 @@ impl Parallelepiped {
         });
         let (min, max) = corners.iter().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(a, b), &c| (a.min(c), b.max(c)));
         Parallelepiped { slabs, corners, widened, bounds: (min.as_vec3().into(), max.as_vec3().into()) }
+    }
+
+    /// Whether it has volume: its half-spaces and widening are finite.
+    fn solid(&self) -> bool {
+        self.widened.is_finite() && self.widened > 0.0 && self.slabs.iter().all(|(n, d)| n.is_finite() && d.is_finite())
     }
 
     /// Whether `x` lies inside, or outside by no more than the rounding of
