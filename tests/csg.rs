@@ -255,6 +255,23 @@ fn the_scanline_walk_finds_what_a_ray_per_pixel_finds() {
     assert!(covered * 20 > pixels, "only {covered} of {pixels} pixels show a solid");
 }
 
+/// A pixel's column and row, what the scanline walk shows there, and what a
+/// ray cast at the whole solid first meets.
+type PixelBesideRay = ((u32, u32), Option<Crossing>, Option<Crossing>);
+
+/// Each pixel of a `w` x `h` frame of `solid` seen by `camera`, the ray
+/// cast beyond the near plane.
+fn walk_beside_rays(solid: &CsgSolid, camera: &kage::scene::Camera, (w, h): (u32, u32)) -> Vec<PixelBesideRay> {
+    let scanned = kage::visibility::csg::scan_solid(solid, camera, w, h);
+    let rays = camera.pixel_rays(glam::Vec2::new(w as f32, h as f32));
+    let pixel = |(x, y): (u32, u32)| {
+        let ray = rays.ray(glam::Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
+        let near = camera.distance_at_depth(&ray, 1.0);
+        ((x, y), scanned[(y * w + x) as usize], first_hit(solid, &ray, near, f32::INFINITY))
+    };
+    (0..h).flat_map(|y| (0..w).map(move |x| (x, y))).map(pixel).collect()
+}
+
 /// A part of a few primitives cut by many, some far from it, some through it,
 /// some through two of its primitives at once: the walk (which leaves each
 /// cutter out wherever the ray misses the region its box shares with a box of
@@ -262,7 +279,6 @@ fn the_scanline_walk_finds_what_a_ray_per_pixel_finds() {
 /// solid shows.
 #[test]
 fn a_cutter_left_out_where_it_cannot_meet_its_part_changes_no_pixel() {
-    use kage::visibility::csg::scan_solid;
     let mut rng = StdRng::seed_from_u64(41);
     let (w, h) = (96u32, 64u32);
     let (mut covered, mut cut) = (0, 0);
@@ -282,24 +298,16 @@ fn a_cutter_left_out_where_it_cannot_meet_its_part_changes_no_pixel() {
         );
         let solid = CsgSolid { primitives, tree: Some(tree) };
         let camera = random_camera(&mut rng, round);
-        let scanned = scan_solid(&solid, &camera, w, h);
-        let rays = camera.pixel_rays(glam::Vec2::new(w as f32, h as f32));
-        for y in 0..h {
-            for x in 0..w {
-                let ray = rays.ray(glam::Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
-                let near = camera.distance_at_depth(&ray, 1.0);
-                let cast = first_hit(&solid, &ray, near, f32::INFINITY);
-                let got = scanned[(y * w + x) as usize];
-                match (got, cast) {
-                    (None, None) => {}
-                    (Some(a), Some(b)) => {
-                        assert_eq!(a.primitive, b.primitive, "({x}, {y}) round {round}");
-                        assert!((a.t - b.t).abs() <= 1e-4 * b.t.abs().max(1.0), "({x}, {y}): {a:?} vs {b:?}");
-                        covered += 1;
-                        cut += usize::from(a.cut);
-                    }
-                    _ => panic!("({x}, {y}) round {round}: scanline {got:?}, ray {cast:?}"),
+        for ((x, y), got, cast) in walk_beside_rays(&solid, &camera, (w, h)) {
+            match (got, cast) {
+                (None, None) => {}
+                (Some(a), Some(b)) => {
+                    assert_eq!(a.primitive, b.primitive, "({x}, {y}) round {round}");
+                    assert!((a.t - b.t).abs() <= 1e-4 * b.t.abs().max(1.0), "({x}, {y}): {a:?} vs {b:?}");
+                    covered += 1;
+                    cut += usize::from(a.cut);
                 }
+                _ => panic!("({x}, {y}) round {round}: scanline {got:?}, ray {cast:?}"),
             }
         }
     }
@@ -315,7 +323,6 @@ fn a_cutter_left_out_where_it_cannot_meet_its_part_changes_no_pixel() {
 /// either: the order in which the difference meets its cutters decides).
 #[test]
 fn cutters_flush_with_their_part_are_left_out_only_where_they_cannot_meet_it() {
-    use kage::visibility::csg::scan_solid;
     let mut rng = StdRng::seed_from_u64(43);
     let (w, h) = (96u32, 64u32);
     let (mut covered, mut same, mut cut) = (0, 0, 0);
@@ -354,20 +361,12 @@ fn cutters_flush_with_their_part_are_left_out_only_where_they_cannot_meet_it() {
         let cutters = CsgTree::Union((1..primitives.len()).map(CsgTree::Leaf).collect());
         let solid = CsgSolid { primitives, tree: Some(CsgTree::Difference(Box::new(CsgTree::Leaf(0)), vec![cutters])) };
         let camera = random_camera(&mut rng, round);
-        let scanned = scan_solid(&solid, &camera, w, h);
-        let rays = camera.pixel_rays(glam::Vec2::new(w as f32, h as f32));
-        for y in 0..h {
-            for x in 0..w {
-                let ray = rays.ray(glam::Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
-                let near = camera.distance_at_depth(&ray, 1.0);
-                let cast = first_hit(&solid, &ray, near, f32::INFINITY);
-                let got = scanned[(y * w + x) as usize];
-                assert_eq!(got.is_some(), cast.is_some(), "({x}, {y}) round {round}: scanline {got:?}, ray {cast:?}");
-                if let (Some(a), Some(b)) = (got, cast) {
-                    covered += 1;
-                    same += usize::from(a.primitive == b.primitive);
-                    cut += usize::from(a.cut);
-                }
+        for ((x, y), got, cast) in walk_beside_rays(&solid, &camera, (w, h)) {
+            assert_eq!(got.is_some(), cast.is_some(), "({x}, {y}) round {round}: scanline {got:?}, ray {cast:?}");
+            if let (Some(a), Some(b)) = (got, cast) {
+                covered += 1;
+                same += usize::from(a.primitive == b.primitive);
+                cut += usize::from(a.cut);
             }
         }
     }
