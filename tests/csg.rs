@@ -207,54 +207,6 @@ fn random_camera(rng: &mut StdRng, round: usize) -> kage::scene::Camera {
     }
 }
 
-#[test]
-fn the_scanline_walk_finds_what_a_ray_per_pixel_finds() {
-    use kage::visibility::csg::scan_solid;
-    let mut rng = StdRng::seed_from_u64(3);
-    let (w, h) = (96u32, 64u32);
-    let (mut pixels, mut covered) = (0, 0);
-    for round in 0..40 {
-        let mut prims = Vec::new();
-        let tree = random_tree(&mut rng, &mut prims, 3);
-        let solid = CsgSolid { primitives: prims, tree: Some(tree) };
-        let camera = random_camera(&mut rng, round);
-        let scanned = scan_solid(&solid, &camera, w, h);
-        // The paper's pattern matrix finds the same surfaces.
-        let method = kage::visibility::csg::CsgMethod::PatternMatrix { limit: 100_000 };
-        let expanded = kage::visibility::csg::scan_solid_with(&solid, &camera, w, h, method).unwrap();
-        let rays = camera.pixel_rays(glam::Vec2::new(w as f32, h as f32));
-        for y in 0..h {
-            for x in 0..w {
-                let ray = rays.ray(glam::Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
-                // The walk clips at the near plane, as the polygon pass does.
-                let near = camera.distance_at_depth(&ray, 1.0);
-                let cast = first_hit(&solid, &ray, near, f32::INFINITY);
-                let got = scanned[(y * w + x) as usize];
-                let paper = expanded[(y * w + x) as usize];
-                assert_eq!(
-                    got.map(|c| c.primitive),
-                    paper.map(|c| c.primitive),
-                    "({x}, {y}) round {round}: pattern matrix"
-                );
-                if let (Some(a), Some(b)) = (got, paper) {
-                    assert!((a.t - b.t).abs() <= 1e-5 * a.t.abs().max(1.0), "({x}, {y}): {a:?} vs {b:?}");
-                }
-                pixels += 1;
-                covered += usize::from(cast.is_some());
-                match (got, cast) {
-                    (None, None) => {}
-                    (Some(a), Some(b)) => {
-                        assert_eq!(a.primitive, b.primitive, "({x}, {y}) round {round}");
-                        assert!((a.t - b.t).abs() <= 1e-4 * b.t.abs().max(1.0), "({x}, {y}): {a:?} vs {b:?}");
-                    }
-                    _ => panic!("({x}, {y}) round {round}: scanline {got:?}, ray {cast:?}"),
-                }
-            }
-        }
-    }
-    assert!(covered * 20 > pixels, "only {covered} of {pixels} pixels show a solid");
-}
-
 /// A pixel's column and row, what the scanline walk shows there, and what a
 /// ray cast at the whole solid first meets.
 type PixelBesideRay = ((u32, u32), Option<Crossing>, Option<Crossing>);
@@ -270,6 +222,45 @@ fn walk_beside_rays(solid: &CsgSolid, camera: &kage::scene::Camera, (w, h): (u32
         ((x, y), scanned[(y * w + x) as usize], first_hit(solid, &ray, near, f32::INFINITY))
     };
     (0..h).flat_map(|y| (0..w).map(move |x| (x, y))).map(pixel).collect()
+}
+
+#[test]
+fn the_scanline_walk_finds_what_a_ray_per_pixel_finds() {
+    let mut rng = StdRng::seed_from_u64(3);
+    let (w, h) = (96u32, 64u32);
+    let (mut pixels, mut covered) = (0, 0);
+    for round in 0..40 {
+        let mut prims = Vec::new();
+        let tree = random_tree(&mut rng, &mut prims, 3);
+        let solid = CsgSolid { primitives: prims, tree: Some(tree) };
+        let camera = random_camera(&mut rng, round);
+        // The paper's pattern matrix finds the same surfaces.
+        let method = kage::visibility::csg::CsgMethod::PatternMatrix { limit: 100_000 };
+        let expanded = kage::visibility::csg::scan_solid_with(&solid, &camera, w, h, method).unwrap();
+        // (The walk clips at the near plane, as the polygon pass does.)
+        for ((x, y), got, cast) in walk_beside_rays(&solid, &camera, (w, h)) {
+            let paper = expanded[(y * w + x) as usize];
+            assert_eq!(
+                got.map(|c| c.primitive),
+                paper.map(|c| c.primitive),
+                "({x}, {y}) round {round}: pattern matrix"
+            );
+            if let (Some(a), Some(b)) = (got, paper) {
+                assert!((a.t - b.t).abs() <= 1e-5 * a.t.abs().max(1.0), "({x}, {y}): {a:?} vs {b:?}");
+            }
+            pixels += 1;
+            covered += usize::from(cast.is_some());
+            match (got, cast) {
+                (None, None) => {}
+                (Some(a), Some(b)) => {
+                    assert_eq!(a.primitive, b.primitive, "({x}, {y}) round {round}");
+                    assert!((a.t - b.t).abs() <= 1e-4 * b.t.abs().max(1.0), "({x}, {y}): {a:?} vs {b:?}");
+                }
+                _ => panic!("({x}, {y}) round {round}: scanline {got:?}, ray {cast:?}"),
+            }
+        }
+    }
+    assert!(covered * 20 > pixels, "only {covered} of {pixels} pixels show a solid");
 }
 
 /// A part of a few primitives cut by many, some far from it, some through it,

@@ -109,18 +109,10 @@ impl CutRegions {
         (camera, vp, size): (&Camera, Mat4, (u32, u32)),
     ) -> Option<Extent> {
         let (Some(pixels), Some(Some(region))) = (pixels, self.regions.get(i)) else { return pixels };
-        let forward = (camera.target - camera.eye).normalize_or_zero();
-        let (lo, hi) = region.own;
-        let farthest = (0..8)
-            .map(|c: u32| {
-                Vec3::new(
-                    [lo.x, hi.x][c as usize & 1],
-                    [lo.y, hi.y][c as usize >> 1 & 1],
-                    [lo.z, hi.z][c as usize >> 2],
-                )
-            })
-            .map(|c| (c - camera.eye).dot(forward))
-            .fold(0.0f32, f32::max);
+        // The depth of the cutter's box's farthest corner.
+        let forward = Vec3A::from((camera.target - camera.eye).normalize_or_zero());
+        let (centre, half) = ((region.own.0 + region.own.1) * 0.5, (region.own.1 - region.own.0) * 0.5);
+        let farthest = (centre - Vec3A::from(camera.eye)).dot(forward) + half.dot(forward.abs());
         if region.widened <= 2.0 * TIE * RAY_PER_DEPTH * farthest.max(1.0) {
             return Some(pixels);
         }
