@@ -175,8 +175,12 @@ impl Block {
 
     /// The lanes' inputs, loaded into vectors.
     fn inputs(&self) -> LaneInputs {
-        let n0 = self.shininess[0];
-        let same = self.shininess.iter().all(|&n| n == n0);
+        // Only the lanes in use decide the exponent's path: an empty lane holds
+        // whatever an earlier block left there, and the result must not depend
+        // on which blocks a worker shaded before.
+        let mut used = self.shininess.iter().zip(self.live).filter_map(|(&n, live)| live.then_some(n));
+        let first = used.next();
+        let whole = first.filter(|&n0| used.all(|n| n == n0)).and_then(whole_exponent);
         LaneInputs {
             a: self.a.load(),
             e1: self.e1.load(),
@@ -188,7 +192,7 @@ impl Block {
             ks: self.ks.load(),
             ke: self.ke.load(),
             shininess: F::new(self.shininess),
-            whole: if same { whole_exponent(n0) } else { None },
+            whole,
         }
     }
 
@@ -484,6 +488,7 @@ impl<'a> Lighting<'a> {
         // Empty lanes repeat the first point (shaded, then dropped).
         for (i, (k_i, s)) in points.iter().map(|q| q.unwrap_or(*first)).enumerate() {
             k.set_coefficients(i, k_i);
+            k.live[i] = true;
             p.set(i, s.position);
             n.set(i, s.normal);
             v.set(i, s.to_eye);
@@ -684,5 +689,38 @@ impl RowRays {
         } else {
             (V3::splat(self.origin), offset.normalize_or(forward))
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::Material;
+
+    /// A block's lanes `0..n` given `material`'s coefficients.
+    fn fill(block: &mut Block, n: usize, material: &Material) {
+        let k = Coefficients::constant(material).expect("no maps");
+        block.clear();
+        for i in 0..n {
+            block.set_coefficients(i, &k);
+            block.live[i] = true;
+        }
+    }
+
+    #[test]
+    fn a_blocks_exponent_path_does_not_depend_on_what_its_empty_lanes_held() {
+        let glossy = Material { shininess: 32.0, ..Material::default() };
+        let mut fresh = Block::default();
+        fill(&mut fresh, 5, &glossy);
+        // A worker's block that shaded eight lanes before, then five.
+        let mut reused = Block::default();
+        fill(&mut reused, LANES, &glossy);
+        fill(&mut reused, 5, &glossy);
+        assert_eq!(fresh.inputs().whole, Some(32));
+        assert_eq!(reused.inputs().whole, fresh.inputs().whole);
+        // A lane in use with another exponent still takes the general path.
+        let rough = Material { shininess: 7.5, ..Material::default() };
+        reused.set_coefficients(4, &Coefficients::constant(&rough).expect("no maps"));
+        assert_eq!(reused.inputs().whole, None);
     }
 }
