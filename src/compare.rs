@@ -10,7 +10,7 @@
 use glam::Vec3;
 
 use crate::error::{Error, Result};
-use crate::resolve::LinearImage;
+use crate::image::LinearImage;
 
 /// How two images differ.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -10,10 +10,11 @@ use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
 use crate::error::{Error, Result};
+use crate::image::LinearImage;
 use crate::raytrace::{item_buffer, TraceCache};
 use crate::resolve::edges::{self, EdgeCache, EdgeOptions};
 use crate::resolve::solid_edges;
-use crate::resolve::{Antialias, LinearImage};
+use crate::resolve::Antialias;
 use crate::scene::Scene;
 use crate::shading::{self, fog, translucency, Component, ComponentSet, SubpixelShading, Target};
 use crate::shadows::MapPool;

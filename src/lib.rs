@@ -29,6 +29,7 @@
 pub mod compare;
 pub mod error;
 pub mod frame;
+pub mod image;
 pub mod output;
 pub mod raytrace;
 pub mod resolve;

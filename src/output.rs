@@ -4,8 +4,7 @@
 use std::path::Path;
 
 use crate::error::{Error, Result};
-use crate::resolve::LinearImage;
-use crate::scene::texture::srgb_to_linear;
+use crate::image::{srgb_to_linear, LinearImage};
 
 /// Writes `image` to `path` as `.png`, `.exr` or `.pfm`. `exposure` (a linear
 /// multiplier) applies to PNG only: float formats keep the rendered values.
@@ -14,11 +13,11 @@ pub fn write_image(image: &LinearImage, path: &Path, exposure: f32) -> Result<()
     let ext = path.extension().and_then(|e| e.to_str()).unwrap_or_default().to_ascii_lowercase();
     let (w, h) = (image.width(), image.height());
     match ext.as_str() {
-        "png" => image::save_buffer(path, &image.to_srgb8(exposure), w, h, image::ColorType::Rgb8)
+        "png" => ::image::save_buffer(path, &image.to_srgb8(exposure), w, h, ::image::ColorType::Rgb8)
             .map_err(|e| fail(e.to_string())),
         "exr" => {
             let data: Vec<f32> = image.pixels().iter().flat_map(|p| p.to_array()).collect();
-            let buf = image::Rgb32FImage::from_raw(w, h, data).ok_or_else(|| fail("buffer size".into()))?;
+            let buf = ::image::Rgb32FImage::from_raw(w, h, data).ok_or_else(|| fail("buffer size".into()))?;
             buf.save(path).map_err(|e| fail(e.to_string()))
         }
         "pfm" => std::fs::write(path, pfm_bytes(image)).map_err(|e| fail(e.to_string())),
@@ -46,7 +45,7 @@ pub fn read_image(path: &Path) -> Result<LinearImage> {
         let bytes = std::fs::read(path).map_err(|source| Error::Read { path: path.to_path_buf(), source })?;
         return parse_pfm(&bytes).map_err(fail);
     }
-    let img = image::open(path).map_err(|e| fail(e.to_string()))?;
+    let img = ::image::open(path).map_err(|e| fail(e.to_string()))?;
     let linear = ext == "exr" || ext == "hdr";
     let rgb = img.into_rgb32f();
     let mut out = LinearImage::new(rgb.width(), rgb.height());

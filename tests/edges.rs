@@ -8,8 +8,9 @@ mod common;
 use std::sync::Arc;
 
 use glam::{Affine3A, Vec2, Vec3};
+use kage::image::LinearImage;
 use kage::resolve::edges::{EdgeFilter, EdgeMode, EdgeSelection};
-use kage::resolve::{Antialias, LinearImage};
+use kage::resolve::Antialias;
 use kage::scene::mesh::{shapes, NormalMode};
 use kage::scene::{Camera, Material, Mesh, Object, Projection, Scene};
 use kage::shading::fog::{Fog, FogMode};

@@ -193,7 +193,7 @@ fn simd_shading_matches_the_scalar_reference() {
     let ortho = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenes/cad-ortho.toml");
     for scene in [scene, kage::scene::file::load_scene(&ortho).unwrap()] {
         let frame = render(&scene, &RenderOptions::default()).unwrap();
-        let mut scalar = kage::resolve::LinearImage::new(scene.width, scene.height);
+        let mut scalar = kage::image::LinearImage::new(scene.width, scene.height);
         kage::shading::shade_into_scalar(&scene, &frame.visibility, &mut scalar);
         let diffs: Vec<f32> =
             frame.image.pixels().iter().zip(scalar.pixels()).map(|(a, b)| (*a - *b).abs().max_element()).collect();
@@ -228,7 +228,7 @@ fn subpixel_samples_match_the_passes_in(name: &str) {
     let centre = |(x, y): (u32, u32)| glam::Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
     let samples = pixels.iter().map(|&p| SubpixelSample { pixel: p, at: centre(p) }).collect();
     let mut subpixel = SubpixelShading::new(&scene, vb, samples);
-    let mut image = kage::resolve::LinearImage::new(scene.width, scene.height);
+    let mut image = kage::image::LinearImage::new(scene.width, scene.height);
     let mut targets = [Target { parts: ComponentSet::ALL, image: &mut image }];
     shade_lit(&scene, vb, &mut targets, &mut kage::shadows::MapPool::default(), &mut subpixel);
     let mut off = 0;
@@ -247,7 +247,7 @@ fn subpixel_samples_match_the_passes_in(name: &str) {
     // Set up while the first pass shades the pixels (as the edge pass does),
     // the samples get the same passes.
     let mut beside = SubpixelShading::default();
-    let mut image = kage::resolve::LinearImage::new(scene.width, scene.height);
+    let mut image = kage::image::LinearImage::new(scene.width, scene.height);
     let mut targets = [Target { parts: ComponentSet::ALL, image: &mut image }];
     let mut pool = kage::shadows::MapPool::default();
     let prepare = |s: &mut SubpixelShading| s.reset(&scene, vb, subpixel.samples.clone());

@@ -3,9 +3,9 @@
 
 use std::path::PathBuf;
 
+use kage::image::linear_to_srgb;
+use kage::image::LinearImage;
 use kage::output::write_image;
-use kage::resolve::LinearImage;
-use kage::scene::texture::linear_to_srgb;
 
 fn gradient() -> LinearImage {
     let mut img = LinearImage::new(7, 5);

@@ -2,9 +2,9 @@
 //! and no shadows they compute the same thing, so on every pixel whose primary hit
 //! agrees the colours must agree; shadows only ever darken.
 
+use kage::image::LinearImage;
 use kage::raytrace::reference::{render_reference, ReferenceOptions};
 use kage::raytrace::TraceScene;
-use kage::resolve::LinearImage;
 use kage::scene::{Ray, ShadowSettings};
 use kage::{render, RenderOptions};
 

@@ -162,7 +162,7 @@ fn slab_scene(deg: f32, t: f32) -> Scene {
 }
 
 /// World x of the red line's centre on the middle row (intensity-weighted).
-fn line_x(scene: &Scene, image: &kage::resolve::LinearImage) -> f32 {
+fn line_x(scene: &Scene, image: &kage::image::LinearImage) -> f32 {
     let (w, y) = (scene.width as usize, scene.height as usize / 2);
     let row = &image.pixels()[y * w..(y + 1) * w];
     let (sum, weight) = row.iter().enumerate().fold((0.0, 0.0), |(s, m), (x, p)| (s + p.x * (x as f32 + 0.5), m + p.x));

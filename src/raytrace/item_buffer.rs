@@ -12,7 +12,7 @@ use rayon::prelude::*;
 
 use super::reference::{ReferenceOptions, Tracer};
 use super::TraceCache;
-use crate::resolve::LinearImage;
+use crate::image::LinearImage;
 use crate::scene::Scene;
 use crate::shading::subpixel::SampleSurface;
 use crate::shading::{ObjectFrames, SubpixelShading};

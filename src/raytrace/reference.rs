@@ -14,7 +14,7 @@ use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
 use super::TraceScene;
-use crate::resolve::LinearImage;
+use crate::image::LinearImage;
 use crate::sampling::{concentric_disc, hash3, stratified};
 use crate::scene::{Light, LightKind, Ray, Scene};
 use crate::shading::phong::{self, Coefficients, Components};

@@ -9,14 +9,9 @@ pub mod jitter;
 mod parts;
 pub mod solid_edges;
 
-use std::sync::LazyLock;
-
-use glam::Vec3;
-use rayon::prelude::*;
-
 pub use jitter::Antialias;
 
-use crate::scene::texture::linear_to_srgb;
+use crate::image::LinearImage;
 
 /// How bright the 8-bit image is made.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -58,124 +53,6 @@ impl Exposure {
     }
 }
 
-/// A linear-light RGB image, rows top to bottom.
-#[derive(Debug, Clone, PartialEq, Default)]
-pub struct LinearImage {
-    width: u32,
-    height: u32,
-    pixels: Vec<Vec3>,
-}
-
-impl LinearImage {
-    /// A black image. The size must have been checked.
-    #[must_use]
-    pub fn new(width: u32, height: u32) -> Self {
-        LinearImage { width, height, pixels: vec![Vec3::ZERO; width as usize * height as usize] }
-    }
-
-    /// Makes the image `width` × `height`, reusing its memory when it can; the
-    /// contents are undefined until written.
-    pub fn resize(&mut self, width: u32, height: u32) {
-        self.width = width;
-        self.height = height;
-        self.pixels.resize(width as usize * height as usize, Vec3::ZERO);
-    }
-
-    /// Width in pixels.
-    #[must_use]
-    pub fn width(&self) -> u32 {
-        self.width
-    }
-
-    /// Height in pixels.
-    #[must_use]
-    pub fn height(&self) -> u32 {
-        self.height
-    }
-
-    /// All pixels, row-major.
-    #[must_use]
-    pub fn pixels(&self) -> &[Vec3] {
-        &self.pixels
-    }
-
-    /// All pixels, row-major, for writing.
-    pub fn pixels_mut(&mut self) -> &mut [Vec3] {
-        &mut self.pixels
-    }
-
-    /// Pixel (x, y).
-    #[must_use]
-    pub fn get(&self, x: u32, y: u32) -> Vec3 {
-        self.pixels[y as usize * self.width as usize + x as usize]
-    }
-
-    /// 8-bit sRGB of the image times `scale` (the exposure), RGB interleaved, rows
-    /// top to bottom.
-    #[must_use]
-    pub fn to_srgb8(&self, scale: f32) -> Vec<u8> {
-        let encoder = &*SRGB8;
-        let mut out = vec![0; self.pixels.len() * 3];
-        let rows = out.par_chunks_mut(3 * 1024).zip(self.pixels.par_chunks(1024));
-        rows.for_each(|(out, pixels)| {
-            let values = pixels.iter().flat_map(|p| p.to_array());
-            out.iter_mut().zip(values).for_each(|(o, c)| *o = encoder.encode(c * scale));
-        });
-        out
-    }
-}
-
-/// The 8-bit sRGB code of a linear value in [0, 1] (clamped; NaN is 0):
-/// round(255 · sRGB(c)), found without a power per value. Code k begins at the
-/// least linear value that rounds to it (`starts[k]`, found once by bisecting
-/// the float line with the transfer curve itself, so every value gets exactly
-/// the curve's code); a table over [`Srgb8Encoder::BUCKETS`] equal steps of
-/// the linear range gives the code at each step's start, and the next codes'
-/// starts are compared from there (at most two lie within one step).
-struct Srgb8Encoder {
-    starts: [f32; 257],
-    bucket: Vec<u8>,
-}
-
-/// The output stage's encoder, built at first use.
-static SRGB8: LazyLock<Srgb8Encoder> = LazyLock::new(Srgb8Encoder::new);
-
-impl Srgb8Encoder {
-    const BUCKETS: usize = 4096;
-
-    fn new() -> Srgb8Encoder {
-        let code = |c: f32| (linear_to_srgb(c.clamp(0.0, 1.0)) * 255.0 + 0.5) as u8;
-        // starts[k]: the least non-negative float whose code is at least k
-        // (codes grow with the value); starts[256] lies past 1.
-        let mut starts = [f32::INFINITY; 257];
-        starts[0] = 0.0;
-        for (k, start) in starts.iter_mut().enumerate().take(256).skip(1) {
-            let (mut lo, mut hi) = (0u32, 1.0f32.to_bits()); // code(lo) < k <= code(hi)
-            while hi - lo > 1 {
-                let mid = lo + (hi - lo) / 2;
-                if usize::from(code(f32::from_bits(mid))) >= k {
-                    hi = mid;
-                } else {
-                    lo = mid;
-                }
-            }
-            *start = f32::from_bits(hi);
-        }
-        let bucket = (0..Self::BUCKETS).map(|i| code(i as f32 / Self::BUCKETS as f32)).collect();
-        Srgb8Encoder { starts, bucket }
-    }
-
-    fn encode(&self, c: f32) -> u8 {
-        let c = c.clamp(0.0, 1.0);
-        let i = ((c * Self::BUCKETS as f32) as usize).min(Self::BUCKETS - 1);
-        let mut k = usize::from(self.bucket[i]);
-        while c >= self.starts[k + 1] {
-            k += 1;
-        }
-        k as u8
-    }
-}
-
 /// A set of pixels (row-major indices, or any small integers) as one bit each.
 pub(crate) struct PixelSet {
     words: Vec<u64>,
@@ -195,27 +72,5 @@ impl PixelSet {
     /// Whether `i` is in the set.
     pub(crate) fn contains(&self, i: u32) -> bool {
         self.words.get(i as usize / 64).is_some_and(|w| w & (1 << (i % 64)) != 0)
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn the_srgb8_table_gives_every_value_the_curves_own_code() {
-        let curve = |c: f32| (linear_to_srgb(c.clamp(0.0, 1.0)) * 255.0 + 0.5) as u8;
-        let encoder = Srgb8Encoder::new();
-        // A million even steps, and each code's start with the floats on either
-        // side of it, where a table is likeliest to be off by one.
-        let even = (0..=1_000_000).map(|i| i as f32 / 1e6);
-        let starts = encoder.starts[1..256].iter().flat_map(|s| {
-            let bits = s.to_bits();
-            [f32::from_bits(bits - 1), *s, f32::from_bits(bits + 1)]
-        });
-        let odd = [-1.0, -0.0, 1.0, 1.5, f32::INFINITY, f32::NAN, f32::MIN_POSITIVE];
-        for c in even.chain(starts).chain(odd) {
-            assert_eq!(encoder.encode(c), curve(c), "linear {c} ({:#x})", c.to_bits());
-        }
     }
 }

@@ -15,7 +15,7 @@
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
-use super::LinearImage;
+use crate::image::LinearImage;
 use crate::raytrace::TraceScene;
 use crate::sampling::{hash3, stratified};
 use crate::scene::Scene;

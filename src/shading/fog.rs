@@ -15,7 +15,7 @@
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
-use crate::resolve::LinearImage;
+use crate::image::LinearImage;
 use crate::scene::{Camera, Projection, Scene};
 use crate::visibility::VisibilityBuffer;
 

@@ -20,7 +20,7 @@ pub mod translucency;
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
-use crate::resolve::LinearImage;
+use crate::image::LinearImage;
 use crate::scene::Scene;
 use crate::shadows::ShadowTerm;
 use crate::visibility::{ItemId, VisibilityBuffer};

@@ -30,7 +30,7 @@ use glam::Vec3;
 
 use super::reflection_map::{add_reflection_map, flat_background};
 use super::{shade_pass, Blend, Component, ComponentSet, Lighting, ShadingPass, SubpixelShading};
-use crate::resolve::LinearImage;
+use crate::image::LinearImage;
 use crate::scene::{Light, Scene};
 use crate::shadows::{MapPool, ShadowTerm};
 use crate::visibility::VisibilityBuffer;

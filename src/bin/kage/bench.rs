@@ -234,7 +234,7 @@ fn median(mut v: Vec<f64>) -> f64 {
     v[v.len() / 2]
 }
 
-fn time_kage(name: &str, scene: &Scene, frames: usize) -> Result<(Row, kage::resolve::LinearImage)> {
+fn time_kage(name: &str, scene: &Scene, frames: usize) -> Result<(Row, kage::image::LinearImage)> {
     let mut renderer = Renderer::new(&RenderOptions::default()).map_err(|e| miette!("{e}"))?;
     renderer.render(scene).map_err(|e| miette!("{e}"))?; // warm-up
     let (mut vis, mut shadow, mut shade, mut total) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
@@ -266,7 +266,7 @@ fn run_llvmpipe(
     mesh: &Path,
     args: &BenchArgs,
     mode: &str,
-    ours: &kage::resolve::LinearImage,
+    ours: &kage::image::LinearImage,
 ) -> Result<(f64, Option<f64>)> {
     let prefix = std::env::temp_dir().join("kage_bench_llvmpipe");
     let out = Command::new(bin)
@@ -296,7 +296,7 @@ fn run_llvmpipe(
     Ok((ms, rmse_against(&png, ours)))
 }
 
-fn rmse_against(png: &Path, ours: &kage::resolve::LinearImage) -> Option<f64> {
+fn rmse_against(png: &Path, ours: &kage::image::LinearImage) -> Option<f64> {
     let theirs = image::open(png).ok()?.into_rgb8();
     if theirs.dimensions() != (ours.width(), ours.height()) {
         return None;
@@ -535,14 +535,14 @@ fn hybrid_row(args: &BenchArgs, scene: &Scene, label: &str) -> Result<()> {
 /// The hybrid's image computed entirely by rays, as a plain ray tracer would:
 /// primary hits from the BVH, shadow rays at them (where the hybrid reads shadow
 /// maps), the same bounces.
-fn trace_everything(scene: &Scene, trace: &kage::raytrace::TraceScene, depth: u32) -> kage::resolve::LinearImage {
+fn trace_everything(scene: &Scene, trace: &kage::raytrace::TraceScene, depth: u32) -> kage::image::LinearImage {
     use kage::raytrace::reference::{ReferenceOptions, Tracer};
     use kage::shading::ObjectFrames;
     let frames = ObjectFrames::new(scene);
     let opts = ReferenceOptions { pixel_samples: 1, light_samples: 1, shadows: true, max_depth: depth };
     let tracer = Tracer::new(scene, trace, &frames, opts);
     let rays = scene.camera.pixel_rays(glam::Vec2::new(scene.width as f32, scene.height as f32));
-    let mut image = kage::resolve::LinearImage::new(scene.width, scene.height);
+    let mut image = kage::image::LinearImage::new(scene.width, scene.height);
     image.pixels_mut().par_chunks_mut(scene.width as usize).enumerate().for_each(|(y, row)| {
         for (x, px) in row.iter_mut().enumerate() {
             *px = tracer.radiance(&rays.ray(glam::Vec2::new(x as f32 + 0.5, y as f32 + 0.5)), depth);

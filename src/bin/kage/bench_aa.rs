@@ -6,8 +6,9 @@
 use std::path::Path;
 
 use glam::Vec2;
+use kage::image::LinearImage;
 use kage::resolve::edges::{EdgeFilter, EdgeMode, EdgeSelection};
-use kage::resolve::{Antialias, LinearImage};
+use kage::resolve::Antialias;
 use kage::visibility::VisibilityBuffer;
 use kage::{RenderOptions, Renderer, Scene};
 use miette::{miette, Result};

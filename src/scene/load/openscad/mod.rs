@@ -35,9 +35,9 @@ use std::sync::Arc;
 use glam::{Affine3A, DVec3, Mat4, Vec3, Vec4};
 
 use crate::error::{Error, Result, SourceLocation};
+use crate::image::srgb_to_linear;
 use crate::scene::csg::{ConvexPolyhedron, CsgSolid, CsgTree, Primitive, Shape};
 use crate::scene::load::{LoadedModel, SolidPart};
-use crate::scene::texture::srgb_to_linear;
 use crate::scene::{Camera, Material, Projection};
 use syntax::{parse_csg, CsgNode, CsgValue};
 
