@@ -10,9 +10,9 @@
 use std::path::Path;
 
 use kage::image::LinearImage;
-use kage::resolve::edges::EdgeMode;
-use kage::resolve::Antialias;
 use kage::scene::load::openscad::{CsgOptions, Geometry};
+use kage::scene::Antialias;
+use kage::scene::EdgeMode;
 use kage::scene::{demo::demo_scene, file, Scene};
 use kage::shading::ComponentSet;
 use kage::{render, RenderOptions};

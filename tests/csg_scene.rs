@@ -252,11 +252,11 @@ fn scene_files_choose_the_geometry_of_csg_objects() {
 /// 64-pass supersampled truth, and pixels inside a solid's face are untouched.
 #[test]
 fn solid_outlines_are_antialiased_like_the_truth() {
-    use kage::resolve::Antialias;
+    use kage::scene::Antialias;
     let mut scene = without_shadows(scene(200, 130));
     let opts = RenderOptions { ray_depth: 0, ..Default::default() };
     let aliased = render(&scene, &opts).unwrap();
-    scene.antialias = Antialias::Edge(kage::resolve::edges::EdgeMode::default());
+    scene.antialias = Antialias::Edge(kage::scene::EdgeMode::default());
     let edge = render(&scene, &opts).unwrap();
     scene.antialias = Antialias::Jitter(64);
     let truth = render(&scene, &opts).unwrap();

@@ -9,11 +9,11 @@ use std::sync::Arc;
 
 use glam::{Affine3A, Vec2, Vec3};
 use kage::image::LinearImage;
-use kage::resolve::edges::{EdgeFilter, EdgeMode, EdgeSelection};
-use kage::resolve::Antialias;
 use kage::scene::mesh::{shapes, NormalMode};
+use kage::scene::Antialias;
 use kage::scene::{Camera, Material, Mesh, Object, Projection, Scene};
-use kage::shading::fog::{Fog, FogMode};
+use kage::scene::{EdgeFilter, EdgeMode, EdgeSelection};
+use kage::scene::{Fog, FogMode};
 use kage::{render, RenderOptions, Renderer};
 
 const SIZE: u32 = 64;

@@ -59,7 +59,7 @@ fn exr_round_trips_unexposed_and_png_is_exposed_srgb() {
 
 #[test]
 fn auto_exposure_brings_the_bright_end_to_white() {
-    use kage::resolve::Exposure;
+    use kage::scene::Exposure;
     let mut img = LinearImage::new(100, 1);
     for (i, p) in img.pixels_mut().iter_mut().enumerate() {
         *p = glam::Vec3::splat(4.0 * i as f32); // physical units, far above 1
@@ -72,9 +72,9 @@ fn auto_exposure_brings_the_bright_end_to_white() {
 
 #[test]
 fn exposure_in_scene_files_and_on_the_command_line() {
-    use kage::resolve::Exposure;
     use kage::scene::file::SceneFile;
     use kage::scene::load::FileSystem;
+    use kage::scene::Exposure;
     let fs = FileSystem { base: std::env::temp_dir() };
     let build = |t: &str| SceneFile::parse(t, std::path::Path::new("e.toml")).and_then(|f| f.build(&fs));
     let obj = "[[object]]\nshape = \"cube\"\n";

@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use glam::Vec3;
-use kage::resolve::Antialias;
+use kage::scene::Antialias;
 use kage::shading::{Component, ComponentSet};
 use kage::{render, RenderOptions};
 
@@ -21,14 +21,14 @@ fn component_images_sum_to_the_final_image() {
         ("reflections.toml", Antialias::None),
         ("spotlights.toml", Antialias::None),
         ("demo.toml", Antialias::Jitter(4)),
-        ("showroom.toml", Antialias::Edge(kage::resolve::edges::EdgeMode::default())),
+        ("showroom.toml", Antialias::Edge(kage::scene::EdgeMode::default())),
         ("environment.toml", Antialias::None),
     ] {
         let mut scene = example(name);
         scene.antialias = antialias;
         if name == "spotlights.toml" {
-            let mode = kage::shading::fog::FogMode::Exp2 { density: 0.12 };
-            scene.fog = Some(kage::shading::fog::Fog { mode, color: Vec3::new(0.3, 0.3, 0.35) });
+            let mode = kage::scene::FogMode::Exp2 { density: 0.12 };
+            scene.fog = Some(kage::scene::Fog { mode, color: Vec3::new(0.3, 0.3, 0.35) });
         }
         let options = RenderOptions { aovs: ComponentSet::ALL, ..RenderOptions::default() };
         let frame = render(&scene, &options).unwrap();

@@ -184,7 +184,7 @@ fn a_selective_light_changes_only_its_objects_and_others_still_hide_them() {
 
 #[test]
 fn fog_in_a_shadow_is_the_lerp_to_the_fog_colour_not_black() {
-    use kage::shading::fog::{Fog, FogMode};
+    use kage::scene::{Fog, FogMode};
     let plain = roofed(0.3);
     let mut foggy = plain.clone();
     // The orthographic eye is 5 units above the ground: f = (5 − 2) / (8 − 2) = 0.5
@@ -282,7 +282,7 @@ fn jittered_passes_share_the_maps_fitted_to_the_view() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenes/cad-ortho.toml");
     let mut scene = kage::scene::file::load_scene(&path).unwrap();
     (scene.width, scene.height) = (160, 120);
-    scene.antialias = kage::resolve::Antialias::Jitter(4);
+    scene.antialias = kage::scene::Antialias::Jitter(4);
     let maps = kage::shading::frame_lights(&scene)
         .iter()
         .flat_map(|l| &l.samples)
@@ -298,7 +298,7 @@ fn jittered_passes_share_the_maps_fitted_to_the_view() {
     assert_eq!(next.shadow_maps_reused, 4 * maps, "the next frame reuses them in every pass");
     // An aliased frame after the jittered ones fits its maps to its own view
     // again: the same image as a fresh render.
-    scene.antialias = kage::resolve::Antialias::None;
+    scene.antialias = kage::scene::Antialias::None;
     let aliased = renderer.render(&scene).unwrap().image.clone();
     assert!(aliased.pixels() == render(&scene, &RenderOptions::default()).unwrap().image.pixels());
 }

@@ -8,9 +8,9 @@ use std::sync::Arc;
 
 use glam::{Affine3A, Vec2, Vec3};
 use kage::compare::compare;
-use kage::resolve::Antialias;
 use kage::scene::material::Filter;
 use kage::scene::mesh::shapes;
+use kage::scene::Antialias;
 use kage::scene::{Camera, Projection, Texture};
 use kage::{render, RenderOptions};
 

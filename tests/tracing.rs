@@ -177,7 +177,7 @@ fn a_glass_slab_shifts_a_line_by_the_snell_offset() {
     for deg in [0.0f32, 20.0, 40.0, 60.0] {
         // 16 samples per pixel put the line's centre to a fraction of a pixel.
         let mut scene = slab_scene(deg, t);
-        scene.antialias = kage::resolve::Antialias::Jitter(16);
+        scene.antialias = kage::scene::Antialias::Jitter(16);
         // Lateral displacement of a ray crossing a parallel slab: t·sin(θi − θt)/cos θt.
         let (ti, tt) = (deg.to_radians(), (deg.to_radians().sin() / 1.5).asin());
         let expected = t * (ti - tt).sin() / tt.cos();

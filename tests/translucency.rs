@@ -7,8 +7,8 @@ use std::sync::Arc;
 
 use glam::{Affine3A, Quat, Vec2, Vec3};
 use kage::scene::mesh::shapes;
+use kage::scene::TranslucencyOrder;
 use kage::scene::{Camera, Material, Object, Projection, Scene};
-use kage::shading::translucency::TranslucencyOrder;
 use kage::shading::{Component, ComponentSet};
 use kage::{render, RenderOptions};
 

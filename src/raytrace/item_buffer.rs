@@ -42,7 +42,7 @@ pub fn add_traced(
         .map(|(y, (out, items))| {
             let mut traced = 0;
             for (x, (px, &item)) in out.iter_mut().zip(items).enumerate() {
-                if item.is_none() || !scene.materials[scene.item_material(item)].traces() {
+                if item.is_none() || !scene.materials[item.material(scene)].traces() {
                     continue;
                 }
                 let ray = rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));

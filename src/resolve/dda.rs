@@ -13,7 +13,7 @@
 
 use glam::{DVec3, Vec2};
 
-use super::edges::EdgeFilter;
+use crate::scene::EdgeFilter;
 
 /// The DDA of pass 2, one walker for both axes: steps column by column along the
 /// major axis through the column centres the segment spans, and in each column

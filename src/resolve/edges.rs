@@ -79,40 +79,8 @@ use rayon::prelude::*;
 use super::dda::{walk, PartBeyond};
 pub use super::parts::{EdgePlan, RESHADED_SHARE};
 use super::{intersections, PixelSet};
-use crate::scene::{Camera, Mesh, Projection, Scene};
+use crate::scene::{Camera, EdgeFilter, EdgeMode, EdgeSelection, Mesh, Projection, Scene};
 use crate::visibility::{ItemId, VisibilityBuffer};
-
-/// Which edges the edge pass walks.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum EdgeSelection {
-    /// Silhouettes, mesh boundaries and creases.
-    #[default]
-    Outline,
-    /// Every triangle edge with a face towards the eye (the paper).
-    All,
-}
-
-/// How the edge pass weights its blends.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum EdgeFilter {
-    /// The pixel the edge crosses moves towards the pixel across by the share of its
-    /// area beyond the edge (exact for a straight edge).
-    #[default]
-    Coverage,
-    /// The paper's: the edge's colour is blended into the two pixels whose centres
-    /// straddle the edge, with alphas `Filter(D_Q)` and `Filter(D_P)`, D the
-    /// distance from each centre (a Wu line along the edge).
-    Paper,
-}
-
-/// Which edges the pass walks and how it blends: what a scene asks for.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub struct EdgeMode {
-    /// Which edges.
-    pub selection: EdgeSelection,
-    /// How blends are weighted.
-    pub filter: EdgeFilter,
-}
 
 /// How the edge pass runs.
 #[derive(Debug, Clone, Copy, PartialEq)]

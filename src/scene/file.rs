@@ -22,13 +22,11 @@ use super::{
     ShadowSettings, Texture,
 };
 use crate::error::{Error, Result, SourceLocation};
-use crate::resolve::edges::{EdgeFilter, EdgeMode, EdgeSelection};
-use crate::resolve::jitter::MAX_JITTER_SAMPLES;
-use crate::resolve::{Antialias, Exposure};
 use crate::scene::material::Filter;
+use crate::scene::settings::{
+    Antialias, EdgeFilter, EdgeMode, EdgeSelection, Exposure, Fog, FogMode, TranslucencyOrder, MAX_JITTER_SAMPLES,
+};
 use crate::scene::texture::Wrap;
-use crate::shading::fog::{Fog, FogMode};
-use crate::shading::translucency::TranslucencyOrder;
 
 type V3 = [f32; 3];
 

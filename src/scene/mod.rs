@@ -11,6 +11,7 @@ pub mod light;
 pub mod load;
 pub mod material;
 pub mod mesh;
+pub mod settings;
 pub mod texture;
 
 use std::sync::Arc;
@@ -23,6 +24,7 @@ pub use environment::Environment;
 pub use light::{Falloff, Light, LightKind, ShadowMethod, ShadowSettings};
 pub use material::{ComponentMaps, Material};
 pub use mesh::Mesh;
+pub use settings::{Antialias, EdgeFilter, EdgeMode, EdgeSelection, Exposure, Fog, FogMode, TranslucencyOrder};
 pub use texture::Texture;
 
 use crate::error::{Error, Result};
@@ -175,15 +177,15 @@ pub struct Scene {
     /// Linear RGB colour of pixels that see no object.
     pub background: Vec3,
     /// Brightness of 8-bit output.
-    pub exposure: crate::resolve::Exposure,
+    pub exposure: Exposure,
     /// How edges are antialiased.
-    pub antialias: crate::resolve::Antialias,
+    pub antialias: Antialias,
     /// Fog (seed 002 §3.5), if any.
-    pub fog: Option<crate::shading::fog::Fog>,
+    pub fog: Option<Fog>,
     /// The environment map (reflection map of eq. 4 and optional background).
     pub environment: Option<Environment>,
     /// How translucent surfaces are ordered (seed 002 §3.4).
-    pub translucency: crate::shading::translucency::TranslucencyOrder,
+    pub translucency: TranslucencyOrder,
     /// The eye.
     pub camera: Camera,
     /// Lights.
@@ -250,17 +252,6 @@ impl Scene {
         match &self.environment {
             Some(env) if env.visible => env.radiance(dir),
             _ => self.background,
-        }
-    }
-
-    /// The material of what item `item` shows (a mesh object's, or a solid's
-    /// primitive's).
-    #[must_use]
-    pub fn item_material(&self, item: crate::visibility::ItemId) -> usize {
-        let o = &self.objects[item.object as usize];
-        match (&o.body, item.primitive()) {
-            (Body::Solid { materials, .. }, Some(p)) => materials.get(p as usize).copied().unwrap_or(o.material),
-            _ => o.material,
         }
     }
 

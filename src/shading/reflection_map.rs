@@ -38,7 +38,7 @@ pub fn add_reflection_map(scene: &Scene, vb: &VisibilityBuffer, targets: &mut [T
                     }
                     continue;
                 }
-                if reflection && reflecting[scene.item_material(item)] {
+                if reflection && reflecting[item.material(scene)] {
                     *px += reflection_map(scene, &frames.surface_at(scene, vb, x as u32, y as u32, &ray()));
                 }
             }

@@ -99,7 +99,7 @@ impl ObjectFrames {
             geometric: normal,
             normals: [normal; 3],
             uvs: None,
-            material: scene.item_material(item),
+            material: item.material(scene),
         }
     }
 

@@ -23,19 +23,9 @@ use rayon::prelude::*;
 use super::phong::{self, Coefficients, Components};
 use super::reflection_map::reflection_map;
 use super::{Component, FrameLight, ObjectFrames, SurfacePoint, Target};
-use crate::scene::Scene;
+use crate::scene::{Scene, TranslucencyOrder};
 use crate::shadows::{MapPool, ShadowTerm};
 use crate::visibility::Fragment;
-
-/// How translucent fragments are ordered in a pixel.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum TranslucencyOrder {
-    /// By depth, far to near (correct wherever surfaces overlap or intersect).
-    #[default]
-    Sorted,
-    /// In drawing order (scene order), as the paper's z-write-off fallback.
-    Unsorted,
-}
 
 /// One translucent fragment, ready to be added.
 struct Layer {

@@ -36,6 +36,8 @@ mod zbuffer;
 
 use glam::Vec3;
 
+use crate::scene::{Body, Scene};
+
 pub use raster::{fragments, rasterize, rasterize_casters, Faces, Fragment, RasterStats};
 
 /// What a pixel sees: an object and one of its triangles, or one primitive of a
@@ -82,6 +84,18 @@ impl ItemId {
     #[must_use]
     pub fn is_none(self) -> bool {
         self == Self::NONE
+    }
+
+    /// The index into [`Scene::materials`] of what this id shows: a mesh
+    /// object's material, or a solid's primitive's (`self` must name an
+    /// object of `scene`).
+    #[must_use]
+    pub fn material(self, scene: &Scene) -> usize {
+        let o = &scene.objects[self.object as usize];
+        match (&o.body, self.primitive()) {
+            (Body::Solid { materials, .. }, Some(p)) => materials.get(p as usize).copied().unwrap_or(o.material),
+            _ => o.material,
+        }
     }
 }
 

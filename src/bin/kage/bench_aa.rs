@@ -7,8 +7,8 @@ use std::path::Path;
 
 use glam::Vec2;
 use kage::image::LinearImage;
-use kage::resolve::edges::{EdgeFilter, EdgeMode, EdgeSelection};
-use kage::resolve::Antialias;
+use kage::scene::Antialias;
+use kage::scene::{EdgeFilter, EdgeMode, EdgeSelection};
 use kage::visibility::VisibilityBuffer;
 use kage::{RenderOptions, Renderer, Scene};
 use miette::{miette, Result};

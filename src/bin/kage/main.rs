@@ -11,10 +11,10 @@ mod report;
 use std::path::{Path, PathBuf};
 
 use clap::{Parser, Subcommand};
-use kage::resolve::edges::{EdgeFilter, EdgeMode, EdgeSelection};
-use kage::resolve::{Antialias, Exposure};
 use kage::scene::load::openscad::{CsgOptions, Geometry};
 use kage::scene::{demo::demo_scene, file, Scene};
+use kage::scene::{Antialias, Exposure};
+use kage::scene::{EdgeFilter, EdgeMode, EdgeSelection};
 use kage::shading::{Component, ComponentSet};
 use kage::{render, RenderOptions};
 
@@ -149,7 +149,7 @@ fn parse_components(s: &str) -> Result<ComponentSet, String> {
 }
 
 fn parse_antialias(s: &str) -> Result<Antialias, String> {
-    let max = kage::resolve::jitter::MAX_JITTER_SAMPLES;
+    let max = kage::scene::settings::MAX_JITTER_SAMPLES;
     let bad = || {
         format!(
             "'{s}' is not an antialiasing method (expected 'none', 'edge' with optional ':all' or ':outline' and \

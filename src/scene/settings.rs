@@ -1,0 +1,216 @@
+//! How a scene is finished: exposure of 8-bit output, antialiasing, fog and the
+//! order of translucent surfaces. Plain data, read from scene files and command
+//! lines; the stages that act on them live further up the frame.
+
+use glam::{Vec2, Vec3};
+
+use super::camera::{Camera, Projection};
+use crate::image::LinearImage;
+use crate::sampling::radical_inverse;
+
+/// How bright the 8-bit image is made.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Exposure {
+    /// Multiply by 2^stops (0: the buffer as it is).
+    Stops(f32),
+    /// Scale so the brightest 5% of pixels just reach white (for scenes lit in
+    /// physical units, such as glTF lights in candela).
+    Auto,
+}
+
+impl Default for Exposure {
+    fn default() -> Self {
+        Exposure::Stops(0.0)
+    }
+}
+
+impl Exposure {
+    /// The linear multiplier this exposure applies to `image`.
+    #[must_use]
+    pub fn scale(self, image: &LinearImage) -> f32 {
+        match self {
+            Exposure::Stops(ev) => ev.exp2(),
+            Exposure::Auto => {
+                let mut lum: Vec<f32> =
+                    image.pixels().iter().map(|p| p.dot(Vec3::new(0.2126, 0.7152, 0.0722))).collect();
+                if lum.is_empty() {
+                    return 1.0;
+                }
+                let k = (lum.len() * 95 / 100).min(lum.len() - 1);
+                let (_, p95, _) = lum.select_nth_unstable_by(k, f32::total_cmp);
+                if *p95 > 0.0 && p95.is_finite() {
+                    (0.9 / *p95).clamp(1.0 / 4096.0, 4096.0)
+                } else {
+                    1.0
+                }
+            }
+        }
+    }
+}
+
+/// How a frame is antialiased.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Antialias {
+    /// One sample at each pixel centre.
+    #[default]
+    None,
+    /// `n` frames with sub-pixel jitter, averaged (n = 1 is one centred frame).
+    Jitter(u32),
+    /// One frame, then the edge pass (seed 004).
+    Edge(EdgeMode),
+}
+
+/// Most jittered passes one frame may take.
+pub const MAX_JITTER_SAMPLES: u32 = 1024;
+
+impl Antialias {
+    /// Sub-pixel offsets of the passes, in pixels within (−0.5, 0.5)²: one centred
+    /// pass, or the first `n` points of the Halton (2, 3) sequence, which fill the
+    /// pixel evenly for every prefix length.
+    #[must_use]
+    pub fn offsets(self) -> Vec<Vec2> {
+        match self {
+            Antialias::None | Antialias::Edge(_) | Antialias::Jitter(0 | 1) => vec![Vec2::ZERO],
+            Antialias::Jitter(n) => (1..=n.min(MAX_JITTER_SAMPLES))
+                .map(|i| Vec2::new(radical_inverse(i, 2), radical_inverse(i, 3)) - 0.5)
+                .collect(),
+        }
+    }
+}
+
+/// Which edges the edge pass walks.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum EdgeSelection {
+    /// Silhouettes, mesh boundaries and creases.
+    #[default]
+    Outline,
+    /// Every triangle edge with a face towards the eye (the paper).
+    All,
+}
+
+/// How the edge pass weights its blends.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum EdgeFilter {
+    /// The pixel the edge crosses moves towards the pixel across by the share of its
+    /// area beyond the edge (exact for a straight edge).
+    #[default]
+    Coverage,
+    /// The paper's: the edge's colour is blended into the two pixels whose centres
+    /// straddle the edge, with alphas `Filter(D_Q)` and `Filter(D_P)`, D the
+    /// distance from each centre (a Wu line along the edge).
+    Paper,
+}
+
+/// Which edges the pass walks and how it blends: what a scene asks for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct EdgeMode {
+    /// Which edges.
+    pub selection: EdgeSelection,
+    /// How blends are weighted.
+    pub filter: EdgeFilter,
+}
+
+/// How fog thickens with distance.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum FogMode {
+    /// f = (d − start) / (end − start), clamped to [0, 1].
+    Linear {
+        /// Distance where fog begins.
+        start: f32,
+        /// Distance where fog is complete.
+        end: f32,
+    },
+    /// f = 1 − e^(−density · d).
+    Exp {
+        /// Extinction per unit distance.
+        density: f32,
+    },
+    /// f = 1 − e^(−(density · d)²).
+    Exp2 {
+        /// Extinction per unit distance.
+        density: f32,
+    },
+}
+
+/// Fog of one colour.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Fog {
+    /// How f grows with distance.
+    pub mode: FogMode,
+    /// Linear RGB colour of full fog.
+    pub color: Vec3,
+}
+
+impl Fog {
+    /// The fog amount f(d) ∈ [0, 1] at distance `d`.
+    #[must_use]
+    pub fn amount(&self, d: f32) -> f32 {
+        let f = match self.mode {
+            FogMode::Linear { start, end } => (d - start) / (end - start).max(f32::MIN_POSITIVE),
+            FogMode::Exp { density } => 1.0 - (-density * d).exp(),
+            FogMode::Exp2 { density } => 1.0 - (-(density * d) * (density * d)).exp(),
+        };
+        f.clamp(0.0, 1.0)
+    }
+
+    /// The fog amount at world point `p` seen by `camera` (the same distance as
+    /// [`fog_amounts`] measures: along the ray, or from the image plane when
+    /// orthographic).
+    #[must_use]
+    pub fn amount_at(&self, camera: &Camera, p: Vec3) -> f32 {
+        let d = match camera.projection {
+            Projection::Perspective { .. } => (p - camera.eye).length(),
+            Projection::Orthographic { .. } => (p - camera.eye).dot((camera.target - camera.eye).normalize()),
+        };
+        self.amount(d)
+    }
+}
+
+/// How translucent fragments are ordered in a pixel.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum TranslucencyOrder {
+    /// By depth, far to near (correct wherever surfaces overlap or intersect).
+    #[default]
+    Sorted,
+    /// In drawing order (scene order), as the paper's z-write-off fallback.
+    Unsorted,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn offsets_stay_inside_the_pixel_and_average_near_its_centre() {
+        assert_eq!(Antialias::None.offsets(), vec![Vec2::ZERO]);
+        for n in [2, 4, 16, 64] {
+            let o = Antialias::Jitter(n).offsets();
+            assert_eq!(o.len(), n as usize);
+            assert!(o.iter().all(|p| p.abs().max_element() < 0.5));
+            let mean = o.iter().sum::<Vec2>() / n as f32;
+            assert!(mean.abs().max_element() < 1.0 / n as f32 + 0.02, "n {n}: mean {mean}");
+        }
+    }
+
+    #[test]
+    fn offsets_fill_each_quarter_of_the_pixel_evenly() {
+        for n in [16, 64, 256] {
+            let o = Antialias::Jitter(n).offsets();
+            for q in 0..4 {
+                let inside = o.iter().filter(|p| (p.x >= 0.0) == (q & 1 == 1) && (p.y >= 0.0) == (q & 2 == 2)).count();
+                assert!(inside.abs_diff(n as usize / 4) <= (n as usize / 64).max(1), "n {n}, quarter {q}: {inside}");
+            }
+        }
+    }
+
+    #[test]
+    fn amounts_follow_their_formulas() {
+        let fog = |mode| Fog { mode, color: Vec3::ONE };
+        let lin = fog(FogMode::Linear { start: 2.0, end: 6.0 });
+        assert_eq!((lin.amount(1.0), lin.amount(4.0), lin.amount(9.0)), (0.0, 0.5, 1.0));
+        let exp = fog(FogMode::Exp { density: 0.5 });
+        assert!((exp.amount(2.0) - (1.0 - (-1.0f32).exp())).abs() < 1e-6);
+        let exp2 = fog(FogMode::Exp2 { density: 0.5 });
+        assert!((exp2.amount(4.0) - (1.0 - (-4.0f32).exp())).abs() < 1e-6);
+    }
+}
