@@ -11,9 +11,7 @@ use std::path::Path;
 
 use kage::image::LinearImage;
 use kage::scene::load::openscad::{CsgOptions, Geometry};
-use kage::scene::Antialias;
-use kage::scene::EdgeMode;
-use kage::scene::{demo::demo_scene, file, Scene};
+use kage::scene::{demo::demo_scene, file, Antialias, EdgeMode, Scene};
 use kage::shading::ComponentSet;
 use kage::{render, RenderOptions};
 

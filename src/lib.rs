@@ -26,6 +26,7 @@
 //! Conventions (handedness, depth range, pixel centres, fill rule) are fixed once in
 //! `ARCHITECTURE.md`.
 
+pub mod camera;
 pub mod compare;
 pub mod error;
 pub mod frame;

@@ -4,9 +4,9 @@
 mod common;
 
 use glam::Vec3;
+use kage::camera::Ray;
 use kage::raytrace::triangle::ShearedRay;
 use kage::raytrace::TraceScene;
-use kage::scene::Ray;
 use kage::visibility::ItemId;
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};

@@ -7,9 +7,9 @@
 //! "inside the solid" (each primitive's own point test, combined by the tree).
 
 use glam::{Affine3A, Mat3, Vec3, Vec4};
+use kage::camera::Ray;
 use kage::raytrace::csg::{first_hit, primitive_span, spans, Crossing};
 use kage::scene::csg::{ConvexPolyhedron, CsgSolid, CsgTree, Primitive, Shape};
-use kage::scene::Ray;
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 
@@ -186,8 +186,8 @@ fn normals_point_out_of_the_solid_and_hole_walls_are_marked_cut() {
 /// A camera looking at the origin from a random direction: every fourth
 /// round orthographic; every fifth from inside the solids' reach, so that
 /// primitives straddle the eye.
-fn random_camera(rng: &mut StdRng, round: usize) -> kage::scene::Camera {
-    use kage::scene::{Camera, Projection};
+fn random_camera(rng: &mut StdRng, round: usize) -> kage::camera::Camera {
+    use kage::camera::{Camera, Projection};
     let dir =
         Vec3::new(rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0)).normalize_or(Vec3::Z);
     let projection = if round % 4 == 3 {
@@ -213,7 +213,7 @@ type PixelBesideRay = ((u32, u32), Option<Crossing>, Option<Crossing>);
 
 /// Each pixel of a `w` x `h` frame of `solid` seen by `camera`, the ray
 /// cast beyond the near plane.
-fn walk_beside_rays(solid: &CsgSolid, camera: &kage::scene::Camera, (w, h): (u32, u32)) -> Vec<PixelBesideRay> {
+fn walk_beside_rays(solid: &CsgSolid, camera: &kage::camera::Camera, (w, h): (u32, u32)) -> Vec<PixelBesideRay> {
     let scanned = kage::visibility::csg::scan_solid(solid, camera, w, h);
     let rays = camera.pixel_rays(glam::Vec2::new(w as f32, h as f32));
     let pixel = |(x, y): (u32, u32)| {
@@ -388,7 +388,7 @@ fn culling_primitives_by_their_boxes_changes_no_hit() {
         for _ in 0..2000 {
             let mut v = || Vec3::new(rng.gen_range(-5.0..5.0), rng.gen_range(-3.0..3.0), rng.gen_range(-3.0..3.0));
             let (origin, to) = (v(), v());
-            let ray = kage::scene::Ray { origin, dir: (to - origin).normalize_or(Vec3::X) };
+            let ray = kage::camera::Ray { origin, dir: (to - origin).normalize_or(Vec3::X) };
             let culled = caster.first_hit(&ray, 0.0, f32::INFINITY);
             let every = caster.first_hit_every_primitive(&ray, 0.0);
             assert_eq!(culled.map(|c| (c.primitive, c.t)), every.map(|c| (c.primitive, c.t)), "{ray:?}");
@@ -472,7 +472,7 @@ fn a_union_of_primitives_walked_as_a_z_buffer_finds_what_the_booleans_find() {
 /// surfaces, to the bit, as the booleans pixel by pixel.
 #[test]
 fn a_crowded_union_walked_as_a_z_buffer_finds_what_the_booleans_find() {
-    use kage::scene::{Camera, Projection};
+    use kage::camera::{Camera, Projection};
     use kage::visibility::csg::{scan_solid_with, CsgMethod};
     let mut rng = StdRng::seed_from_u64(37);
     let (w, h) = (96u32, 64u32);
@@ -583,7 +583,7 @@ fn reuse_follows_a_cut_decided_within_the_tie() {
 /// 200x100 by `method`, and how many pixels of the middle row show
 /// primitive 0 and primitive 1.
 fn down_z(solid: &CsgSolid, method: kage::visibility::csg::CsgMethod) -> (Vec<Option<Crossing>>, [usize; 2]) {
-    use kage::scene::{Camera, Projection};
+    use kage::camera::{Camera, Projection};
     let camera = Camera {
         eye: Vec3::new(0.0, 0.0, 5.0),
         target: Vec3::ZERO,

@@ -137,7 +137,7 @@ fn a_solid_is_shaded_and_reflected_as_the_reference_sees_it() {
                 // The floor: does it mirror the solid here?
                 let s = kage::shading::ObjectFrames::new(&scene).surface(&scene, item, &ray);
                 let dir = ray.dir - 2.0 * ray.dir.dot(s.normal) * s.normal;
-                let bounce = kage::scene::Ray { origin: s.position + s.normal * 1e-4, dir };
+                let bounce = kage::camera::Ray { origin: s.position + s.normal * 1e-4, dir };
                 solid_in_floor +=
                     usize::from(trace.intersect(&bounce, f32::INFINITY).is_some_and(|h| h.item.primitive().is_some()));
             }

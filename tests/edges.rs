@@ -8,12 +8,10 @@ mod common;
 use std::sync::Arc;
 
 use glam::{Affine3A, Vec2, Vec3};
+use kage::camera::{Camera, Projection};
 use kage::image::LinearImage;
 use kage::scene::mesh::{shapes, NormalMode};
-use kage::scene::Antialias;
-use kage::scene::{Camera, Material, Mesh, Object, Projection, Scene};
-use kage::scene::{EdgeFilter, EdgeMode, EdgeSelection};
-use kage::scene::{Fog, FogMode};
+use kage::scene::{Antialias, EdgeFilter, EdgeMode, EdgeSelection, Fog, FogMode, Material, Mesh, Object, Scene};
 use kage::{render, RenderOptions, Renderer};
 
 const SIZE: u32 = 64;

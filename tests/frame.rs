@@ -6,9 +6,10 @@ mod common;
 use std::path::Path;
 
 use glam::Vec3;
+use kage::camera::{Camera, Projection};
 use kage::scene::file::scene_for_model;
 use kage::scene::mesh::shapes;
-use kage::scene::{Camera, Falloff, Light, LightKind, Projection};
+use kage::scene::{Falloff, Light, LightKind};
 use kage::{render, RenderOptions};
 
 fn plane_scene(light: Light) -> kage::Scene {

@@ -170,7 +170,7 @@ fn faceted_solids_agree_with_openscads_own_mesh_point_by_point() {
 }
 
 /// The corpus camera of `name` and its image size, from its `.camera.txt` sidecar.
-fn sidecar_camera(dir: &Path, name: &str) -> Option<(kage::scene::Camera, u32, u32)> {
+fn sidecar_camera(dir: &Path, name: &str) -> Option<(kage::camera::Camera, u32, u32)> {
     kage::scene::load::openscad::sidecar_camera(&std::fs::read_to_string(dir.join(format!("{name}.camera.txt"))).ok()?)
 }
 

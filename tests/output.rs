@@ -3,8 +3,7 @@
 
 use std::path::PathBuf;
 
-use kage::image::linear_to_srgb;
-use kage::image::LinearImage;
+use kage::image::{linear_to_srgb, LinearImage};
 use kage::output::write_image;
 
 fn gradient() -> LinearImage {

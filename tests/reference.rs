@@ -2,10 +2,11 @@
 //! and no shadows they compute the same thing, so on every pixel whose primary hit
 //! agrees the colours must agree; shadows only ever darken.
 
+use kage::camera::Ray;
 use kage::image::LinearImage;
 use kage::raytrace::reference::{render_reference, ReferenceOptions};
 use kage::raytrace::TraceScene;
-use kage::scene::{Ray, ShadowSettings};
+use kage::scene::ShadowSettings;
 use kage::{render, RenderOptions};
 
 #[test]

@@ -8,9 +8,10 @@ use std::path::Path;
 use std::sync::Arc;
 
 use glam::{Affine3A, Vec2, Vec3};
+use kage::camera::Ray;
 use kage::raytrace::TraceScene;
 use kage::scene::mesh::shapes;
-use kage::scene::{Light, LightKind, Material, Object, Ray, Scene, ShadowSettings};
+use kage::scene::{Light, LightKind, Material, Object, Scene, ShadowSettings};
 use kage::shading::ObjectFrames;
 use kage::shadows::ShadowTerm;
 use kage::{render, RenderOptions};
@@ -76,13 +77,13 @@ fn shadow_maps_agree_with_shadow_rays_on_the_example_scenes() {
 
 /// A ground square under a directional light straight down, a roof square above it.
 fn roofed(ambient: f32) -> Scene {
-    let camera = kage::scene::Camera {
+    let camera = kage::camera::Camera {
         eye: Vec3::new(0.0, 5.0, 0.001),
         target: Vec3::ZERO,
         up: Vec3::NEG_Z,
         near: 0.1,
         far: 20.0,
-        projection: kage::scene::Projection::Orthographic { height: 4.0 },
+        projection: kage::camera::Projection::Orthographic { height: 4.0 },
         shift: Vec2::ZERO,
     };
     let mut scene = common::scene_with(shapes::plane(), camera, 64, 64, false);
@@ -306,13 +307,13 @@ fn jittered_passes_share_the_maps_fitted_to_the_view() {
 /// A wide floor that casts no shadow under a small box, lit by a point light
 /// above: the light's map is fitted to the box alone.
 fn box_on_a_shadowless_floor() -> Scene {
-    let camera = kage::scene::Camera {
+    let camera = kage::camera::Camera {
         eye: Vec3::new(0.0, 6.0, 8.0),
         target: Vec3::ZERO,
         up: Vec3::Y,
         near: 0.1,
         far: 50.0,
-        projection: kage::scene::Projection::Perspective { fov_y_deg: 40.0 },
+        projection: kage::camera::Projection::Perspective { fov_y_deg: 40.0 },
         shift: Vec2::ZERO,
     };
     let mut scene = common::scene_with(shapes::plane(), camera, 160, 120, false);

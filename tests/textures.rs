@@ -7,11 +7,11 @@ mod common;
 use std::sync::Arc;
 
 use glam::{Affine3A, Vec2, Vec3};
+use kage::camera::{Camera, Projection};
 use kage::compare::compare;
 use kage::scene::material::Filter;
 use kage::scene::mesh::shapes;
-use kage::scene::Antialias;
-use kage::scene::{Camera, Projection, Texture};
+use kage::scene::{Antialias, Texture};
 use kage::{render, RenderOptions};
 
 fn checkered_ground(filter: Filter) -> kage::Scene {

@@ -5,9 +5,10 @@
 use std::sync::Arc;
 
 use glam::{Affine3A, Quat, Vec2, Vec3};
+use kage::camera::{Camera, Projection};
 use kage::raytrace::reference::{refract, render_reference, ReferenceOptions};
 use kage::scene::mesh::shapes;
-use kage::scene::{Camera, Material, Object, Projection, Scene};
+use kage::scene::{Material, Object, Scene};
 use kage::{render, RenderOptions};
 
 #[test]

@@ -6,9 +6,9 @@ mod common;
 use std::sync::Arc;
 
 use glam::{Affine3A, Quat, Vec2, Vec3};
+use kage::camera::{Camera, Projection};
 use kage::scene::mesh::shapes;
-use kage::scene::TranslucencyOrder;
-use kage::scene::{Camera, Material, Object, Projection, Scene};
+use kage::scene::{Material, Object, Scene, TranslucencyOrder};
 use kage::shading::{Component, ComponentSet};
 use kage::{render, RenderOptions};
 

@@ -6,8 +6,9 @@ mod common;
 
 use common::{cast, scene_with};
 use glam::{DVec2, Vec3};
+use kage::camera::{Camera, Projection};
 use kage::scene::mesh::NormalMode;
-use kage::scene::{Camera, Mesh, Projection};
+use kage::scene::Mesh;
 use kage::visibility::scan::{scan_triangle, FixedPoint, ONE};
 use kage::visibility::{rasterize, VisibilityBuffer};
 use proptest::prelude::*;

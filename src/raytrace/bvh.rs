@@ -7,7 +7,7 @@
 use glam::{Vec3, Vec3A};
 use rayon::prelude::*;
 
-use crate::scene::Ray;
+use crate::camera::Ray;
 
 /// An axis-aligned box.
 #[derive(Debug, Clone, Copy, PartialEq)]

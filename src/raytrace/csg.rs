@@ -21,9 +21,8 @@
 use glam::{Affine3A, Mat3A, Vec3, Vec3A};
 
 use super::bvh::{Aabb, Bvh};
-use crate::scene::camera::RowLine;
+use crate::camera::{Ray, RowLine};
 use crate::scene::csg::{ConvexPolyhedron, CsgSolid, CsgTree, Primitive, Shape};
-use crate::scene::Ray;
 use crate::visibility::occupancy::OccupancyTree;
 
 mod booleans;
@@ -756,7 +755,7 @@ mod tests {
             y in 0usize..120,
             ortho in any::<bool>(),
         ) {
-            use crate::scene::{Camera, Projection};
+            use crate::camera::{Camera, Projection};
             let eye = eye + Vec3::new(0.0, 0.0, 4.0);
             let transform = Affine3A::from_scale_rotation_translation(
                 stretch.max(Vec3::splat(0.5)),

@@ -17,7 +17,9 @@ pub mod triangle;
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
-use crate::scene::{CsgSolid, Ray, Scene};
+use crate::scene::{CsgSolid, Scene};
+
+use crate::camera::Ray;
 use crate::visibility::ItemId;
 use bvh::{Aabb, Bvh};
 use csg::CsgCaster;

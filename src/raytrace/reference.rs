@@ -14,9 +14,10 @@ use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
 use super::TraceScene;
+use crate::camera::Ray;
 use crate::image::LinearImage;
 use crate::sampling::{concentric_disc, hash3, stratified};
-use crate::scene::{Light, LightKind, Ray, Scene};
+use crate::scene::{Light, LightKind, Scene};
 use crate::shading::phong::{self, Coefficients, Components};
 use crate::shading::reflection_map::reflection_map;
 use crate::shading::{ObjectFrames, SurfacePoint};
@@ -95,7 +96,7 @@ impl<'a> Tracer<'a> {
         Tracer { scene, trace, frames, opts, epsilon }
     }
 
-    fn pixel(&self, rays: &crate::scene::camera::PixelRays, x: u32, y: u32) -> Vec3 {
+    fn pixel(&self, rays: &crate::camera::PixelRays, x: u32, y: u32) -> Vec3 {
         let n = self.opts.pixel_samples.max(1);
         let mut sum = Vec3::ZERO;
         for k in 0..n * n {

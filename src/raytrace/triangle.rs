@@ -6,7 +6,7 @@
 
 use glam::{DVec3, Vec2, Vec3};
 
-use crate::scene::Ray;
+use crate::camera::Ray;
 
 /// A ray prepared for many triangle tests.
 #[derive(Debug, Clone, Copy)]

@@ -79,7 +79,8 @@ use rayon::prelude::*;
 use super::dda::{walk, PartBeyond};
 pub use super::parts::{EdgePlan, RESHADED_SHARE};
 use super::{intersections, PixelSet};
-use crate::scene::{Camera, EdgeFilter, EdgeMode, EdgeSelection, Mesh, Projection, Scene};
+use crate::camera::{Camera, Projection};
+use crate::scene::{EdgeFilter, EdgeMode, EdgeSelection, Mesh, Scene};
 use crate::visibility::{ItemId, VisibilityBuffer};
 
 /// How the edge pass runs.

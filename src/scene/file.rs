@@ -18,9 +18,10 @@ use super::load::openscad::{CsgOptions, Geometry};
 use super::load::{self, AssetSource, LoadedModel};
 use super::mesh::shapes;
 use super::{
-    framing, Body, Camera, Environment, Falloff, Light, LightKind, Material, Object, Projection, Scene, ShadowMethod,
-    ShadowSettings, Texture,
+    framing, Body, Environment, Falloff, Light, LightKind, Material, Object, Scene, ShadowMethod, ShadowSettings,
+    Texture,
 };
+use crate::camera::{Camera, Projection};
 use crate::error::{Error, Result, SourceLocation};
 use crate::scene::material::Filter;
 use crate::scene::settings::{

@@ -2,7 +2,6 @@
 //! from where it is seen. Scene files are parsed to plain records first
 //! ([`mod@file`]), then meshes and textures are loaded ([`load`]) into this form.
 
-pub mod camera;
 pub mod csg;
 pub mod demo;
 pub mod environment;
@@ -18,7 +17,6 @@ use std::sync::Arc;
 
 use glam::{Affine3A, Vec3};
 
-pub use camera::{Camera, Projection, Ray};
 pub use csg::CsgSolid;
 pub use environment::Environment;
 pub use light::{Falloff, Light, LightKind, ShadowMethod, ShadowSettings};
@@ -27,6 +25,7 @@ pub use mesh::Mesh;
 pub use settings::{Antialias, EdgeFilter, EdgeMode, EdgeSelection, Exposure, Fog, FogMode, TranslucencyOrder};
 pub use texture::Texture;
 
+use crate::camera::{Camera, Projection};
 use crate::error::{Error, Result};
 
 /// Largest image side kage accepts, in pixels.

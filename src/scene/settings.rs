@@ -4,7 +4,7 @@
 
 use glam::{Vec2, Vec3};
 
-use super::camera::{Camera, Projection};
+use crate::camera::{Camera, Projection};
 use crate::image::LinearImage;
 use crate::sampling::radical_inverse;
 

@@ -13,7 +13,7 @@ use wide::f32x8;
 
 use super::phong::{Coefficients, Component, ComponentSet, Components};
 use super::surface::{PreparedTriangle, SurfacePoint, TriangleGeometry};
-use crate::scene::camera::PixelRays;
+use crate::camera::PixelRays;
 use crate::scene::{Falloff, Light, LightKind};
 use crate::shadows::ShadowTerm;
 

@@ -25,8 +25,8 @@ use super::phong::{Coefficients, Component, ComponentSet, Components};
 use super::reflection_map::reflection_map;
 use super::surface::{ObjectFrames, SurfacePoint};
 use super::TriangleCache;
-use crate::scene::camera::PixelRays;
-use crate::scene::{Ray, Scene};
+use crate::camera::{PixelRays, Ray};
+use crate::scene::Scene;
 use crate::visibility::VisibilityBuffer;
 
 /// A point to shade on the surface a pixel shows.

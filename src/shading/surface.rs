@@ -10,7 +10,9 @@
 
 use glam::{Affine3A, Mat3A, Vec2, Vec3};
 
-use crate::scene::{Ray, Scene};
+use crate::scene::Scene;
+
+use crate::camera::Ray;
 use crate::visibility::{ItemId, VisibilityBuffer};
 
 /// What shading needs to know about the visible point of a pixel.

@@ -11,7 +11,9 @@
 use glam::{Mat4, Vec3};
 use wide::f32x8;
 
-use crate::scene::{Camera, Projection, Scene, ShadowSettings};
+use crate::scene::{Scene, ShadowSettings};
+
+use crate::camera::{Camera, Projection};
 use crate::visibility::{rasterize_casters, Faces, VisibilityBuffer};
 
 /// Largest tan θ the slope bias uses (θ ≈ 84°); beyond it the bias would push

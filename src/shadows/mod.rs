@@ -15,7 +15,9 @@ use wide::f32x8;
 
 pub use map::DepthMap;
 
-use crate::scene::{Camera, GeometryKey, Light, LightKind, Projection, Scene, ShadowMethod, ShadowSettings};
+use crate::scene::{GeometryKey, Light, LightKind, Scene, ShadowMethod, ShadowSettings};
+
+use crate::camera::{Camera, Projection};
 use crate::visibility::VisibilityBuffer;
 
 /// Widest spot cone (half-angle, degrees) one perspective map covers; wider spots

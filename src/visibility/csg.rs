@@ -60,11 +60,10 @@ use glam::{Vec2, Vec3};
 use rayon::iter::IndexedParallelIterator;
 use rayon::prelude::*;
 
+use crate::camera::{Camera, PixelRays, RowLine};
 use crate::raytrace::csg::{Crossing, CsgCaster, FacesOnScreen, Hit, SpanScratch};
-use crate::scene::camera::PixelRays;
-use crate::scene::camera::RowLine;
 use crate::scene::csg::{CsgSolid, Primitive};
-use crate::scene::{Camera, Object, Scene};
+use crate::scene::{Object, Scene};
 use crate::visibility::block::BlockOrder;
 use crate::visibility::bounds::{self, BoundingLeaves};
 use crate::visibility::coherence::{self, PixelCoherence};

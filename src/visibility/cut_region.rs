@@ -20,9 +20,9 @@
 use glam::{DVec3, Mat4, Vec3, Vec3A};
 use rayon::prelude::*;
 
+use crate::camera::Camera;
 use crate::raytrace::csg::{CsgCaster, TIE};
 use crate::scene::csg::{BoxBound, CsgSolid};
-use crate::scene::Camera;
 use crate::visibility::occupancy::{CutterBodies, OccupancyTree};
 use crate::visibility::outline::{screen_point, Extent};
 

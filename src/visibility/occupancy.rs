@@ -496,7 +496,7 @@ mod tests {
             .collect();
         let caster = CsgCaster::new(&CsgSolid { primitives, tree: Some(CsgTree::Leaf(i)) });
         caster
-            .interval(i, &crate::scene::Ray { origin: Vec3::ZERO, dir: Vec3::Z })
+            .interval(i, &crate::camera::Ray { origin: Vec3::ZERO, dir: Vec3::Z })
             .expect("the ray runs through the cube")
     }
 

@@ -8,7 +8,7 @@
 
 use glam::{DVec2, Mat4, Vec2, Vec3, Vec4};
 
-use crate::scene::camera::PixelRays;
+use crate::camera::PixelRays;
 use crate::scene::csg::{BoxBound, Primitive, Shape};
 
 /// How far (in pixels) an exact extent is widened, so that rounding never drops

@@ -14,7 +14,8 @@ use rayon::prelude::*;
 use super::clip::{ClipPlanes, MAX_CLIPPED};
 use super::scan::{column_range, row_range, scan_triangle, signed_area2, FixedPoint, SpanSink, ONE};
 use super::{ItemId, VisibilityBuffer};
-use crate::scene::{Camera, Material, Object, Scene};
+use crate::camera::Camera;
+use crate::scene::{Material, Object, Scene};
 
 /// Rows per band: the unit of parallel work and of binning.
 pub const BAND_ROWS: usize = 16;

@@ -8,10 +8,10 @@
 
 use std::cell::{Cell, RefCell};
 
+use crate::camera::RowLine;
 use crate::raytrace::csg::{
     Booleans, CsgCaster, FacesOnScreen, Hit, Interval, IntervalLanes, LeafSpans, RowFaces, SpanScratch,
 };
-use crate::scene::camera::RowLine;
 use crate::visibility::block::BlockOrder;
 use crate::visibility::horizon::Horizon;
 

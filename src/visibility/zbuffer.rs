@@ -23,10 +23,10 @@
 use glam::{BVec3A, Vec3, Vec3A};
 use wide::{f32x8, i32x8, u32x8};
 
+use crate::camera::RowLine;
 #[cfg(doc)]
 use crate::raytrace::csg::CsgCaster;
 use crate::raytrace::csg::{Hit, IntervalLanes};
-use crate::scene::camera::RowLine;
 use crate::visibility::spans::RowSpans;
 
 /// Relative depth by which a primitive must lie behind a pixel's surface

@@ -7,8 +7,9 @@
 use std::sync::Arc;
 
 use glam::{Affine3A, Vec3};
+use kage::camera::{Camera, Projection};
 use kage::scene::mesh::NormalMode;
-use kage::scene::{Camera, Falloff, Light, LightKind, Material, Mesh, Object, Projection, Scene};
+use kage::scene::{Falloff, Light, LightKind, Material, Mesh, Object, Scene};
 use rand::rngs::StdRng;
 use rand::Rng;
 

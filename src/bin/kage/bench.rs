@@ -8,8 +8,9 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use glam::{Affine3A, Vec3};
+use kage::camera::{Camera, Projection};
 use kage::scene::load::{self, FileSystem};
-use kage::scene::{file::add_model, Camera, Falloff, Light, LightKind, Material, Projection, Scene, ShadowSettings};
+use kage::scene::{file::add_model, Falloff, Light, LightKind, Material, Scene, ShadowSettings};
 use kage::{RenderOptions, Renderer};
 use miette::{miette, IntoDiagnostic, Result};
 use rayon::prelude::*;

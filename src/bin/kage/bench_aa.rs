@@ -7,8 +7,7 @@ use std::path::Path;
 
 use glam::Vec2;
 use kage::image::LinearImage;
-use kage::scene::Antialias;
-use kage::scene::{EdgeFilter, EdgeMode, EdgeSelection};
+use kage::scene::{Antialias, EdgeFilter, EdgeMode, EdgeSelection};
 use kage::visibility::VisibilityBuffer;
 use kage::{RenderOptions, Renderer, Scene};
 use miette::{miette, Result};

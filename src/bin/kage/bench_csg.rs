@@ -10,9 +10,10 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use glam::Vec2;
+use kage::camera::{Camera, Ray};
 use kage::raytrace::csg::{Crossing, CsgCaster};
 use kage::scene::load::openscad::{load_csg, CsgOptions, Geometry};
-use kage::scene::{Camera, CsgSolid, Ray};
+use kage::scene::CsgSolid;
 use kage::visibility::csg::{CsgMethod, PreparedSolid};
 use kage::visibility::pattern::PatternMatrix;
 use kage::visibility::surface_frame::SurfaceFrame;
@@ -214,7 +215,7 @@ pub fn run_random(args: &BenchArgs) -> Result<()> {
         up: glam::Vec3::Y,
         near: 0.1,
         far: 100.0,
-        projection: kage::scene::Projection::Perspective { fov_y_deg: 40.0 },
+        projection: kage::camera::Projection::Perspective { fov_y_deg: 40.0 },
         shift: Vec2::ZERO,
     };
     let tables = [

@@ -12,9 +12,7 @@ use std::path::{Path, PathBuf};
 
 use clap::{Parser, Subcommand};
 use kage::scene::load::openscad::{CsgOptions, Geometry};
-use kage::scene::{demo::demo_scene, file, Scene};
-use kage::scene::{Antialias, Exposure};
-use kage::scene::{EdgeFilter, EdgeMode, EdgeSelection};
+use kage::scene::{demo::demo_scene, file, Antialias, EdgeFilter, EdgeMode, EdgeSelection, Exposure, Scene};
 use kage::shading::{Component, ComponentSet};
 use kage::{render, RenderOptions};
 

@@ -28,7 +28,7 @@ use std::ops::Range;
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
-use crate::scene::camera::RowLine;
+use crate::camera::RowLine;
 use crate::scene::csg::ConvexPolyhedron;
 
 /// Items sorted into cells (a compressed table): cell `c` holds

@@ -15,7 +15,7 @@ use glam::{Mat3A, Vec3, Vec4};
 use wide::f32x8;
 
 use super::shapes::{BOTTOM, SIDE, TOP};
-use crate::scene::camera::RowLine;
+use crate::camera::RowLine;
 use crate::scene::csg::{ConvexPolyhedron, Shape};
 
 /// Eight pixels' rays `o + t·d`, a coordinate per array entry.

@@ -12,8 +12,9 @@ use std::sync::Arc;
 use glam::{Affine3A, Mat4, Vec2, Vec3};
 
 use super::{checked, AssetSource, LoadedModel, Part};
+use crate::camera::{Camera, Projection};
 use crate::scene::mesh::{Mesh, NormalMode};
-use crate::scene::{Camera, ComponentMaps, Falloff, Light, LightKind, Material, Projection, Texture};
+use crate::scene::{ComponentMaps, Falloff, Light, LightKind, Material, Texture};
 
 struct Context<'a> {
     doc: gltf::Document,

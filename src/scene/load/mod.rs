@@ -20,7 +20,8 @@ use std::sync::Arc;
 use glam::{Affine3A, Vec3};
 
 use super::mesh::{Mesh, MeshRepairs};
-use super::{Camera, CsgSolid, Light, Material, Texture};
+use super::{CsgSolid, Light, Material, Texture};
+use crate::camera::Camera;
 use crate::error::{Error, Result};
 use openscad::CsgOptions;
 

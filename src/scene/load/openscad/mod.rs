@@ -34,11 +34,12 @@ use std::sync::Arc;
 
 use glam::{Affine3A, DVec3, Mat4, Vec3, Vec4};
 
+use crate::camera::{Camera, Projection};
 use crate::error::{Error, Result, SourceLocation};
 use crate::image::srgb_to_linear;
 use crate::scene::csg::{ConvexPolyhedron, CsgSolid, CsgTree, Primitive, Shape};
 use crate::scene::load::{LoadedModel, SolidPart};
-use crate::scene::{Camera, Material, Projection};
+use crate::scene::Material;
 use syntax::{parse_csg, CsgNode, CsgValue};
 
 /// How spheres and cylinders become primitives.
