@@ -9,8 +9,8 @@
 
 use std::path::Path;
 
+use kage::csg::openscad::{CsgOptions, Geometry};
 use kage::image::LinearImage;
-use kage::scene::load::openscad::{CsgOptions, Geometry};
 use kage::scene::{demo::demo_scene, file, Antialias, EdgeMode, Scene};
 use kage::shading::ComponentSet;
 use kage::{render, RenderOptions};

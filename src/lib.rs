@@ -26,8 +26,10 @@
 //! Conventions (handedness, depth range, pixel centres, fill rule) are fixed once in
 //! `ARCHITECTURE.md`.
 
+pub mod bvh;
 pub mod camera;
 pub mod compare;
+pub mod csg;
 pub mod error;
 pub mod frame;
 pub mod image;

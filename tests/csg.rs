@@ -8,8 +8,7 @@
 
 use glam::{Affine3A, Mat3, Vec3, Vec4};
 use kage::camera::Ray;
-use kage::raytrace::csg::{first_hit, primitive_span, spans, Crossing};
-use kage::scene::csg::{ConvexPolyhedron, CsgSolid, CsgTree, Primitive, Shape};
+use kage::csg::{first_hit, primitive_span, spans, ConvexPolyhedron, Crossing, CsgSolid, CsgTree, Primitive, Shape};
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 
@@ -214,7 +213,7 @@ type PixelBesideRay = ((u32, u32), Option<Crossing>, Option<Crossing>);
 /// Each pixel of a `w` x `h` frame of `solid` seen by `camera`, the ray
 /// cast beyond the near plane.
 fn walk_beside_rays(solid: &CsgSolid, camera: &kage::camera::Camera, (w, h): (u32, u32)) -> Vec<PixelBesideRay> {
-    let scanned = kage::visibility::csg::scan_solid(solid, camera, w, h);
+    let scanned = kage::visibility::solids::scan_solid(solid, camera, w, h);
     let rays = camera.pixel_rays(glam::Vec2::new(w as f32, h as f32));
     let pixel = |(x, y): (u32, u32)| {
         let ray = rays.ray(glam::Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
@@ -235,8 +234,8 @@ fn the_scanline_walk_finds_what_a_ray_per_pixel_finds() {
         let solid = CsgSolid { primitives: prims, tree: Some(tree) };
         let camera = random_camera(&mut rng, round);
         // The paper's pattern matrix finds the same surfaces.
-        let method = kage::visibility::csg::CsgMethod::PatternMatrix { limit: 100_000 };
-        let expanded = kage::visibility::csg::scan_solid_with(&solid, &camera, w, h, method).unwrap();
+        let method = kage::visibility::solids::CsgMethod::PatternMatrix { limit: 100_000 };
+        let expanded = kage::visibility::solids::scan_solid_with(&solid, &camera, w, h, method).unwrap();
         // (The walk clips at the near plane, as the polygon pass does.)
         for ((x, y), got, cast) in walk_beside_rays(&solid, &camera, (w, h)) {
             let paper = expanded[(y * w + x) as usize];
@@ -370,7 +369,7 @@ fn cutters_flush_with_their_part_are_left_out_only_where_they_cannot_meet_it() {
 /// large enough to get a BVH, for rays from inside and outside their reach.
 #[test]
 fn culling_primitives_by_their_boxes_changes_no_hit() {
-    use kage::raytrace::csg::CsgCaster;
+    use kage::csg::CsgCaster;
     let mut rng = StdRng::seed_from_u64(61);
     let (mut hits, mut rays) = (0, 0);
     for _ in 0..40 {
@@ -406,7 +405,7 @@ fn culling_primitives_by_their_boxes_changes_no_hit() {
 /// solids and cameras.
 #[test]
 fn reusing_the_answer_along_a_scanline_changes_no_surface() {
-    use kage::visibility::csg::{scan_solid_with, CsgMethod};
+    use kage::visibility::solids::{scan_solid_with, CsgMethod};
     let mut rng = StdRng::seed_from_u64(11);
     let (w, h) = (96u32, 64u32);
     let (mut covered, mut blocks_rounds) = (0, 0);
@@ -438,7 +437,7 @@ fn reusing_the_answer_along_a_scanline_changes_no_surface() {
 /// primitive (the rows where a ray starts inside go to the booleans).
 #[test]
 fn a_union_of_primitives_walked_as_a_z_buffer_finds_what_the_booleans_find() {
-    use kage::visibility::csg::{scan_solid_with, CsgMethod};
+    use kage::visibility::solids::{scan_solid_with, CsgMethod};
     let mut rng = StdRng::seed_from_u64(23);
     let (w, h) = (96u32, 64u32);
     let (mut covered, mut twins_seen) = (0, 0);
@@ -473,7 +472,7 @@ fn a_union_of_primitives_walked_as_a_z_buffer_finds_what_the_booleans_find() {
 #[test]
 fn a_crowded_union_walked_as_a_z_buffer_finds_what_the_booleans_find() {
     use kage::camera::{Camera, Projection};
-    use kage::visibility::csg::{scan_solid_with, CsgMethod};
+    use kage::visibility::solids::{scan_solid_with, CsgMethod};
     let mut rng = StdRng::seed_from_u64(37);
     let (w, h) = (96u32, 64u32);
     let mut covered = 0;
@@ -516,8 +515,8 @@ fn a_crowded_union_walked_as_a_z_buffer_finds_what_the_booleans_find() {
 /// viewer keeps it while the camera moves.
 #[test]
 fn a_frame_scanned_again_holds_only_the_last_scan() {
-    use kage::visibility::csg::{scan_solid_with, CsgMethod, PreparedSolid};
-    use kage::visibility::surface_frame::SurfaceFrame;
+    use kage::visibility::solids::surface_frame::SurfaceFrame;
+    use kage::visibility::solids::{scan_solid_with, CsgMethod, PreparedSolid};
     let mut rng = StdRng::seed_from_u64(29);
     let mut frame = SurfaceFrame::new();
     let (mut stale, mut covered) = (0, 0);
@@ -553,8 +552,8 @@ fn a_frame_scanned_again_holds_only_the_last_scan() {
 /// inside the run; the coherent walk must change its answer there too.
 #[test]
 fn reuse_follows_a_cut_decided_within_the_tie() {
-    use kage::raytrace::csg::TIE;
-    use kage::visibility::csg::CsgMethod;
+    use kage::csg::TIE;
+    use kage::visibility::solids::CsgMethod;
     let cube = || Shape::Polyhedron(ConvexPolyhedron::unit_cube());
     let solid_box = Affine3A::from_scale(Vec3::splat(2.0)) * Affine3A::from_translation(Vec3::splat(-0.5));
     // The cutter's front face: z = 1 + s·x, from two TIEs (of t ≈ 4) in
@@ -582,7 +581,7 @@ fn reuse_follows_a_cut_decided_within_the_tie() {
 /// `solid` seen straight down the z axis (orthographic, 3 units high) at
 /// 200x100 by `method`, and how many pixels of the middle row show
 /// primitive 0 and primitive 1.
-fn down_z(solid: &CsgSolid, method: kage::visibility::csg::CsgMethod) -> (Vec<Option<Crossing>>, [usize; 2]) {
+fn down_z(solid: &CsgSolid, method: kage::visibility::solids::CsgMethod) -> (Vec<Option<Crossing>>, [usize; 2]) {
     use kage::camera::{Camera, Projection};
     let camera = Camera {
         eye: Vec3::new(0.0, 0.0, 5.0),
@@ -594,7 +593,7 @@ fn down_z(solid: &CsgSolid, method: kage::visibility::csg::CsgMethod) -> (Vec<Op
         shift: glam::Vec2::ZERO,
     };
     let (w, h) = (200u32, 100u32);
-    let scan = kage::visibility::csg::scan_solid_with(solid, &camera, w, h, method).unwrap();
+    let scan = kage::visibility::solids::scan_solid_with(solid, &camera, w, h, method).unwrap();
     let row = &scan[(h / 2 * w) as usize..((h / 2 + 1) * w) as usize];
     let shows = |p: u32| row.iter().flatten().filter(|c| c.primitive == p).count();
     let counts = [shows(0), shows(1)];
@@ -606,7 +605,7 @@ fn down_z(solid: &CsgSolid, method: kage::visibility::csg::CsgMethod) -> (Vec<Op
 /// spreading a block's answer must not take "nearly equal" for "equal".
 #[test]
 fn spreading_a_block_keeps_faces_that_cross_within_rounding_apart() {
-    use kage::visibility::csg::CsgMethod;
+    use kage::visibility::solids::CsgMethod;
     let cube = || Shape::Polyhedron(ConvexPolyhedron::unit_cube());
     let flat = Affine3A::from_translation(Vec3::new(-1.5, -0.5, 0.0));
     // The second box's top: z = 1 + s·x, s a few units of the last place of

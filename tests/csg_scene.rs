@@ -240,7 +240,7 @@ fn scene_files_choose_the_geometry_of_csg_objects() {
     };
     let polyhedra = |scene: &Scene| {
         let solid = scene.objects[0].solid().expect("a solid");
-        solid.primitives.iter().all(|p| matches!(p.shape, kage::scene::csg::Shape::Polyhedron(_)))
+        solid.primitives.iter().all(|p| matches!(p.shape, kage::csg::Shape::Polyhedron(_)))
     };
     assert!(!polyhedra(&build("").unwrap()), "exact by default: the sphere is a quadric");
     assert!(polyhedra(&build("geometry = \"faceted\"").unwrap()), "faceted: every primitive a polyhedron");

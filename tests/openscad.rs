@@ -7,8 +7,8 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use glam::Vec3;
-use kage::scene::load::openscad::syntax::{parse_csg, CsgNode};
-use kage::scene::load::openscad::{load_csg, CsgOptions, Geometry};
+use kage::csg::openscad::syntax::{parse_csg, CsgNode};
+use kage::csg::openscad::{load_csg, CsgOptions, Geometry};
 use kage::scene::load::{model, FileSystem};
 
 fn corpus() -> Option<(PathBuf, Vec<PathBuf>)> {
@@ -171,7 +171,7 @@ fn faceted_solids_agree_with_openscads_own_mesh_point_by_point() {
 
 /// The corpus camera of `name` and its image size, from its `.camera.txt` sidecar.
 fn sidecar_camera(dir: &Path, name: &str) -> Option<(kage::camera::Camera, u32, u32)> {
-    kage::scene::load::openscad::sidecar_camera(&std::fs::read_to_string(dir.join(format!("{name}.camera.txt"))).ok()?)
+    kage::csg::openscad::sidecar_camera(&std::fs::read_to_string(dir.join(format!("{name}.camera.txt"))).ok()?)
 }
 
 #[test]
@@ -191,7 +191,7 @@ fn scanned_coverage_matches_openscads_mesh_rasterized_by_kage() {
         let name = path.file_stem().and_then(|s| s.to_str()).unwrap_or_default();
         let (camera, w, h) = sidecar_camera(dir, name).unwrap_or_else(|| panic!("{name}: no camera sidecar"));
         let solid = load_csg(path, read(path), &options).unwrap().solid;
-        let scanned = kage::visibility::csg::scan_solid(&solid, &camera, w, h);
+        let scanned = kage::visibility::solids::scan_solid(&solid, &camera, w, h);
         let mut scene = kage::scene::file::scene_for_model(&path.with_extension("stl"), w, h).unwrap();
         scene.camera = camera;
         let mut vb = kage::visibility::VisibilityBuffer::new(w, h);

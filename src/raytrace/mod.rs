@@ -2,14 +2,12 @@
 //! secondary rays of seed 002 §4 (reflection and refraction traced from the item
 //! buffer).
 //!
-//! [`bvh`] is the acceleration structure (binned SAH), [`triangle`] the watertight
+//! [`crate::bvh`] is the acceleration structure (binned SAH), [`triangle`] the watertight
 //! ray/triangle test; [`TraceScene`] puts a scene's triangles, in world space and
 //! with their item ids, behind one BVH and answers `intersect` (nearest hit) and
-//! `occluded` (anything before a distance?). [`csg`] casts rays at CSG solids.
+//! `occluded` (anything before a distance?). [`crate::csg`] casts rays at CSG solids.
 
-pub mod bvh;
 pub mod cache;
-pub mod csg;
 pub mod item_buffer;
 pub mod reference;
 pub mod triangle;
@@ -17,12 +15,13 @@ pub mod triangle;
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
-use crate::scene::{CsgSolid, Scene};
+use crate::scene::Scene;
 
+use crate::csg::{CsgCaster, CsgSolid};
+
+use crate::bvh::{Aabb, Bvh};
 use crate::camera::Ray;
 use crate::visibility::ItemId;
-use bvh::{Aabb, Bvh};
-use csg::CsgCaster;
 use triangle::ShearedRay;
 
 pub use cache::TraceCache;
@@ -43,7 +42,7 @@ pub struct Hit {
 
 /// A scene's triangles and CSG solids in world space behind one BVH: a
 /// triangle is a leaf, and so is a whole solid, by its bounds (its rays are
-/// cast by [`csg::CsgCaster`]).
+/// cast by [`crate::csg::CsgCaster`]).
 #[derive(Debug, Clone)]
 pub struct TraceScene {
     /// Per leaf, in leaf order; a solid's leaf holds a triangle that no ray hits.

@@ -7,7 +7,7 @@
 //! primitives meet, none of them stored anywhere. So the share is measured: a
 //! pixel where a solid meets something else (another object, another primitive,
 //! the background) casts `SAMPLES` stratified rays through its area (the ray
-//! tracer sees solids by interval arithmetic, [`crate::raytrace::csg`]), and
+//! tracer sees solids by interval arithmetic, [`crate::csg`]), and
 //! each ray that sees what a neighbouring pixel shows takes that neighbour's
 //! colour. Only outline pixels are touched, and the frame is never re-shaded:
 //! the colours come from the aliased frame, as in seed 004.

@@ -14,7 +14,6 @@ use glam::{Affine3A, EulerRot, Quat, Vec3};
 use serde::Deserialize;
 use toml::Spanned;
 
-use super::load::openscad::{CsgOptions, Geometry};
 use super::load::{self, AssetSource, LoadedModel};
 use super::mesh::shapes;
 use super::{
@@ -22,6 +21,7 @@ use super::{
     Texture,
 };
 use crate::camera::{Camera, Projection};
+use crate::csg::openscad::{CsgOptions, Geometry};
 use crate::error::{Error, Result, SourceLocation};
 use crate::scene::material::Filter;
 use crate::scene::settings::{

@@ -2,7 +2,6 @@
 //! from where it is seen. Scene files are parsed to plain records first
 //! ([`mod@file`]), then meshes and textures are loaded ([`load`]) into this form.
 
-pub mod csg;
 pub mod demo;
 pub mod environment;
 pub mod file;
@@ -17,7 +16,6 @@ use std::sync::Arc;
 
 use glam::{Affine3A, Vec3};
 
-pub use csg::CsgSolid;
 pub use environment::Environment;
 pub use light::{Falloff, Light, LightKind, ShadowMethod, ShadowSettings};
 pub use material::{ComponentMaps, Material};
@@ -26,6 +24,7 @@ pub use settings::{Antialias, EdgeFilter, EdgeMode, EdgeSelection, Exposure, Fog
 pub use texture::Texture;
 
 use crate::camera::{Camera, Projection};
+use crate::csg::CsgSolid;
 use crate::error::{Error, Result};
 
 /// Largest image side kage accepts, in pixels.
@@ -39,7 +38,7 @@ pub enum Body {
     /// A triangle mesh, drawn by the polygon pass.
     Mesh(Arc<Mesh>),
     /// A CSG solid (seed 003), drawn by the scanline walk of
-    /// [`crate::visibility::csg`]; its pixels' item ids name the primitive.
+    /// [`crate::visibility::solids`]; its pixels' item ids name the primitive.
     Solid {
         /// The solid, in object space.
         solid: Arc<CsgSolid>,

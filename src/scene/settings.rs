@@ -154,7 +154,7 @@ impl Fog {
     }
 
     /// The fog amount at world point `p` seen by `camera` (the same distance as
-    /// [`fog_amounts`] measures: along the ray, or from the image plane when
+    /// fog pass measures: along the ray, or from the image plane when
     /// orthographic).
     #[must_use]
     pub fn amount_at(&self, camera: &Camera, p: Vec3) -> f32 {

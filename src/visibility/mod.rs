@@ -5,34 +5,14 @@
 //!
 //! Stages, one file each: [`clip`] (homogeneous clipping), [`scan`] (exact
 //! fixed-point DDA scan conversion, top-left rule) and [`raster`] (projection,
-//! binning into bands and the band-parallel z-buffer). [`csg`] finds the visible
-//! surfaces of CSG solids by seed 003's scanline walk, from each primitive's
-//! outline on the screen (`outline.rs`: its procedures 1 and 2) clipped by
-//! [`bounds`] (to the nodes that bound it) and by `cut_region.rs` (a cutter to
-//! where in space it meets its part), each occupant's intervals found eight
-//! pixels at a time (`spans.rs`), a union of primitives as a z-buffer
-//! (`zbuffer.rs`), other trees over [`occupancy`] (its reference
-//! counts, in tree form) or [`pattern`] (its pattern matrix), with [`block`]
-//! (its reuse of an answer, a block of eight pixels at a time) and [`horizon`]
-//! (occupants wholly behind the surface left out of the booleans), or
-//! [`coherence`] (its reuse pixel by pixel, as the paper has it) on request,
-//! into a [`surface_frame`] kept from scan to scan.
+//! binning into bands and the band-parallel z-buffer). [`solids`] finds the
+//! visible surfaces of CSG solids by seed 003's scanline walk and writes them
+//! into the same buffer, so solids and meshes hide each other.
 
-pub mod block;
-pub mod bounds;
 pub mod clip;
-pub mod coherence;
-pub mod csg;
-mod cut_region;
-pub mod horizon;
-pub mod occupancy;
-mod outline;
-pub mod pattern;
 pub mod raster;
 pub mod scan;
-mod spans;
-pub mod surface_frame;
-mod zbuffer;
+pub mod solids;
 
 use glam::Vec3;
 

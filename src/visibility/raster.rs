@@ -118,12 +118,12 @@ pub enum Faces {
 /// Draws every opaque object of `scene` seen by the scene's camera into `vb`,
 /// which is cleared first (each band clears its own rows, in parallel, just before
 /// drawing them): meshes by the polygon pass, then solids by the scanline walk
-/// ([`super::csg::draw_solids`]; solids are drawn opaque whatever their
+/// ([`super::solids::draw_solids`]; solids are drawn opaque whatever their
 /// material). Translucent meshes are left to [`fragments`].
 pub fn rasterize(scene: &Scene, vb: &mut VisibilityBuffer) -> RasterStats {
     let pass = PolygonPass::new(scene, &scene.camera, Faces::AsMaterials, vb.width(), vb.height());
     let stats = pass.draw(&chunks(scene, |_, m| !m.translucent()), vb);
-    RasterStats { solids: super::csg::draw_solids(scene, &scene.camera, |_| true, vb), ..stats }
+    RasterStats { solids: super::solids::draw_solids(scene, &scene.camera, |_| true, vb), ..stats }
 }
 
 /// Draws every object of `scene` that casts shadows ([`Object::casts_shadows`]),
@@ -132,7 +132,7 @@ pub fn rasterize(scene: &Scene, vb: &mut VisibilityBuffer) -> RasterStats {
 pub fn rasterize_casters(scene: &Scene, camera: &Camera, faces: Faces, vb: &mut VisibilityBuffer) -> RasterStats {
     let pass = PolygonPass::new(scene, camera, faces, vb.width(), vb.height());
     let stats = pass.draw(&chunks(scene, |o, _| o.casts_shadows), vb);
-    RasterStats { solids: super::csg::draw_solids(scene, camera, |o| o.casts_shadows, vb), ..stats }
+    RasterStats { solids: super::solids::draw_solids(scene, camera, |o| o.casts_shadows, vb), ..stats }
 }
 
 /// A sample of a translucent surface at a pixel centre.

@@ -11,12 +11,11 @@ use std::time::Instant;
 
 use glam::Vec2;
 use kage::camera::{Camera, Ray};
-use kage::raytrace::csg::{Crossing, CsgCaster};
-use kage::scene::load::openscad::{load_csg, CsgOptions, Geometry};
-use kage::scene::CsgSolid;
-use kage::visibility::csg::{CsgMethod, PreparedSolid};
-use kage::visibility::pattern::PatternMatrix;
-use kage::visibility::surface_frame::SurfaceFrame;
+use kage::csg::openscad::{load_csg, CsgOptions, Geometry};
+use kage::csg::{Crossing, CsgCaster, CsgSolid};
+use kage::visibility::solids::paper::pattern::PatternMatrix;
+use kage::visibility::solids::surface_frame::SurfaceFrame;
+use kage::visibility::solids::{CsgMethod, PreparedSolid};
 use miette::{miette, Result};
 use rayon::prelude::*;
 
@@ -168,14 +167,14 @@ fn cast(camera: &Camera, w: u32, h: u32, first: impl Fn(&Ray) -> Option<Crossing
 /// The camera of the corpus sidecar `NAME.camera.txt`.
 fn corpus_camera(dir: &Path, name: &str) -> Option<Camera> {
     let text = std::fs::read_to_string(dir.join(format!("{name}.camera.txt"))).ok()?;
-    kage::scene::load::openscad::sidecar_camera(&text).map(|(camera, _, _)| camera)
+    kage::csg::openscad::sidecar_camera(&text).map(|(camera, _, _)| camera)
 }
 
 /// A union of `segments` intersections of `per` spheres each: spheres of radius
 /// 0.25–0.45 scattered in the cube [−2, 2]³, each segment's spheres within 0.2
 /// of a common centre so that their intersection is not empty.
 fn random_spheres(seed: u64, segments: usize, per: usize) -> CsgSolid {
-    use kage::scene::csg::{CsgTree, Primitive, Shape};
+    use kage::csg::{CsgTree, Primitive, Shape};
     let mut state = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1;
     let mut unit = move || {
         state ^= state << 13;

@@ -11,7 +11,7 @@ mod report;
 use std::path::{Path, PathBuf};
 
 use clap::{Parser, Subcommand};
-use kage::scene::load::openscad::{CsgOptions, Geometry};
+use kage::csg::openscad::{CsgOptions, Geometry};
 use kage::scene::{demo::demo_scene, file, Antialias, EdgeFilter, EdgeMode, EdgeSelection, Exposure, Scene};
 use kage::shading::{Component, ComponentSet};
 use kage::{render, RenderOptions};

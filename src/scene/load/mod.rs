@@ -1,5 +1,5 @@
 //! Mesh and texture files: Wavefront OBJ + MTL, STL (binary and ASCII), glTF 2.0;
-//! and OpenSCAD `.csg` files, read into a syntax tree ([`openscad`]).
+//! and OpenSCAD `.csg` files ([`crate::csg::openscad`] reads the solid).
 //!
 //! Each loader turns a file into a [`LoadedModel`]: parts (a mesh with an optional
 //! material of its own and a placement), solids (an OpenSCAD file's CSG solid
@@ -10,7 +10,7 @@
 
 mod gltf;
 mod obj;
-pub mod openscad;
+mod openscad;
 mod stl;
 
 use std::io;
@@ -20,10 +20,11 @@ use std::sync::Arc;
 use glam::{Affine3A, Vec3};
 
 use super::mesh::{Mesh, MeshRepairs};
-use super::{CsgSolid, Light, Material, Texture};
+use super::{Light, Material, Texture};
 use crate::camera::Camera;
+use crate::csg::openscad::CsgOptions;
+use crate::csg::CsgSolid;
 use crate::error::{Error, Result};
-use openscad::CsgOptions;
 
 /// Where scene files find the files they name.
 pub trait AssetSource: Sync {

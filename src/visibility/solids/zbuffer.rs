@@ -25,9 +25,9 @@ use wide::{f32x8, i32x8, u32x8};
 
 use crate::camera::RowLine;
 #[cfg(doc)]
-use crate::raytrace::csg::CsgCaster;
-use crate::raytrace::csg::{Hit, IntervalLanes};
-use crate::visibility::spans::RowSpans;
+use crate::csg::CsgCaster;
+use crate::csg::{Hit, IntervalLanes};
+use crate::visibility::solids::spans::RowSpans;
 
 /// Relative depth by which a primitive must lie behind a pixel's surface
 /// for the z-buffer to leave it unsolved there (far above the rounding of a

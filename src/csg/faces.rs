@@ -29,7 +29,7 @@ use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
 use crate::camera::RowLine;
-use crate::scene::csg::ConvexPolyhedron;
+use crate::csg::ConvexPolyhedron;
 
 /// Items sorted into cells (a compressed table): cell `c` holds
 /// `items[starts[c − first]..starts[c − first + 1]]`, in the order the items

@@ -12,7 +12,7 @@
 //! boxes kept all of the part's box it covers.
 //!
 //! The boxes are widened (a hundredth of each unit box's side) so that the
-//! booleans' tie ([`crate::raytrace::csg::TIE`], which widens a cutter's
+//! booleans' tie ([`crate::csg::TIE`], which widens a cutter's
 //! interval by a relative hair of `t`) stays inside them: a frame that sees
 //! the region so far away that the tie could reach past the widening keeps
 //! the primitive's box as it was.
@@ -21,10 +21,9 @@ use glam::{DVec3, Mat4, Vec3, Vec3A};
 use rayon::prelude::*;
 
 use crate::camera::Camera;
-use crate::raytrace::csg::{CsgCaster, TIE};
-use crate::scene::csg::{BoxBound, CsgSolid};
-use crate::visibility::occupancy::{CutterBodies, OccupancyTree};
-use crate::visibility::outline::{screen_point, Extent};
+use crate::csg::occupancy::{CutterBodies, OccupancyTree};
+use crate::csg::outline::{screen_point, Extent};
+use crate::csg::{BoxBound, CsgCaster, CsgSolid, TIE};
 
 /// How far each unit box is widened on each side, as a part of its side.
 const WIDENING: f64 = 0.01;

@@ -9,7 +9,7 @@
 use glam::{DVec2, Mat4, Vec2, Vec3, Vec4};
 
 use crate::camera::PixelRays;
-use crate::scene::csg::{BoxBound, Primitive, Shape};
+use crate::csg::{BoxBound, Primitive, Shape};
 
 /// How far (in pixels) an exact extent is widened, so that rounding never drops
 /// a pixel whose ray grazes the primitive.
@@ -17,11 +17,11 @@ const ROUNDING_PX: f64 = 1e-3;
 
 /// Pixels a primitive may cover: rows `y0..=y1`, columns `x0..=x1`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(super) struct Extent {
-    pub(super) x0: i64,
-    pub(super) x1: i64,
-    pub(super) y0: i64,
-    pub(super) y1: i64,
+pub(crate) struct Extent {
+    pub(crate) x0: i64,
+    pub(crate) x1: i64,
+    pub(crate) y0: i64,
+    pub(crate) y1: i64,
 }
 
 impl BoxBound for Extent {
@@ -38,9 +38,9 @@ impl BoxBound for Extent {
 /// Where a primitive shows on the screen: its scanlines (the y-entry table's
 /// key; procedure 1) and, per scanline, its left and right ends (procedure 2).
 #[derive(Debug, Clone)]
-pub(super) struct Outline {
+pub(crate) struct Outline {
     /// Rows, and the columns of its bounding box.
-    pub(super) rows: Extent,
+    pub(crate) rows: Extent,
     /// An ellipsoid under a perspective camera, its ends exact.
     ellipsoid: Option<EllipsoidView>,
     /// The convex hull (pixel coordinates, in order round it) of the projected
@@ -49,7 +49,7 @@ pub(super) struct Outline {
     hull: Vec<DVec2>,
     /// The least distance along the view axis of those corners: no ray meets
     /// the primitive nearer (a row line's `t` counts that distance).
-    pub(super) nearest: f32,
+    pub(crate) nearest: f32,
 }
 
 /// An ellipsoid `{M·q + c : |q| ≤ 1}` seen from an eye outside it, in the unit
@@ -70,7 +70,7 @@ struct EllipsoidView {
 impl Outline {
     /// The outline of `p` seen through `vp` with pixel rays `rays`, or
     /// `None` where it shows nowhere.
-    pub(super) fn new(p: &Primitive, vp: Mat4, rays: &PixelRays) -> Option<Outline> {
+    pub(crate) fn new(p: &Primitive, vp: Mat4, rays: &PixelRays) -> Option<Outline> {
         let (width, height) = (rays.size.x as u32, rays.size.y as u32);
         let points = outline_points(p);
         let depth = |q: &Vec3| (*q - rays.origin).dot(rays.forward) / rays.forward.length_squared();
@@ -110,7 +110,7 @@ impl Outline {
     }
 
     /// The columns the primitive may cover on row `y`.
-    pub(super) fn columns(&self, y: i64) -> Option<(i64, i64)> {
+    pub(crate) fn columns(&self, y: i64) -> Option<(i64, i64)> {
         let (x0, x1) = (self.rows.x0, self.rows.x1);
         let Some(e) = &self.ellipsoid else {
             if self.hull.is_empty() {
@@ -154,7 +154,7 @@ impl EllipsoidView {
 /// The pixel coordinates (pixel `(x, y)` has its centre at `x + ½, y + ½`)
 /// of world point `p` seen through `vp` in a `width` x `height` image, or
 /// `None` at or behind the eye.
-pub(super) fn screen_point(p: Vec3, vp: Mat4, (width, height): (u32, u32)) -> Option<Vec2> {
+pub(crate) fn screen_point(p: Vec3, vp: Mat4, (width, height): (u32, u32)) -> Option<Vec2> {
     pixel_of(vp * p.extend(1.0), DVec2::new(f64::from(width), f64::from(height))).map(DVec2::as_vec2)
 }
 

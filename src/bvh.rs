@@ -1,8 +1,10 @@
-//! Bounding volume hierarchy: binned surface-area-heuristic build (as pbrt-v4's
-//! `BVHAggregate`, 16 bins), flattened depth-first, traversed near child first.
+//! Bounding volume hierarchy over boxes: binned surface-area-heuristic build (as
+//! pbrt-v4's `BVHAggregate`, 16 bins), flattened depth-first, traversed near child
+//! first.
 //!
-//! The hierarchy knows only boxes. Traversal hands each leaf primitive to a closure
-//! that intersects it, so triangles today and CSG primitives later share one walker.
+//! The hierarchy knows only boxes. Traversal hands each leaf to a closure that
+//! intersects it, so one walker serves the scene's triangles and solids (ray
+//! tracing) and a solid's primitives (CSG casting).
 
 use glam::{Vec3, Vec3A};
 use rayon::prelude::*;

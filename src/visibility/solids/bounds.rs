@@ -30,7 +30,7 @@
 //! lose 60% of theirs but the frame only 4%: the ring's outline still takes
 //! in the axis, where they all meet.
 
-use crate::scene::csg::{Bound, BoxBound, CsgTree, Reach};
+use crate::csg::{Bound, BoxBound, CsgTree, Reach};
 
 /// Most bounding leaves kept per primitive (the innermost ones, nearest the
 /// primitive in the tree and usually the tightest): each costs a clip of the

@@ -8,7 +8,7 @@
 use glam::{Affine3A, Mat3A, Vec3, Vec3A, Vec4};
 use wide::f32x8;
 
-use crate::scene::csg::{ConvexPolyhedron, Shape};
+use crate::csg::{ConvexPolyhedron, Shape};
 
 /// The (unnormalised) outward normal of a unit shape's face `face` at its
 /// point `p`: the sphere's radius; a frustum's side (face [`SIDE`]) or caps

@@ -16,7 +16,7 @@ use wide::f32x8;
 
 use super::shapes::{BOTTOM, SIDE, TOP};
 use crate::camera::RowLine;
-use crate::scene::csg::{ConvexPolyhedron, Shape};
+use crate::csg::{ConvexPolyhedron, Shape};
 
 /// Eight pixels' rays `o + t·d`, a coordinate per array entry.
 #[derive(Debug, Clone, Copy)]

@@ -20,20 +20,18 @@
 
 use glam::{Affine3A, Mat3A, Vec3, Vec3A};
 
-use super::bvh::{Aabb, Bvh};
+use super::model::{ConvexPolyhedron, CsgSolid, CsgTree, Primitive, Shape};
+use super::occupancy::OccupancyTree;
+use crate::bvh::{Aabb, Bvh};
 use crate::camera::{Ray, RowLine};
-use crate::scene::csg::{ConvexPolyhedron, CsgSolid, CsgTree, Primitive, Shape};
-use crate::visibility::occupancy::OccupancyTree;
 
-mod booleans;
-mod faces;
-mod lanes;
-mod shapes;
-
-pub use booleans::{above, below, combine, Booleans, LeafSpans, Operation, Parts, SpanScratch, TIE};
-use booleans::{difference, first_crossing, first_entry, first_of_all, union, Inside};
-pub use faces::{FacesOnScreen, RowFaces};
-use shapes::{normal_matrix, unit_cube, unit_normal, unit_span, Clipping, PlaneLanes};
+use super::booleans::{
+    combine, difference, first_crossing, first_entry, first_of_all, union, Booleans, Inside, LeafSpans, Operation,
+    Parts, SpanScratch,
+};
+use super::faces::{self, FacesOnScreen, RowFaces};
+use super::lanes;
+use super::shapes::{self, normal_matrix, unit_cube, unit_normal, unit_span, Clipping, PlaneLanes};
 
 /// Where a ray crosses a solid's surface.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -71,12 +69,12 @@ pub struct Hit {
     /// The face of the primitive's unit shape (a polyhedron's plane; a
     /// frustum's side or cap), and in its top bit whether the surface
     /// belongs to a subtracted primitive (a hole's wall).
-    face: u32,
+    pub(super) face: u32,
 }
 
 impl Hit {
     /// The bit of `face` that marks a hole's wall.
-    const CUT: u32 = 1 << 31;
+    pub(super) const CUT: u32 = 1 << 31;
 
     /// A crossing at `t` of face `face` of `primitive`.
     pub(crate) const fn new(t: f32, primitive: usize, face: u32) -> Hit {
@@ -276,7 +274,7 @@ impl CsgCaster {
     /// Primitives from which [`CsgCaster::first_hit`] culls by a BVH.
     pub const BVH_PRIMITIVES: usize = 8;
 
-    /// A ray's booleans count the primitives it meets ([`Occupied`](crate::visibility::occupancy::Occupied)) when
+    /// A ray's booleans count the primitives it meets ([`Occupied`](crate::csg::occupancy::Occupied)) when
     /// they are fewer than the tree's nodes over this, and walk the whole
     /// tree otherwise: counting one costs about as much as walking four nodes
     /// (measured on the Menger sponge, whose rays meet a third of its 221
@@ -538,7 +536,7 @@ impl CsgCaster {
     /// the caller), who finds the normal of the hit returned.
     pub fn first_hit_of_segments<'s>(
         &self,
-        segments: impl IntoIterator<Item = &'s crate::visibility::pattern::Segment>,
+        segments: impl IntoIterator<Item = &'s crate::visibility::solids::paper::pattern::Segment>,
         occupying: &impl Fn(usize) -> bool,
         span: &mut impl FnMut(usize) -> Option<Interval>,
         t_min: f32,

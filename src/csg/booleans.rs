@@ -9,8 +9,8 @@
 //! instead of speckling.
 
 use super::{Hit, Interval};
-use crate::scene::csg::CsgTree;
-use crate::visibility::occupancy::Occupied;
+use crate::csg::occupancy::Occupied;
+use crate::csg::CsgTree;
 
 /// Relative width (of `t`) within which a cutter's boundary counts as reaching a
 /// solid's boundary.
@@ -93,7 +93,7 @@ pub struct Parts<B, I> {
 
 /// A tree of booleans the span combiner ([`combine`]) walks: a [`CsgTree`], or
 /// a view of one that leaves out what cannot matter at a pixel
-/// ([`crate::visibility::occupancy`]).
+/// ([`crate::csg::occupancy`]).
 pub trait Booleans: Copy {
     /// The node's operation and operands.
     fn parts(self) -> Parts<Self, impl Iterator<Item = Self> + Clone>;

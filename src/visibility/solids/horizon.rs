@@ -15,7 +15,7 @@
 //!
 //! Why the answer is the whole tree's. Let `T` be the horizon. A left-out
 //! occupant's interval lies at or beyond `T`; the booleans
-//! ([`crate::raytrace::csg`]) compare its ends with others' unmoved (union,
+//! ([`crate::csg`]) compare its ends with others' unmoved (union,
 //! intersection) or moved nearer by one [`TIE`] move (a difference's cutter,
 //! from `t` to `below(t)`). So a union gains from it spans beyond `T` only;
 //! an intersection with it lies beyond `T`, where read as missed it is
@@ -26,7 +26,7 @@
 //! there. The block spreading ([`super::block`]) then checks the answer
 //! against every occupant, as for an answer found with all of them.
 
-use crate::raytrace::csg::TIE;
+use crate::csg::TIE;
 
 /// How far along a pixel's ray the booleans read occupants: those whose
 /// interval starts at or beyond it are left out.
@@ -83,8 +83,8 @@ mod tests {
     use proptest::prelude::*;
 
     use super::*;
-    use crate::raytrace::csg::{CsgCaster, Hit, Interval, SpanScratch};
-    use crate::scene::csg::{random_tree, ConvexPolyhedron, CsgSolid, CsgTree, Primitive, Shape};
+    use crate::csg::{random_tree, ConvexPolyhedron, CsgSolid, CsgTree, Primitive, Shape};
+    use crate::csg::{CsgCaster, Hit, Interval, SpanScratch};
 
     const N: usize = 8;
 

@@ -23,10 +23,9 @@
 //! of its positive primitives' intervals minus its flagged negative ones', and the
 //! pixel's surface is the nearest over the visible segments.
 
-use crate::raytrace::csg::{CsgCaster, Hit, Interval, SpanScratch};
-use crate::scene::csg::CsgTree;
-use crate::visibility::csg::XOrder;
-use crate::visibility::occupancy::PlacedSet;
+use crate::csg::occupancy::PlacedSet;
+use crate::csg::{CsgCaster, CsgTree, Hit, Interval, SpanScratch};
+use crate::visibility::solids::XOrder;
 
 /// One segment: an intersection of positive primitives and complements of
 /// negative ones (indices into the solid's primitives, sorted).
@@ -74,7 +73,7 @@ impl PatternMatrix {
     /// One scanline, given each occupant's left and right ends (`ends`): RCy,
     /// then the x-walk with RCx and the visible-segment list; writes each
     /// covered pixel's nearest surface into `row`.
-    pub(super) fn walk_row(
+    pub(crate) fn walk_row(
         &self,
         caster: &CsgCaster,
         ends: &[(usize, i64, i64)],

@@ -1,5 +1,5 @@
 //! A frame of a solid's visible surfaces kept from scan to scan, as a viewer
-//! keeps its buffer while the camera moves ([`super::csg::scan_solid_into`]).
+//! keeps its buffer while the camera moves ([`super::scan_solid_into`]).
 //!
 //! A scan writes only the columns its scanline walk may cover (the occupants'
 //! ends, procedure 2 of seed 003 §5); every other pixel must read `None`. The
@@ -12,7 +12,7 @@ use std::ops::Range;
 
 use rayon::prelude::*;
 
-use crate::raytrace::csg::Crossing;
+use crate::csg::Crossing;
 
 /// Each pixel's visible surface (rows top to bottom, `None` where the ray
 /// misses), and per row the columns that may hold one.

@@ -9,11 +9,9 @@
 use std::cell::{Cell, RefCell};
 
 use crate::camera::RowLine;
-use crate::raytrace::csg::{
-    Booleans, CsgCaster, FacesOnScreen, Hit, Interval, IntervalLanes, LeafSpans, RowFaces, SpanScratch,
-};
-use crate::visibility::block::BlockOrder;
-use crate::visibility::horizon::Horizon;
+use crate::csg::{Booleans, CsgCaster, FacesOnScreen, Hit, Interval, IntervalLanes, LeafSpans, RowFaces, SpanScratch};
+use crate::visibility::solids::block::BlockOrder;
+use crate::visibility::solids::horizon::Horizon;
 
 /// Each occupant's intervals at the eight-pixel block of the scanline last
 /// asked of it: the first pixel of a block that needs a primitive's interval

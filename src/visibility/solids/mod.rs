@@ -6,7 +6,7 @@
 //! occupants by left end into the x-entry table (and by right end, for leaving),
 //! and walks its pixels keeping the x-occupancy list. A pixel with occupants gets
 //! its visible surface from the depth intervals of the occupants only (seed
-//! 003's procedure 3 in closed form, [`crate::raytrace::csg`]), clipped at the
+//! 003's procedure 3 in closed form, [`crate::csg`]), clipped at the
 //! near plane as polygons are. Intervals come eight pixels of a scanline at a
 //! time (one SIMD pass per occupant and block, `BlockSpans`), and a polyhedron
 //! of many planes is clipped only by the faces the scanline's plane meets.
@@ -20,7 +20,7 @@
 //! whose count is zero enters the visible-segment list. Expanding can explode
 //! (the paper names it; OpenSCAD aborts previews past 100,000 terms), so the
 //! tree is not expanded: the same counts are kept at every node of it
-//! ([`super::occupancy`]). A primitive entering or leaving the x-occupancy list
+//! ([`crate::csg::occupancy`]). A primitive entering or leaving the x-occupancy list
 //! updates its leaf and the few nodes above it whose emptiness changes; the
 //! root's list of non-empty operands is the visible-segment list, a
 //! difference's list of non-empty cutters is the fast path for negative
@@ -28,12 +28,12 @@
 //!
 //! Coherence (§5.2.2): the paper reuses a pixel's answer at the next pixel
 //! unless a primitive entered or left or the depth order changed. kage has it
-//! exactly as the paper puts it ([`super::coherence`],
+//! exactly as the paper puts it ([`paper::coherence`],
 //! `CsgMethod::SegmentsCoherent`), but measured on the corpus, checking the
 //! order at every pixel costs about what the booleans of the few primitives
 //! there cost, and the order of many primitives' ends breaks too often to
 //! pay. By default the walk takes it a block at a time instead
-//! ([`super::block`]): in an eight-pixel block no occupant enters or leaves,
+//! (`block.rs`): in an eight-pixel block no occupant enters or leaves,
 //! the booleans run at its first pixel, and their answer goes to the other
 //! seven when the ends before it keep their order at all eight (checked in
 //! lanes, once per block); ends behind the surface may swap.
@@ -42,7 +42,7 @@
 //! features lie behind its surface. Where the booleans run, the occupants
 //! whose interval starts beyond a horizon guessed a little past the surface
 //! of the pixel before are left out, and the answer is kept when it provably
-//! is the whole tree's ([`super::horizon`]).
+//! is the whole tree's (`horizon.rs`).
 //!
 //! Extents (procedures 1 and 2): an ellipsoid seen in perspective from outside
 //! gets the paper's exact rows (scanline planes through the eye tangent to it)
@@ -54,6 +54,15 @@
 //! orthographic camera, fall back to their box. A too-wide extent only costs
 //! time: where a primitive does not reach, its interval is empty.
 
+mod block;
+mod bounds;
+mod cut_region;
+mod horizon;
+pub mod paper;
+mod spans;
+pub mod surface_frame;
+mod zbuffer;
+
 use std::cell::{Cell, RefCell};
 
 use glam::{Vec2, Vec3};
@@ -61,21 +70,20 @@ use rayon::iter::IndexedParallelIterator;
 use rayon::prelude::*;
 
 use crate::camera::{Camera, PixelRays, RowLine};
-use crate::raytrace::csg::{Crossing, CsgCaster, FacesOnScreen, Hit, SpanScratch};
-use crate::scene::csg::{CsgSolid, Primitive};
+use crate::csg::occupancy::{OccupancyTree, Occupied};
+use crate::csg::outline::{screen_point, Extent, Outline};
+use crate::csg::{Crossing, CsgCaster, CsgSolid, FacesOnScreen, Hit, Primitive, SpanScratch};
 use crate::scene::{Object, Scene};
-use crate::visibility::block::BlockOrder;
-use crate::visibility::bounds::{self, BoundingLeaves};
-use crate::visibility::coherence::{self, PixelCoherence};
-use crate::visibility::cut_region::CutRegions;
-use crate::visibility::horizon::Horizon;
-use crate::visibility::occupancy::{OccupancyTree, Occupied};
-use crate::visibility::outline::{screen_point, Extent, Outline};
-use crate::visibility::pattern::{PatternMatrix, TooManySegments};
-use crate::visibility::spans::{BlockSpans, PixelSpans, RowSpans};
-use crate::visibility::surface_frame::{row_to_write, SurfaceFrame};
-use crate::visibility::zbuffer::{DepthEnds, UnionRow};
 use crate::visibility::{ItemId, VisibilityBuffer};
+use block::BlockOrder;
+use bounds::BoundingLeaves;
+use cut_region::CutRegions;
+use horizon::Horizon;
+use paper::coherence::{self, PixelCoherence};
+use paper::pattern::{PatternMatrix, TooManySegments};
+use spans::{BlockSpans, PixelSpans, RowSpans};
+use surface_frame::{row_to_write, SurfaceFrame};
+use zbuffer::{DepthEnds, UnionRow};
 
 /// Rows scanned by one worker in turn, each band a task of its own
 /// ([`scan_bands`]). Measured with the walk's loops aligned (so that layout
@@ -96,17 +104,17 @@ pub fn scan_solid(solid: &CsgSolid, camera: &Camera, width: u32, height: u32) ->
 pub enum CsgMethod {
     /// The tree's own segments, cut down to the occupants (no expansion),
     /// an eight-pixel block's answer found at its first pixel and spread to
-    /// the others where it provably holds ([`super::block`]; the default).
+    /// the others where it provably holds (`block.rs`; the default).
     Segments,
     /// [`CsgMethod::Segments`] with the booleans run at every pixel: the
     /// same surfaces to the bit (what the spreading is tested against).
     SegmentsEachPixel,
     /// [`CsgMethod::SegmentsEachPixel`] with a pixel's answer reused along
     /// the scanline while the order of every end holds (seed 003 §5.2.2 as
-    /// the paper has it; [`super::coherence`]): the same surfaces to the
+    /// the paper has it; [`paper::coherence`]): the same surfaces to the
     /// bit, measured slower on every corpus model.
     SegmentsCoherent,
-    /// The paper's pattern matrix ([`super::pattern`]), expanded up to `limit`
+    /// The paper's pattern matrix ([`paper::pattern`]), expanded up to `limit`
     /// segments.
     PatternMatrix {
         /// Most segments the expansion may make.
@@ -231,7 +239,7 @@ struct SegmentWalk {
     /// How an answer is reused along the scanline (seed 003 §5.2.2).
     reuse: Reuse,
     /// Whether the booleans leave out occupants beyond a guessed horizon
-    /// ([`super::horizon`]): not pixel by pixel (the tests' oracle), and not
+    /// (`horizon.rs`): not pixel by pixel (the tests' oracle), and not
     /// for a union of primitives, whose booleans read each occupant once
     /// anyway (where leaving some out saved nothing and the second passes
     /// at silhouettes cost: the paper's random spheres).

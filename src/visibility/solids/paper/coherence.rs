@@ -4,10 +4,10 @@
 //! walk reads that end's depth at the new pixel instead of combining the
 //! intervals again.
 //!
-//! "The same order" is made exact. The booleans ([`crate::raytrace::csg`])
+//! "The same order" is made exact. The booleans ([`crate::csg`])
 //! decide only by comparing `t` values: interval ends with each other, with
 //! the near plane, and — in a difference — with a cutter's ends moved by
-//! [`crate::raytrace::csg::TIE`] ([`below`], [`above`]). At a pixel the
+//! [`crate::csg::TIE`] ([`below`], [`above`]). At a pixel the
 //! booleans evaluate, every value they could compare is listed and sorted
 //! ([`PixelCoherence::learn`]); at the next pixel the same list, read in the
 //! same order, must still rise strictly (a tie or a NaN breaks the run), and
@@ -23,13 +23,12 @@
 //! (`docs/benchmarks.md`), the booleans of the few primitives at a pixel are
 //! cheap beside that pass, and the order of many primitives' ends breaks too
 //! often (any two ends swapping, however far behind the surface): the walk
-//! uses it only when asked ([`super::csg::CsgMethod::SegmentsCoherent`]).
+//! uses it only when asked ([`super::super::CsgMethod::SegmentsCoherent`]).
 
+use crate::csg::occupancy::PlacedSet;
 #[cfg(doc)]
-use crate::raytrace::csg::{above, below};
-use crate::raytrace::csg::{Hit, Interval, TIE};
-use crate::scene::csg::CsgTree;
-use crate::visibility::occupancy::PlacedSet;
+use crate::csg::{above, below};
+use crate::csg::{CsgTree, Hit, Interval, TIE};
 
 /// How a value is made from an end's `t`: `t + k·max(|t|, 1)`, where `k` is
 /// 0 (the end itself), `−TIE` ([`below`]) or `+TIE` ([`above`]) — the same

@@ -14,7 +14,7 @@
 //! the block the same way (the walk keeps each occupant's lanes of two
 //! blocks), and the booleans do not run at all.
 //!
-//! Why it holds. The booleans ([`crate::raytrace::csg`]) build the set of
+//! Why it holds. The booleans ([`crate::csg`]) build the set of
 //! ray parameters inside the solid out of the occupants' intervals, comparing
 //! ends with each other, with the near plane and — a difference's cutter —
 //! moved by [`TIE`]; their answer is the first end of that set beyond the
@@ -46,7 +46,7 @@
 
 use wide::f32x8;
 
-use crate::raytrace::csg::{Hit, IntervalLanes, TIE};
+use crate::csg::{Hit, IntervalLanes, TIE};
 
 /// The pixels (bits of lanes) where `b` and `a` compare as they do at the
 /// reference pixel, where they are `rb` and `ra`: where `b` lies beyond `a`

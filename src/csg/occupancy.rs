@@ -19,13 +19,12 @@
 //! A primitive entering or leaving the x-occupancy list changes its leaf, and
 //! the change climbs only while a node's emptiness changes: a few nodes
 //! however large the tree, with no allocation. A pixel's booleans
-//! ([`crate::raytrace::csg::combine`] through [`Booleans`]) then visit only
+//! ([`crate::csg::combine`] through [`Booleans`]) then visit only
 //! the non-empty parts. Nested unions, intersections and differences are
 //! merged into their parents first (`(a − b) − c` is `a − b − c`), so the
 //! lists are long and the tree shallow.
 
-use crate::raytrace::csg::{Booleans, Operation, Parts};
-use crate::scene::csg::CsgTree;
+use crate::csg::{Booleans, CsgTree, Operation, Parts};
 
 /// No node.
 const NONE: u32 = u32::MAX;
@@ -124,7 +123,7 @@ impl OccupancyTree {
 /// a difference (the nearest such), the primitives of that difference's
 /// first operand, its body. A difference's set lies within its body's
 /// primitives, and such a primitive changes the set of the cutters it lies
-/// under only within itself (widened by [`crate::raytrace::csg::TIE`]):
+/// under only within itself (widened by [`crate::csg::TIE`]):
 /// where the two do not meet, it changes nothing of the solid.
 #[derive(Debug, Clone, Default)]
 pub struct CutterBodies {
@@ -466,8 +465,8 @@ mod tests {
     use proptest::prelude::*;
 
     use super::*;
-    use crate::raytrace::csg::{combine, CsgCaster, Interval, SpanScratch};
-    use crate::scene::csg::{random_tree, ConvexPolyhedron, CsgSolid, Primitive, Shape};
+    use crate::csg::{combine, CsgCaster, Interval, SpanScratch};
+    use crate::csg::{random_tree, ConvexPolyhedron, CsgSolid, Primitive, Shape};
 
     /// Whether `tree` can be non-empty where only `on` primitives are present
     /// (the counts' meaning, stated recursively).
