@@ -528,15 +528,16 @@ impl CsgCaster {
         first_of_all(tree, leaf, t_min, scratch)
     }
 
-    /// The first surface beyond `t_min` of a union of pattern-matrix segments
-    /// (seed 003 §5.2.1): per segment, the intersection of its positive
-    /// primitives' intervals minus the intervals of its negative primitives
-    /// that `occupying` says cover the pixel; the nearest over the segments.
+    /// The first surface beyond `t_min` of a union of segments (seed 003
+    /// §5.2.1's pattern matrix), each given as its positive and its negative
+    /// primitives: per segment, the intersection of its positive primitives'
+    /// intervals minus the intervals of its negative primitives that
+    /// `occupying` says cover the pixel; the nearest over the segments.
     /// `span` gives a primitive's interval ([`CsgCaster::span_on`], cached by
     /// the caller), who finds the normal of the hit returned.
     pub fn first_hit_of_segments<'s>(
         &self,
-        segments: impl IntoIterator<Item = &'s crate::visibility::solids::paper::pattern::Segment>,
+        segments: impl IntoIterator<Item = (&'s [usize], &'s [usize])>,
         occupying: &impl Fn(usize) -> bool,
         span: &mut impl FnMut(usize) -> Option<Interval>,
         t_min: f32,
@@ -544,9 +545,9 @@ impl CsgCaster {
     ) -> Option<Hit> {
         scratch.stack.clear();
         let mut parts = 0;
-        'segments: for seg in segments {
+        'segments: for (positive, negative) in segments {
             let mut inside: Option<Interval> = None;
-            for &i in &seg.positive {
+            for &i in positive {
                 let Some(s) = span(i) else { continue 'segments };
                 inside = Some(match inside {
                     None => s,
@@ -559,7 +560,7 @@ impl CsgCaster {
             let Some(inside) = inside.filter(|s| s.enter.t < s.exit.t) else { continue };
             let base = scratch.stack.len();
             scratch.stack.push(inside);
-            for &i in seg.negative.iter().filter(|&&i| occupying(i)) {
+            for &i in negative.iter().filter(|&&i| occupying(i)) {
                 let Some(cut) = span(i) else { continue };
                 let SpanScratch { stack, out, .. } = scratch;
                 out.clear();

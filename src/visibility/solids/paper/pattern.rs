@@ -116,7 +116,11 @@ impl PatternMatrix {
             if !visible.ids().is_empty() {
                 spans.next_pixel();
                 *px = caster.first_hit_of_segments(
-                    visible.ids().iter().map(|&s| &self.segments[s as usize]),
+                    visible
+                        .ids()
+                        .iter()
+                        .map(|&s| &self.segments[s as usize])
+                        .map(|s| (&s.positive[..], &s.negative[..])),
                     &|i| flagged[i],
                     &mut |i| spans.get(i, || span(i, x)),
                     near,
