@@ -28,7 +28,7 @@
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
-use super::edges::EdgeBlend;
+use super::blend::EdgeBlend;
 use crate::image::LinearImage;
 use crate::shading::{ComponentSet, SubpixelSample, SubpixelShading, Target};
 use crate::visibility::{ItemId, VisibilityBuffer};

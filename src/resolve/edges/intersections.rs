@@ -25,9 +25,9 @@ use std::ops::Range;
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
+use super::blend::{EdgeBlend, PixelSet};
 use super::dda::square_part;
-use super::edges::{ClipMap, DepthPlane, EdgeBlend, Screen};
-use super::PixelSet;
+use super::screen::{ClipMap, DepthPlane, Screen};
 use crate::scene::{box_corners, Scene};
 use crate::visibility::{ItemId, VisibilityBuffer};
 
