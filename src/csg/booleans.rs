@@ -8,7 +8,7 @@
 //! widened by a hair ([`TIE`]), so a cut face exactly on a solid face removes it
 //! instead of speckling.
 
-use super::{Hit, Interval};
+use super::hit::{Hit, Interval};
 use crate::csg::occupancy::Occupied;
 use crate::csg::CsgTree;
 

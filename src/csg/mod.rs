@@ -25,6 +25,7 @@
 mod booleans;
 mod caster;
 mod faces;
+mod hit;
 mod lanes;
 mod model;
 pub mod occupancy;
@@ -33,8 +34,9 @@ pub(crate) mod outline;
 mod shapes;
 
 pub use booleans::{above, below, combine, Booleans, LeafSpans, Operation, Parts, SpanScratch, TIE};
-pub use caster::{first_hit, primitive_span, spans, Crossing, CsgCaster, Hit, Interval, IntervalLanes, Span};
+pub use caster::{first_hit, primitive_span, spans, CsgCaster};
 pub use faces::{FacesOnScreen, RowFaces};
+pub use hit::{Crossing, Hit, Interval, IntervalLanes, Span};
 #[cfg(test)]
 pub(crate) use model::random_tree;
 pub use model::{Bound, BoxBound, ConvexPolyhedron, CsgSolid, CsgTree, Primitive, Reach, Shape};
