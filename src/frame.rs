@@ -11,7 +11,7 @@ use rayon::prelude::*;
 
 use crate::error::{Error, Result};
 use crate::image::LinearImage;
-use crate::raytrace::{item_buffer, TraceCache};
+use crate::raytrace::{traced, TraceCache};
 use crate::resolve::edges as solid_edges;
 use crate::resolve::edges::{self, EdgeCache, EdgeOptions};
 use crate::scene::{Antialias, Scene};
@@ -274,15 +274,15 @@ fn render_pass(scene: &Scene, frame: &mut Frame, scratch: &mut Scratch, ray_dept
     let t2 = Instant::now();
     let builds = trace.builds();
     frame.stats.traced_pixels += match &mut traced_aov {
-        None => item_buffer::add_traced(scene, vb, targets[0].image, ray_depth, trace),
+        None => traced::add_traced(scene, vb, targets[0].image, ray_depth, trace),
         Some(t) => {
             t.pixels_mut().fill(Vec3::ZERO);
-            let n = item_buffer::add_traced(scene, vb, t, ray_depth, trace);
+            let n = traced::add_traced(scene, vb, t, ray_depth, trace);
             add_scaled(targets[0].image, t, 1.0);
             n
         }
     };
-    item_buffer::trace_subpixel(scene, subpixel, ray_depth, trace);
+    traced::trace_subpixel(scene, subpixel, ray_depth, trace);
     let t3 = Instant::now();
     frame.stats.bvh_built |= trace.builds() > builds;
     targets.extend(traced_aov.map(|image| Target { parts: ComponentSet::only(Component::Traced), image }));

@@ -6,7 +6,8 @@ use std::sync::Arc;
 
 use glam::{Affine3A, Quat, Vec2, Vec3};
 use kage::camera::{Camera, Projection};
-use kage::raytrace::reference::{refract, render_reference, ReferenceOptions};
+use kage::raytrace::reference::{render_reference, ReferenceOptions};
+use kage::raytrace::tracer::refract;
 use kage::scene::mesh::shapes;
 use kage::scene::{Material, Object, Scene};
 use kage::{render, RenderOptions};

@@ -2,14 +2,18 @@
 //! secondary rays of seed 002 §4 (reflection and refraction traced from the item
 //! buffer).
 //!
-//! [`crate::bvh`] is the acceleration structure (binned SAH), [`triangle`] the watertight
-//! ray/triangle test; [`TraceScene`] puts a scene's triangles, in world space and
-//! with their item ids, behind one BVH and answers `intersect` (nearest hit) and
-//! `occluded` (anything before a distance?). [`crate::csg`] casts rays at CSG solids.
+//! [`TraceScene`] puts a scene's triangles (in world space, with their item ids;
+//! [`triangle`] is the watertight ray/triangle test) and its CSG solids (cast by
+//! [`crate::csg::CsgCaster`]) behind one [`crate::bvh`], and answers `intersect`
+//! (nearest hit) and `occluded` (anything before a distance?); [`TraceCache`]
+//! keeps it while the geometry stays. [`tracer`] shades what a ray sees, bounces
+//! included; [`traced`] is the raster frame's traced term, [`mod@reference`] the
+//! ray-traced oracle, both on top of it.
 
 pub mod cache;
-pub mod item_buffer;
 pub mod reference;
+pub mod traced;
+pub mod tracer;
 pub mod triangle;
 
 use glam::{Vec2, Vec3};

@@ -15,7 +15,7 @@
 //! need be) and the point the ray goes through. The passes add each sample's
 //! components eight at a time ([`Lighting::shade_points`], the arithmetic they
 //! shade pixels with); the reflection map's term is looked up once; the traced
-//! term ([`crate::raytrace::item_buffer`]) traces its bounces from there.
+//! term ([`crate::raytrace::traced`]) traces its bounces from there.
 
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;

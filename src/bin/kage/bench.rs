@@ -537,11 +537,10 @@ fn hybrid_row(args: &BenchArgs, scene: &Scene, label: &str) -> Result<()> {
 /// primary hits from the BVH, shadow rays at them (where the hybrid reads shadow
 /// maps), the same bounces.
 fn trace_everything(scene: &Scene, trace: &kage::raytrace::TraceScene, depth: u32) -> kage::image::LinearImage {
-    use kage::raytrace::reference::{ReferenceOptions, Tracer};
+    use kage::raytrace::tracer::{ShadowRay, Tracer};
     use kage::shading::ObjectFrames;
     let frames = ObjectFrames::new(scene);
-    let opts = ReferenceOptions { pixel_samples: 1, light_samples: 1, shadows: true, max_depth: depth };
-    let tracer = Tracer::new(scene, trace, &frames, opts);
+    let tracer = Tracer::new(scene, trace, &frames, ShadowRay);
     let rays = scene.camera.pixel_rays(glam::Vec2::new(scene.width as f32, scene.height as f32));
     let mut image = kage::image::LinearImage::new(scene.width, scene.height);
     image.pixels_mut().par_chunks_mut(scene.width as usize).enumerate().for_each(|(y, row)| {

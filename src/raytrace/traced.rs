@@ -1,16 +1,17 @@
-//! Item-buffer ray tracing (seed 002 §4): reflections and refraction for the pixels
-//! that need them, starting from the visibility buffer.
+//! The traced term (seed 002 §4, eq. 5's IrayTracing): reflections and
+//! refraction for the pixels that need them, starting from the item buffer.
 //!
 //! The primary hit of every pixel is already known — the item id the polygon pass
 //! left there — so it costs one ray/plane intersection with that triangle, no
 //! traversal. Only pixels whose material reflects or refracts spawn secondary rays
 //! (and the shadow rays seen in them), traced through the BVH to `depth` bounces;
-//! their light is added to the image as the IrayTracing term of eq. 5.
+//! their light, shaded by the [`Tracer`] with one shadow ray per light, is added
+//! to the image.
 
 use glam::Vec2;
 use rayon::prelude::*;
 
-use super::reference::{ReferenceOptions, Tracer};
+use super::tracer::{ShadowRay, Tracer};
 use super::TraceCache;
 use crate::image::LinearImage;
 use crate::scene::Scene;
@@ -33,8 +34,7 @@ pub fn add_traced(
     }
     let trace = cache.get(scene);
     let frames = ObjectFrames::new(scene);
-    let opts = traced_term(depth);
-    let tracer = Tracer::new(scene, trace, &frames, opts);
+    let tracer = Tracer::new(scene, trace, &frames, ShadowRay);
     let w = vb.width() as usize;
     let rays = scene.camera.pixel_rays(Vec2::new(w as f32, vb.height() as f32));
     let rows = image.pixels_mut().par_chunks_mut(w).zip(vb.items().par_chunks(w));
@@ -55,12 +55,6 @@ pub fn add_traced(
         .sum()
 }
 
-/// The reference tracer's settings for the traced term: one ray from the
-/// known surface, shadow rays, `depth` bounces.
-fn traced_term(depth: u32) -> ReferenceOptions {
-    ReferenceOptions { pixel_samples: 1, light_samples: 1, shadows: true, max_depth: depth }
-}
-
 /// The traced term at every sub-pixel sample of `subpixel` whose surface
 /// reflects or refracts (as [`add_traced`] traces it at pixel centres).
 pub fn trace_subpixel(scene: &Scene, subpixel: &mut SubpixelShading, depth: u32, cache: &mut TraceCache) {
@@ -71,8 +65,7 @@ pub fn trace_subpixel(scene: &Scene, subpixel: &mut SubpixelShading, depth: u32,
     }
     let trace = cache.get(scene);
     let frames = ObjectFrames::new(scene);
-    let opts = traced_term(depth);
-    let tracer = Tracer::new(scene, trace, &frames, opts);
+    let tracer = Tracer::new(scene, trace, &frames, ShadowRay);
     let SubpixelShading { surfaces, traced, .. } = subpixel;
     traced.par_iter_mut().zip(surfaces.par_iter()).filter(|(_, s)| traces(s)).for_each(|(out, s)| {
         if let Some(s) = s {

@@ -1,0 +1,173 @@
+//! What a ray sees, shaded: the nearest surface along it lit by seed 002's
+//! eq. 1 with shadow rays, its mirror and glass bounces followed, translucent
+//! surfaces blended over what lies behind them. The traced term of the raster
+//! frame (seed 002 §4, [`super::traced`]) and the ray-traced reference
+//! ([`super::reference`]) both shade their rays here; how much of each light
+//! reaches a point is the one thing they decide differently ([`LightRays`]).
+
+use glam::Vec3;
+
+use super::TraceScene;
+use crate::camera::Ray;
+use crate::scene::{Light, LightKind, Scene};
+use crate::shading::phong::{self, Coefficients, Components};
+use crate::shading::reflection_map::reflection_map;
+use crate::shading::{ObjectFrames, SurfacePoint};
+
+/// Most translucent surfaces one ray passes through before it stops looking.
+const MAX_LAYERS: u32 = 64;
+
+/// How a tracer finds the share of a light that reaches a surface point.
+pub trait LightRays: Sync {
+    /// The share of `light` seen from `origin` (the surface point `at`, nudged
+    /// off its surface) through `trace`; `salt` tells sample patterns apart.
+    fn lit(&self, trace: &TraceScene, light: &Light, origin: Vec3, at: Vec3, salt: u32) -> f32;
+}
+
+/// One shadow ray to each light: to its centre, or along a directional light.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct ShadowRay;
+
+impl LightRays for ShadowRay {
+    fn lit(&self, trace: &TraceScene, light: &Light, origin: Vec3, _at: Vec3, _salt: u32) -> f32 {
+        match light.kind {
+            LightKind::Directional { direction } => {
+                f32::from(u8::from(!trace.occluded(&Ray { origin, dir: -direction }, f32::INFINITY)))
+            }
+            LightKind::Point { position } | LightKind::Spot { position, .. } => {
+                f32::from(u8::from(!occluded_towards(trace, origin, position)))
+            }
+        }
+    }
+}
+
+/// Every light reaches every point (no shadow rays).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Unshadowed;
+
+impl LightRays for Unshadowed {
+    fn lit(&self, _: &TraceScene, _: &Light, _: Vec3, _: Vec3, _: u32) -> f32 {
+        1.0
+    }
+}
+
+/// Whether anything lies between `origin` and `target` (short of it by a
+/// relative hair, so the light's own position does not count).
+#[must_use]
+pub fn occluded_towards(trace: &TraceScene, origin: Vec3, target: Vec3) -> bool {
+    let to = target - origin;
+    let dist = to.length();
+    trace.occluded(&Ray { origin, dir: to / dist }, dist * (1.0 - 1e-4))
+}
+
+/// Shades points hit by rays: eq. 1 with shadow rays (as `L` casts them),
+/// plus mirror and glass bounces.
+pub struct Tracer<'a, L: LightRays = ShadowRay> {
+    scene: &'a Scene,
+    trace: &'a TraceScene,
+    frames: &'a ObjectFrames,
+    lights: L,
+    epsilon: f32,
+}
+
+impl<'a, L: LightRays> Tracer<'a, L> {
+    /// A tracer over `trace` (built from `scene`), its shadow rays cast by `lights`.
+    #[must_use]
+    pub fn new(scene: &'a Scene, trace: &'a TraceScene, frames: &'a ObjectFrames, lights: L) -> Self {
+        let epsilon = scene.bounds().map_or(1e-4, |(lo, hi)| (hi - lo).length() * 1e-5);
+        Tracer { scene, trace, frames, lights, epsilon }
+    }
+
+    /// Light arriving along `ray` (unit direction), following `depth` bounces.
+    /// Translucent surfaces (opacity α < 1, seed 002 §3.4) are blended over what
+    /// the ray meets behind them: α · their colour + (1 − α) · the rest.
+    #[must_use]
+    pub fn radiance(&self, ray: &Ray, depth: u32) -> Vec3 {
+        self.through_layers(ray, depth, MAX_LAYERS)
+    }
+
+    fn through_layers(&self, ray: &Ray, depth: u32, layers: u32) -> Vec3 {
+        let Some(hit) = self.trace.intersect(ray, f32::INFINITY) else { return self.scene.background_along(ray.dir) };
+        let s = match hit.item.primitive() {
+            // A solid: its tangent plane at the hit, which the ray meets there.
+            Some(_) => ObjectFrames::tangent(self.scene, hit.item, ray.at(hit.t), hit.normal).surface(ray),
+            None => self.frames.prepare(self.scene, hit.item).surface(ray),
+        };
+        let material = &self.scene.materials[s.material];
+        let behind = || {
+            let next = Ray { origin: s.position + ray.dir * self.epsilon, dir: ray.dir };
+            if layers > 0 {
+                self.through_layers(&next, depth, layers - 1)
+            } else {
+                self.scene.background_along(ray.dir)
+            }
+        };
+        if material.translucent() && !material.two_sided && !s.front {
+            return behind(); // a culled back face, as the polygon pass draws it
+        }
+        let k = Coefficients::at(material, &s);
+        let mut acc = Components { emission: k.parts().3, ..Default::default() };
+        for (i, light) in self.scene.lights.iter().enumerate() {
+            if light.only.as_ref().is_some_and(|o| !o.contains(&(hit.item.object as usize))) {
+                continue; // selective lighting (seed 002 §3.3)
+            }
+            let origin = s.position + s.normal * self.epsilon;
+            let shadow = self.lights.lit(self.trace, light, origin, s.position, i as u32);
+            phong::add_light(&mut acc, light, &k, &s, shadow);
+        }
+        let own = acc.total() + reflection_map(self.scene, &s) + self.bounces(ray, &s, depth);
+        if material.translucent() {
+            material.opacity * own + (1.0 - material.opacity) * behind()
+        } else {
+            own
+        }
+    }
+
+    /// IrayTracing of seed 002 eq. 5 at `s`, seen along `ray`: Kr times the light of
+    /// the mirror ray plus Kt times the light of the refracted ray (total internal
+    /// reflection sends it back in), each followed `depth` bounces.
+    #[must_use]
+    pub fn bounces(&self, ray: &Ray, s: &SurfacePoint, depth: u32) -> Vec3 {
+        let m = &self.scene.materials[s.material];
+        if depth == 0 || !m.traces() {
+            return Vec3::ZERO;
+        }
+        let d = ray.dir;
+        let mut out = Vec3::ZERO;
+        if m.kr.max_element() > 0.0 {
+            let r = reflect(d, s.normal);
+            out += m.kr * self.radiance(&Ray { origin: s.position + s.normal * self.epsilon, dir: r }, depth - 1);
+        }
+        if m.kt.max_element() > 0.0 {
+            // Entering when the ray meets the front (outward) side of the surface.
+            let eta = if s.front { 1.0 / m.ior } else { m.ior };
+            let (dir, sign) = match refract(d, s.normal, eta) {
+                Some(t) => (t, -1.0),
+                None => (reflect(d, s.normal), 1.0),
+            };
+            let origin = s.position + s.normal * (sign * self.epsilon);
+            out += m.kt * self.radiance(&Ray { origin, dir }, depth - 1);
+        }
+        out
+    }
+}
+
+/// The mirror direction of unit `d` about unit normal `n`.
+#[must_use]
+pub fn reflect(d: Vec3, n: Vec3) -> Vec3 {
+    d - 2.0 * d.dot(n) * n
+}
+
+/// Snell refraction of unit `d` through a surface with unit normal `n` facing the
+/// incoming ray, `eta` = n_from / n_to; `None` past the critical angle (total
+/// internal reflection).
+#[must_use]
+pub fn refract(d: Vec3, n: Vec3, eta: f32) -> Option<Vec3> {
+    let cos_i = -d.dot(n);
+    let sin2_t = eta * eta * (1.0 - cos_i * cos_i);
+    if sin2_t > 1.0 {
+        return None;
+    }
+    let cos_t = (1.0 - sin2_t).sqrt();
+    Some((eta * d + (eta * cos_i - cos_t) * n).normalize())
+}
