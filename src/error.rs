@@ -128,6 +128,15 @@ pub enum Error {
         /// Why it is refused.
         reason: &'static str,
     },
+    /// The worker threads asked for cannot be had: more than kage allows, or
+    /// more than the system starts.
+    #[error("{requested} threads requested, but {reason}")]
+    Threads {
+        /// Threads asked for.
+        requested: usize,
+        /// Why not.
+        reason: String,
+    },
     /// The scene has nothing that can be drawn, or a value makes the camera unusable.
     #[error("invalid scene: {0}")]
     Scene(String),

@@ -1,21 +1,28 @@
-//! One frame, start to finish: visibility pass → shading passes → traced term,
-//! repeated and averaged for jittered antialiasing (seed 002 §4) → resolve.
+//! One frame, start to finish, one call per stage:
 //!
-//! A [`Renderer`] keeps its buffers between frames, as an interactive preview
-//! re-renders the same size again and again; [`render`] is the one-shot form.
+//! ```text
+//! visibility ─► shadows and shading ─► traced term ─► edge pass: record ─► fog ─► translucency ─► edge pass: apply
+//!  (item buffer)  (seed 002 §3; the edge     (seed 002 §4)                    (§3.5)   (§3.4)        (seed 004; solids'
+//!                  pass planned beside                                                               outlines by rays)
+//!                  the first pass)
+//! ```
+//!
+//! repeated and averaged for jittered antialiasing (seed 002 §4,
+//! [`crate::resolve::jitter`]). A [`Renderer`] keeps its buffers between frames,
+//! as an interactive preview re-renders the same size again and again; [`render`]
+//! is the one-shot form.
 
 use std::time::{Duration, Instant};
 
 use glam::{Vec2, Vec3};
-use rayon::prelude::*;
 
 use crate::error::{Error, Result};
 use crate::image::LinearImage;
 use crate::raytrace::{traced, TraceCache};
-use crate::resolve::edges as solid_edges;
-use crate::resolve::edges::{self, EdgeCache, EdgeOptions};
+use crate::resolve::edges::{EdgeOptions, EdgePass};
+use crate::resolve::jitter;
 use crate::scene::{Antialias, Scene};
-use crate::shading::{self, fog, translucency, Component, ComponentSet, SubpixelShading, Target};
+use crate::shading::{self, fog, translucency, Component, ComponentSet, PassStats, SubpixelShading, Target};
 use crate::shadows::MapPool;
 use crate::visibility::{self, RasterStats, VisibilityBuffer};
 
@@ -32,18 +39,23 @@ pub struct RenderOptions {
     /// Components also written out on their own ([`Frame::aovs`]); they sum to
     /// the final image.
     pub aovs: ComponentSet,
+    /// Keep the lights' shadow maps from one frame to the next while nothing
+    /// they depend on changes (the default: a viewer whose camera moves renders
+    /// no spot or point light's map again). Off, every frame renders every map,
+    /// as a renderer that keeps nothing between frames does.
+    pub keep_shadow_maps: bool,
 }
 
 impl Default for RenderOptions {
     fn default() -> Self {
-        RenderOptions { threads: None, ray_depth: 4, aovs: ComponentSet::EMPTY }
+        RenderOptions { threads: None, ray_depth: 4, aovs: ComponentSet::EMPTY, keep_shadow_maps: true }
     }
 }
 
 /// Timings and counts of one frame.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct FrameStats {
-    /// Milliseconds in the visibility (polygon) passes.
+    /// Milliseconds in the visibility (polygon and solid) passes.
     pub visibility_ms: f64,
     /// Milliseconds rendering shadow maps.
     pub shadow_ms: f64,
@@ -54,8 +66,8 @@ pub struct FrameStats {
     pub shadow_maps_reused: usize,
     /// Shading passes run (summed over jittered passes).
     pub shading_passes: u32,
-    /// Milliseconds in the shading passes (shadow maps aside; the edge pass's
-    /// plan, run beside the first, included).
+    /// Milliseconds in the shading passes, fog and translucency (shadow maps
+    /// aside; the edge pass's plan, run beside the first pass, included).
     pub shading_ms: f64,
     /// Milliseconds tracing reflections and refraction from the item buffer.
     pub traced_ms: f64,
@@ -80,6 +92,46 @@ pub struct FrameStats {
     /// accumulation buffer of jittered passes and the largest light's shadow
     /// maps).
     pub buffer_bytes: usize,
+}
+
+/// The stages a frame's time is told by ([`FrameStats`]).
+#[derive(Debug, Clone, Copy)]
+enum Stage {
+    Visibility,
+    Shading,
+    Traced,
+    Edges,
+}
+
+impl FrameStats {
+    /// Runs `work`, adding the time it takes to `stage`'s.
+    fn timed<T>(&mut self, stage: Stage, work: impl FnOnce() -> T) -> T {
+        let start = Instant::now();
+        let out = work();
+        self.add(stage, start.elapsed());
+        out
+    }
+
+    /// Adds `time` to `stage`'s milliseconds.
+    fn add(&mut self, stage: Stage, time: Duration) {
+        let ms = time.as_secs_f64() * 1e3;
+        match stage {
+            Stage::Visibility => self.visibility_ms += ms,
+            Stage::Shading => self.shading_ms += ms,
+            Stage::Traced => self.traced_ms += ms,
+            Stage::Edges => self.edge_ms += ms,
+        }
+    }
+
+    /// Counts a pass's shading: its shadow maps' time moves from the
+    /// shading's to their own.
+    fn add_lit(&mut self, lit: &PassStats) {
+        self.shading_ms -= lit.shadow_ms;
+        self.shadow_ms += lit.shadow_ms;
+        self.shadow_maps_reused += lit.maps_reused;
+        self.shadow_bytes = self.shadow_bytes.max(lit.shadow_bytes);
+        self.shading_passes += lit.passes;
+    }
 }
 
 /// A rendered frame and the buffer it was shaded from.
@@ -109,20 +161,25 @@ pub struct Renderer {
 struct Scratch {
     /// Sum of the jittered passes.
     accum: LinearImage,
-    /// One jittered pass's components (when AOVs are requested).
+    /// One pass's components (when AOVs are requested), in `Frame::aovs`' order.
     aovs: Vec<LinearImage>,
     /// Shadow-map buffers, reused from light to light and frame to frame.
     maps: MapPool,
     /// The BVH of the traced term, rebuilt only when the geometry changes.
     trace: TraceCache,
-    /// The meshes' edges for the edge pass (seed 004), kept while the meshes live.
-    edges: EdgeCache,
+    /// The edge pass (seed 004), with the meshes' edges kept while they live.
+    edges: EdgePass,
     /// The edge pass's sub-pixel samples and what the passes added there.
     subpixel: SubpixelShading,
 }
 
 impl Renderer {
     /// A renderer with empty buffers.
+    ///
+    /// # Errors
+    ///
+    /// [`Error::Threads`] when `options.threads` is more than [`MAX_THREADS`]
+    /// or the threads cannot be started.
     pub fn new(options: &RenderOptions) -> Result<Renderer> {
         let pool = thread_pool(options.threads)?;
         let frame = Frame {
@@ -135,6 +192,10 @@ impl Renderer {
     }
 
     /// Renders `scene` (validated first) and returns the frame.
+    ///
+    /// # Errors
+    ///
+    /// What [`Scene::validate`] finds wrong with the scene.
     pub fn render(&mut self, scene: &Scene) -> Result<&Frame> {
         scene.validate()?;
         let (frame, scratch) = (&mut self.frame, &mut self.scratch);
@@ -153,21 +214,30 @@ impl Renderer {
     }
 }
 
-/// A pool of `threads` workers (`None`: rayon's global pool, one per core);
-/// refuses more than [`MAX_THREADS`].
+/// A pool of `threads` workers (`None`: rayon's global pool, one per core).
+///
+/// # Errors
+///
+/// [`Error::Threads`] for more than [`MAX_THREADS`] threads, or when the
+/// system cannot start them.
 pub fn thread_pool(threads: Option<usize>) -> Result<Option<rayon::ThreadPool>> {
     let Some(n) = threads else { return Ok(None) };
+    let refused = |reason: String| Error::Threads { requested: n, reason };
     if n > MAX_THREADS {
-        return Err(Error::Scene(format!("{n} threads requested; at most {MAX_THREADS}")));
+        return Err(refused(format!("at most {MAX_THREADS} can be used")));
     }
     rayon::ThreadPoolBuilder::new()
         .num_threads(n.max(1))
         .build()
         .map(Some)
-        .map_err(|e| Error::Scene(format!("cannot start {n} threads: {e}")))
+        .map_err(|e| refused(format!("the system could not start them: {e}")))
 }
 
 /// Renders `scene` once.
+///
+/// # Errors
+///
+/// As [`Renderer::new`] and [`Renderer::render`].
 pub fn render(scene: &Scene, options: &RenderOptions) -> Result<Frame> {
     let mut r = Renderer::new(options)?;
     r.render(scene)?;
@@ -175,56 +245,21 @@ pub fn render(scene: &Scene, options: &RenderOptions) -> Result<Frame> {
 }
 
 fn render_into(scene: &Scene, frame: &mut Frame, scratch: &mut Scratch, options: &RenderOptions) {
-    let offsets = scene.antialias.offsets();
     frame.stats = FrameStats::default();
-    let (w, h) = (scene.width, scene.height);
-    // The component images are kept from frame to frame, like every other buffer.
-    let components: Vec<Component> = options.aovs.iter().collect();
-    frame.aovs.resize_with(components.len(), || (Component::Ambient, LinearImage::default()));
-    for ((slot, image), &c) in frame.aovs.iter_mut().zip(&components) {
-        *slot = c;
-        image.resize(w, h);
+    if !options.keep_shadow_maps {
+        scratch.maps.forget();
     }
-    scratch.aovs.resize_with(frame.aovs.len(), LinearImage::default);
-    scratch.aovs.iter_mut().for_each(|a| a.resize(w, h));
+    fit_component_images(scene, options.aovs, frame, scratch);
+    let offsets = scene.antialias.offsets();
     if offsets.len() == 1 && offsets[0] == Vec2::ZERO {
-        let edge = match scene.antialias {
+        let edges = match scene.antialias {
             Antialias::Edge(mode) => Some(EdgeOptions { mode, ..EdgeOptions::default() }),
             _ => None,
         };
-        render_pass(scene, frame, scratch, options.ray_depth, edge.as_ref());
-        if edge.is_some() && scene.objects.iter().any(|o| o.solid().is_some()) {
-            // Solids' outlines are curves no mesh edge bounds: measured by rays.
-            let t = Instant::now();
-            let mut images: Vec<&mut LinearImage> =
-                std::iter::once(&mut frame.image).chain(&mut scratch.aovs).collect();
-            let blends = solid_edges::find_outline_blends(scene, &frame.visibility, scratch.trace.get(scene));
-            images.iter_mut().for_each(|image| solid_edges::apply_outline_blends(image, &blends));
-            frame.stats.edge_blends += blends.len();
-            frame.stats.edge_ms += t.elapsed().as_secs_f64() * 1e3;
-        }
+        render_pass(scene, frame, scratch, options.ray_depth, edges.as_ref());
         frame.aovs.iter_mut().zip(&mut scratch.aovs).for_each(|((_, a), s)| std::mem::swap(a, s));
     } else {
-        // Seed 002 §4: each pass shifts the image by a fraction of a pixel, so its
-        // item buffer samples another point of every pixel; the passes are averaged.
-        scratch.accum.resize(w, h);
-        scratch.accum.pixels_mut().fill(Vec3::ZERO);
-        frame.aovs.iter_mut().for_each(|(_, a)| a.pixels_mut().fill(Vec3::ZERO));
-        let mut pass = scene.clone();
-        // Directional lights' maps are fitted to the unshifted view: the
-        // passes share them (and the next frame may reuse them).
-        scratch.maps.fit_to(Some(scene.camera));
-        let pixel = 2.0 / Vec2::new(w as f32, h as f32);
-        let k = 1.0 / offsets.len() as f32;
-        for &o in &offsets {
-            // Pixel offsets (y down) to NDC (y up).
-            pass.camera.shift = scene.camera.shift + Vec2::new(o.x, -o.y) * pixel;
-            render_pass(&pass, frame, scratch, options.ray_depth, None);
-            add_scaled(&mut scratch.accum, &frame.image, k);
-            frame.aovs.iter_mut().zip(&scratch.aovs).for_each(|((_, a), s)| add_scaled(a, s, k));
-        }
-        scratch.maps.fit_to(None);
-        std::mem::swap(&mut frame.image, &mut scratch.accum);
+        render_jittered(scene, &offsets, frame, scratch, options.ray_depth);
     }
     frame.stats.buffer_bytes = frame.visibility.memory_bytes()
         + std::mem::size_of_val(frame.image.pixels())
@@ -233,100 +268,143 @@ fn render_into(scene: &Scene, frame: &mut Frame, scratch: &mut Scratch, options:
         + scratch.maps.memory_bytes();
 }
 
-/// `acc += k · img`.
-fn add_scaled(acc: &mut LinearImage, img: &LinearImage, k: f32) {
-    acc.pixels_mut().par_iter_mut().zip(img.pixels().par_iter()).for_each(|(a, &p)| *a += p * k);
+/// Makes the frame's component images (and one pass's, in `scratch`) the
+/// components `wanted` names, at the scene's size; the images are kept from
+/// frame to frame, like every other buffer.
+fn fit_component_images(scene: &Scene, wanted: ComponentSet, frame: &mut Frame, scratch: &mut Scratch) {
+    let (w, h) = (scene.width, scene.height);
+    let components: Vec<Component> = wanted.iter().collect();
+    frame.aovs.resize_with(components.len(), || (Component::Ambient, LinearImage::default()));
+    for ((slot, image), &c) in frame.aovs.iter_mut().zip(&components) {
+        *slot = c;
+        image.resize(w, h);
+    }
+    scratch.aovs.resize_with(frame.aovs.len(), LinearImage::default);
+    scratch.aovs.iter_mut().for_each(|a| a.resize(w, h));
 }
 
-/// One visibility pass, its shading and its traced term into `frame.image`, and
-/// the components `frame.aovs` names into `scratch.aovs` (same order), with
-/// seed 004's edge pass if `edge` says so; adds its timings to the frame's
-/// statistics.
-fn render_pass(scene: &Scene, frame: &mut Frame, scratch: &mut Scratch, ray_depth: u32, edge: Option<&EdgeOptions>) {
-    let Scratch { aovs, maps, trace, edges: edge_cache, subpixel, .. } = scratch;
-    let t0 = Instant::now();
-    frame.visibility.resize(scene.width, scene.height);
-    frame.stats.raster = visibility::rasterize(scene, &mut frame.visibility);
-    let t1 = Instant::now();
-    frame.image.resize(scene.width, scene.height);
-    let mut targets = vec![Target { parts: ComponentSet::ALL, image: &mut frame.image }];
-    let mut traced_aov = None;
-    for ((c, _), image) in frame.aovs.iter().zip(aovs.iter_mut()) {
-        if *c == Component::Traced {
-            traced_aov = Some(image);
-        } else {
-            targets.push(Target { parts: ComponentSet::only(*c), image });
-        }
+/// Seed 002 §4's accumulation buffer: one pass per sub-pixel `offsets`, each
+/// shifting the image so its item buffer samples another point of every
+/// pixel, averaged into the frame's image and component images.
+fn render_jittered(scene: &Scene, offsets: &[Vec2], frame: &mut Frame, scratch: &mut Scratch, ray_depth: u32) {
+    scratch.accum.resize(scene.width, scene.height);
+    scratch.accum.pixels_mut().fill(Vec3::ZERO);
+    frame.aovs.iter_mut().for_each(|(_, a)| a.pixels_mut().fill(Vec3::ZERO));
+    // Directional lights' maps are fitted to the unshifted view: the passes
+    // share them (and the next frame may reuse them).
+    scratch.maps.fit_to(Some(scene.camera));
+    let weight = 1.0 / offsets.len() as f32;
+    let mut pass = scene.clone();
+    for &offset in offsets {
+        pass.camera = jitter::shifted(&scene.camera, offset, (scene.width, scene.height));
+        render_pass(&pass, frame, scratch, ray_depth, None);
+        jitter::accumulate(&mut scratch.accum, &frame.image, weight);
+        frame.aovs.iter_mut().zip(&scratch.aovs).for_each(|((_, a), s)| jitter::accumulate(a, s, weight));
     }
-    let vb = &frame.visibility;
-    // The edges are found while the first pass shades the pixels (they need
-    // only the visibility buffer), so every pass shades the sub-pixel points
-    // the crossed pixels' parts need.
-    let (mut plan, mut planned) = (None, Duration::ZERO);
-    let prepare = |subpixel: &mut SubpixelShading| {
-        let t = Instant::now();
-        plan = edge.map(|o| edges::plan(scene, vb, o, edge_cache));
-        let samples = plan.as_ref().map_or_else(Vec::new, |p| p.samples(scene.width));
-        subpixel.reset(scene, vb, samples);
-        planned = t.elapsed();
+    scratch.maps.fit_to(None);
+    std::mem::swap(&mut frame.image, &mut scratch.accum);
+}
+
+/// One visibility pass and everything shaded from it into `frame.image`, and
+/// the components `frame.aovs` names into `scratch.aovs` (same order), with
+/// the edge pass if `edges` asks for one; adds its timings to the frame's
+/// statistics.
+fn render_pass(scene: &Scene, frame: &mut Frame, scratch: &mut Scratch, ray_depth: u32, edges: Option<&EdgeOptions>) {
+    let Frame { image, visibility, aovs, stats } = frame;
+    let Scratch { aovs: component_images, maps, trace, edges: edge_pass, subpixel, .. } = scratch;
+    visibility.resize(scene.width, scene.height);
+    stats.raster = stats.timed(Stage::Visibility, || visibility::rasterize(scene, visibility));
+    let vb = &*visibility;
+    image.resize(scene.width, scene.height);
+    let mut images = PassImages::new(image, aovs, component_images);
+    let targets = &mut images.targets;
+    let beside = |s: &mut SubpixelShading| {
+        let start = Instant::now();
+        edge_pass.plan(scene, vb, edges, s);
+        start.elapsed()
     };
-    let lit = shading::shade_lit_while(scene, vb, (&mut targets, maps), subpixel, prepare);
-    let t2 = Instant::now();
+    let (lit, planned) = stats.timed(Stage::Shading, || shade(scene, vb, targets, maps, subpixel, beside));
+    stats.add_lit(&lit);
+    stats.add(Stage::Edges, planned);
     let builds = trace.builds();
-    frame.stats.traced_pixels += match &mut traced_aov {
-        None => traced::add_traced(scene, vb, targets[0].image, ray_depth, trace),
-        Some(t) => {
-            t.pixels_mut().fill(Vec3::ZERO);
-            let n = traced::add_traced(scene, vb, t, ray_depth, trace);
-            add_scaled(targets[0].image, t, 1.0);
+    stats.traced_pixels +=
+        stats.timed(Stage::Traced, || traced_term(scene, vb, &mut images, subpixel, ray_depth, trace));
+    let targets = &mut images.targets;
+    stats.bvh_built |= trace.builds() > builds;
+    // Translucent surfaces are drawn last, over everything opaque (seed 002 §3.4).
+    let layers = visibility::fragments(scene, vb);
+    let nothing_over = scene.fog.is_none() && layers.is_empty();
+    stats.timed(Stage::Edges, || edge_pass.record(targets, subpixel, nothing_over));
+    let fog = stats.timed(Stage::Shading, || fog::fog_targets(scene, vb, targets));
+    stats.translucent_fragments +=
+        stats.timed(Stage::Shading, || translucency::composite(scene, layers, targets, maps));
+    stats.timed(Stage::Edges, || edge_pass.apply(scene, vb, targets, fog.as_deref(), trace));
+    stats.edge_blends = edge_pass.blends();
+    stats.passes += 1;
+}
+
+/// The shading passes ([`shading::shade_lit_beside`]) with `beside` run beside
+/// the first; returns their statistics and what `beside` returned.
+fn shade<T: Send>(
+    scene: &Scene,
+    vb: &VisibilityBuffer,
+    targets: &mut [Target],
+    maps: &mut MapPool,
+    subpixel: &mut SubpixelShading,
+    beside: impl FnOnce(&mut SubpixelShading) -> T + Send,
+) -> (PassStats, T) {
+    let mut out = None;
+    let lit = shading::shade_lit_beside(scene, vb, targets, maps, subpixel, |s| out = Some(beside(s)));
+    (lit, out.expect("the passes run what goes beside them"))
+}
+
+/// The images one pass writes.
+struct PassImages<'a> {
+    /// The frame's image (every component) first, then the image of each
+    /// requested component.
+    targets: Vec<Target<'a>>,
+    /// The traced component's image, when it is requested: written by the
+    /// traced term alone, it joins `targets` then.
+    traced: Option<&'a mut LinearImage>,
+}
+
+impl<'a> PassImages<'a> {
+    /// `image` and the `components`' own `images` (same order).
+    fn new(image: &'a mut LinearImage, components: &[(Component, LinearImage)], images: &'a mut [LinearImage]) -> Self {
+        let mut targets = vec![Target { parts: ComponentSet::ALL, image }];
+        let mut traced = None;
+        for ((c, _), image) in components.iter().zip(images) {
+            match c {
+                Component::Traced => traced = Some(image),
+                c => targets.push(Target { parts: ComponentSet::only(*c), image }),
+            }
+        }
+        PassImages { targets, traced }
+    }
+}
+
+/// Seed 002 §4's traced term, at the pixels (into the frame's image, through
+/// the traced component's own image when it is requested, which then joins the
+/// targets) and at the edge pass's sub-pixel samples; returns the pixels
+/// traced.
+fn traced_term(
+    scene: &Scene,
+    vb: &VisibilityBuffer,
+    images: &mut PassImages,
+    subpixel: &mut SubpixelShading,
+    ray_depth: u32,
+    trace: &mut TraceCache,
+) -> usize {
+    let pixels = match images.traced.take() {
+        None => traced::add_traced(scene, vb, images.targets[0].image, ray_depth, trace),
+        Some(own) => {
+            own.pixels_mut().fill(Vec3::ZERO);
+            let n = traced::add_traced(scene, vb, own, ray_depth, trace);
+            jitter::accumulate(images.targets[0].image, own, 1.0);
+            images.targets.push(Target { parts: ComponentSet::only(Component::Traced), image: own });
             n
         }
     };
     traced::trace_subpixel(scene, subpixel, ray_depth, trace);
-    let t3 = Instant::now();
-    frame.stats.bvh_built |= trace.builds() > builds;
-    targets.extend(traced_aov.map(|image| Target { parts: ComponentSet::only(Component::Traced), image }));
-    // Translucent surfaces are drawn last, over everything opaque (seed 002 §3.4).
-    let layers = visibility::fragments(scene, vb);
-    // Where nothing is drawn over the passes' image, each part of a crossed
-    // pixel is coloured as the pixel is blended.
-    let fused = scene.fog.is_none() && layers.is_empty();
-    let t = Instant::now();
-    match &mut plan {
-        Some(plan) if fused => plan.record_and_apply(&mut targets, subpixel),
-        Some(plan) => plan.record(&targets, subpixel),
-        None => {}
-    }
-    let mut edge_time = t.elapsed();
-    let fogged = scene.fog.as_ref().map(|fog| {
-        let amounts = fog::fog_amounts(scene, fog, vb);
-        for t in &mut targets {
-            let color = if t.parts.contains(Component::Fog) { fog.color } else { Vec3::ZERO };
-            fog::apply(t.image, &amounts, color);
-        }
-        amounts
-    });
-    if !layers.is_empty() {
-        let lights = shading::frame_lights(scene);
-        frame.stats.translucent_fragments +=
-            translucency::composite(scene, layers, scene.translucency, &lights, &mut targets, maps);
-    }
-    if let Some(plan) = &plan {
-        let t = Instant::now();
-        if !fused {
-            targets.iter_mut().for_each(|t| plan.apply(t.image, t.parts, fogged.as_deref()));
-        }
-        edge_time += t.elapsed();
-        frame.stats.edge_blends = plan.len();
-        frame.stats.edge_ms = (planned + edge_time).as_secs_f64() * 1e3;
-    }
-    frame.stats.visibility_ms += (t1 - t0).as_secs_f64() * 1e3;
-    // The edge pass's plan ran beside the first pass, within this time.
-    frame.stats.shading_ms += ((t2 - t1) + t3.elapsed()).as_secs_f64() * 1e3 - lit.shadow_ms;
-    frame.stats.shadow_ms += lit.shadow_ms;
-    frame.stats.shadow_maps_reused += lit.maps_reused;
-    frame.stats.shadow_bytes = frame.stats.shadow_bytes.max(lit.shadow_bytes);
-    frame.stats.shading_passes += lit.passes;
-    frame.stats.traced_ms += (t3 - t2).as_secs_f64() * 1e3;
-    frame.stats.passes += 1;
+    pixels
 }

@@ -168,6 +168,28 @@ fn the_cli_exits_non_zero_with_a_located_report() {
 }
 
 #[test]
+fn a_csg_node_kage_cannot_render_is_reported_at_its_line() {
+    let dir = scratch("csg-node");
+    let model =
+        write(&dir, "extrude.csg", "group() {\n\tlinear_extrude(height = 2) {\n\t\tsquare(size = 1);\n\t}\n}\n");
+    let (ok, err) = kage(&["render", model.to_str().unwrap(), "-o", dir.join("x.png").to_str().unwrap()]);
+    assert!(!ok && err.contains("extrude.csg:2:2") && err.contains("is not a node kage renders"), "{err}");
+    // The report shows the offending line of the file, the node marked.
+    assert!(err.contains("linear_extrude(height = 2)") && err.contains("here"), "{err}");
+}
+
+#[test]
+fn an_impossible_thread_count_is_refused_as_such_not_as_a_bad_scene() {
+    for threads in [kage::frame::MAX_THREADS + 1, usize::MAX] {
+        let options = RenderOptions { threads: Some(threads), ..RenderOptions::default() };
+        let e = kage::Renderer::new(&options).expect_err("refused");
+        assert!(matches!(e, Error::Threads { requested, .. } if requested == threads), "{e:?}");
+        let message = e.to_string();
+        assert!(message.contains("threads requested") && !message.contains("invalid scene"), "{message}");
+    }
+}
+
+#[test]
 fn an_empty_view_is_warned_about_not_silent() {
     let dir = scratch("empty-view");
     let scene =

@@ -15,9 +15,24 @@
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
+use super::{Component, Target};
 use crate::image::LinearImage;
 use crate::scene::{Fog, Scene};
 use crate::visibility::VisibilityBuffer;
+
+/// Fogs every target by the scene's fog, the paper's way: each image scaled
+/// by `1 − f(d)`, and the fog colour times `f(d)` added to the image that
+/// holds the fog component. Returns each pixel's fog amount (`None`, and
+/// nothing changed, without fog).
+pub fn fog_targets(scene: &Scene, vb: &VisibilityBuffer, targets: &mut [Target]) -> Option<Vec<f32>> {
+    let fog = scene.fog.as_ref()?;
+    let amounts = fog_amounts(scene, fog, vb);
+    for t in targets {
+        let color = if t.parts.contains(Component::Fog) { fog.color } else { Vec3::ZERO };
+        apply(t.image, &amounts, color);
+    }
+    Some(amounts)
+}
 
 /// Per pixel, the fog amount f(d) of the surface it sees (0 where it sees nothing).
 #[must_use]

@@ -26,7 +26,7 @@ use crate::shadows::ShadowTerm;
 use crate::visibility::{ItemId, VisibilityBuffer};
 
 pub use lanes::{Blend, Lighting};
-pub use passes::{frame_lights, shade_lit, shade_lit_while, FrameLight, PassStats, Target};
+pub use passes::{frame_lights, shade_lit, shade_lit_beside, FrameLight, PassStats, Target};
 pub use phong::{Component, ComponentSet, Components};
 pub use subpixel::{SubpixelSample, SubpixelShading};
 pub use surface::{ObjectFrames, PreparedTriangle, SurfacePoint};

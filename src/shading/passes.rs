@@ -114,20 +114,21 @@ pub fn shade_lit(
     pool: &mut MapPool,
     subpixel: &mut SubpixelShading,
 ) -> PassStats {
-    shade_lit_while(scene, vb, (targets, pool), subpixel, |_| {})
+    shade_lit_beside(scene, vb, targets, pool, subpixel, |_| {})
 }
 
-/// [`shade_lit`] with the sub-pixel samples set up by `prepare` while the
+/// [`shade_lit`] with the sub-pixel samples set up by `beside` while the
 /// first pass shades the pixels: work that needs only the visibility buffer
 /// (the edge pass's plan) fills the gaps the pixels' shading leaves on the
 /// workers, instead of running before it. The samples get every pass, the
-/// first included (shaded beside the pixels too, once `prepare` is done).
-pub fn shade_lit_while(
+/// first included (shaded beside the pixels too, once `beside` is done).
+pub fn shade_lit_beside(
     scene: &Scene,
     vb: &VisibilityBuffer,
-    (targets, pool): (&mut [Target], &mut MapPool),
+    targets: &mut [Target],
+    pool: &mut MapPool,
     subpixel: &mut SubpixelShading,
-    prepare: impl FnOnce(&mut SubpixelShading) + Send,
+    beside: impl FnOnce(&mut SubpixelShading) + Send,
 ) -> PassStats {
     let mut stats = PassStats::default();
     pool.begin_frame(scene);
@@ -148,7 +149,7 @@ pub fn shade_lit_while(
     let direct = fused.iter().map(|(l, t)| (&l.light, t.as_slice())).collect();
     let ambient = lights.iter().map(|l| &l.light).filter(|l| l.only.is_none());
     let first = Lighting::pass(ambient, direct, true);
-    run(scene, vb, (targets, &mut *subpixel), (&first, Blend::Replace, None), prepare);
+    run(scene, vb, (targets, &mut *subpixel), (&first, Blend::Replace, None), beside);
     stats.passes = 1;
     // The fused terms stay for the next frame (within the same budget).
     for (light, terms) in fused {

@@ -22,7 +22,7 @@ use rayon::prelude::*;
 
 use super::phong::{self, Coefficients, Components};
 use super::reflection_map::reflection_map;
-use super::{Component, FrameLight, ObjectFrames, SurfacePoint, Target};
+use super::{frame_lights, Component, FrameLight, ObjectFrames, SurfacePoint, Target};
 use crate::scene::{Scene, TranslucencyOrder};
 use crate::shadows::{MapPool, ShadowTerm};
 use crate::visibility::Fragment;
@@ -38,21 +38,15 @@ struct Layer {
     lit: Components,
 }
 
-/// Blends `fragments` (in front of the opaque surfaces) into every target, lit by
-/// `lights` (the frame's). Returns how many fragments were blended.
-pub fn composite(
-    scene: &Scene,
-    mut fragments: Vec<Fragment>,
-    order: TranslucencyOrder,
-    lights: &[FrameLight],
-    targets: &mut [Target],
-    pool: &mut MapPool,
-) -> usize {
+/// Blends `fragments` (in front of the opaque surfaces) into every target, in
+/// the scene's [`TranslucencyOrder`], lit by the frame's lights (their shadow
+/// maps taken from `pool`). Returns how many fragments were blended.
+pub fn composite(scene: &Scene, mut fragments: Vec<Fragment>, targets: &mut [Target], pool: &mut MapPool) -> usize {
     if fragments.is_empty() {
         return 0;
     }
     // Nearest first within each pixel: by depth, or the last drawn first.
-    match order {
+    match scene.translucency {
         TranslucencyOrder::Sorted => {
             fragments.par_sort_by(|a, b| a.pixel.cmp(&b.pixel).then(b.depth.total_cmp(&a.depth)))
         }
@@ -70,7 +64,7 @@ pub fn composite(
     }
     let mut layers = prepare(scene, &fragments, &weights, w, h);
     let bounds = scene.bounds().unwrap_or_default();
-    for FrameLight { light, samples } in lights {
+    for FrameLight { light, samples } in &frame_lights(scene) {
         let terms: Vec<ShadowTerm> = samples.iter().map(|s| ShadowTerm::build_within(scene, s, bounds, pool)).collect();
         layers.par_iter_mut().filter(|l| light.only.as_ref().is_none_or(|o| o.contains(&l.object))).for_each(|l| {
             let s = &l.surface;

@@ -242,6 +242,13 @@ impl MapKey {
 }
 
 impl MapPool {
+    /// Forgets every kept term (their buffers stay, for reuse): the next
+    /// frame renders every map again.
+    pub fn forget(&mut self) {
+        let kept: Vec<_> = self.kept.drain(..).chain(self.previous.drain(..)).collect();
+        kept.into_iter().for_each(|(_, term)| self.recycle(term));
+    }
+
     /// Starts a frame of `scene`: last frame's terms become reusable, unless
     /// the geometry changed ([`GeometryKey`]: an object's body, transform or
     /// whether it casts shadows), which drops them all.

@@ -232,7 +232,10 @@ fn render_command(args: &RenderArgs) -> kage::error::Result<()> {
         return reference_command(args, &scene);
     }
     let aovs = args.aov.unwrap_or(ComponentSet::EMPTY);
-    let frame = render(&scene, &RenderOptions { threads: args.threads, ray_depth: args.ray_depth, aovs })?;
+    let frame = render(
+        &scene,
+        &RenderOptions { threads: args.threads, ray_depth: args.ray_depth, aovs, ..RenderOptions::default() },
+    )?;
     let exposure = args.exposure.unwrap_or(scene.exposure).scale(&frame.image);
     kage::output::write_image(&frame.image, &args.output, exposure)?;
     for (c, image) in &frame.aovs {

@@ -9,7 +9,8 @@ pub fn to_report(e: Error) -> Report {
     let located = match &e {
         Error::SceneSyntax { location, message }
         | Error::SceneInvalid { location, message }
-        | Error::CsgSyntax { location, message } => Some((location.clone(), message.clone())),
+        | Error::CsgSyntax { location, message }
+        | Error::CsgInvalid { location, message } => Some((location.clone(), message.clone())),
         _ => None,
     };
     match located {

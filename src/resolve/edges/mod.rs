@@ -30,7 +30,7 @@
 //!   right behind the silhouette, and a grazing surface's shading changes fast
 //!   within one pixel. So the blends are found from the visibility buffer alone
 //!   ([`plan`], while the first pass shades the pixels:
-//!   [`crate::shading::shade_lit_while`]), and a part's colour is its pixel's
+//!   [`EdgePass::plan`]), and a part's colour is its pixel's
 //!   moved by how the shading changes from the pixel's centre to the part's
 //!   centroid: shaded there by the passes themselves
 //!   (parts beyond edges, and own parts on curved surfaces), or stepped along the
@@ -85,10 +85,101 @@ pub use mesh_edges::{EdgeCache, MeshEdges};
 pub use parts::{EdgePlan, RESHADED_SHARE};
 pub use solid_outlines::{apply_outline_blends, find_outline_blends, OutlineBlend};
 
+use crate::raytrace::TraceCache;
 use crate::scene::{EdgeFilter, EdgeMode, Object, Scene};
+use crate::shading::{SubpixelShading, Target};
 use crate::visibility::{ItemId, VisibilityBuffer};
 use screen::ClipMap;
 use walk::{find_blends, merge};
+
+/// The edge pass as one stage of the frame, kept from frame to frame (the
+/// meshes' edges are found once per mesh). Its steps, at their places in the
+/// frame:
+///
+/// 1. [`EdgePass::plan`], beside the first shading pass: the blends, found
+///    from the visibility buffer alone, and the sub-pixel points the passes
+///    shade for the parts' colours;
+/// 2. [`EdgePass::record`], after the traced term: how far each part's colour
+///    moves from its pixel's, as the passes left the images (and the blends
+///    applied at once when nothing is drawn over the frame later);
+/// 3. [`EdgePass::apply`], after fog and translucency: the crossed pixels
+///    blended, then the solids' outlines, measured by rays.
+///
+/// A jittered frame has no edge pass: its passes sample every pixel at as many
+/// points, outlines and all (the scene asks for one or the other,
+/// [`crate::scene::Antialias`]).
+#[derive(Debug, Default)]
+pub struct EdgePass {
+    cache: EdgeCache,
+    /// This frame's plan (`None`: no edge pass).
+    plan: Option<EdgePlan>,
+    /// Whether the plan's blends are in the images already.
+    applied: bool,
+    /// Pixels blended this frame.
+    blends: usize,
+}
+
+impl EdgePass {
+    /// Step 1: plans the pass over the frame whose visibility buffer is `vb`
+    /// (nothing when `options` is `None`), and sets `subpixel` to the samples
+    /// the plan needs shaded.
+    pub fn plan(
+        &mut self,
+        scene: &Scene,
+        vb: &VisibilityBuffer,
+        options: Option<&EdgeOptions>,
+        subpixel: &mut SubpixelShading,
+    ) {
+        self.plan = options.map(|o| plan(scene, vb, o, &mut self.cache));
+        (self.applied, self.blends) = (false, self.plan.as_ref().map_or(0, EdgePlan::len));
+        let samples = self.plan.as_ref().map_or_else(Vec::new, |p| p.samples(vb.width()));
+        subpixel.reset(scene, vb, samples);
+    }
+
+    /// Step 2: records the parts' colours from `targets` as the shading
+    /// passes and the traced term left them, and `subpixel`'s samples, shaded;
+    /// when `nothing_over` (no fog, no translucent surface to come) the
+    /// blends go into the images at once.
+    pub fn record(&mut self, targets: &mut [Target], subpixel: &SubpixelShading, nothing_over: bool) {
+        let Some(plan) = &mut self.plan else { return };
+        if nothing_over {
+            plan.record_and_apply(targets, subpixel);
+            self.applied = true;
+        } else {
+            plan.record(targets, subpixel);
+        }
+    }
+
+    /// Step 3: blends the crossed pixels of every target (each part's move
+    /// fogged as its pixel is, by `fog`), then the pixels on solids'
+    /// outlines, measured by rays through the scene's BVH (from `trace`).
+    pub fn apply(
+        &mut self,
+        scene: &Scene,
+        vb: &VisibilityBuffer,
+        targets: &mut [Target],
+        fog: Option<&[f32]>,
+        trace: &mut TraceCache,
+    ) {
+        let Some(plan) = &self.plan else { return };
+        if !self.applied {
+            targets.iter_mut().for_each(|t| plan.apply(t.image, t.parts, fog));
+            self.applied = true;
+        }
+        if scene.objects.iter().any(|o| o.solid().is_some()) {
+            // Solids' outlines are curves no mesh edge bounds: measured by rays.
+            let blends = find_outline_blends(scene, vb, trace.get(scene));
+            targets.iter_mut().for_each(|t| apply_outline_blends(t.image, &blends));
+            self.blends += blends.len();
+        }
+    }
+
+    /// The pixels this frame's pass blended (0 without one).
+    #[must_use]
+    pub fn blends(&self) -> usize {
+        self.blends
+    }
+}
 
 /// How the edge pass runs.
 #[derive(Debug, Clone, Copy, PartialEq)]
