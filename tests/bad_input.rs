@@ -2,7 +2,6 @@
 //! for missing files — and never a panic or a silent black image.
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 use kage::scene::file::{load_scene, scene_for_model, SceneFile};
 use kage::scene::load::FileSystem;
@@ -134,50 +133,6 @@ fn absurd_image_sizes_are_refused_before_allocating() {
     }
 }
 
-fn kage(args: &[&str]) -> (bool, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_kage")).args(args).output().unwrap();
-    (out.status.success(), String::from_utf8_lossy(&out.stderr).into_owned())
-}
-
-#[test]
-fn the_cli_exits_non_zero_with_a_located_report() {
-    let dir = scratch("cli");
-    let scene = write(&dir, "broken.toml", "[[object]]\nshape = \"cube\"\nmaterial = \"gold\"\n");
-    let (ok, err) = kage(&["render", scene.to_str().unwrap(), "-o", dir.join("x.png").to_str().unwrap()]);
-    assert!(!ok);
-    assert!(err.contains("broken.toml:3:12") && err.contains("no material named 'gold'"), "{err}");
-    let (ok, err) =
-        kage(&["render", "--width", "100000", "--height", "100000", "-o", dir.join("y.png").to_str().unwrap()]);
-    assert!(!ok && err.contains("invalid image size 100000x100000"), "{err}");
-    let (ok, err) = kage(&["render", "-o", dir.join("z.bmp").to_str().unwrap()]);
-    assert!(!ok && err.contains("unknown image format '.bmp'"), "{err}");
-    let (ok, err) = kage(&["render", "--antialias", "edge:most", "-o", dir.join("e.png").to_str().unwrap()]);
-    assert!(!ok && err.contains("'edge:most' is not an antialiasing method"), "{err}");
-    let (ok, err) = kage(&[
-        "render",
-        "--width",
-        "96",
-        "--height",
-        "54",
-        "--antialias",
-        "edge",
-        "-o",
-        dir.join("e.png").to_str().unwrap(),
-    ]);
-    assert!(ok && err.contains("edge pass (seed 004)"), "{err}");
-}
-
-#[test]
-fn a_csg_node_kage_cannot_render_is_reported_at_its_line() {
-    let dir = scratch("csg-node");
-    let model =
-        write(&dir, "extrude.csg", "group() {\n\tlinear_extrude(height = 2) {\n\t\tsquare(size = 1);\n\t}\n}\n");
-    let (ok, err) = kage(&["render", model.to_str().unwrap(), "-o", dir.join("x.png").to_str().unwrap()]);
-    assert!(!ok && err.contains("extrude.csg:2:2") && err.contains("is not a node kage renders"), "{err}");
-    // The report shows the offending line of the file, the node marked.
-    assert!(err.contains("linear_extrude(height = 2)") && err.contains("here"), "{err}");
-}
-
 #[test]
 fn an_impossible_thread_count_is_refused_as_such_not_as_a_bad_scene() {
     for threads in [kage::frame::MAX_THREADS + 1, usize::MAX] {
@@ -187,44 +142,4 @@ fn an_impossible_thread_count_is_refused_as_such_not_as_a_bad_scene() {
         let message = e.to_string();
         assert!(message.contains("threads requested") && !message.contains("invalid scene"), "{message}");
     }
-}
-
-#[test]
-fn an_empty_view_is_warned_about_not_silent() {
-    let dir = scratch("empty-view");
-    let scene =
-        write(&dir, "away.toml", "[camera]\neye = [0, 0, 5]\ntarget = [0, 0, 10]\n[[object]]\nshape = \"cube\"\n");
-    let (ok, err) = kage(&["render", scene.to_str().unwrap(), "-o", dir.join("a.png").to_str().unwrap()]);
-    assert!(ok, "{err}");
-    assert!(err.contains("no object is in view"), "{err}");
-}
-
-#[test]
-fn too_many_threads_is_an_error_not_a_hang() {
-    let out = scratch("threads").join("t.png");
-    let (ok, err) = kage(&["render", "--threads", "1000000", "-o", out.to_str().unwrap()]);
-    assert!(!ok && err.contains("threads requested"), "{err}");
-}
-
-#[test]
-fn compare_reports_metrics_and_refuses_mismatched_sizes() {
-    let dir = scratch("compare");
-    let (a, b, c) = (dir.join("a.pfm"), dir.join("b.pfm"), dir.join("c.pfm"));
-    for (p, w) in [(&a, "64"), (&b, "64"), (&c, "32")] {
-        let (ok, err) = kage(&["render", "--width", w, "--height", "32", "-o", p.to_str().unwrap()]);
-        assert!(ok, "{err}");
-    }
-    let out = Command::new(env!("CARGO_BIN_EXE_kage"))
-        .args(["compare", a.to_str().unwrap(), b.to_str().unwrap()])
-        .output()
-        .unwrap();
-    let text = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success() && text.contains("rmse        0.000000") && text.contains("psnr        inf dB"),
-        "{text}"
-    );
-    let (ok, err) = kage(&["compare", a.to_str().unwrap(), c.to_str().unwrap()]);
-    assert!(!ok && err.contains("differ in size: 64x32 vs 32x32"), "{err}");
-    let (ok, err) = kage(&["compare", a.to_str().unwrap(), dir.join("missing.pfm").to_str().unwrap()]);
-    assert!(!ok && err.contains("missing.pfm"), "{err}");
 }

@@ -6,7 +6,6 @@
 //! but the per-primitive interval routine.
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 use glam::Vec2;
 use kage::raytrace::reference::{render_reference, ReferenceOptions};
@@ -185,49 +184,6 @@ fn a_solid_casts_shadows_where_shadow_rays_find_it() {
     assert!(both > floor / 20, "the solid and the block must shade the floor ({both} of {floor} floor pixels)");
     // Shadow-map texels and the bias move the boundary by a pixel or so.
     assert!(both * 100 >= either * 90, "shadow masks: {both} agree of {either} shadowed by either");
-}
-
-fn kage(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_kage")).args(args).output().unwrap()
-}
-
-/// `kage render model.csg` renders it lit and shadowed from its camera
-/// sidecar, exact or faceted; an unsupported node stops it with file, line and
-/// column unless told to skip it.
-#[test]
-fn the_cli_renders_openscad_files() {
-    let dir = std::env::temp_dir().join(format!("kage-csg-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let model = data().join("ex004_cube_minus_sphere.csg");
-    for geometry in ["exact", "faceted"] {
-        let out = dir.join(format!("{geometry}.png"));
-        let o = kage(&[
-            "render",
-            model.to_str().unwrap(),
-            "--geometry",
-            geometry,
-            "--width",
-            "160",
-            "--height",
-            "120",
-            "-o",
-            out.to_str().unwrap(),
-        ]);
-        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-        let img = image::open(&out).unwrap().to_rgb8();
-        // The cube sits in the middle of the sidecar's view in OpenSCAD's yellow.
-        let [r, g, b] = img.get_pixel(80, 60).0;
-        assert!(r > 120 && g > 100 && b < r / 2, "centre pixel {r},{g},{b} is not yellow");
-    }
-    let bad = dir.join("bad.csg");
-    std::fs::write(&bad, "group() {\n  cube(size = [1, 1, 1], center = false);\n  linear_extrude(height = 2, center = false) {\n    square(size = [1, 1], center = false);\n  }\n}\n").unwrap();
-    let o = kage(&["render", bad.to_str().unwrap(), "-o", dir.join("bad.png").to_str().unwrap()]);
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert!(!o.status.success() && err.contains("linear_extrude") && err.contains("bad.csg:3:3"), "{err}");
-    let o = kage(&["render", bad.to_str().unwrap(), "--skip-unsupported", "-o", dir.join("bad.png").to_str().unwrap()]);
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert!(o.status.success() && err.contains("warning") && err.contains("linear_extrude"), "{err}");
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// A scene file's `.csg` object reads exact quadrics by default and OpenSCAD's

@@ -212,6 +212,27 @@ pub fn check_image_size(width: u64, height: u64) -> Result<()> {
 }
 
 impl Scene {
+    /// An empty `width` × `height` scene seen by `camera`: no objects, lights
+    /// or materials yet, a dark background, every setting at its default.
+    #[must_use]
+    pub fn new(width: u32, height: u32, camera: Camera) -> Scene {
+        Scene {
+            width,
+            height,
+            background: Vec3::new(0.1, 0.1, 0.15),
+            exposure: Exposure::default(),
+            antialias: Antialias::default(),
+            fog: None,
+            environment: None,
+            translucency: TranslucencyOrder::default(),
+            camera,
+            lights: Vec::new(),
+            materials: Vec::new(),
+            objects: Vec::new(),
+            warnings: Vec::new(),
+        }
+    }
+
     /// Checks everything a render relies on: image size, camera, materials referenced.
     pub fn validate(&self) -> Result<()> {
         check_image_size(self.width as u64, self.height as u64)?;

@@ -12,7 +12,17 @@ use kage::visibility::VisibilityBuffer;
 use kage::{RenderOptions, Renderer, Scene};
 use miette::{miette, Result};
 
-use crate::bench::BenchArgs;
+use crate::{repository, Common};
+
+/// Options of `kage-bench aa`.
+#[derive(clap::Args, Debug)]
+pub struct AaArgs {
+    #[command(flatten)]
+    common: Common,
+    /// Also write side-by-side crops (aliased | edge pass | truth) here.
+    #[arg(long)]
+    crops: Option<std::path::PathBuf>,
+}
 
 fn edge(selection: EdgeSelection, filter: EdgeFilter) -> Antialias {
     Antialias::Edge(EdgeMode { selection, filter })
@@ -23,14 +33,14 @@ const TRUTH_PASSES: u32 = 256;
 
 /// The scenes measured: every example scene that has silhouettes to speak of, and
 /// two models from `../shared/assets` when that folder is there.
-fn scenes(args: &BenchArgs) -> Result<Vec<(String, Scene)>> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenes");
+fn scenes(args: &Common) -> Result<Vec<(String, Scene)>> {
+    let dir = repository().join("examples/scenes");
     let mut out = Vec::new();
     for name in ["demo", "spotlights", "cad-ortho", "showroom", "reflections"] {
         let scene = kage::scene::file::load_scene(&dir.join(format!("{name}.toml"))).map_err(|e| miette!("{e}"))?;
         out.push((format!("{name}.toml"), scene));
     }
-    let assets = args.peers.join("../assets");
+    let assets = args.assets();
     for model in ["meshes/stanford-bunny/stanford-bunny.obj", "gltf/CesiumMilkTruck/CesiumMilkTruck.glb"] {
         let path = assets.join(model);
         if path.exists() {
@@ -48,7 +58,8 @@ fn scenes(args: &BenchArgs) -> Result<Vec<(String, Scene)>> {
 }
 
 /// Runs the table.
-pub fn run(args: &BenchArgs) -> Result<()> {
+pub fn run(aa: &AaArgs) -> Result<()> {
+    let args = &aa.common;
     println!(
         "| scene | method | ms/frame | of which edge pass | x aliased | edge-pixel RMSE | share of aliased removed | \
          same, 3 x 3 mask | image RMSE |"
@@ -85,7 +96,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                 edged = Some(image);
             }
         }
-        if let (Some(dir), Some(edged)) = (&args.crops, edged) {
+        if let (Some(dir), Some(edged)) = (&aa.crops, edged) {
             write_crop(dir, &label, [&aliased, &edged, &truth], &mask, scene.width)?;
         }
     }

@@ -1,11 +1,8 @@
-//! `kage`: render scenes and models, and benchmark the renderer.
+//! `kage`: render scenes, models and OpenSCAD files; compare images.
 //!
 //! Library errors arrive typed; this binary turns them into reports that point at
 //! the offending line of a scene file.
 
-mod bench;
-mod bench_aa;
-mod bench_csg;
 mod report;
 
 use std::path::{Path, PathBuf};
@@ -29,8 +26,6 @@ enum Command {
     /// Render a scene file (.toml) or a model (.obj, .stl, .gltf, .glb, or an
     /// OpenSCAD .csg); with no input, the built-in demo scene.
     Render(RenderArgs),
-    /// Time frames at 1920x1080 on the peers' procedural scenes and print a table.
-    Bench(bench::BenchArgs),
     /// Measure image A against reference B: RMSE, PSNR, max error, share over a
     /// threshold, mask disagreement; optionally write a false-colour difference.
     Compare(CompareArgs),
@@ -196,7 +191,6 @@ fn main() -> miette::Result<()> {
     miette::set_hook(Box::new(|_| Box::new(miette::MietteHandlerOpts::new().wrap_lines(false).build())))?;
     match cli.command {
         Command::Render(args) => render_command(&args).map_err(report::to_report),
-        Command::Bench(args) => bench::run(&args),
         Command::Compare(args) => compare_command(&args).map_err(report::to_report),
     }
 }

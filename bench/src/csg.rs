@@ -19,12 +19,50 @@ use kage::visibility::solids::{CsgMethod, PreparedSolid};
 use miette::{miette, Result};
 use rayon::prelude::*;
 
-use crate::bench::BenchArgs;
+use crate::{median, Common};
+
+/// Which corpus models a CSG table takes.
+#[derive(clap::Args, Debug)]
+pub struct Models {
+    /// Only these corpus models (comma-separated names; default all).
+    #[arg(long)]
+    models: Option<String>,
+}
+
+/// Options of `kage-bench csg`.
+#[derive(clap::Args, Debug)]
+pub struct CsgArgs {
+    #[command(flatten)]
+    common: Common,
+    #[command(flatten)]
+    models: Models,
+}
+
+/// Options of `kage-bench csg-random`.
+#[derive(clap::Args, Debug)]
+pub struct RandomArgs {
+    #[command(flatten)]
+    common: Common,
+}
+
+/// Options of `kage-bench csg-preview`.
+#[derive(clap::Args, Debug)]
+pub struct PreviewArgs {
+    #[command(flatten)]
+    common: Common,
+    #[command(flatten)]
+    models: Models,
+    /// The `kage` command timed to its first image (default: the one built
+    /// beside this program, `cargo build --release` makes both).
+    #[arg(long)]
+    kage: Option<PathBuf>,
+}
 
 /// Runs the table.
-pub fn run(args: &BenchArgs) -> Result<()> {
-    let dir = args.peers.join("../assets/csg");
-    let files = corpus(&dir, args)?;
+pub fn run(csg: &CsgArgs) -> Result<()> {
+    let args = &csg.common;
+    let dir = args.assets().join("csg");
+    let files = corpus(&dir, &csg.models)?;
     let (w, h) = (args.width, args.height);
     println!(
         "| model | primitives | scanline ms | covered pixels | naive rays ms | ratio | BVH rays ms | ratio | \
@@ -82,7 +120,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
 }
 
 /// The corpus's `.csg` files (those `--models` names, if given), sorted.
-fn corpus(dir: &Path, args: &BenchArgs) -> Result<Vec<PathBuf>> {
+fn corpus(dir: &Path, models: &Models) -> Result<Vec<PathBuf>> {
     let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
         .map_err(|e| miette!("cannot read {}: {e}", dir.display()))?
         .flatten()
@@ -90,7 +128,7 @@ fn corpus(dir: &Path, args: &BenchArgs) -> Result<Vec<PathBuf>> {
         .filter(|p| p.extension().is_some_and(|e| e == "csg"))
         .filter(|p| {
             let name = p.file_stem().and_then(|s| s.to_str()).unwrap_or_default();
-            args.models.as_ref().is_none_or(|m| m.split(',').any(|k| k.trim() == name))
+            models.models.as_ref().is_none_or(|m| m.split(',').any(|k| k.trim() == name))
         })
         .collect();
     files.sort();
@@ -131,12 +169,6 @@ fn scan_times(
     scan(&mut out);
     let times = (0..frames).map(|_| timed(|| scan(&mut out)).0).collect();
     (times, out.pixels().iter().filter(|p| p.is_some()).count())
-}
-
-/// The median of `v` (0 when empty).
-fn median(v: &mut [f64]) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v.get(v.len() / 2).copied().unwrap_or(0.0)
 }
 
 /// Milliseconds `f` takes, and what it returns.
@@ -207,7 +239,8 @@ fn random_spheres(seed: u64, segments: usize, per: usize) -> CsgSolid {
 /// The paper's Tables 1 (random spheres) and 2 (120 spheres in fewer, larger
 /// segments): scanline and naive ray casting, at the paper's 160x100 and at
 /// 1920x1080.
-pub fn run_random(args: &BenchArgs) -> Result<()> {
+pub fn run_random(args: &RandomArgs) -> Result<()> {
+    let args = &args.common;
     let camera = Camera {
         eye: glam::Vec3::new(0.0, 0.0, 9.0),
         target: glam::Vec3::ZERO,
@@ -269,10 +302,17 @@ fn openscad_preview_seconds(peers: &Path) -> std::collections::HashMap<String, f
 /// Time to image of `kage render NAME.csg` (a fresh process, 640x480, median of
 /// three) beside OpenSCAD's preview, and frames per second of a viewer whose
 /// camera orbits the model, with and without shadows.
-pub fn run_preview(args: &BenchArgs) -> Result<()> {
-    let dir = args.peers.join("../assets/csg");
-    let openscad = openscad_preview_seconds(&args.peers);
-    let exe = std::env::current_exe().map_err(|e| miette!("{e}"))?;
+pub fn run_preview(preview: &PreviewArgs) -> Result<()> {
+    let args = &preview.common;
+    let dir = args.assets().join("csg");
+    let openscad = openscad_preview_seconds(&args.peers());
+    let exe = match &preview.kage {
+        Some(exe) => exe.clone(),
+        None => std::env::current_exe().map_err(|e| miette!("{e}"))?.with_file_name("kage"),
+    };
+    if !exe.exists() {
+        return Err(miette!("{} is not built: `cargo build --release` builds it beside kage-bench", exe.display()));
+    }
     let out = std::env::temp_dir().join(format!("kage-bench-{}.png", std::process::id()));
     let (w, h) = (args.width, args.height);
     println!(
@@ -280,7 +320,7 @@ pub fn run_preview(args: &BenchArgs) -> Result<()> {
     );
     println!("|---|---:|---:|---:|---:|---:|");
     let (mut ratios, mut fps_shadowed, mut fps_plain_all) = (Vec::new(), Vec::new(), Vec::new());
-    for path in corpus(&dir, args)? {
+    for path in corpus(&dir, &preview.models)? {
         let name = path.file_stem().and_then(|s| s.to_str()).unwrap_or_default().to_string();
         let mut runs: Vec<f64> = (0..3)
             .map(|_| {

@@ -1,0 +1,114 @@
+//! `kage-bench`: kage beside other engines on the same jobs, each table printed
+//! as Markdown (what `docs/benchmarks.md` holds, with the command that made it).
+//!
+//! The peers are the programs in `../shared/peers` (Mesa llvmpipe and Embree,
+//! built into `target/peers/` by `scripts/build-peers.sh`; OpenSCAD's measured
+//! preview times), and the models those of `../shared/assets`; a peer that is
+//! not built leaves its columns empty. Per-stage timings that need no peer are
+//! criterion benchmarks: `cargo bench -p kage-bench`.
+
+mod aa;
+mod csg;
+mod raster;
+mod rays;
+
+use std::path::PathBuf;
+
+use clap::{Parser, Subcommand};
+
+/// kage's benchmarks beside other engines, as Markdown tables.
+#[derive(Parser)]
+#[command(name = "kage-bench", version, about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Milliseconds per frame on the peers' procedural meshes, split into
+    /// visibility, shadow maps and shading, beside Mesa llvmpipe (unshadowed,
+    /// and with a 2048² shadow map rendered every frame, as llvmpipe does).
+    Raster(raster::RasterArgs),
+    /// Milliseconds per frame as the lights grow (1, 4, 16, 100 spot lights),
+    /// with and without shadow maps.
+    Lights(raster::LightsArgs),
+    /// BVH build time and primary-ray throughput beside Embree.
+    Rays(rays::RaysArgs),
+    /// Seed 002 §4's hybrid (item buffer + traced secondary rays) beside the
+    /// same image traced entirely by rays.
+    Hybrid(rays::HybridArgs),
+    /// Antialiasing: the edge pass (seed 004) and jittered passes against a
+    /// 256-pass supersampled truth.
+    Aa(aa::AaArgs),
+    /// CSG solids (seed 003): the scanline walk's visible surfaces beside a ray
+    /// per pixel cast at every primitive (the paper's baseline) and BVH rays,
+    /// on the OpenSCAD corpus.
+    Csg(csg::CsgArgs),
+    /// The CSG paper's Tables 1 and 2 on random spheres, scanline beside naive
+    /// ray casting.
+    CsgRandom(csg::RandomArgs),
+    /// Time to image of `kage render NAME.csg` beside OpenSCAD's preview, and
+    /// frames per second when only the camera moves.
+    CsgPreview(csg::PreviewArgs),
+}
+
+/// What every table takes.
+#[derive(clap::Args, Debug, Clone)]
+pub struct Common {
+    /// Timed frames per row (the median is reported).
+    #[arg(long, default_value_t = 10)]
+    pub frames: usize,
+    /// Image width.
+    #[arg(long, default_value_t = 1920)]
+    pub width: u32,
+    /// Image height.
+    #[arg(long, default_value_t = 1080)]
+    pub height: u32,
+    /// The shared folder: `peers/` (the other engines' programs and notes) and
+    /// `assets/` (the corpus of models); default `../shared` beside the
+    /// repository, or `$KAGE_SHARED`.
+    #[arg(long, env = "KAGE_SHARED", default_value_os_t = default_shared())]
+    pub shared: PathBuf,
+}
+
+impl Common {
+    /// The peers' folder.
+    pub fn peers(&self) -> PathBuf {
+        self.shared.join("peers")
+    }
+
+    /// The corpus of models.
+    pub fn assets(&self) -> PathBuf {
+        self.shared.join("assets")
+    }
+}
+
+/// `../shared` beside the repository this crate is built from.
+fn default_shared() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared")
+}
+
+/// The repository's own files (example scenes), whatever the working folder.
+pub fn repository() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+/// The median of `v` (0 when empty).
+pub fn median(v: &mut [f64]) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v.get(v.len() / 2).copied().unwrap_or(0.0)
+}
+
+fn main() -> miette::Result<()> {
+    match Cli::parse().command {
+        Command::Raster(args) => raster::run(&args),
+        Command::Lights(args) => raster::run_lights(&args),
+        Command::Rays(args) => rays::run(&args),
+        Command::Hybrid(args) => rays::run_hybrid(&args),
+        Command::Aa(args) => aa::run(&args),
+        Command::Csg(args) => csg::run(&args),
+        Command::CsgRandom(args) => csg::run_random(&args),
+        Command::CsgPreview(args) => csg::run_preview(&args),
+    }
+}

@@ -1,0 +1,254 @@
+//! `kage-bench rays`: the BVH (binned SAH) beside Embree — build time and
+//! primary-ray throughput on the peers' meshes. `kage-bench hybrid`: seed 002
+//! §4's item-buffer hybrid beside the same image traced entirely by rays.
+
+use std::path::Path;
+use std::process::Command;
+
+use kage::image::LinearImage;
+use kage::raytrace::tracer::{ShadowRay, Tracer};
+use kage::raytrace::TraceScene;
+use kage::scene::Scene;
+use kage::shading::ObjectFrames;
+use kage::{FrameStats, RenderOptions, Renderer};
+use miette::{miette, IntoDiagnostic, Result};
+use rayon::prelude::*;
+
+use crate::raster::{peer_scene_for_rays, Meshes};
+use crate::{median, repository, Common};
+
+/// Options of `kage-bench rays`.
+#[derive(clap::Args, Debug)]
+pub struct RaysArgs {
+    #[command(flatten)]
+    common: Common,
+    #[command(flatten)]
+    meshes: Meshes,
+    /// The Embree peer program (`scripts/build-peers.sh` builds it); its
+    /// columns stay empty if it is absent.
+    #[arg(long, default_value = "target/peers/embree_bench")]
+    embree: std::path::PathBuf,
+    /// Alternating rounds of kage and Embree; the best round of each is reported.
+    #[arg(long, default_value_t = 5)]
+    rounds: usize,
+}
+
+/// Options of `kage-bench hybrid`.
+#[derive(clap::Args, Debug)]
+pub struct HybridArgs {
+    #[command(flatten)]
+    common: Common,
+}
+
+/// One row of the ray benchmark: (build ms, Mrays/s) for kage and Embree.
+struct RayRow {
+    name: String,
+    triangles: usize,
+    build_ms: f64,
+    mrays: f64,
+    peer: Option<(f64, f64)>,
+}
+
+/// Runs the ray table and prints it.
+pub fn run(args: &RaysArgs) -> Result<()> {
+    let common = &args.common;
+    let mut rows = Vec::new();
+    for name in args.meshes.scenes.split(',').map(str::trim) {
+        let (mesh, scene) = peer_scene_for_rays(common, &args.meshes, name)?;
+        let mut best: Option<RayRow> = None;
+        for _ in 0..args.rounds.max(1) {
+            let (build_ms, mrays) = time_rays(&scene, common.frames);
+            let peer = args.embree.exists().then(|| run_embree(&args.embree, &mesh, common)).transpose()?;
+            let row = RayRow { name: name.to_string(), triangles: scene.triangle_count(), build_ms, mrays, peer };
+            best = Some(match best {
+                None => row,
+                Some(b) => RayRow {
+                    build_ms: b.build_ms.min(row.build_ms),
+                    mrays: b.mrays.max(row.mrays),
+                    peer: match (b.peer, row.peer) {
+                        (Some(p), Some(q)) => Some((p.0.min(q.0), p.1.max(q.1))),
+                        (p, q) => p.or(q),
+                    },
+                    ..row
+                },
+            });
+        }
+        rows.push(best.expect("one round"));
+        eprintln!("{name}: done");
+    }
+    println!("| scene | triangles | kage build ms | Embree build ms | build ratio | kage Mrays/s | Embree Mrays/s | rate ratio |");
+    println!("|---|---:|---:|---:|---:|---:|---:|---:|");
+    for r in &rows {
+        let (pb, pr, bratio, rratio) = match r.peer {
+            Some((b, m)) => {
+                (format!("{b:.1}"), format!("{m:.2}"), format!("{:.2}", r.build_ms / b), format!("{:.2}", r.mrays / m))
+            }
+            None => ("not built".into(), "not built".into(), "n/a".into(), "n/a".into()),
+        };
+        println!(
+            "| {} | {} | {:.1} | {pb} | {bratio} | {:.2} | {pr} | {rratio} |",
+            r.name, r.triangles, r.build_ms, r.mrays
+        );
+    }
+    println!(
+        "\n{}x{} primary rays (one per pixel centre, nearest hit, no shading), median of {} frames; build median of 5; best of {} rounds; {} threads.",
+        common.width,
+        common.height,
+        common.frames,
+        args.rounds.max(1),
+        rayon::current_num_threads()
+    );
+    Ok(())
+}
+
+/// Median BVH build time (ms) and primary-ray throughput (Mrays/s).
+fn time_rays(scene: &Scene, frames: usize) -> (f64, f64) {
+    let mut builds = Vec::new();
+    let mut trace = TraceScene::new(scene);
+    for _ in 0..5 {
+        let t = std::time::Instant::now();
+        trace = TraceScene::new(scene);
+        builds.push(t.elapsed().as_secs_f64() * 1e3);
+    }
+    let rays = scene.camera.pixel_rays(glam::Vec2::new(scene.width as f32, scene.height as f32));
+    let (w, h) = (scene.width, scene.height);
+    let mut times = Vec::new();
+    for _ in 0..frames.max(1) + 1 {
+        let t = std::time::Instant::now();
+        let hits: usize = (0..h)
+            .into_par_iter()
+            .map(|y| {
+                (0..w)
+                    .filter(|&x| {
+                        let ray = rays.ray(glam::Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
+                        trace.intersect(&ray, f32::INFINITY).is_some()
+                    })
+                    .count()
+            })
+            .sum();
+        std::hint::black_box(hits);
+        times.push(t.elapsed().as_secs_f64());
+    }
+    times.remove(0); // warm-up
+    (median(&mut builds), (w * h) as f64 / median(&mut times) / 1e6)
+}
+
+/// Runs Embree's primary-ray benchmark (rtcIntersect1, no shading) on the same mesh.
+fn run_embree(bin: &Path, mesh: &Path, common: &Common) -> Result<(f64, f64)> {
+    let out = Command::new(bin)
+        .args(["-t", "2", "-n", "-m", "primary", "-a", "1", "-f", &common.frames.to_string()])
+        .args(["-w", &common.width.to_string(), "-h", &common.height.to_string()])
+        .arg(mesh)
+        .output()
+        .into_diagnostic()?;
+    let text = String::from_utf8_lossy(&out.stdout);
+    let field = |line: &str, key: &str| -> Option<f64> {
+        line.split_whitespace().find_map(|w| w.strip_prefix(key)).and_then(|v| v.parse().ok())
+    };
+    let build = text.lines().find(|l| l.contains("what=build")).and_then(|l| field(l, "median_ms="));
+    let rate = text.lines().find(|l| l.contains("mode=primary")).and_then(|l| field(l, "mrays_s="));
+    match (build, rate) {
+        (Some(b), Some(r)) => Ok((b, r)),
+        _ => Err(miette!("Embree printed no build/primary results: {text}{}", String::from_utf8_lossy(&out.stderr))),
+    }
+}
+
+/// Item-buffer hybrid vs full ray tracing of the same image (two ray levels).
+pub fn run_hybrid(args: &HybridArgs) -> Result<()> {
+    let args = &args.common;
+    let load = |name: &str| {
+        let path = repository().join("examples/scenes").join(name);
+        let mut scene = kage::scene::file::load_scene(&path).map_err(|e| miette!("{e}"))?;
+        (scene.width, scene.height) = (args.width, args.height);
+        Ok::<Scene, miette::Report>(scene)
+    };
+    let showroom = load("showroom.toml")?;
+    let mut balls = load("reflections.toml")?;
+    // A matte floor leaves the curved chrome and glass balls as the only reflecting
+    // and refracting pixels.
+    balls.materials.iter_mut().filter(|m| m.name == "floor").for_each(|m| m.kr = glam::Vec3::ZERO);
+    let mut closer = balls.clone();
+    let cam = &mut closer.camera;
+    cam.eye = cam.target + (cam.eye - cam.target) * 0.8; // the balls fill about a fifth
+    println!(
+        "| scene | triangles | pixels traced | hybrid ms/frame | of which visibility / shadow maps / shading / traced | full trace ms/frame | speed-up | BVH build ms (once) | RMSE between them | pixels over 0.01 |"
+    );
+    println!("|---|---:|---:|---:|---|---:|---:|---:|---:|---:|");
+    let rows = [
+        ("showroom.toml (polished stage, chrome ball)", &showroom),
+        ("reflections.toml, matte floor (chrome and glass balls)", &balls),
+        ("the same, eye at 0.8x", &closer),
+    ];
+    for (label, scene) in rows {
+        hybrid_row(args, scene, label)?;
+    }
+    println!(
+        "\nTwo ray levels (primary + one bounce); primary shadows from shadow maps (hybrid) or shadow rays (full trace); \
+         shadow rays at the surfaces secondary rays reach in both; one BVH, built before timing; median of {} frames; {} threads.",
+        args.frames.max(1),
+        rayon::current_num_threads()
+    );
+    Ok(())
+}
+
+/// One row of the hybrid table: the item-buffer frame and the fully traced image of
+/// `scene`, timed alternately.
+fn hybrid_row(args: &Common, scene: &Scene, label: &str) -> Result<()> {
+    // "Traced up to the second ray" (seed 002 §4): primary + one bounce.
+    let depth = 1;
+    let mut renderer =
+        Renderer::new(&RenderOptions { ray_depth: depth, ..RenderOptions::default() }).map_err(|e| miette!("{e}"))?;
+    let (mut hybrid, mut full) = (Vec::new(), Vec::new());
+    let mut parts = Vec::new();
+    let mut full_image = None;
+    // Both sides trace through one BVH, built once (an interactive preview keeps it
+    // while only the view changes); the build is reported on its own.
+    let t = std::time::Instant::now();
+    let trace = TraceScene::new(scene);
+    let build_ms = t.elapsed().as_secs_f64() * 1e3;
+    renderer.render(scene).map_err(|e| miette!("{e}"))?; // builds the renderer's copy
+    for _ in 0..args.frames.max(1) {
+        let t = std::time::Instant::now();
+        parts.push(renderer.render(scene).map_err(|e| miette!("{e}"))?.stats);
+        hybrid.push(t.elapsed().as_secs_f64() * 1e3);
+        let t = std::time::Instant::now();
+        full_image = Some(trace_everything(scene, &trace, depth));
+        full.push(t.elapsed().as_secs_f64() * 1e3);
+    }
+    let frame = renderer.into_frame();
+    let c = kage::compare::compare(&frame.image, &full_image.expect("one frame"), 0.01).map_err(|e| miette!("{e}"))?;
+    let (h, f) = (median(&mut hybrid), median(&mut full));
+    let traced = parts.last().map_or(0, |s| s.traced_pixels);
+    let share = 100.0 * traced as f64 / (scene.width as f64 * scene.height as f64);
+    let part = |get: fn(&FrameStats) -> f64| median(&mut parts.iter().map(get).collect::<Vec<_>>());
+    println!(
+        "| {label} {}x{} | {} | {share:.1}% | {h:.1} | {:.0} / {:.0} / {:.0} / {:.0} | {f:.1} | {:.2}x | {build_ms:.1} | {:.5} | {:.3}% |",
+        scene.width,
+        scene.height,
+        trace.len(),
+        part(|s| s.visibility_ms),
+        part(|s| s.shadow_ms),
+        part(|s| s.shading_ms),
+        part(|s| s.traced_ms),
+        f / h,
+        c.rmse,
+        100.0 * c.share_over
+    );
+    Ok(())
+}
+
+/// The hybrid's image computed entirely by rays, as a plain ray tracer would:
+/// primary hits from the BVH, shadow rays at them (where the hybrid reads shadow
+/// maps), the same bounces.
+fn trace_everything(scene: &Scene, trace: &TraceScene, depth: u32) -> LinearImage {
+    let frames = ObjectFrames::new(scene);
+    let tracer = Tracer::new(scene, trace, &frames, ShadowRay);
+    let rays = scene.camera.pixel_rays(glam::Vec2::new(scene.width as f32, scene.height as f32));
+    let mut image = LinearImage::new(scene.width, scene.height);
+    image.pixels_mut().par_chunks_mut(scene.width as usize).enumerate().for_each(|(y, row)| {
+        for (x, px) in row.iter_mut().enumerate() {
+            *px = tracer.radiance(&rays.ray(glam::Vec2::new(x as f32 + 0.5, y as f32 + 0.5)), depth);
+        }
+    });
+    image
+}
