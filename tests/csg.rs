@@ -515,7 +515,7 @@ fn a_crowded_union_walked_as_a_z_buffer_finds_what_the_booleans_find() {
 /// viewer keeps it while the camera moves.
 #[test]
 fn a_frame_scanned_again_holds_only_the_last_scan() {
-    use kage::visibility::solids::surface_frame::SurfaceFrame;
+    use kage::visibility::solids::SurfaceFrame;
     use kage::visibility::solids::{scan_solid_with, CsgMethod, PreparedSolid};
     let mut rng = StdRng::seed_from_u64(29);
     let mut frame = SurfaceFrame::new();

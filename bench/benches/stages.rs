@@ -93,7 +93,7 @@ fn csg_walk(c: &mut Criterion) {
     let object = scene.objects.iter().find(|o| o.solid().is_some()).expect("a solid");
     let solid = object.solid().expect("a solid").transformed(&object.transform);
     let prepared = solids::PreparedSolid::new(&solid, solids::CsgMethod::Segments).expect("no expansion");
-    let mut out = solids::surface_frame::SurfaceFrame::new();
+    let mut out = solids::SurfaceFrame::new();
     c.bench_function("csg walk/ex001 at 1280x720", |b| {
         b.iter(|| prepared.scan_into(&scene.camera, (scene.width, scene.height), black_box(&mut out)))
     });

@@ -14,7 +14,7 @@ use kage::camera::{Camera, Ray};
 use kage::csg::openscad::{load_csg, CsgOptions, Geometry};
 use kage::csg::{Crossing, CsgCaster, CsgSolid};
 use kage::visibility::solids::paper::pattern::PatternMatrix;
-use kage::visibility::solids::surface_frame::SurfaceFrame;
+use kage::visibility::solids::SurfaceFrame;
 use kage::visibility::solids::{CsgMethod, PreparedSolid};
 use miette::{miette, Result};
 use rayon::prelude::*;

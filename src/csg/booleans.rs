@@ -93,7 +93,7 @@ pub struct Parts<B, I> {
 
 /// A tree of booleans the span combiner ([`combine`]) walks: a [`CsgTree`], or
 /// a view of one that leaves out what cannot matter at a pixel
-/// ([`crate::csg::occupancy`]).
+/// (`csg/occupancy.rs`).
 pub trait Booleans: Copy {
     /// The node's operation and operands.
     fn parts(self) -> Parts<Self, impl Iterator<Item = Self> + Clone>;

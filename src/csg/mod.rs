@@ -16,7 +16,7 @@
 //! normals), `lanes` (the same, eight pixels of a scanline at once), `faces`
 //! (which of a many-planed polyhedron's faces a block of pixels can cross),
 //! `booleans` (intervals combined along the tree; coplanar cuts decided by
-//! [`TIE`]), [`occupancy`] (seed 003's reference counts, kept at every node of
+//! [`TIE`]), `occupancy.rs` (seed 003's reference counts, kept at every node of
 //! the tree), `outline` (where a primitive shows on the screen: procedures 1
 //! and 2), the caster, and [`openscad`] (OpenSCAD `.csg` files read into a
 //! solid). A new kind of primitive is a new [`Shape`] and its arms in these
@@ -28,7 +28,7 @@ mod faces;
 mod hit;
 mod lanes;
 mod model;
-pub mod occupancy;
+pub(crate) mod occupancy;
 pub mod openscad;
 pub(crate) mod outline;
 mod shapes;

@@ -93,12 +93,6 @@ impl OccupancyTree {
         self.nodes.len()
     }
 
-    /// Whether the tree has no nodes (never: a tree has a root).
-    #[must_use]
-    pub fn is_empty(&self) -> bool {
-        self.nodes.is_empty()
-    }
-
     /// Whether the tree is one primitive or a union of primitives: the
     /// booleans then read each occupant once, on its own, and nothing cuts,
     /// clips or merges.
@@ -302,6 +296,7 @@ pub struct Occupied {
 
 impl Occupied {
     /// Counts for `tree` with no primitive present.
+    #[cfg(test)]
     #[must_use]
     pub fn new(tree: &OccupancyTree) -> Occupied {
         let mut counts = Occupied::default();
@@ -414,6 +409,7 @@ impl Occupied {
     }
 
     /// Whether `tree` is non-empty here.
+    #[cfg(test)]
     #[must_use]
     pub fn is_full(&self, tree: &OccupancyTree) -> bool {
         self.full[tree.root as usize]

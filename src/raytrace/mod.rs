@@ -10,7 +10,7 @@
 //! included; [`traced`] is the raster frame's traced term, [`mod@reference`] the
 //! ray-traced oracle, both on top of it.
 
-pub mod cache;
+mod cache;
 pub mod reference;
 pub mod traced;
 pub mod tracer;

@@ -2,20 +2,20 @@
 //! visible pixel's surface is reconstructed from its item id and lit by eq. 1, and
 //! the passes are summed in a linear float accumulation buffer (eq. 4).
 //!
-//! [`passes`] decides which lights share a pass ([`shade_lit`] runs a frame's);
-//! [`shade_pass`] runs one, eight pixels at a time ([`lanes`]); [`phong`] is the
-//! scalar statement of eq. 1 the lanes are tested against; [`reflection_map`],
-//! [`fog`] and [`translucency`] are the once-per-frame passes of §3.4, §3.5 and
+//! `passes.rs` decides which lights share a pass ([`shade_lit`] runs a frame's);
+//! [`shade_pass`] runs one, eight pixels at a time (`lanes.rs`); `phong.rs` is the
+//! scalar statement of eq. 1 the lanes are tested against; `reflection_map.rs`,
+//! `fog.rs` and `translucency.rs` are the once-per-frame passes of §3.4, §3.5 and
 //! eq. 4's Ie.
 
-pub mod fog;
-pub mod lanes;
-pub mod passes;
-pub mod phong;
-pub mod reflection_map;
-pub mod subpixel;
-pub mod surface;
-pub mod translucency;
+pub(crate) mod fog;
+pub(crate) mod lanes;
+pub(crate) mod passes;
+pub(crate) mod phong;
+pub(crate) mod reflection_map;
+pub(crate) mod subpixel;
+pub(crate) mod surface;
+pub(crate) mod translucency;
 
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
@@ -57,7 +57,7 @@ impl ShadingPass<'_> {
 }
 
 /// Runs one pass over `vb` into `image` (same size), rows in parallel, eight pixels
-/// at a time ([`lanes`]).
+/// at a time (`lanes.rs`).
 pub fn shade_pass(scene: &Scene, vb: &VisibilityBuffer, image: &mut LinearImage, pass: &ShadingPass) {
     assert_eq!((image.width(), image.height()), (vb.width(), vb.height()), "image and buffer sizes");
     let w = vb.width() as usize;
@@ -178,7 +178,7 @@ impl TriangleCache {
 }
 
 /// The scalar reference of [`shade_lit`]: one pixel at a time through
-/// [`PreparedTriangle::surface`] and [`phong::add_light`], with the frame's
+/// [`PreparedTriangle::surface`] and `phong::add_light`, with the frame's
 /// lights ([`passes::frame_lights`]), each one's shadow term (the mean of its
 /// samples') and its selective-lighting list.
 pub fn shade_into_scalar(scene: &Scene, vb: &VisibilityBuffer, image: &mut LinearImage) {

@@ -219,19 +219,3 @@ pub fn phong_power(x: f32, n: f32) -> f32 {
         x.powf(n)
     }
 }
-
-/// Seed 002 eq. 1 for all lights, unshadowed.
-#[must_use]
-pub fn shade(lights: &[Light], m: &Material, s: &SurfacePoint) -> Components {
-    shade_with(lights, &Coefficients::at(m, s), s)
-}
-
-/// Seed 002 eq. 1 for all lights, unshadowed, with the coefficients already known.
-#[must_use]
-pub fn shade_with(lights: &[Light], k: &Coefficients, s: &SurfacePoint) -> Components {
-    let mut acc = Components { emission: k.ke, ..Default::default() };
-    for light in lights {
-        add_light(&mut acc, light, k, s, 1.0);
-    }
-    acc
-}

@@ -2,13 +2,13 @@
 //! light, multiplying that light's diffuse and specular components (never its
 //! ambient).
 //!
-//! This is the plain version — shadow maps ([`map`]) placed per light type:
+//! This is the plain version — shadow maps (`map.rs`) placed per light type:
 //! a spot light sees its cone through one perspective map, a point light through a
 //! cube of six 90° maps, a directional light through one orthographic map fitted to
 //! the part of the scene the camera sees. The silhouette-line buffer (seed 000) and
 //! the two-map soft shadows (seed 001) plug into the same [`ShadowTerm`].
 
-pub mod map;
+mod map;
 
 use glam::{Vec2, Vec3};
 use wide::f32x8;

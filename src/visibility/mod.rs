@@ -3,14 +3,14 @@
 //! pixel the depth and the id of the nearest item. Shading happens afterwards, once
 //! per visible pixel, by passes that read this buffer.
 //!
-//! Stages, one file each: [`clip`] (homogeneous clipping), [`scan`] (exact
-//! fixed-point DDA scan conversion, top-left rule) and [`raster`] (projection,
+//! Stages, one file each: `clip.rs` (homogeneous clipping), [`scan`] (exact
+//! fixed-point DDA scan conversion, top-left rule) and `raster.rs` (projection,
 //! binning into bands and the band-parallel z-buffer). [`solids`] finds the
 //! visible surfaces of CSG solids by seed 003's scanline walk and writes them
 //! into the same buffer, so solids and meshes hide each other.
 
-pub mod clip;
-pub mod raster;
+mod clip;
+mod raster;
 pub mod scan;
 pub mod solids;
 

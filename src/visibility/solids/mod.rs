@@ -20,7 +20,7 @@
 //! whose count is zero enters the visible-segment list. Expanding can explode
 //! (the paper names it; OpenSCAD aborts previews past 100,000 terms), so the
 //! tree is not expanded: the same counts are kept at every node of it
-//! ([`crate::csg::occupancy`]). A primitive entering or leaving the x-occupancy list
+//! (`csg/occupancy.rs`). A primitive entering or leaving the x-occupancy list
 //! updates its leaf and the few nodes above it whose emptiness changes; the
 //! root's list of non-empty operands is the visible-segment list, a
 //! difference's list of non-empty cutters is the fast path for negative
@@ -60,8 +60,10 @@ mod cut_region;
 mod horizon;
 pub mod paper;
 mod spans;
-pub mod surface_frame;
+mod surface_frame;
 mod zbuffer;
+
+pub use surface_frame::SurfaceFrame;
 
 use std::cell::{Cell, RefCell};
 
@@ -82,7 +84,7 @@ use horizon::Horizon;
 use paper::coherence::{self, PixelCoherence};
 use paper::pattern::{PatternMatrix, TooManySegments};
 use spans::{BlockSpans, PixelSpans, RowSpans};
-use surface_frame::{row_to_write, SurfaceFrame};
+use surface_frame::row_to_write;
 use zbuffer::{DepthEnds, UnionRow};
 
 /// Rows scanned by one worker in turn, each band a task of its own
