@@ -149,7 +149,8 @@ pub fn shade_lit_beside(
     let direct = fused.iter().map(|(l, t)| (&l.light, t.as_slice())).collect();
     let ambient = lights.iter().map(|l| &l.light).filter(|l| l.only.is_none());
     let first = Lighting::pass(ambient, direct, true);
-    run(scene, vb, (targets, &mut *subpixel), (&first, Blend::Replace, None), beside);
+    let first = LitPass { lighting: &first, blend: Blend::Replace, receivers: None };
+    run(scene, vb, targets, subpixel, first, beside);
     stats.passes = 1;
     // The fused terms stay for the next frame (within the same budget).
     for (light, terms) in fused {
@@ -163,7 +164,8 @@ pub fn shade_lit_beside(
         // A light that lights every object had its ambient added in the first pass.
         let ambient = light.only.is_some().then_some(light);
         let lighting = Lighting::pass(ambient, vec![(light, &terms)], false);
-        run(scene, vb, (targets, &mut *subpixel), (&lighting, Blend::Add, receivers), |_| {});
+        let pass = LitPass { lighting: &lighting, blend: Blend::Add, receivers };
+        run(scene, vb, targets, subpixel, pass, |_| {});
         stats.passes += 1;
         terms.into_iter().for_each(|t| pool.recycle(t));
     }
@@ -172,15 +174,25 @@ pub fn shade_lit_beside(
     stats
 }
 
-/// One pass (its lighting, how it writes, whom it reaches) into every target
-/// and, beside it, at every sub-pixel sample, once `prepare` has set them up.
+/// What one lit pass adds, and how: its lighting, whether it replaces or adds,
+/// and which objects receive it (`None`: all).
+struct LitPass<'a> {
+    lighting: &'a Lighting<'a>,
+    blend: Blend,
+    receivers: Option<Vec<bool>>,
+}
+
+/// One pass into every target and, beside it, at every sub-pixel sample, once
+/// `prepare` has set them up.
 fn run(
     scene: &Scene,
     vb: &VisibilityBuffer,
-    (targets, subpixel): (&mut [Target], &mut SubpixelShading),
-    (lighting, blend, receivers): (&Lighting, Blend, Option<Vec<bool>>),
+    targets: &mut [Target],
+    subpixel: &mut SubpixelShading,
+    pass: LitPass,
     prepare: impl FnOnce(&mut SubpixelShading) + Send,
 ) {
+    let LitPass { lighting, blend, receivers } = pass;
     let pixels = || {
         for t in targets {
             let lighting = lighting.restricted(t.parts);

@@ -70,16 +70,19 @@ pub struct SubpixelShading {
     pub traced: Vec<Vec3>,
 }
 
+/// What finding a sample's surface reads: the frame it lies in.
+struct SampleFrame<'a> {
+    scene: &'a Scene,
+    vb: &'a VisibilityBuffer,
+    frames: ObjectFrames,
+    rays: PixelRays,
+}
+
 impl SubpixelSample {
-    /// The surface the sample's ray meets on what its pixel shows in `vb`;
-    /// `triangles` holds the triangles earlier samples met.
-    fn surface(
-        &self,
-        (scene, vb): (&Scene, &VisibilityBuffer),
-        frames: &ObjectFrames,
-        rays: &PixelRays,
-        triangles: &mut TriangleCache,
-    ) -> Option<SampleSurface> {
+    /// The surface the sample's ray meets on what its pixel shows in the
+    /// frame; `triangles` holds the triangles earlier samples met.
+    fn surface(&self, frame: &SampleFrame, triangles: &mut TriangleCache) -> Option<SampleSurface> {
+        let SampleFrame { scene, vb, frames, rays } = frame;
         let (x, y) = self.pixel;
         let item = vb.item(x, y);
         if item.is_none() {
@@ -130,12 +133,11 @@ impl SubpixelShading {
         if n == 0 {
             return; // most frames: nothing to set up
         }
-        let frames = ObjectFrames::new(scene);
         let rays = scene.camera.pixel_rays(Vec2::new(vb.width() as f32, vb.height() as f32));
+        let frame = SampleFrame { scene, vb, frames: ObjectFrames::new(scene), rays };
         // One cache of triangles per worker: samples along an edge keep
         // meeting the same few.
-        let surface =
-            |triangles: &mut TriangleCache, s: &SubpixelSample| s.surface((scene, vb), &frames, &rays, triangles);
+        let surface = |triangles: &mut TriangleCache, s: &SubpixelSample| s.surface(&frame, triangles);
         self.samples.par_iter().map_init(|| TriangleCache::new(64), surface).collect_into_vec(&mut self.surfaces);
         let reflected = self.reflected.par_iter_mut().zip(&self.surfaces);
         reflected.for_each(|(r, s)| *r = s.as_ref().map_or(Vec3::ZERO, |s| reflection_map(scene, &s.point)));

@@ -202,7 +202,7 @@ impl Default for EdgeOptions {
 pub fn plan(scene: &Scene, vb: &VisibilityBuffer, options: &EdgeOptions, cache: &mut EdgeCache) -> EdgePlan {
     let edges = cache.edges_of(scene, options.crease_deg);
     let clips = ClipMap::of_objects(scene, vb.width(), vb.height());
-    let mut blends = find_blends(scene, vb, (&edges, &clips), options.mode);
+    let mut blends = find_blends(scene, vb, &edges, &clips, options.mode);
     if options.mode.filter == EdgeFilter::Coverage {
         // Where an edge runs between two pixels it bounds what they show; an
         // intersection is only looked for where none does.

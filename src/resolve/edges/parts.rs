@@ -193,8 +193,8 @@ impl EdgePlan {
         }
         let record = |t: &Target| {
             let moves = (0..self.moves()).into_par_iter();
-            let image = (t.image.pixels(), t.image.width() as usize);
-            moves.map(|k| self.part_move(k, image, t.parts, shaded)).collect()
+            let (px, width) = (t.image.pixels(), t.image.width() as usize);
+            moves.map(|k| self.part_move(k, px, width, t.parts, shaded)).collect()
         };
         self.moved = targets.iter().map(|t| (t.parts, record(t))).collect();
     }
@@ -221,7 +221,7 @@ impl EdgePlan {
             let (parts, width) = (t.parts, t.image.width() as usize);
             let moved = |px: &[Vec3], _, k| {
                 if reshaded {
-                    self.part_move(k, (px, width), parts, shaded)
+                    self.part_move(k, px, width, parts, shaded)
                 } else {
                     Vec3::ZERO
                 }
@@ -244,7 +244,7 @@ impl EdgePlan {
     /// How far part `k`'s colour moves from its pixel's in an image (its
     /// pixels, its width) holding the components `parts`: a shaded part's
     /// sample in `shaded` less its pixel, a stepped part by its neighbours.
-    fn part_move(&self, k: usize, (px, w): (&[Vec3], usize), parts: ComponentSet, shaded: &SubpixelShading) -> Vec3 {
+    fn part_move(&self, k: usize, px: &[Vec3], w: usize, parts: ComponentSet, shaded: &SubpixelShading) -> Vec3 {
         let sampled = |s: usize| {
             let (x, y) = shaded.samples[s].pixel;
             shaded.colour(s, parts).map_or(Vec3::ZERO, |colour| colour - px[y as usize * w + x as usize])

@@ -20,7 +20,8 @@ use crate::visibility::{ItemId, VisibilityBuffer};
 pub(super) fn find_blends(
     scene: &Scene,
     vb: &VisibilityBuffer,
-    (edges, clips): (&[Option<Arc<MeshEdges>>], &[ClipMap]),
+    edges: &[Option<Arc<MeshEdges>>],
+    clips: &[ClipMap],
     mode: EdgeMode,
 ) -> Vec<EdgeBlend> {
     let camera = &scene.camera;
@@ -74,6 +75,15 @@ struct WalkedObject<'a> {
     two_sided: bool,
 }
 
+/// The edge being walked: its object, the edge, and the welded vertices of
+/// the faces beside it (a pixel showing a triangle that touches one shows
+/// the edge's own surface).
+struct WalkedEdge<'a> {
+    object: &'a WalkedObject<'a>,
+    edge: &'a MeshEdge,
+    near: [u32; 6],
+}
+
 /// What walking an edge reads: the frame's visibility buffer and the view.
 struct Walker<'a> {
     scene: &'a Scene,
@@ -91,7 +101,7 @@ impl Walker<'_> {
         let source = (u64::from(object.index) << 32) | k as u64;
         let [a, b] = e.v.map(|i| clip.points * mesh.positions[i as usize].as_dvec3().extend(1.0));
         let Some((a, b)) = self.screen.clip_and_project(a, b) else { return };
-        let near = object.edges.neighbourhood(mesh, e);
+        let edge = WalkedEdge { object, edge: e, near: object.edges.neighbourhood(mesh, e) };
         let mut planes = LastTwo::new();
         // A column the edge crosses in two rows visits both pixels twice, each
         // as the other's neighbour.
@@ -105,7 +115,7 @@ impl Walker<'_> {
             if !ours(c) && !ours(other) {
                 return;
             }
-            let mut side = |i: usize| sides.get((i, point), || self.side((object, e), &near, &mut planes, i, point));
+            let mut side = |i: usize| sides.get((i, point), || self.side(&edge, &mut planes, i, point));
             if let Some(blend) = depth_tested(w, &mut side, c, other, alpha, self.mode.filter) {
                 out.push(EdgeBlend { source, far: far.centroid(), ..blend });
             }
@@ -113,16 +123,16 @@ impl Walker<'_> {
         walk(a, b, visit, (w, h), self.mode.filter);
     }
 
-    /// How pixel `i` relates to `edge` of `object`, whose point there is
-    /// `point` (screen x, y, depth); `near` is the edge's neighbourhood.
+    /// How pixel `i` relates to `walked`, whose point there is `point`
+    /// (screen x, y, depth).
     fn side(
         &self,
-        (object, edge): (&WalkedObject, &MeshEdge),
-        near: &[u32; 6],
+        walked: &WalkedEdge,
         planes: &mut LastTwo<ItemId, Option<DepthPlane>>,
         i: usize,
         point: DVec3,
     ) -> Side {
+        let WalkedEdge { object, edge, near } = walked;
         let item = self.vb.items()[i];
         if item.is_none() {
             return Side::Behind;

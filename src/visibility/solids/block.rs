@@ -55,7 +55,7 @@ use crate::csg::{Hit, IntervalLanes, TIE};
 /// if they are there; none otherwise. At those pixels no comparison of
 /// theirs, moved or not, comes out differently from the reference pixel's.
 #[inline]
-fn settled((a, ra): (&[f32; 8], f32), (b, rb): (&[f32; 8], f32)) -> u8 {
+fn settled(a: &[f32; 8], ra: f32, b: &[f32; 8], rb: f32) -> u8 {
     if clear(ra, rb) {
         clear_lanes(a, b)
     } else if ra == rb {
@@ -87,6 +87,25 @@ fn clear_lanes(a: &[f32; 8], b: &[f32; 8]) -> u8 {
 /// An end's lanes in the run's block, and its value at the reference pixel.
 type End = ([f32; 8], f32);
 
+/// The occupants' lanes a spread reads, by primitive: at the reference pixel
+/// with that pixel's lane (`reference`), and over the block (`target`).
+pub struct BlockLanes<R, T> {
+    /// A primitive's lanes holding the reference pixel, and its lane there.
+    pub reference: R,
+    /// A primitive's lanes over the block.
+    pub target: T,
+}
+
+/// The pixels of a block a spread may settle.
+pub struct BlockRun<'o> {
+    /// The block's pixels (eight, fewer at the row's end).
+    pub out: &'o mut [Option<Hit>],
+    /// The first pixel (index into `out`) to settle.
+    pub from: usize,
+    /// The last pixel (index into `out`) that may be settled.
+    pub upto: usize,
+}
+
 /// Room to order a block's ends in, kept from block to block.
 #[derive(Debug, Clone, Default)]
 pub struct BlockOrder {
@@ -94,23 +113,27 @@ pub struct BlockOrder {
 }
 
 impl BlockOrder {
-    /// The surfaces at pixels `from..=upto` of a block (`out`, its eight
-    /// pixels, fewer at the row's end), where no occupant enters or leaves,
-    /// given `first` — the booleans' answer at a reference pixel (in the
-    /// block, before `from`, or the last of the block before), beyond the
-    /// near plane at `near` — and, by primitive, the occupants' lanes at the
-    /// reference pixel with its lane (`reference`) and in the block
-    /// (`target`): written into `out` from `from` to the last pixel where it
+    /// The surfaces at a block's pixels `run.from..=run.upto`, where no
+    /// occupant enters or leaves, given `first` — the booleans' answer at a
+    /// reference pixel (in the block, before `from`, or the last of the block
+    /// before), beyond the near plane at `near` — and the occupants' lanes
+    /// (`lanes`): written into `run.out` from `from` to the last pixel where it
     /// provably holds (see the module's doc), which is returned; `None` when
     /// it does not hold at `from`.
-    pub fn spread<'a>(
+    pub fn spread<'a, R, T>(
         &mut self,
         ids: &[u32],
-        (reference, target): (impl Fn(usize) -> (&'a IntervalLanes, usize), impl Fn(usize) -> &'a IntervalLanes),
+        lanes: &BlockLanes<R, T>,
         near: f32,
         first: Option<Hit>,
-        (out, (from, upto)): (&mut [Option<Hit>], (usize, usize)),
-    ) -> Option<usize> {
+        run: BlockRun,
+    ) -> Option<usize>
+    where
+        R: Fn(usize) -> (&'a IntervalLanes, usize),
+        T: Fn(usize) -> &'a IntervalLanes,
+    {
+        let BlockLanes { reference, target } = lanes;
+        let BlockRun { out, from, upto } = run;
         // The answer: its primitive, end, reference value and lanes.
         let answer = match first {
             None => None,
@@ -177,7 +200,7 @@ impl BlockOrder {
                 match answer {
                     Some((p, k, _, _)) if p == primitive && k == end => {}
                     // Beyond the answer: only to stay beyond it.
-                    Some((_, _, re, e)) if r > re => held &= settled((e, re), (t, r)),
+                    Some((_, _, re, e)) if r > re => held &= settled(e, re, t, r),
                     _ => self.before.push((*t, r)),
                 }
             }
@@ -188,7 +211,7 @@ impl BlockOrder {
         self.before.sort_unstable_by(|a, b| a.1.total_cmp(&b.1));
         self.before.extend(answer.map(|(_, _, r, e)| (*e, r)));
         for w in self.before.windows(2) {
-            held &= settled((&w[0].0, w[0].1), (&w[1].0, w[1].1));
+            held &= settled(&w[0].0, w[0].1, &w[1].0, w[1].1);
         }
         held
     }

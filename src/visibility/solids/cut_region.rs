@@ -105,7 +105,9 @@ impl CutRegions {
         &self,
         i: usize,
         pixels: Option<Extent>,
-        (camera, vp, size): (&Camera, Mat4, (u32, u32)),
+        camera: &Camera,
+        vp: Mat4,
+        size: (u32, u32),
     ) -> Option<Extent> {
         let (Some(pixels), Some(Some(region))) = (pixels, self.regions.get(i)) else { return pixels };
         // The depth of the cutter's box's farthest corner.

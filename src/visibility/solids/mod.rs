@@ -83,7 +83,7 @@ use cut_region::CutRegions;
 use horizon::Horizon;
 use paper::coherence::{self, PixelCoherence};
 use paper::pattern::{PatternMatrix, TooManySegments};
-use spans::{BlockSpans, PixelSpans, RowSpans};
+use spans::{BlockSpans, PixelSpans, RowRun, RowSpans};
 use surface_frame::row_to_write;
 use zbuffer::{DepthEnds, UnionRow};
 
@@ -488,7 +488,7 @@ impl<'a> FrameWalk<'a> {
             let mut boxes: Vec<Option<Extent>> = outlines.iter().map(|o| o.as_ref().map(|o| o.rows)).collect();
             bounds::narrow(tree, &mut boxes);
             for (i, b) in boxes.iter_mut().enumerate() {
-                *b = prepared.regions.narrow(i, *b, (camera, vp, (width, height)));
+                *b = prepared.regions.narrow(i, *b, camera, vp, (width, height));
             }
             for (o, b) in outlines.iter_mut().zip(boxes) {
                 match (o.as_mut(), b) {
@@ -514,9 +514,9 @@ impl<'a> FrameWalk<'a> {
     }
 
     /// Procedure 2 on row `y` for each of the `occupied`: their ends, each
-    /// clipped to the ends of the leaves that bound it (`own` keeps every
-    /// occupant's unclipped ends, stamped with the row).
-    fn ends(&self, y: usize, occupied: &[(usize, Extent)], (own, ends): (&mut [OwnEnds], &mut Vec<RowEnds>)) {
+    /// clipped to the ends of the leaves that bound it, into `ends` (`own`
+    /// keeps every occupant's unclipped ends, stamped with the row).
+    fn ends(&self, y: usize, occupied: &[(usize, Extent)], own: &mut [OwnEnds], ends: &mut Vec<RowEnds>) {
         for &(i, _) in occupied {
             own[i] = (y, self.outlines[i].as_ref().and_then(|o| o.columns(y as i64)));
         }
@@ -541,13 +541,15 @@ impl<'a> FrameWalk<'a> {
         &self,
         ends: &[RowEnds],
         spans: &RowSpans,
-        (row, by_depth, union): (&mut [Option<Hit>], &mut Vec<DepthEnds>, &mut UnionRow),
+        row: &mut [Option<Hit>],
+        by_depth: &mut Vec<DepthEnds>,
+        union: &mut UnionRow,
     ) -> bool {
         let nearest = |i: usize| self.outlines[i].as_ref().map_or(f32::MIN, |o| o.nearest);
         by_depth.clear();
         by_depth.extend(ends.iter().map(|&(i, a, b)| (i, a, b, nearest(i))));
         by_depth.sort_unstable_by(|p, q| p.3.total_cmp(&q.3));
-        let found = spans.nearest_entries(by_depth, self.near, (row, union));
+        let found = spans.nearest_entries(by_depth, self.near, row, union);
         if !found {
             row.fill(None);
         }
@@ -563,23 +565,10 @@ impl<'a> FrameWalk<'a> {
         buffers: &mut RowBuffers,
         visit: impl FnOnce(&ScannedRow),
     ) {
-        let RowBuffers {
-            row,
-            lines,
-            own_ends,
-            ends,
-            x_order,
-            counts,
-            scratch,
-            blocks,
-            coherence,
-            order,
-            by_depth,
-            union,
-        } = buffers;
+        let RowBuffers { row, lines, own_ends, ends, scan, blocks, by_depth, union } = buffers;
         let caster = self.caster;
         // Procedure 2: each occupant's left and right ends on this scanline.
-        self.ends(y, occupied, (own_ends, ends));
+        self.ends(y, occupied, own_ends, ends);
         let ends = &*ends;
         // The columns the occupants may cover: the walk writes no other.
         debug_assert!(row.iter().all(Option::is_none), "row {y}: hits left from the row before");
@@ -589,13 +578,12 @@ impl<'a> FrameWalk<'a> {
         // The row's rays, carried into each occupant's unit space once.
         let line = self.rays.row_line(y);
         ends.iter().for_each(|&(i, _, _)| lines[i] = caster.unit_line(i, &line));
-        blocks.begin_row(caster, ends.iter().map(|e| e.0), lines, (&self.faces, y));
+        blocks.begin_row(caster, ends.iter().map(|e| e.0), lines, &self.faces, y);
         let spans = RowSpans { blocks, caster, lines };
         match self.walker {
             RowWalker::Segments(walk) => {
-                if !(walk.nearest_entries && self.nearest_entries(ends, &spans, (row, by_depth, union))) {
-                    let reuse = (&mut *coherence, &mut *order);
-                    scan_row(caster, (walk, counts), ends, &spans, self.near, (row, scratch, reuse), x_order);
+                if !(walk.nearest_entries && self.nearest_entries(ends, &spans, row, by_depth, union)) {
+                    scan_row(walk, &spans, self.near, ends, row, scan);
                 }
             }
             RowWalker::Pattern(matrix) => {
@@ -652,15 +640,23 @@ struct RowBuffers {
     own_ends: Vec<OwnEnds>,
     /// The row's occupants with their ends, clipped by their bounds.
     ends: Vec<RowEnds>,
-    x_order: XOrder,
-    counts: Occupied,
-    scratch: SpanScratch,
+    /// What the booleans' walk along the row keeps.
+    scan: ScanBuffers,
     blocks: BlockSpans,
-    coherence: PixelCoherence,
-    order: BlockOrder,
     /// A union's occupants, nearest first ([`RowSpans::nearest_entries`]).
     by_depth: Vec<DepthEnds>,
     union: UnionRow,
+}
+
+/// What [`scan_row`] keeps from row to row: the x-entry and x-exit tables,
+/// the occupancy counts, the booleans' stack and the reused answers' state.
+#[derive(Default)]
+struct ScanBuffers {
+    x_order: XOrder,
+    counts: Occupied,
+    scratch: SpanScratch,
+    coherence: PixelCoherence,
+    order: BlockOrder,
 }
 
 thread_local! {
@@ -683,7 +679,7 @@ impl Lent {
         b.own_ends.clear();
         b.own_ends.resize(primitives, (usize::MAX, None));
         if let RowWalker::Segments(walk) = walker {
-            b.counts.fit(&walk.tree);
+            b.scan.counts.fit(&walk.tree);
         }
         b.blocks.fit(primitives);
         Lent(b)
@@ -754,16 +750,16 @@ impl EventSpreads {
 /// surface from the non-empty part of the tree, reused as the walk's
 /// [`Reuse`] says.
 fn scan_row(
-    caster: &CsgCaster,
-    (walk, counts): (&SegmentWalk, &mut Occupied),
-    ends: &[(usize, i64, i64)],
+    walk: &SegmentWalk,
     spans: &RowSpans,
     near: f32,
-    (row, scratch, (coherence, order)): (&mut [Option<Hit>], &mut SpanScratch, (&mut PixelCoherence, &mut BlockOrder)),
-    tables: &mut XOrder,
+    ends: &[RowEnds],
+    row: &mut [Option<Hit>],
+    buffers: &mut ScanBuffers,
 ) {
-    let tree = &walk.tree;
-    let XOrder { entry, exit } = tables.sort(ends.iter().copied());
+    let ScanBuffers { x_order, counts, scratch, coherence, order } = buffers;
+    let (tree, caster) = (&walk.tree, spans.caster);
+    let XOrder { entry, exit } = x_order.sort(ends.iter().copied());
     let (mut next_in, mut next_out) = (0, 0);
     let Some(first) = entry.first().map(|e| e.1.max(0) as usize) else { return };
     coherence.forget();
@@ -802,7 +798,7 @@ fn scan_row(
             // (Carried only into a block's first pixel: the pixel before is
             // the last of the block before, whose lanes the walk keeps.)
             let carry = spreading && steady && x % 8 == 0;
-            let carried = carry.then(|| spans.carry(order, ids, x, near, (row, upto))).flatten();
+            let carried = carry.then(|| spans.carry(order, ids, x, near, RowRun { row, upto })).flatten();
             if let Some(l) = carried {
                 last = l;
             } else {
@@ -821,7 +817,7 @@ fn scan_row(
                 };
                 row[x] = hit;
                 if spreading && upto > x {
-                    last = spans.spread(order, ids, (x, hit), near, (row, upto));
+                    last = spans.spread(order, ids, x, hit, near, RowRun { row: &mut *row, upto });
                     if x % 8 != 0 {
                         event_spreads.paid(x, last);
                     }

@@ -8,10 +8,10 @@
 
 use std::cell::{Cell, RefCell};
 
+use super::block::{BlockLanes, BlockOrder, BlockRun};
+use super::horizon::Horizon;
 use crate::camera::RowLine;
 use crate::csg::{Booleans, CsgCaster, FacesOnScreen, Hit, Interval, IntervalLanes, LeafSpans, RowFaces, SpanScratch};
-use crate::visibility::solids::block::BlockOrder;
-use crate::visibility::solids::horizon::Horizon;
 
 /// Each occupant's intervals at the eight-pixel block of the scanline last
 /// asked of it: the first pixel of a block that needs a primitive's interval
@@ -45,7 +45,8 @@ impl BlockSpans {
         caster: &CsgCaster,
         occupants: impl Iterator<Item = usize>,
         lines: &[RowLine],
-        (faces, y): (&[Option<FacesOnScreen>], usize),
+        faces: &[Option<FacesOnScreen>],
+        y: usize,
     ) {
         let cached = self.cached.get_mut();
         for i in occupants {
@@ -150,17 +151,19 @@ impl RowSpans<'_> {
     }
 
     /// [`BlockOrder::spread`] of `first`, the answer at pixel `x`, among the
-    /// occupants `ids`, over the pixels after it up to `upto` (in its block):
-    /// `row`'s pixels written as far as the answer holds, the last returned.
-    /// (All occupants: the answer is the whole tree's, however found.)
+    /// occupants `ids`, over the pixels after it up to `run.upto` (in its
+    /// block): `run.row`'s pixels written as far as the answer holds, the last
+    /// returned. (All occupants: the answer is the whole tree's, however found.)
     pub(super) fn spread(
         &self,
         order: &mut BlockOrder,
         ids: &[u32],
-        (x, first): (usize, Option<Hit>),
+        x: usize,
+        first: Option<Hit>,
         near: f32,
-        (row, upto): (&mut [Option<Hit>], usize),
+        run: RowRun,
     ) -> usize {
+        let RowRun { row, upto } = run;
         let mut cached = self.blocks.cached.borrow_mut();
         for &i in ids {
             let i = i as usize;
@@ -168,24 +171,20 @@ impl RowSpans<'_> {
         }
         let (x0, slot) = (x / 8 * 8, x / 8 % 2);
         let end = (x0 + 8).min(row.len());
-        let at = |i: usize| (&cached[i][slot].1, x - x0);
-        let run = (x - x0 + 1, upto - x0);
-        x0 + order.spread(ids, (at, |i| &cached[i][slot].1), near, first, (&mut row[x0..end], run)).unwrap_or(x - x0)
+        let lanes =
+            BlockLanes { reference: |i: usize| (&cached[i][slot].1, x - x0), target: |i: usize| &cached[i][slot].1 };
+        let run = BlockRun { out: &mut row[x0..end], from: x - x0 + 1, upto: upto - x0 };
+        x0 + order.spread(ids, &lanes, near, first, run).unwrap_or(x - x0)
     }
 
     /// The answer of pixel `x − 1` (the last of the block before, found with
-    /// the same occupants `ids`) carried on into `x`'s block, up to `upto`,
-    /// as [`RowSpans::spread`] hands an answer on inside a block: `row`'s
-    /// pixels written from `x` as far as it holds, the last returned (`None`
-    /// when it does not hold at `x`, or the lanes of `x − 1` are gone).
-    pub(super) fn carry(
-        &self,
-        order: &mut BlockOrder,
-        ids: &[u32],
-        x: usize,
-        near: f32,
-        (row, upto): (&mut [Option<Hit>], usize),
-    ) -> Option<usize> {
+    /// the same occupants `ids`) carried on into `x`'s block, up to
+    /// `run.upto`, as [`RowSpans::spread`] hands an answer on inside a block:
+    /// `run.row`'s pixels written from `x` as far as it holds, the last
+    /// returned (`None` when it does not hold at `x`, or the lanes of `x − 1`
+    /// are gone).
+    pub(super) fn carry(&self, order: &mut BlockOrder, ids: &[u32], x: usize, near: f32, run: RowRun) -> Option<usize> {
+        let RowRun { row, upto } = run;
         let (block, before) = (x / 8, x / 8 - 1);
         let mut cached = self.blocks.cached.borrow_mut();
         if ids.iter().any(|&i| cached[i as usize][before % 2].0 != before) {
@@ -196,10 +195,20 @@ impl RowSpans<'_> {
             self.blocks.fill_if_stale(&mut cached[i][block % 2], self.caster, i, &self.lines[i], block);
         }
         let end = (x + 8).min(row.len());
-        let at = |i: usize| (&cached[i][before % 2].1, 7);
-        let (first, out) = (row[x - 1], &mut row[x..end]);
-        order.spread(ids, (at, |i| &cached[i][block % 2].1), near, first, (out, (0, upto - x))).map(|last| x + last)
+        let lanes = BlockLanes {
+            reference: |i: usize| (&cached[i][before % 2].1, 7),
+            target: |i: usize| &cached[i][block % 2].1,
+        };
+        let first = row[x - 1];
+        let run = BlockRun { out: &mut row[x..end], from: 0, upto: upto - x };
+        order.spread(ids, &lanes, near, first, run).map(|last| x + last)
     }
+}
+
+/// The pixels of a row an answer may be handed on to: `row`, up to `upto`.
+pub(super) struct RowRun<'r> {
+    pub(super) row: &'r mut [Option<Hit>],
+    pub(super) upto: usize,
 }
 
 /// The intervals at pixel `x` of a scanline: a [`LeafSpans`] whose reading

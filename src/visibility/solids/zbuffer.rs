@@ -103,7 +103,8 @@ impl RowSpans<'_> {
         &self,
         ends: &[DepthEnds],
         near: f32,
-        (row, buffers): (&mut [Option<Hit>], &mut UnionRow),
+        row: &mut [Option<Hit>],
+        buffers: &mut UnionRow,
     ) -> bool {
         let last = row.len() as i64 - 1;
         buffers.occupants.clear();
