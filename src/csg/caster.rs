@@ -1,4 +1,4 @@
-//! Ray casting of CSG solids (issue 6): the depth interval a ray spends inside each
+//! Ray casting of CSG solids: the depth interval a ray spends inside each
 //! convex primitive (seed 003's procedure 3, "front and back depth at a pixel",
 //! solved in closed form), combined along the boolean tree into the spans the ray
 //! spends inside the solid, whose first entry is the visible surface.
@@ -132,8 +132,8 @@ impl CsgCaster {
     /// A ray's booleans count the primitives it meets ([`Occupied`](crate::csg::occupancy::Occupied)) when
     /// they are fewer than the tree's nodes over this, and walk the whole
     /// tree otherwise: counting one costs about as much as walking four nodes
-    /// (measured on the Menger sponge, whose rays meet a third of its 221
-    /// cutters, and the name tag, whose rays meet a few of its 1023 parts).
+    /// (measured on a solid whose rays meet a third of its hundreds of
+    /// cutters, and on one whose rays meet a few of its thousand parts).
     const NODES_PER_COUNTED: usize = 4;
 
     /// The solid.

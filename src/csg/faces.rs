@@ -154,13 +154,13 @@ impl FacesOnScreen {
     const SORT_FROM: usize = 12;
 
     /// Faces from which [`FacesOnScreen::new`] finds them in pieces at once
-    /// (ex006_hull_dice's 482).
+    /// (a hull of faceted balls has hundreds).
     const SPLIT_FROM: usize = 256;
 
     /// Faces in each such piece: in two halves, one half waited on the
     /// other (the frame's start took as long on two threads as on one); in
-    /// sixteen pieces of 32, ex006_hull_dice's frame starts its bands after
-    /// ~85 us instead of ~120.
+    /// pieces of 32, a hull of some 500 faces starts its bands about a third
+    /// sooner.
     const PIECE: usize = 32;
 
     /// The faces of `faces`, whose corners project to `at` (pixel

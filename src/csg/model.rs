@@ -1,4 +1,4 @@
-//! CSG solids made of convex primitives (seed 003 §5–6; issue 6).
+//! CSG solids made of convex primitives (seed 003 §5–6), as data.
 //!
 //! A [`CsgSolid`] is a tree of booleans ([`CsgTree`]) over convex primitives
 //! ([`Primitive`]): spheres and ellipsoids, cylinders, cones and frustums (exact

@@ -1,4 +1,4 @@
-//! OpenSCAD `.csg` files as CSG solids (issue 6).
+//! OpenSCAD `.csg` files as CSG solids.
 //!
 //! [`syntax`] reads the file into a tree of nodes; this module says what the nodes
 //! mean, following `../shared/peers/openscad/CSG_FORMAT.md` §3–5:

@@ -1,5 +1,5 @@
-//! The syntax of OpenSCAD's flattened `.csg` files (issue 6: CSG solids
-//! by scanline, seed 003, read from the models OpenSCAD users already have).
+//! The syntax of OpenSCAD's flattened `.csg` files: the models OpenSCAD users
+//! already have, read as CSG solids (seed 003).
 //!
 //! OpenSCAD 2021.01 writes a `.csg` file as a tree of built-in nodes with literal
 //! arguments, every language feature evaluated away (the grammar, found by

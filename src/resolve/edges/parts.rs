@@ -20,10 +20,9 @@
 //!   is moved along the colour steps from `c` to its neighbours on the same
 //!   object, on the centroid's side, in x and in y ([`OwnPart::Stepped`]): on a
 //!   plane the passes' colour changes slowly, and the neighbours are already
-//!   shaded. Measured against 256 jittered passes, this moves no scene's share
-//!   of the aliased edge error removed by more than 0.6 points (bunny 65.7 →
-//!   65.1%, showroom 60.3 → 60.9%), while the milk truck shades 35% fewer
-//!   samples and the CAD scene 55% fewer.
+//!   shaded. Against 256 jittered passes this costs no scene more than 0.6
+//!   points of the aliased edge error removed, and saves a third to a half of
+//!   the samples (`docs/benchmarks.md`, "Design measurements").
 
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
@@ -35,10 +34,9 @@ use crate::visibility::{ItemId, VisibilityBuffer};
 
 /// The least share of a pixel beyond an edge whose colour is re-shaded at its
 /// centroid; a smaller part takes the colour of the pixel across as it is.
-/// Measured against 256 jittered passes: from 0.1 to 0.2 no scene's share of
-/// the aliased edge error removed moves by more than 0.3 points (bunny 65.1 →
-/// 64.8%, spotlights 60.71 → 60.67%), while the milk truck shades 19% fewer
-/// samples; at 0.25 spotlights and showroom come within 0.6 points of 60%.
+/// From 0.1 to 0.2 no scene's share of the aliased edge error removed moves by
+/// more than 0.3 points while a fifth fewer samples are shaded; 0.25 starts to
+/// cost (`docs/benchmarks.md`, "Design measurements").
 pub const RESHADED_SHARE: f32 = 0.2;
 
 /// How the colour of a crossed pixel's own part is found.

@@ -17,18 +17,16 @@
 //! absence alone. (The one trace `p`'s absence can leave is the order in
 //! which a difference meets its cutters, which follows the order they came
 //! to occupy the row: where two cutters' faces lie within the booleans' tie
-//! of each other, that order picks the face shown — 4 of 143,600 pixels of
-//! the corpus's z_axis at 1280x720 changed so, none on the other models.)
+//! of each other, that order picks the face shown: a few pixels in a hundred
+//! thousand, on the models that have such ties at all.)
 //!
 //! The pay-off is where cutters reach past what they cut (a hole's cylinder
 //! longer than the plate is thick, a slot's box wider than the part): their
-//! ends keep to the part's outline. On the corpus at 1280x720 the scanline
-//! pixels occupied fall 27% on x_end (frame 10% faster) and 19% on
-//! p3_x_carriage; old_z_axis_bottom's cutters, bounded by a union of
-//! blocks, keep to its box (13% faster). A bevel gear's teeth, long spikes
-//! from the gear's axis intersected with the ring that keeps their ends,
-//! lose 60% of theirs but the frame only 4%: the ring's outline still takes
-//! in the axis, where they all meet.
+//! ends keep to the part's outline, and the pixels the walk visits fall by
+//! up to a quarter on the corpus's printer parts (`docs/benchmarks.md`,
+//! "Design measurements"). Where the bounding node's own outline is wide (a
+//! gear's teeth, intersected with the ring that keeps their ends, still
+//! reach the axis inside the ring) the clip saves pixels but little time.
 
 use crate::csg::{Bound, BoxBound, CsgTree, Reach};
 

@@ -5,7 +5,7 @@
 //! A primitive's extent on the screen says nothing of its depth: a printer
 //! part's holes and ribs behind its front face occupy the same pixels as the
 //! face, and most of a pixel's occupants lie behind its surface (three in four
-//! on p3_x_carriage). The scanline walk guesses a [`Horizon`] a little beyond
+//! on a printer carriage of hundreds of primitives). The scanline walk guesses a [`Horizon`] a little beyond
 //! the surface of the pixel before; occupants whose interval at the pixel
 //! starts at or beyond it are read as missed, and the booleans — union
 //! merges, cuts, clips — run over the rest. The answer stands when nothing

@@ -1,4 +1,4 @@
-//! Scanline visibility of CSG solids (seed 003 §5; issue 6).
+//! Scanline visibility of CSG solids (seed 003 §5).
 //!
 //! The frame is walked the paper's way: primitives are bucket-sorted by their
 //! top scanline into the y-entry table; each scanline moves entering primitives
@@ -88,9 +88,8 @@ use surface_frame::row_to_write;
 use zbuffer::{DepthEnds, UnionRow};
 
 /// Rows scanned by one worker in turn, each band a task of its own
-/// ([`scan_bands`]). Measured with the walk's loops aligned (so that layout
-/// moves no model's time): 16 rows 3-4% sooner than 8 on the median models,
-/// 12 alike, 32 slower.
+/// ([`scan_bands`]): 16 rows were a few per cent sooner than 8 on the median
+/// models, 12 alike, 32 slower (`docs/benchmarks.md`, "Design measurements").
 const BAND_ROWS: usize = 16;
 
 /// The visible surface of `solid` (in world space) at each pixel centre of a
@@ -412,8 +411,8 @@ fn scan_bands<B: Send>(
         let h = height as usize;
         // Each band its own piece of work: left to split only where stolen,
         // rayon hands each thread a quarter of the frame, and a thread done
-        // with its own finds the rest of the other's unsplittable (ex_csg_modules'
-        // second thread sat idle for the last 40% of the frame).
+        // with its own finds the rest of the other's unsplittable (a second
+        // thread could sit idle for the last part of the frame).
         bands.enumerate().with_max_len(1).for_each_init(
             || Lent::fitted(width as usize, prepared.caster.solid().primitives.len(), walker),
             |lent, (band, mut out)| {
@@ -725,8 +724,8 @@ impl XOrder {
 /// after an occupant entered or left inside a block (beyond the paper, which
 /// reuses an answer only where nothing entered or left). It pays where at
 /// least three of the block's pixels follow and the answer holds on for two
-/// or more of them; on rows of many small parts (a Menger sponge, a carriage
-/// of 417 primitives) it mostly stops at once, and the booleans pixel by
+/// or more of them; on rows of many small parts (a Menger sponge, a printer
+/// carriage of hundreds of primitives) it mostly stops at once, and the booleans pixel by
 /// pixel cost less. A row starts out spreading and stops once such spreads
 /// have failed twice more than they paid (two paid ones at most banked).
 #[derive(Debug, Clone, Copy, Default)]
