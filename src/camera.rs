@@ -167,6 +167,12 @@ impl Camera {
     }
 
     /// Checks the camera can form an image; returns what is wrong otherwise.
+    ///
+    /// # Errors
+    ///
+    /// What makes the camera unusable: a non-finite eye, target or up, the
+    /// eye on its target, `up` along the view, not `0 < near < far`, a field
+    /// of view outside (0°, 180°) or a height that is not positive.
     pub fn validate(&self) -> Result<(), String> {
         let finite = self.eye.is_finite() && self.target.is_finite() && self.up.is_finite();
         if !finite {

@@ -28,6 +28,10 @@ pub struct Comparison {
 }
 
 /// Compares `a` with reference `b` (same size).
+///
+/// # Errors
+///
+/// [`Error::SizeMismatch`] when the images differ in size.
 pub fn compare(a: &LinearImage, b: &LinearImage, threshold: f32) -> Result<Comparison> {
     same_size(a, b)?;
     let (mut sum, mut max, mut over) = (0.0f64, 0.0f64, 0usize);
@@ -45,6 +49,10 @@ pub fn compare(a: &LinearImage, b: &LinearImage, threshold: f32) -> Result<Compa
 
 /// Share (0–1) of pixels that one image puts above `level` and the other not,
 /// judged on each pixel's mean channel value.
+///
+/// # Errors
+///
+/// [`Error::SizeMismatch`] when the images differ in size.
 pub fn mask_disagreement(a: &LinearImage, b: &LinearImage, level: f32) -> Result<f64> {
     same_size(a, b)?;
     let above = |p: &Vec3| p.element_sum() / 3.0 > level;
@@ -54,6 +62,10 @@ pub fn mask_disagreement(a: &LinearImage, b: &LinearImage, level: f32) -> Result
 
 /// A false-colour picture of |a − b|: black where equal, then blue, green, yellow
 /// and red as the largest channel difference grows to `full_scale` and beyond.
+///
+/// # Errors
+///
+/// [`Error::SizeMismatch`] when the images differ in size.
 pub fn difference_image(a: &LinearImage, b: &LinearImage, full_scale: f32) -> Result<LinearImage> {
     same_size(a, b)?;
     let mut out = LinearImage::new(a.width(), a.height());

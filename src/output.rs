@@ -8,6 +8,11 @@ use crate::image::{srgb_to_linear, LinearImage};
 
 /// Writes `image` to `path` as `.png`, `.exr` or `.pfm`. `exposure` (a linear
 /// multiplier) applies to PNG only: float formats keep the rendered values.
+///
+/// # Errors
+///
+/// [`Error::Output`] for an unknown extension or when the file cannot be
+/// written.
 pub fn write_image(image: &LinearImage, path: &Path, exposure: f32) -> Result<()> {
     let fail = |message: String| Error::Output { path: path.to_path_buf(), message };
     let ext = path.extension().and_then(|e| e.to_str()).unwrap_or_default().to_ascii_lowercase();
@@ -38,6 +43,11 @@ pub fn pfm_bytes(image: &LinearImage) -> Vec<u8> {
 
 /// Reads an image as linear RGB: `.exr` and `.pfm` as stored, 8-bit formats
 /// (`.png`, `.jpg`) decoded from sRGB.
+///
+/// # Errors
+///
+/// [`Error::Read`] when the file cannot be read, [`Error::ImageRead`] when it
+/// does not decode.
 pub fn read_image(path: &Path) -> Result<LinearImage> {
     let fail = |message: String| Error::ImageRead { path: path.to_path_buf(), message };
     let ext = path.extension().and_then(|e| e.to_str()).unwrap_or_default().to_ascii_lowercase();

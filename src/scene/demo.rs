@@ -20,6 +20,11 @@ static FILES: [(&str, &[u8]); 5] = [
 ];
 
 /// Builds the demo scene from the embedded files.
+///
+/// # Errors
+///
+/// None in a released build: the scene and its files are compiled in (an
+/// error would mean they were edited into something that does not load).
 pub fn demo_scene() -> Result<Scene> {
     SceneFile::parse(DEMO_SCENE, Path::new("<builtin demo>"))?.build(&Embedded(&FILES))
 }

@@ -434,6 +434,11 @@ struct ObjectRec {
 
 impl SceneFile {
     /// Parses scene text. `path` is used for messages and to resolve relative files.
+    ///
+    /// # Errors
+    ///
+    /// [`Error::SceneSyntax`] for text that is not TOML or does not match the
+    /// scene format, located at the offending characters.
     pub fn parse(text: &str, path: &Path) -> Result<SceneFile> {
         let shared: Arc<str> = Arc::from(text);
         let mut file: SceneFile = toml::from_str(text).map_err(|e| Error::SceneSyntax {
@@ -536,6 +541,11 @@ impl SceneFile {
     }
 
     /// Loads every mesh and texture and builds the scene.
+    ///
+    /// # Errors
+    ///
+    /// [`Error::SceneInvalid`] for impossible values (located in the file), and
+    /// whatever loading a named mesh, model or texture fails with.
     pub fn build(&self, assets: &dyn AssetSource) -> Result<Scene> {
         let (w, h) = (&self.image.width, &self.image.height);
         for side in [w, h] {
@@ -903,6 +913,11 @@ fn add_ground(scene: &mut Scene, (lo, hi): (Vec3, Vec3)) {
 }
 
 /// Reads and builds a scene file from disk.
+///
+/// # Errors
+///
+/// [`Error::Read`] when the file cannot be read; then as [`SceneFile::parse`]
+/// and [`SceneFile::build`].
 pub fn load_scene(path: &Path) -> Result<Scene> {
     let text = std::fs::read_to_string(path).map_err(|source| Error::Read { path: path.to_path_buf(), source })?;
     let base = path.parent().unwrap_or(Path::new(".")).to_path_buf();
@@ -910,6 +925,10 @@ pub fn load_scene(path: &Path) -> Result<Scene> {
 }
 
 /// A scene showing one model file, framed automatically.
+///
+/// # Errors
+///
+/// As [`scene_for_model_with`].
 pub fn scene_for_model(path: &Path, width: u32, height: u32) -> Result<Scene> {
     scene_for_model_with(path, width, height, &CsgOptions::default())
 }
@@ -919,6 +938,11 @@ pub fn scene_for_model(path: &Path, width: u32, height: u32) -> Result<Scene> {
 /// OpenSCAD's default view, lit from above by the same rig as other models
 /// turned z-up (only the key light casts shadows), and stands on a ground that
 /// catches its shadows (left out when the camera looks from below it).
+///
+/// # Errors
+///
+/// What loading the model fails with ([`load::model_with`]), or
+/// [`Error::Scene`] when it holds nothing to draw.
 pub fn scene_for_model_with(path: &Path, width: u32, height: u32, csg: &CsgOptions) -> Result<Scene> {
     let base = path.parent().unwrap_or(Path::new(".")).to_path_buf();
     let fs = load::FileSystem { base };

@@ -40,6 +40,11 @@ pub enum NormalMode {
 impl Mesh {
     /// Checks and builds a mesh. `normals` and `uvs` may be empty; missing normals
     /// are computed with `mode`.
+    ///
+    /// # Errors
+    ///
+    /// A message when a vertex is not finite, a triangle refers to a vertex
+    /// past the positions, or no triangle has any area.
     pub fn new(
         positions: Vec<Vec3>,
         normals: Vec<Vec3>,

@@ -197,6 +197,11 @@ pub struct Scene {
 }
 
 /// Checks an image size before anything is allocated for it.
+///
+/// # Errors
+///
+/// [`Error::ImageSize`] for a side of 0 or over [`MAX_IMAGE_SIDE`], or more
+/// than [`MAX_IMAGE_PIXELS`] pixels.
 pub fn check_image_size(width: u64, height: u64) -> Result<()> {
     let err = |reason| Err(Error::ImageSize { width, height, reason });
     if width == 0 || height == 0 {
@@ -234,6 +239,12 @@ impl Scene {
     }
 
     /// Checks everything a render relies on: image size, camera, materials referenced.
+    ///
+    /// # Errors
+    ///
+    /// [`Error::ImageSize`] as [`check_image_size`]; [`Error::Scene`] for an
+    /// unusable camera, an object without a material or with a non-finite
+    /// transform.
     pub fn validate(&self) -> Result<()> {
         check_image_size(self.width as u64, self.height as u64)?;
         self.camera.validate().map_err(Error::Scene)?;

@@ -104,6 +104,10 @@ pub struct Texture {
 impl Texture {
     /// Decodes an encoded image (PNG, JPEG or OpenEXR). `srgb` says whether its
     /// values are sRGB-encoded colours (true for colour maps) or already linear.
+    ///
+    /// # Errors
+    ///
+    /// The decoder's message when the bytes are no image it reads.
     pub fn decode(bytes: &[u8], srgb: bool) -> Result<Texture, String> {
         let img = ::image::load_from_memory(bytes).map_err(|e| e.to_string())?.into_rgb32f();
         let (width, height) = img.dimensions();
@@ -115,8 +119,11 @@ impl Texture {
         Ok(Texture::from_texels(width, height, texels))
     }
 
-    /// A texture from linear texels, row 0 at the top, repeating. Panics if the
-    /// sizes disagree.
+    /// A texture from linear texels, row 0 at the top, repeating.
+    ///
+    /// # Panics
+    ///
+    /// If there are not `width × height` texels.
     #[must_use]
     pub fn from_texels(width: u32, height: u32, texels: Vec<Vec3>) -> Texture {
         assert_eq!(texels.len(), (width * height) as usize, "texel count");

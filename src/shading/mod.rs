@@ -56,8 +56,12 @@ impl ShadingPass<'_> {
     }
 }
 
-/// Runs one pass over `vb` into `image` (same size), rows in parallel, eight pixels
-/// at a time (`lanes.rs`).
+/// Runs one pass over `vb` into `image`, rows in parallel, eight pixels at a
+/// time (`lanes.rs`).
+///
+/// # Panics
+///
+/// If `image` and `vb` differ in size.
 pub fn shade_pass(scene: &Scene, vb: &VisibilityBuffer, image: &mut LinearImage, pass: &ShadingPass) {
     assert_eq!((image.width(), image.height()), (vb.width(), vb.height()), "image and buffer sizes");
     let w = vb.width() as usize;

@@ -49,8 +49,11 @@ impl ObjectFrames {
         ObjectFrames { frames }
     }
 
-    /// The world-space vertices of an item's triangle (`item` must name a
-    /// triangle of a mesh object).
+    /// The world-space vertices of an item's triangle.
+    ///
+    /// # Panics
+    ///
+    /// If `item` names no triangle of a mesh object of `scene`.
     #[must_use]
     pub fn triangle(&self, scene: &Scene, item: ItemId) -> [Vec3; 3] {
         let (m, _) = self.frames[item.object as usize];
@@ -108,6 +111,10 @@ impl ObjectFrames {
     /// Gathers everything about `item`'s triangle (a mesh's) that does not
     /// depend on the ray, so neighbouring pixels showing the same triangle share
     /// the work.
+    ///
+    /// # Panics
+    ///
+    /// If `item` names no triangle of a mesh object of `scene`.
     #[must_use]
     pub fn prepare(&self, scene: &Scene, item: ItemId) -> PreparedTriangle {
         let object = &scene.objects[item.object as usize];

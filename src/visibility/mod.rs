@@ -153,7 +153,11 @@ impl VisibilityBuffer {
         &self.items
     }
 
-    /// Item at pixel (x, y) (panics on a depth-only buffer).
+    /// Item at pixel (x, y).
+    ///
+    /// # Panics
+    ///
+    /// On a depth-only buffer, or outside the buffer.
     #[must_use]
     pub fn item(&self, x: u32, y: u32) -> ItemId {
         self.items[y as usize * self.width as usize + x as usize]

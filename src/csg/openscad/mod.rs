@@ -119,6 +119,12 @@ pub fn default_view((lo, hi): (Vec3, Vec3)) -> Camera {
 const ALWAYS_FACETED_FN: f64 = 8.0;
 
 /// Reads the text of a `.csg` file (named `path` in messages) as a solid.
+///
+/// # Errors
+///
+/// As [`parse_csg`]; [`Error::CsgInvalid`] for a node kage cannot render
+/// (unless [`CsgOptions::skip_unsupported`]), a malformed argument or a
+/// polyhedron that is not convex.
 pub fn load_csg(path: &Path, text: Arc<str>, options: &CsgOptions) -> Result<LoadedCsg> {
     let nodes = parse_csg(path, Arc::clone(&text))?;
     let mut b =

@@ -80,6 +80,11 @@ impl CsgNode {
 
 /// Parses the text of a `.csg` file (named `path` in messages) into its top-level
 /// nodes. Errors carry the file, line and column of the offending characters.
+///
+/// # Errors
+///
+/// [`Error::CsgSyntax`] where the text leaves OpenSCAD's grammar, located
+/// at the offending characters.
 pub fn parse_csg(path: &Path, text: Arc<str>) -> Result<Vec<CsgNode>> {
     let mut p = Parser { text: &text, pos: 0 };
     let nodes = p.nodes(None);

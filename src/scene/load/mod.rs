@@ -148,12 +148,23 @@ impl LoadedModel {
 
 /// Loads a model file, choosing the loader by extension (`.csg` files with
 /// the default [`CsgOptions`]).
+///
+/// # Errors
+///
+/// As [`model_with`].
 pub fn model(path: &Path, assets: &dyn AssetSource) -> Result<LoadedModel> {
     model_with(path, assets, &CsgOptions::default())
 }
 
 /// Loads a model file, choosing the loader by extension; `.csg` files are read
 /// with `csg`.
+///
+/// # Errors
+///
+/// [`Error::Read`] when the file cannot be read, [`Error::MeshLoad`] when it
+/// does not parse (or its format is unknown), [`Error::MeshInvalid`] when its
+/// data cannot be drawn, and an OpenSCAD file's located
+/// [`Error::CsgSyntax`] / [`Error::CsgInvalid`].
 pub fn model_with(path: &Path, assets: &dyn AssetSource, csg: &CsgOptions) -> Result<LoadedModel> {
     let shown = assets.display_path(path);
     let ext = path.extension().and_then(|e| e.to_str()).unwrap_or_default().to_ascii_lowercase();
@@ -174,11 +185,20 @@ pub fn model_with(path: &Path, assets: &dyn AssetSource, csg: &CsgOptions) -> Re
 }
 
 /// Reads a file through `assets`, naming it in the error.
+///
+/// # Errors
+///
+/// [`Error::Read`], naming the file as `assets` shows it.
 pub fn read(path: &Path, assets: &dyn AssetSource) -> Result<Vec<u8>> {
     assets.read(path).map_err(|source| Error::Read { path: assets.display_path(path), source })
 }
 
 /// Loads a colour (`srgb`) or data texture.
+///
+/// # Errors
+///
+/// [`Error::Read`] when the file cannot be read, [`Error::TextureLoad`] when
+/// it does not decode.
 pub fn texture(path: &Path, srgb: bool, assets: &dyn AssetSource) -> Result<Arc<Texture>> {
     // OpenEXR and Radiance HDR hold linear values whatever they depict.
     let ext = path.extension().and_then(|e| e.to_str()).unwrap_or_default().to_ascii_lowercase();

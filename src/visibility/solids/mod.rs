@@ -125,6 +125,11 @@ pub enum CsgMethod {
 
 /// [`scan_solid`] by `method`; fails when the pattern matrix would pass its
 /// limit.
+///
+/// # Errors
+///
+/// [`TooManySegments`] when `method` is the pattern matrix and the solid
+/// expands past its limit.
 pub fn scan_solid_with(
     solid: &CsgSolid,
     camera: &Camera,
@@ -140,6 +145,10 @@ pub fn scan_solid_with(
 /// [`scan_solid_with`] into `out` (made the image's size), so a viewer
 /// re-scanning frame after frame reuses one buffer, as the frame's
 /// visibility buffer is reused, and clears only what the last scan wrote.
+///
+/// # Errors
+///
+/// As [`scan_solid_with`].
 pub fn scan_solid_into(
     solid: &CsgSolid,
     camera: &Camera,
@@ -169,6 +178,10 @@ pub struct PreparedSolid {
 impl PreparedSolid {
     /// `solid` made ready to be walked by `method`; fails when the pattern
     /// matrix would pass its limit.
+    ///
+    /// # Errors
+    ///
+    /// As [`scan_solid_with`].
     pub fn new(solid: &CsgSolid, method: CsgMethod) -> Result<PreparedSolid, TooManySegments> {
         let bounds = solid.tree.as_ref().map(|t| BoundingLeaves::new(t, solid.primitives.len())).unwrap_or_default();
         let (caster, walker) = (CsgCaster::without_bvh(solid), RowWalker::new(solid, method)?);

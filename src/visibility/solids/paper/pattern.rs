@@ -59,6 +59,10 @@ pub struct PatternMatrix {
 impl PatternMatrix {
     /// Expands `tree` over `primitives` primitives, giving up past `limit`
     /// segments.
+    ///
+    /// # Errors
+    ///
+    /// [`TooManySegments`] past `limit` segments.
     pub fn expand(tree: &CsgTree, primitives: usize, limit: usize) -> Result<PatternMatrix, TooManySegments> {
         let segments = sum_of_products(tree, limit)?;
         let mut positive_in = vec![Vec::new(); primitives];
