@@ -1,13 +1,32 @@
 //! # kage — a CPU renderer for design previews
 //!
 //! kage implements five rendering papers (kept in `../shared/seeds/`, restated in
-//! `SPEC.md`) as one frame pipeline. The module tree follows the frame's data flow:
+//! `SPEC.md`) as one frame pipeline. The module tree is the frame, ground floor
+//! first; a module uses only the ones before it (`tests/layering.rs` holds it
+//! to that):
 //!
 //! ```text
-//! scene ──► visibility ──► shadows ──► shading ──► raytrace ──► resolve ──► image
-//! (files,    (rasterizer    (shadow      (seed 002    (item-buffer   (jitter    (PNG, EXR,
-//!  meshes,    into the       term per     eq. 1,       reflections,   average,   PFM)
-//!  lights)    item buffer)   light)       per light)   refraction)    exposure)
+//! error · sampling · image · camera · bvh        the ground floor: typed errors, sample
+//!                                                patterns, the linear float image and
+//!                                                sRGB, the view and its rays, the BVH
+//!   ▼
+//! csg            CSG solids (seed 003): model, OpenSCAD reader, ray casting by intervals
+//!   ▼
+//! scene          what is drawn: objects, lights, materials, settings; files and loaders
+//!   ▼
+//! visibility     the item buffer: polygons (seed 004 §3(1)) and solids' scanline walk
+//!   ▼
+//! shadows        the shadow term per light (shadow maps)
+//!   ▼
+//! shading        seed 002's passes: eq. 1 per light, summed; fog, translucency
+//!   ▼
+//! raytrace       reflections and refraction from the item buffer; the reference
+//!   ▼
+//! resolve        the edge pass (seed 004) and jittered passes (seed 002 §4)
+//!   ▼
+//! frame          Renderer: one call per stage, buffers kept between frames
+//!   ▼
+//! output · compare                               images written and read; measured
 //! ```
 //!
 //! [`frame::render`] runs the whole chain; each stage is usable on its own, so tests
