@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Builds the llvmpipe and Embree peers of ../shared/peers into target/peers/
-# (shared/ is read-only), for `kage bench` and `kage bench --rays`. Debian 12;
+# (shared/ is read-only), for `kage-bench raster` and `kage-bench rays`. Debian 12;
 # installs their packages when run as root.
 set -euo pipefail
 cd "$(dirname "$0")/.."

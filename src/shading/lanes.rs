@@ -1,6 +1,6 @@
 //! Seed 002 eq. 1, eight pixels at a time.
 //!
-//! The scalar path ([`super::surface`] + [`super::phong`]) says what is computed;
+//! The scalar path (`surface.rs` + `phong.rs`) says what is computed;
 //! this module computes the same thing for eight neighbouring pixels of a row in
 //! SIMD lanes (`wide::f32x8`), which is what makes per-pixel Phong affordable on a
 //! CPU. Per lane it gathers the pixel's prepared triangle and material, then runs
@@ -434,7 +434,7 @@ fn facing_normal(inp: &LaneInputs, w: [F; 3], v: &V3) -> V3 {
 
 /// A light whose diffuse and specular a pass adds, with the shadow terms whose
 /// mean multiplies them: one term, or an area light's jittered samples' (see
-/// [`crate::shading::passes`]).
+/// `passes.rs`).
 pub type Direct<'a> = (&'a Light, &'a [ShadowTerm]);
 
 /// What one shading pass adds (seed 002 eq. 4): the ambient of some lights, the
