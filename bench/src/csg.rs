@@ -358,7 +358,8 @@ pub fn run_preview(preview: &PreviewArgs) -> Result<()> {
     println!(
         "\nkage: `kage render NAME.csg --width 640 --height 480` (exact quadrics, lit, shadowed, on a ground), wall \
          clock of the whole process, median of 3. OpenSCAD 2021.01: its preview PNG at 640x480 (no shadows), from \
-         ../shared/peers/openscad/TIMINGS.md (same machine type). Orbit: the camera turns 3° about the model per \
+         peers/openscad/TIMINGS.md (taken on the workplace's standard machine). Orbit: the camera turns 3° about \
+         the model per \
          frame, median of {} frames of a reused renderer ({} threads). Medians: OpenSCAD / kage {:.1}, fps with \
          shadows {:.1}, without {:.1}.",
         args.frames.max(3),
