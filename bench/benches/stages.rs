@@ -35,6 +35,7 @@ fn visibility_of(scene: &Scene) -> VisibilityBuffer {
 
 fn frames(c: &mut Criterion) {
     let mut group = c.benchmark_group("frame");
+    group.sample_size(20);
     for (name, scene) in [("demo", demo()), ("reflections", example("reflections.toml"))] {
         let mut renderer = Renderer::new(&RenderOptions::default()).expect("renderer");
         group.bench_function(name, |b| b.iter(|| black_box(renderer.render(&scene).expect("renders").stats)));
@@ -82,9 +83,12 @@ fn traced_term(c: &mut Criterion) {
     let scene = example("reflections.toml");
     let vb = visibility_of(&scene);
     let (mut image, mut cache) = (LinearImage::new(scene.width, scene.height), TraceCache::default());
-    c.bench_function("traced/reflections, BVH kept", |b| {
+    let mut group = c.benchmark_group("traced");
+    group.sample_size(20);
+    group.bench_function("reflections, BVH kept", |b| {
         b.iter(|| black_box(traced::add_traced(&scene, &vb, &mut image, 4, &mut cache)))
     });
+    group.finish();
 }
 
 fn csg_walk(c: &mut Criterion) {
