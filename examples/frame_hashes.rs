@@ -52,7 +52,7 @@ fn load(input: &str, geometry: Geometry) -> kage::error::Result<Scene> {
         return file::load_scene(path);
     }
     let csg = CsgOptions { geometry, skip_unsupported: false };
-    file::scene_for_model_with(path, 480, 270, &csg)
+    file::scene_for_model_with(path, 480, 270, &file::ModelOptions { csg, ..Default::default() })
 }
 
 /// The ways each input is rendered: as its file says, with the edge pass, and

@@ -53,6 +53,18 @@ pub struct Ray {
 }
 
 impl Camera {
+    /// The same camera with its eye, target and up moved by `m` (a rigid
+    /// motion: a model's frame carried into the world's).
+    #[must_use]
+    pub fn transformed(&self, m: &glam::Affine3A) -> Camera {
+        Camera {
+            eye: m.transform_point3(self.eye),
+            target: m.transform_point3(self.target),
+            up: m.transform_vector3(self.up),
+            ..*self
+        }
+    }
+
     /// World → view matrix.
     #[must_use]
     pub fn view(&self) -> Mat4 {

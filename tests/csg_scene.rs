@@ -54,7 +54,6 @@ kd = [0.1, 0.2, 0.8]
 name = "part"
 mesh = "ex004_cube_minus_sphere.csg"
 scale = 0.05
-rotate = [-90, 0, 0]
 translate = [0.0, 0.75, 0.0]
 
 [[object]]

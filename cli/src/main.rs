@@ -9,7 +9,8 @@ use std::path::{Path, PathBuf};
 
 use clap::{Parser, Subcommand};
 use kage::csg::openscad::{CsgOptions, Geometry};
-use kage::scene::{demo::demo_scene, file, Antialias, EdgeFilter, EdgeMode, EdgeSelection, Exposure, Scene};
+use kage::scene::file::{self, ModelOptions};
+use kage::scene::{demo::demo_scene, Antialias, EdgeFilter, EdgeMode, EdgeSelection, Exposure, Scene, Up};
 use kage::shading::{Component, ComponentSet};
 use kage::{render, RenderOptions};
 
@@ -107,6 +108,36 @@ struct RenderArgs {
     /// text, import, ...) with a warning instead of failing.
     #[arg(long)]
     skip_unsupported: bool,
+    /// A model file: which of its axes points up (default: its format's — z
+    /// for STL and OpenSCAD, y for OBJ and glTF).
+    #[arg(long, value_enum)]
+    up: Option<UpArg>,
+    /// A model file: no ground under it.
+    #[arg(long)]
+    no_ground: bool,
+    /// A model file: `framed` (a camera that frames the model) or `file` (the
+    /// file's own camera: a glTF camera, an OpenSCAD camera sidecar or
+    /// OpenSCAD's default view).
+    #[arg(long, value_enum, default_value_t = CameraArg::Framed)]
+    camera: CameraArg,
+}
+
+/// `--up`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum UpArg {
+    /// +y up.
+    Y,
+    /// +z up.
+    Z,
+}
+
+/// `--camera`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum CameraArg {
+    /// A camera that frames the model.
+    Framed,
+    /// The file's own camera.
+    File,
 }
 
 /// `--geometry`.
@@ -204,11 +235,19 @@ fn load(args: &RenderArgs) -> kage::error::Result<Scene> {
         GeometryArg::Exact => Geometry::Exact,
         GeometryArg::Faceted => Geometry::Faceted,
     };
-    let csg = CsgOptions { geometry, skip_unsupported: args.skip_unsupported };
+    let options = ModelOptions {
+        csg: CsgOptions { geometry, skip_unsupported: args.skip_unsupported },
+        up: args.up.map(|u| match u {
+            UpArg::Y => Up::Y,
+            UpArg::Z => Up::Z,
+        }),
+        ground: !args.no_ground,
+        file_camera: args.camera == CameraArg::File,
+    };
     let (width, height) = (args.width, args.height);
     let mut scene = match args.input.as_deref() {
         None => demo_scene()?,
-        Some(p) if is_model(p) => file::scene_for_model_with(p, width.unwrap_or(960), height.unwrap_or(540), &csg)?,
+        Some(p) if is_model(p) => file::scene_for_model_with(p, width.unwrap_or(960), height.unwrap_or(540), &options)?,
         Some(p) => file::load_scene(p)?,
     };
     scene.width = width.unwrap_or(scene.width);

@@ -110,8 +110,8 @@ fn compare_reports_metrics_and_refuses_mismatched_sizes() {
     assert!(!ok && err.contains("missing.pfm"), "{err}");
 }
 
-/// `kage render model.csg` renders it lit and shadowed from its camera
-/// sidecar, exact or faceted; an unsupported node stops it with file, line and
+/// `kage render model.csg --camera file` renders it lit and shadowed from its
+/// camera sidecar, exact or faceted; an unsupported node stops it with file, line and
 /// column unless told to skip it.
 #[test]
 fn the_cli_renders_openscad_files() {
@@ -125,6 +125,8 @@ fn the_cli_renders_openscad_files() {
             model.to_str().unwrap(),
             "--geometry",
             geometry,
+            "--camera",
+            "file",
             "--width",
             "160",
             "--height",

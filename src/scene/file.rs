@@ -17,8 +17,8 @@ use toml::Spanned;
 use super::load::{self, AssetSource, LoadedModel};
 use super::mesh::shapes;
 use super::{
-    framing, Body, Environment, Falloff, Light, LightKind, Material, Object, Scene, ShadowMethod, ShadowSettings,
-    Texture,
+    box_corners, framing, Body, Environment, Falloff, Light, LightKind, Material, Object, Scene, ShadowMethod,
+    ShadowSettings, Texture, Up,
 };
 use crate::camera::{Camera, Projection};
 use crate::csg::openscad::{CsgOptions, Geometry};
@@ -401,6 +401,13 @@ enum GeometryRec {
     Faceted,
 }
 
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+enum UpRec {
+    Y,
+    Z,
+}
+
 #[derive(Debug, Deserialize)]
 #[serde(untagged)]
 enum ScaleRec {
@@ -421,6 +428,8 @@ struct ObjectRec {
     rotate: V3,
     scale: Option<ScaleRec>,
     fit: Option<Spanned<f32>>,
+    /// The model's up axis, when not its format's ([`LoadedModel::up`]).
+    up: Option<UpRec>,
     /// A `.csg` model's spheres and cylinders.
     #[serde(default)]
     geometry: GeometryRec,
@@ -835,21 +844,33 @@ impl SceneFile {
             Some(ScaleRec::Axes(a)) => a.into(),
         };
         let [rx, ry, rz] = r.rotate.map(f32::to_radians);
+        let up = match r.up {
+            Some(UpRec::Y) => Up::Y,
+            Some(UpRec::Z) => Up::Z,
+            None => model.up,
+        };
+        let turn = up.turn();
         let placed = Affine3A::from_scale_rotation_translation(
             scale,
             Quat::from_euler(EulerRot::ZYX, rz, ry, rx),
             r.translate.into(),
         );
-        let Some(fit) = &r.fit else { return Ok(placed) };
-        let (lo, hi) = model.bounds();
+        let Some(fit) = &r.fit else { return Ok(placed * turn) };
+        let (lo, hi) = turned_bounds(model, &turn);
         let extent = (hi - lo).max_element();
         if fit.get_ref().is_nan() || *fit.get_ref() <= 0.0 || extent <= 0.0 {
             return Err(self.invalid(fit.span(), "`fit` must be > 0 and the mesh must have a non-zero extent"));
         }
         let s = fit.get_ref() / extent;
         let base = Vec3::new((lo.x + hi.x) * 0.5, lo.y, (lo.z + hi.z) * 0.5);
-        Ok(placed * Affine3A::from_scale(Vec3::splat(s)) * Affine3A::from_translation(-base))
+        Ok(placed * Affine3A::from_scale(Vec3::splat(s)) * Affine3A::from_translation(-base) * turn)
     }
+}
+
+/// The bounds of `model` turned by `turn` (the box around its turned box).
+fn turned_bounds(model: &LoadedModel, turn: &Affine3A) -> (Vec3, Vec3) {
+    let corners = box_corners(model.bounds()).map(|c| turn.transform_point3(c));
+    corners.iter().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &c| (lo.min(c), hi.max(c)))
 }
 
 /// Adds every part of a loaded model to the scene as objects, with `material`
@@ -888,17 +909,15 @@ pub fn add_model(scene: &mut Scene, model: &LoadedModel, label: &str, transform:
     }
 }
 
-/// A matte ground under `bounds` (z up), four times their size, unless the
-/// camera looks at it from below.
+/// A matte ground under `bounds` (kage's y-up world), four times their size,
+/// unless the camera looks at it from below.
 fn add_ground(scene: &mut Scene, (lo, hi): (Vec3, Vec3)) {
-    if scene.camera.eye.z <= lo.z {
+    if scene.camera.eye.y <= lo.y {
         return;
     }
     let size = 4.0 * (hi - lo).max_element().max(1e-3);
-    let centre = Vec3::new((lo.x + hi.x) * 0.5, (lo.y + hi.y) * 0.5, lo.z);
-    let placed = Affine3A::from_translation(centre)
-        * Affine3A::from_rotation_x(std::f32::consts::FRAC_PI_2)
-        * Affine3A::from_scale(Vec3::splat(size));
+    let centre = Vec3::new((lo.x + hi.x) * 0.5, lo.y, (lo.z + hi.z) * 0.5);
+    let placed = Affine3A::from_translation(centre) * Affine3A::from_scale(Vec3::splat(size));
     scene.materials.push(Material {
         name: "ground".into(),
         ka: Vec3::splat(0.6),
@@ -924,67 +943,79 @@ pub fn load_scene(path: &Path) -> Result<Scene> {
     SceneFile::parse(&text, path)?.build(&load::FileSystem { base })
 }
 
-/// A scene showing one model file, framed automatically.
+/// How a lone model file becomes a scene ([`scene_for_model_with`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ModelOptions {
+    /// How a `.csg` file is read.
+    pub csg: CsgOptions,
+    /// The model's up axis (`None`: its format's, [`LoadedModel::up`]).
+    pub up: Option<Up>,
+    /// Stand the model on a ground that catches its shadows.
+    pub ground: bool,
+    /// See the model through the file's own camera (a glTF camera, an
+    /// OpenSCAD camera sidecar, else OpenSCAD's default view) rather than one
+    /// that frames it.
+    pub file_camera: bool,
+}
+
+impl Default for ModelOptions {
+    fn default() -> Self {
+        ModelOptions { csg: CsgOptions::default(), up: None, ground: true, file_camera: false }
+    }
+}
+
+/// A scene showing one model file, framed automatically, on a ground.
 ///
 /// # Errors
 ///
 /// As [`scene_for_model_with`].
 pub fn scene_for_model(path: &Path, width: u32, height: u32) -> Result<Scene> {
-    scene_for_model_with(path, width, height, &CsgOptions::default())
+    scene_for_model_with(path, width, height, &ModelOptions::default())
 }
 
-/// A scene showing one model file, framed automatically, reading `.csg` files
-/// with `csg`. An OpenSCAD model (z up) is seen from its camera sidecar or
-/// OpenSCAD's default view, lit from above by the same rig as other models
-/// turned z-up (only the key light casts shadows), and stands on a ground that
-/// catches its shadows (left out when the camera looks from below it).
+/// A scene showing one model file as `options` say: turned so that its up
+/// axis is kage's +y, seen by a camera that frames it (or the file's own),
+/// lit by a key light and a dim fill (or the file's own lights), and standing
+/// on a ground that catches its shadows (left out when the camera looks from
+/// below it).
 ///
 /// # Errors
 ///
 /// What loading the model fails with ([`load::model_with`]), or
 /// [`Error::Scene`] when it holds nothing to draw.
-pub fn scene_for_model_with(path: &Path, width: u32, height: u32, csg: &CsgOptions) -> Result<Scene> {
+pub fn scene_for_model_with(path: &Path, width: u32, height: u32, options: &ModelOptions) -> Result<Scene> {
     let base = path.parent().unwrap_or(Path::new(".")).to_path_buf();
     let fs = load::FileSystem { base };
     let name = Path::new(path.file_name().unwrap_or(path.as_os_str()));
-    let model = load::model_with(name, &fs, csg)?;
-    let mut scene = Scene {
-        width,
-        height,
-        background: default_background().into(),
-        camera: framing((Vec3::ZERO, Vec3::ONE), 1.0).0,
-        lights: Vec::new(),
-        materials: Vec::new(),
-        objects: Vec::new(),
-        warnings: Vec::new(),
-        exposure: Default::default(),
-        antialias: Default::default(),
-        fog: None,
-        environment: None,
-        translucency: Default::default(),
-    };
-    add_model(&mut scene, &model, &path.display().to_string(), Affine3A::IDENTITY, None);
+    let model = load::model_with(name, &fs, &options.csg)?;
+    let turn = options.up.unwrap_or(model.up).turn();
+    let mut scene = Scene::new(width, height, framing((Vec3::ZERO, Vec3::ONE), 1.0).0);
+    scene.background = default_background().into();
+    add_model(&mut scene, &model, &path.display().to_string(), turn, None);
     let bounds = scene.bounds().ok_or_else(|| Error::Scene(format!("{}: the model is empty", path.display())))?;
     let (camera, mut lights) = framing(bounds, width as f32 / height as f32);
-    scene.camera = model.camera.unwrap_or(camera);
+    scene.camera = match model.camera.filter(|_| options.file_camera) {
+        Some(own) => own.transformed(&turn),
+        None => camera,
+    };
     if !model.solids.is_empty() {
-        // OpenSCAD models stand on the xy-plane, z up: turn the y-up rig.
-        let centre = (bounds.0 + bounds.1) * 0.5;
-        let z_up = Affine3A::from_translation(centre)
-            * Affine3A::from_rotation_x(std::f32::consts::FRAC_PI_2)
-            * Affine3A::from_translation(-centre);
-        lights.iter_mut().for_each(|l| l.kind = l.kind.transformed(&z_up));
-        // Shadow maps are drawn by the same scanline walk as the view, texel by
-        // texel: the key light's four jittered maps at 256², fitted to the
-        // model alone (the ground casts nothing), so the model spans the map
-        // (their average hides the coarser texels), and none for the fill
-        // light, whose map fitted to the whole view would cost more than the
-        // rest of the frame.
+        // Shadow maps of solids are drawn by the same scanline walk as the
+        // view, texel by texel: the key light's four jittered maps at 512²,
+        // fitted to the model alone (the ground casts nothing), so the model
+        // spans the map (their average hides the coarser texels), and none
+        // for the fill light, whose map fitted to the whole view would cost
+        // more than the rest of the frame.
         lights[0].shadow.resolution = 512;
         lights.iter_mut().skip(1).for_each(|l| l.shadow = ShadowSettings::NONE);
+    }
+    if options.ground {
         add_ground(&mut scene, bounds);
     }
-    scene.lights = if model.lights.is_empty() { lights } else { model.lights.clone() };
+    scene.lights = if model.lights.is_empty() {
+        lights
+    } else {
+        model.lights.iter().map(|l| Light { kind: l.kind.transformed(&turn), ..l.clone() }).collect()
+    };
     if !model.lights.is_empty() {
         // The file's lights are in physical units (candela, lux): expose for them.
         scene.exposure = Exposure::Auto;

@@ -20,7 +20,7 @@ pub use environment::Environment;
 pub use light::{Falloff, Light, LightKind, ShadowMethod, ShadowSettings};
 pub use material::{ComponentMaps, Material};
 pub use mesh::Mesh;
-pub use settings::{Antialias, EdgeFilter, EdgeMode, EdgeSelection, Exposure, Fog, FogMode, TranslucencyOrder};
+pub use settings::{Antialias, EdgeFilter, EdgeMode, EdgeSelection, Exposure, Fog, FogMode, TranslucencyOrder, Up};
 pub use texture::Texture;
 
 use crate::camera::{Camera, Projection};

@@ -2,11 +2,34 @@
 //! order of translucent surfaces. Plain data, read from scene files and command
 //! lines; the stages that act on them live further up the frame.
 
-use glam::{Vec2, Vec3};
+use glam::{Affine3A, Vec2, Vec3};
 
 use crate::camera::{Camera, Projection};
 use crate::image::LinearImage;
 use crate::sampling::radical_inverse;
+
+/// Which axis of a model file points up. kage's world is y-up; a z-up model
+/// (STL from CAD tools and slicers, OpenSCAD) is turned as it is placed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Up {
+    /// +y up (OBJ's convention, glTF's rule).
+    #[default]
+    Y,
+    /// +z up (STL, OpenSCAD).
+    Z,
+}
+
+impl Up {
+    /// The turn from a model with this up axis into kage's y-up world: a
+    /// z-up model's +z becomes +y, its +y becomes −z.
+    #[must_use]
+    pub fn turn(self) -> Affine3A {
+        match self {
+            Up::Y => Affine3A::IDENTITY,
+            Up::Z => Affine3A::from_rotation_x(-std::f32::consts::FRAC_PI_2),
+        }
+    }
+}
 
 /// How bright the 8-bit image is made.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -20,7 +20,7 @@ use std::sync::Arc;
 use glam::{Affine3A, Vec3};
 
 use super::mesh::{Mesh, MeshRepairs};
-use super::{Light, Material, Texture};
+use super::{Light, Material, Texture, Up};
 use crate::camera::Camera;
 use crate::csg::openscad::CsgOptions;
 use crate::csg::CsgSolid;
@@ -113,6 +113,9 @@ pub struct LoadedModel {
     pub lights: Vec<Light>,
     /// What the loader repaired or ignored.
     pub warnings: Vec<String>,
+    /// The up axis its format's files use: z for STL and OpenSCAD, y for
+    /// OBJ and glTF.
+    pub up: Up,
 }
 
 impl LoadedModel {
@@ -172,12 +175,12 @@ pub fn model_with(path: &Path, assets: &dyn AssetSource, csg: &CsgOptions) -> Re
     let fail = |message: String| Error::MeshLoad { path: shown.clone(), message };
     let model = match ext.as_str() {
         "obj" => obj::load(&bytes, path, assets).map_err(fail)?,
-        "stl" => stl::load(&bytes).map_err(fail)?,
+        "stl" => LoadedModel { up: Up::Z, ..stl::load(&bytes).map_err(fail)? },
         "gltf" | "glb" => gltf::load(&bytes, path, assets).map_err(fail)?,
         "csg" => {
             let text = String::from_utf8(bytes).map_err(|_| fail("the file is not UTF-8 text".into()))?;
             let sidecar = assets.read(&path.with_extension("camera.txt")).ok();
-            openscad::model(&shown, text.into(), sidecar.as_deref(), csg)?
+            LoadedModel { up: Up::Z, ..openscad::model(&shown, text.into(), sidecar.as_deref(), csg)? }
         }
         _ => return Err(fail(format!("unknown model format '.{ext}' (kage reads .obj, .stl, .gltf, .glb and .csg)"))),
     };

@@ -1,0 +1,115 @@
+//! A model file dropped in as it is: it stands up as its format means (STL and
+//! OpenSCAD z-up, OBJ and glTF y-up), on a ground that catches its shadow,
+//! seen by a camera that frames it.
+
+use std::path::{Path, PathBuf};
+
+use glam::Vec3;
+use kage::scene::file::{scene_for_model, scene_for_model_with, ModelOptions};
+use kage::scene::Up;
+use kage::shading::{Component, ComponentSet};
+use kage::{render, RenderOptions, Scene};
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("kage-models-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// The twelve triangles of the box `lo..hi`, outward and counter-clockwise.
+fn box_triangles(lo: Vec3, hi: Vec3) -> Vec<[Vec3; 3]> {
+    let c = |i: usize| {
+        Vec3::new(
+            if i & 1 == 0 { lo.x } else { hi.x },
+            if i & 2 == 0 { lo.y } else { hi.y },
+            if i & 4 == 0 { lo.z } else { hi.z },
+        )
+    };
+    let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
+    quads.iter().flat_map(|q| [[c(q[0]), c(q[1]), c(q[2])], [c(q[0]), c(q[2]), c(q[3])]]).collect()
+}
+
+fn write_stl(path: &Path, triangles: &[[Vec3; 3]]) {
+    let mut text = String::from("solid box\n");
+    for t in triangles {
+        let n = (t[1] - t[0]).cross(t[2] - t[0]).normalize();
+        text += &format!("facet normal {} {} {}\nouter loop\n", n.x, n.y, n.z);
+        t.iter().for_each(|v| text += &format!("vertex {} {} {}\n", v.x, v.y, v.z));
+        text += "endloop\nendfacet\n";
+    }
+    text += "endsolid box\n";
+    std::fs::write(path, text).unwrap();
+}
+
+fn write_obj(path: &Path, triangles: &[[Vec3; 3]]) {
+    let mut text = String::new();
+    for t in triangles {
+        t.iter().for_each(|v| text += &format!("v {} {} {}\n", v.x, v.y, v.z));
+    }
+    (0..triangles.len()).for_each(|k| text += &format!("f {} {} {}\n", 3 * k + 1, 3 * k + 2, 3 * k + 3));
+    std::fs::write(path, text).unwrap();
+}
+
+/// Width and height in pixels of what `scene` shows of objects other than
+/// its ground.
+fn shown_size(scene: &Scene) -> (u32, u32) {
+    let frame = render(scene, &RenderOptions::default()).unwrap();
+    let (mut lo, mut hi) = ((u32::MAX, u32::MAX), (0, 0));
+    for y in 0..scene.height {
+        for x in 0..scene.width {
+            let item = frame.visibility.item(x, y);
+            if !item.is_none() && scene.objects[item.object as usize].name != "ground" {
+                (lo, hi) = ((lo.0.min(x), lo.1.min(y)), (hi.0.max(x), hi.1.max(y)));
+            }
+        }
+    }
+    assert!(hi.0 >= lo.0, "the model shows");
+    (hi.0 - lo.0 + 1, hi.1 - lo.1 + 1)
+}
+
+#[test]
+fn a_tall_box_stands_up_from_a_z_up_stl_and_from_a_y_up_obj() {
+    let dir = scratch("tall");
+    let (stl, obj) = (dir.join("tall.stl"), dir.join("tall.obj"));
+    write_stl(&stl, &box_triangles(Vec3::ZERO, Vec3::new(1.0, 1.0, 3.0)));
+    write_obj(&obj, &box_triangles(Vec3::ZERO, Vec3::new(1.0, 3.0, 1.0)));
+    let bare = ModelOptions { ground: false, ..ModelOptions::default() };
+    let mut standing = f32::INFINITY;
+    for path in [&stl, &obj] {
+        let (w, h) = shown_size(&scene_for_model_with(path, 160, 160, &bare).unwrap());
+        assert!(h as f32 > 1.5 * w as f32, "{}: {w} x {h} pixels, not standing", path.display());
+        standing = standing.min(h as f32 / w as f32);
+    }
+    // Told the STL is y-up, the box lies on its side, its long side towards
+    // the camera: far less tall for its width.
+    let lying = ModelOptions { up: Some(Up::Y), ..bare };
+    let (w, h) = shown_size(&scene_for_model_with(&stl, 160, 160, &lying).unwrap());
+    assert!((h as f32 / w as f32) < 0.75 * standing, "lying {w} x {h}, standing {standing} high for wide");
+}
+
+#[test]
+fn a_lone_model_stands_on_a_ground_that_catches_its_shadow() {
+    let dir = scratch("ground");
+    let stl = dir.join("cube.stl");
+    write_stl(&stl, &box_triangles(Vec3::ZERO, Vec3::splat(1.0)));
+    let scene = scene_for_model(&stl, 160, 120).unwrap();
+    let ground = scene.objects.iter().position(|o| o.name == "ground").expect("a ground");
+    assert!(!scene.objects[ground].casts_shadows, "the ground takes no share of the shadow map");
+    let options = RenderOptions { aovs: ComponentSet::only(Component::Diffuse), ..RenderOptions::default() };
+    let frame = render(&scene, &options).unwrap();
+    let diffuse = &frame.aovs[0].1;
+    let mut on_ground: Vec<f32> = (0..scene.height)
+        .flat_map(|y| (0..scene.width).map(move |x| (x, y)))
+        .filter(|&(x, y)| frame.visibility.item(x, y).object as usize == ground)
+        .map(|(x, y)| diffuse.get(x, y).max_element())
+        .collect();
+    assert!(on_ground.len() > 1000, "the ground shows: {} pixels", on_ground.len());
+    on_ground.sort_by(f32::total_cmp);
+    let lit = on_ground[on_ground.len() * 9 / 10];
+    let shadowed = on_ground.iter().filter(|&&d| d < 0.5 * lit).count();
+    assert!(shadowed * 100 >= on_ground.len(), "{shadowed} of {} ground pixels in shadow", on_ground.len());
+    // Without a ground, none.
+    let bare =
+        scene_for_model_with(&stl, 160, 120, &ModelOptions { ground: false, ..ModelOptions::default() }).unwrap();
+    assert!(bare.objects.iter().all(|o| o.name != "ground"));
+}
