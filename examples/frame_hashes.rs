@@ -11,7 +11,7 @@ use std::path::Path;
 
 use kage::csg::openscad::{CsgOptions, Geometry};
 use kage::image::LinearImage;
-use kage::scene::{demo::demo_scene, file, Antialias, EdgeMode, Scene};
+use kage::scene::{demo::demo_scene, file, model, Antialias, EdgeMode, Scene};
 use kage::shading::ComponentSet;
 use kage::{render, RenderOptions};
 
@@ -52,7 +52,7 @@ fn load(input: &str, geometry: Geometry) -> kage::error::Result<Scene> {
         return file::load_scene(path);
     }
     let csg = CsgOptions { geometry, skip_unsupported: false };
-    file::scene_for_model_with(path, 480, 270, &file::ModelOptions { csg, ..Default::default() })
+    model::scene_for_model_with(path, 480, 270, &model::ModelOptions { csg, ..Default::default() })
 }
 
 /// The ways each input is rendered: as its file says, with the edge pass, and

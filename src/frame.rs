@@ -197,12 +197,23 @@ impl Renderer {
     ///
     /// What [`Scene::validate`] finds wrong with the scene.
     pub fn render(&mut self, scene: &Scene) -> Result<&Frame> {
+        self.render_reporting(scene, &|_, _| {})
+    }
+
+    /// As [`Renderer::render`], calling `progress(done, total)` after each
+    /// pass of the frame (a jittered frame has one per sub-pixel sample, any
+    /// other frame one).
+    ///
+    /// # Errors
+    ///
+    /// What [`Scene::validate`] finds wrong with the scene.
+    pub fn render_reporting(&mut self, scene: &Scene, progress: &(dyn Fn(u32, u32) + Sync)) -> Result<&Frame> {
         scene.validate()?;
         let (frame, scratch) = (&mut self.frame, &mut self.scratch);
         let options = &self.options;
         match &self.pool {
-            None => render_into(scene, frame, scratch, options),
-            Some(pool) => pool.install(|| render_into(scene, frame, scratch, options)),
+            None => render_into(scene, frame, scratch, options, progress),
+            Some(pool) => pool.install(|| render_into(scene, frame, scratch, options, progress)),
         }
         Ok(&self.frame)
     }
@@ -244,7 +255,13 @@ pub fn render(scene: &Scene, options: &RenderOptions) -> Result<Frame> {
     Ok(r.into_frame())
 }
 
-fn render_into(scene: &Scene, frame: &mut Frame, scratch: &mut Scratch, options: &RenderOptions) {
+fn render_into(
+    scene: &Scene,
+    frame: &mut Frame,
+    scratch: &mut Scratch,
+    options: &RenderOptions,
+    progress: &(dyn Fn(u32, u32) + Sync),
+) {
     frame.stats = FrameStats::default();
     if !options.keep_shadow_maps {
         scratch.maps.forget();
@@ -258,8 +275,9 @@ fn render_into(scene: &Scene, frame: &mut Frame, scratch: &mut Scratch, options:
         };
         render_pass(scene, frame, scratch, options.ray_depth, edges.as_ref());
         frame.aovs.iter_mut().zip(&mut scratch.aovs).for_each(|((_, a), s)| std::mem::swap(a, s));
+        progress(1, 1);
     } else {
-        render_jittered(scene, &offsets, frame, scratch, options.ray_depth);
+        render_jittered(scene, &offsets, frame, scratch, options.ray_depth, progress);
     }
     frame.stats.buffer_bytes = frame.visibility.memory_bytes()
         + std::mem::size_of_val(frame.image.pixels())
@@ -286,7 +304,14 @@ fn fit_component_images(scene: &Scene, wanted: ComponentSet, frame: &mut Frame, 
 /// Seed 002 §4's accumulation buffer: one pass per sub-pixel `offsets`, each
 /// shifting the image so its item buffer samples another point of every
 /// pixel, averaged into the frame's image and component images.
-fn render_jittered(scene: &Scene, offsets: &[Vec2], frame: &mut Frame, scratch: &mut Scratch, ray_depth: u32) {
+fn render_jittered(
+    scene: &Scene,
+    offsets: &[Vec2],
+    frame: &mut Frame,
+    scratch: &mut Scratch,
+    ray_depth: u32,
+    progress: &(dyn Fn(u32, u32) + Sync),
+) {
     scratch.accum.resize(scene.width, scene.height);
     scratch.accum.pixels_mut().fill(Vec3::ZERO);
     frame.aovs.iter_mut().for_each(|(_, a)| a.pixels_mut().fill(Vec3::ZERO));
@@ -295,11 +320,12 @@ fn render_jittered(scene: &Scene, offsets: &[Vec2], frame: &mut Frame, scratch: 
     scratch.maps.fit_to(Some(scene.camera));
     let weight = 1.0 / offsets.len() as f32;
     let mut pass = scene.clone();
-    for &offset in offsets {
+    for (done, &offset) in (1..).zip(offsets) {
         pass.camera = jitter::shifted(&scene.camera, offset, (scene.width, scene.height));
         render_pass(&pass, frame, scratch, ray_depth, None);
         jitter::accumulate(&mut scratch.accum, &frame.image, weight);
         frame.aovs.iter_mut().zip(&scratch.aovs).for_each(|((_, a), s)| jitter::accumulate(a, s, weight));
+        progress(done, offsets.len() as u32);
     }
     scratch.maps.fit_to(None);
     std::mem::swap(&mut frame.image, &mut scratch.accum);

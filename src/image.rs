@@ -2,10 +2,14 @@
 //! the frame writes into, and the sRGB transfer curve that turns it into 8-bit
 //! colour for display (and decodes 8-bit colour textures).
 
+mod tone;
+
 use std::sync::LazyLock;
 
 use glam::Vec3;
 use rayon::prelude::*;
+
+pub use tone::ToneCurve;
 
 /// A linear-light RGB image, rows top to bottom.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -63,12 +67,22 @@ impl LinearImage {
     /// top to bottom.
     #[must_use]
     pub fn to_srgb8(&self, scale: f32) -> Vec<u8> {
+        self.to_srgb8_toned(scale, ToneCurve::Clip)
+    }
+
+    /// 8-bit sRGB of the image times `scale` through the tone curve `tone`,
+    /// RGB interleaved, rows top to bottom.
+    #[must_use]
+    pub fn to_srgb8_toned(&self, scale: f32, tone: ToneCurve) -> Vec<u8> {
         let encoder = &*SRGB8;
         let mut out = vec![0; self.pixels.len() * 3];
         let rows = out.par_chunks_mut(3 * 1024).zip(self.pixels.par_chunks(1024));
         rows.for_each(|(out, pixels)| {
-            let values = pixels.iter().flat_map(|p| p.to_array());
-            out.iter_mut().zip(values).for_each(|(o, c)| *o = encoder.encode(c * scale));
+            let values = pixels.iter().flat_map(|&p| match tone {
+                ToneCurve::Clip => (p * scale).to_array(),
+                _ => tone.apply(p * scale).to_array(),
+            });
+            out.iter_mut().zip(values).for_each(|(o, c)| *o = encoder.encode(c));
         });
         out
     }

@@ -1,32 +1,44 @@
-//! Writing and reading images: 8-bit sRGB PNG for looking at, linear float OpenEXR
-//! and PFM for measuring. The format follows the file extension.
+//! Writing and reading images: 8-bit sRGB PNG and JPEG for looking at (through
+//! a tone curve), linear float OpenEXR and PFM for measuring. The format follows
+//! the file extension.
 
 use std::path::Path;
 
 use crate::error::{Error, Result};
-use crate::image::{srgb_to_linear, LinearImage};
+use crate::image::{srgb_to_linear, LinearImage, ToneCurve};
 
-/// Writes `image` to `path` as `.png`, `.exr` or `.pfm`. `exposure` (a linear
-/// multiplier) applies to PNG only: float formats keep the rendered values.
+/// JPEG quality of `.jpg` output: no visible blocking on smooth shading.
+const JPEG_QUALITY: u8 = 92;
+
+/// Writes `image` to `path` as `.png`, `.jpg`/`.jpeg`, `.exr` or `.pfm`.
+/// `exposure` (a linear multiplier) and the tone curve `tone` apply to the
+/// 8-bit formats only: float formats keep the rendered values.
 ///
 /// # Errors
 ///
 /// [`Error::Output`] for an unknown extension or when the file cannot be
 /// written.
-pub fn write_image(image: &LinearImage, path: &Path, exposure: f32) -> Result<()> {
+pub fn write_image(image: &LinearImage, path: &Path, exposure: f32, tone: ToneCurve) -> Result<()> {
     let fail = |message: String| Error::Output { path: path.to_path_buf(), message };
     let ext = path.extension().and_then(|e| e.to_str()).unwrap_or_default().to_ascii_lowercase();
     let (w, h) = (image.width(), image.height());
     match ext.as_str() {
-        "png" => ::image::save_buffer(path, &image.to_srgb8(exposure), w, h, ::image::ColorType::Rgb8)
+        "png" => ::image::save_buffer(path, &image.to_srgb8_toned(exposure, tone), w, h, ::image::ColorType::Rgb8)
             .map_err(|e| fail(e.to_string())),
+        "jpg" | "jpeg" => {
+            let file = std::fs::File::create(path).map_err(|e| fail(e.to_string()))?;
+            let mut out = std::io::BufWriter::new(file);
+            let mut encoder = ::image::codecs::jpeg::JpegEncoder::new_with_quality(&mut out, JPEG_QUALITY);
+            let pixels = image.to_srgb8_toned(exposure, tone);
+            encoder.encode(&pixels, w, h, ::image::ExtendedColorType::Rgb8).map_err(|e| fail(e.to_string()))
+        }
         "exr" => {
             let data: Vec<f32> = image.pixels().iter().flat_map(|p| p.to_array()).collect();
             let buf = ::image::Rgb32FImage::from_raw(w, h, data).ok_or_else(|| fail("buffer size".into()))?;
             buf.save(path).map_err(|e| fail(e.to_string()))
         }
         "pfm" => std::fs::write(path, pfm_bytes(image)).map_err(|e| fail(e.to_string())),
-        _ => Err(fail(format!("unknown image format '.{ext}' (use .png, .exr or .pfm)"))),
+        _ => Err(fail(format!("unknown image format '.{ext}' (use .png, .jpg, .exr or .pfm)"))),
     }
 }
 

@@ -3,8 +3,9 @@
 
 use std::path::{Path, PathBuf};
 
-use kage::scene::file::{load_scene, scene_for_model, SceneFile};
+use kage::scene::file::{load_scene, SceneFile};
 use kage::scene::load::FileSystem;
+use kage::scene::model::scene_for_model;
 use kage::{render, Error, RenderOptions};
 
 fn scratch(name: &str) -> PathBuf {

@@ -70,7 +70,8 @@ material = "floor"
 "#
     );
     let file = SceneFile::parse(&text, &data().join("scene.toml")).unwrap();
-    file.build(&FileSystem { base: data() }).unwrap()
+    // Aliased: compared pixel centre for pixel centre with rays.
+    Scene { antialias: kage::scene::Antialias::None, ..file.build(&FileSystem { base: data() }).unwrap() }
 }
 
 fn without_shadows(mut scene: Scene) -> Scene {

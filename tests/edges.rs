@@ -301,7 +301,7 @@ fn silhouette_rmse(image: &LinearImage, truth: &LinearImage, vb: &kage::visibili
 fn the_edge_pass_brings_silhouettes_towards_a_supersampled_frame() {
     let mut scene = kage::scene::demo::demo_scene().unwrap();
     (scene.width, scene.height) = (320, 180);
-    let aliased = render(&scene, &RenderOptions::default()).unwrap();
+    let aliased = render(&Scene { antialias: Antialias::None, ..scene.clone() }, &RenderOptions::default()).unwrap();
     let edged = render(&with_edges(&scene, EdgeSelection::Outline), &RenderOptions::default()).unwrap();
     let truth =
         render(&Scene { antialias: Antialias::Jitter(64), ..scene.clone() }, &RenderOptions::default()).unwrap();

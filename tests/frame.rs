@@ -7,8 +7,8 @@ use std::path::Path;
 
 use glam::Vec3;
 use kage::camera::{Camera, Projection};
-use kage::scene::file::scene_for_model;
 use kage::scene::mesh::shapes;
+use kage::scene::model::scene_for_model;
 use kage::scene::{Falloff, Light, LightKind};
 use kage::{render, RenderOptions};
 
@@ -157,8 +157,8 @@ fn real_models_load_and_frame() {
 #[test]
 fn gltf_cameras_and_lights() {
     if let Some(p) = shared("gltf/Cameras/Cameras.gltf") {
-        let own = kage::scene::file::ModelOptions { file_camera: true, ..Default::default() };
-        let scene = kage::scene::file::scene_for_model_with(&p, 64, 48, &own).unwrap();
+        let own = kage::scene::model::ModelOptions { file_camera: true, ..Default::default() };
+        let scene = kage::scene::model::scene_for_model_with(&p, 64, 48, &own).unwrap();
         assert!(scene.camera.eye.z > 1.0, "the file's camera, not a fitted one: {:?}", scene.camera);
     }
     if let Some(p) = shared("gltf/LightsPunctualLamp/LightsPunctualLamp.gltf") {
@@ -195,7 +195,8 @@ fn simd_shading_matches_the_scalar_reference() {
     });
     scene.materials[1].shininess = 17.5;
     let ortho = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenes/cad-ortho.toml");
-    for scene in [scene, kage::scene::file::load_scene(&ortho).unwrap()] {
+    for mut scene in [scene, kage::scene::file::load_scene(&ortho).unwrap()] {
+        scene.antialias = kage::scene::Antialias::None; // the scalar shader has no edge pass
         let frame = render(&scene, &RenderOptions::default()).unwrap();
         let mut scalar = kage::image::LinearImage::new(scene.width, scene.height);
         kage::shading::shade_into_scalar(&scene, &frame.visibility, &mut scalar);

@@ -5,7 +5,7 @@
 use std::path::{Path, PathBuf};
 
 use glam::Vec3;
-use kage::scene::file::{scene_for_model, scene_for_model_with, ModelOptions};
+use kage::scene::model::{scene_for_model, scene_for_model_with, ModelOptions};
 use kage::scene::Up;
 use kage::shading::{Component, ComponentSet};
 use kage::{render, RenderOptions, Scene};

@@ -194,9 +194,9 @@ fn scanned_coverage_matches_openscads_mesh_rasterized_by_kage() {
         let scanned = kage::visibility::solids::scan_solid(&solid, &camera, w, h);
         // The mesh as OpenSCAD wrote it (z up, no ground): the sidecar camera's frame.
         let as_written =
-            kage::scene::file::ModelOptions { up: Some(kage::scene::Up::Y), ground: false, ..Default::default() };
+            kage::scene::model::ModelOptions { up: Some(kage::scene::Up::Y), ground: false, ..Default::default() };
         let mut scene =
-            kage::scene::file::scene_for_model_with(&path.with_extension("stl"), w, h, &as_written).unwrap();
+            kage::scene::model::scene_for_model_with(&path.with_extension("stl"), w, h, &as_written).unwrap();
         scene.camera = camera;
         let mut vb = kage::visibility::VisibilityBuffer::new(w, h);
         kage::visibility::rasterize(&scene, &mut vb);

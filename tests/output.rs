@@ -3,6 +3,7 @@
 
 use std::path::PathBuf;
 
+use kage::image::ToneCurve;
 use kage::image::{linear_to_srgb, LinearImage};
 use kage::output::write_image;
 
@@ -22,7 +23,7 @@ fn scratch(name: &str) -> PathBuf {
 fn pfm_holds_the_linear_floats_bottom_row_first() {
     let img = gradient();
     let path = scratch("g.pfm");
-    write_image(&img, &path, 1.0).unwrap();
+    write_image(&img, &path, 1.0, ToneCurve::Clip).unwrap();
     let bytes = std::fs::read(&path).unwrap();
     let header = b"PF\n7 5\n-1.0\n";
     assert_eq!(&bytes[..header.len()], header);
@@ -40,13 +41,13 @@ fn pfm_holds_the_linear_floats_bottom_row_first() {
 fn exr_round_trips_unexposed_and_png_is_exposed_srgb() {
     let img = gradient();
     let exr = scratch("g.exr");
-    write_image(&img, &exr, 2.0).unwrap();
+    write_image(&img, &exr, 2.0, ToneCurve::Clip).unwrap();
     let back = image::open(&exr).unwrap().into_rgb32f();
     for (a, b) in back.pixels().zip(img.pixels()) {
         assert_eq!([a[0], a[1], a[2]], b.to_array());
     }
     let png = scratch("g.png");
-    write_image(&img, &png, 0.5).unwrap();
+    write_image(&img, &png, 0.5, ToneCurve::Clip).unwrap();
     let back = image::open(&png).unwrap().into_rgb8();
     for (a, b) in back.pixels().zip(img.pixels()) {
         for k in 0..3 {
@@ -89,11 +90,11 @@ fn written_images_read_back() {
     let img = gradient();
     for ext in ["pfm", "exr"] {
         let path = scratch(&format!("rb.{ext}"));
-        write_image(&img, &path, 1.0).unwrap();
+        write_image(&img, &path, 1.0, ToneCurve::Clip).unwrap();
         assert_eq!(read_image(&path).unwrap(), img, "{ext}");
     }
     let png = scratch("rb.png");
-    write_image(&img, &png, 1.0).unwrap();
+    write_image(&img, &png, 1.0, ToneCurve::Clip).unwrap();
     let back = read_image(&png).unwrap();
     for (a, b) in back.pixels().iter().zip(img.pixels()) {
         // 8-bit sRGB quantisation, values clamped to [0, 1].

@@ -74,6 +74,7 @@ fn two_maps_on_a_component_add_like_two_passes() {
     };
     let (a, b) = (checker(0.2, 0.7), checker(0.5, 0.1));
     let mut scene = example("demo.toml");
+    scene.antialias = kage::scene::Antialias::None;
     scene.lights.iter_mut().for_each(|l| l.ambient = 0.0);
     let with = |maps: Vec<Arc<kage::scene::Texture>>| {
         let mut s = scene.clone();

@@ -14,6 +14,7 @@ fn one_ray_per_pixel_without_shadows_matches_the_rasterizer() {
     let mut scene = kage::scene::demo::demo_scene().unwrap();
     scene.width = 240;
     scene.height = 135;
+    scene.antialias = kage::scene::Antialias::None; // one ray per pixel centre, as the reference
     scene.lights.iter_mut().for_each(|l| l.shadow = ShadowSettings::NONE);
     // The reference filters textures by supersampling, so it reads the finest
     // level; so does the rasterizer with bilinear filtering.

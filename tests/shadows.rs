@@ -218,6 +218,7 @@ fn jittered_area_lights_approach_the_reference_penumbra() {
     use kage::raytrace::reference::{render_reference, ReferenceOptions};
     let mut scene = kage::scene::demo::demo_scene().unwrap();
     (scene.width, scene.height) = (240, 135);
+    scene.antialias = kage::scene::Antialias::None; // one ray per pixel centre, as the reference
     scene.lights.truncate(1); // the point light with size 0.3
                               // The reference filters textures by supersampling (finest level): so here too.
     scene.materials.iter_mut().for_each(|m| m.maps.filter = kage::scene::material::Filter::Bilinear);
@@ -357,7 +358,7 @@ fn scene_files_and_the_model_rig_say_which_objects_cast_shadows() {
     assert_eq!(scene.caster_bounds(), scene.objects[1].world_bounds(), "the maps fit the box");
     // The ground a `.csg` model stands on casts nothing; the model does.
     let model = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/csg/ex004_cube_minus_sphere.csg");
-    let rig = kage::scene::file::scene_for_model(&model, 320, 240).unwrap();
+    let rig = kage::scene::model::scene_for_model(&model, 320, 240).unwrap();
     let ground: Vec<bool> = rig.objects.iter().filter(|o| o.name == "ground").map(|o| o.casts_shadows).collect();
     assert_eq!(ground, [false]);
     assert!(rig.objects.iter().filter(|o| o.name != "ground").all(|o| o.casts_shadows));

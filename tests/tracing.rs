@@ -54,6 +54,7 @@ fn mirror_scene() -> Scene {
         fog: None,
         environment: None,
         translucency: Default::default(),
+        tone: Default::default(),
         camera: Camera {
             eye: Vec3::new(0.0, 0.0, 5.0),
             target: Vec3::ZERO,

@@ -11,7 +11,7 @@ use std::path::Path;
 use criterion::{criterion_group, criterion_main, Criterion};
 use kage::image::LinearImage;
 use kage::raytrace::{traced, TraceCache};
-use kage::scene::{demo::demo_scene, file, Antialias, EdgeMode, Scene};
+use kage::scene::{demo::demo_scene, file, model, Antialias, EdgeMode, Scene};
 use kage::shading::{shade_lit, ComponentSet, SubpixelShading, Target};
 use kage::shadows::{MapPool, ShadowTerm};
 use kage::visibility::{rasterize, solids, VisibilityBuffer};
@@ -93,7 +93,7 @@ fn traced_term(c: &mut Criterion) {
 
 fn csg_walk(c: &mut Criterion) {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/data/csg/ex001_sphere_minus_cylinders.csg");
-    let scene = file::scene_for_model(&path, 1280, 720).expect("the part loads");
+    let scene = model::scene_for_model(&path, 1280, 720).expect("the part loads");
     let object = scene.objects.iter().find(|o| o.solid().is_some()).expect("a solid");
     let solid = object.solid().expect("a solid").transformed(&object.transform);
     let prepared = solids::PreparedSolid::new(&solid, solids::CsgMethod::Segments).expect("no expansion");

@@ -45,7 +45,7 @@ fn scenes(args: &Common) -> Result<Vec<(String, Scene)>> {
         let path = assets.join(model);
         if path.exists() {
             let scene =
-                kage::scene::file::scene_for_model(&path, args.width, args.height).map_err(|e| miette!("{e}"))?;
+                kage::scene::model::scene_for_model(&path, args.width, args.height).map_err(|e| miette!("{e}"))?;
             out.push((model.rsplit('/').next().unwrap_or(model).to_string(), scene));
         } else {
             eprintln!("skipped {} (not found)", path.display());

@@ -339,8 +339,8 @@ pub fn run_preview(preview: &PreviewArgs) -> Result<()> {
         let kage_s = median(&mut runs);
         let theirs = openscad.get(&name).copied();
         let options = CsgOptions { geometry: Geometry::Exact, skip_unsupported: true };
-        let options = kage::scene::file::ModelOptions { csg: options, file_camera: true, ..Default::default() };
-        let scene = kage::scene::file::scene_for_model_with(&path, w, h, &options).map_err(|e| miette!("{e}"))?;
+        let options = kage::scene::model::ModelOptions { csg: options, file_camera: true, ..Default::default() };
+        let scene = kage::scene::model::scene_for_model_with(&path, w, h, &options).map_err(|e| miette!("{e}"))?;
         let fps = orbit_fps(&scene, args.frames.max(3))?;
         let mut plain = scene.clone();
         plain.lights.iter_mut().for_each(|l| l.shadow = kage::scene::ShadowSettings::NONE);

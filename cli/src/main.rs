@@ -8,11 +8,14 @@ mod report;
 use std::path::{Path, PathBuf};
 
 use clap::{Parser, Subcommand};
+use glam::Vec3;
 use kage::csg::openscad::{CsgOptions, Geometry};
-use kage::scene::file::{self, ModelOptions};
-use kage::scene::{demo::demo_scene, Antialias, EdgeFilter, EdgeMode, EdgeSelection, Exposure, Scene, Up};
+use kage::image::ToneCurve;
+use kage::scene::framing::{CameraOverride, View};
+use kage::scene::model::{self, ModelOptions};
+use kage::scene::{demo::demo_scene, file, Antialias, EdgeFilter, EdgeMode, EdgeSelection, Exposure, Scene, Up};
 use kage::shading::{Component, ComponentSet};
-use kage::{render, RenderOptions};
+use kage::{RenderOptions, Renderer};
 
 /// A CPU renderer for design previews.
 #[derive(Parser)]
@@ -56,59 +59,68 @@ struct CompareArgs {
 struct RenderArgs {
     /// Scene or model file (omit for the built-in demo).
     input: Option<PathBuf>,
-    /// Output image: .png (8-bit sRGB), .exr or .pfm (linear float).
+    /// Output image: .png or .jpg (8-bit sRGB through the tone curve), .exr or
+    /// .pfm (linear float, as rendered).
     #[arg(short, long, default_value = "kage.png")]
     output: PathBuf,
-    /// Override the image width in pixels.
+    /// Image width in pixels (default: the scene's, 960 for a model).
     #[arg(long)]
     width: Option<u32>,
-    /// Override the image height in pixels.
+    /// Image height in pixels (default: the scene's, 540 for a model).
     #[arg(long)]
     height: Option<u32>,
     /// Worker threads (default: one per core).
     #[arg(long)]
     threads: Option<usize>,
-    /// Render the ray-traced reference instead of the raster pipeline.
+    /// Render the ray-traced reference (slow, the truth to compare with)
+    /// instead of the fast raster pipeline.
     #[arg(long)]
     reference: bool,
     /// Reference: primary rays per pixel along each axis (n x n per pixel).
     #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=64))]
     spp: u32,
-    /// Reference: shadow rays per light along each axis for lights with a size.
+    /// Reference: shadow rays per light along each axis, for lights with a size.
     #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=64))]
     light_samples: u32,
-    /// Reference: no shadow rays (like the raster pipeline before shadows).
+    /// Reference: no shadows.
     #[arg(long)]
     no_shadows: bool,
-    /// Reflection/refraction bounces for materials with `kr`/`kt` (item-buffer
-    /// tracing in the raster pipeline, recursion in the reference).
+    /// How many times light may bounce off mirrors and through glass
+    /// (materials with reflection `kr` or transmission `kt`).
     #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(0..=16))]
     ray_depth: u32,
-    /// Antialiasing: `none`; `edge` (seed 004's edge pass over silhouettes, boundaries
-    /// and creases), with `:all` for every triangle edge and `:paper` for the paper's
-    /// Wu-line weights (e.g. `edge:all:paper`, the paper as written); or `jitter:N`
-    /// (N sub-pixel-jittered passes averaged, seed 002 §4). Overrides the scene. The
-    /// reference uses --spp instead.
+    /// Antialiasing. `edge` (the default): smooths outlines and creases in one
+    /// extra step, about 1.0-1.3x the time of a frame; `edge:all` smooths every
+    /// triangle edge, `edge:paper` blends as the original edge-pass paper does.
+    /// `jitter:N`: renders N slightly shifted frames and averages them (also
+    /// smooths shadows, textures and reflections; N times the time). `none`: off.
     #[arg(long, value_parser = parse_antialias)]
     antialias: Option<Antialias>,
-    /// Also write these components, each on its own (seed 002 Fig. 4), next to the
-    /// output as NAME.COMPONENT.EXT: a comma list of ambient, diffuse, specular,
-    /// emission (with the background), traced; or `all`. They sum to the image.
+    /// Also write these parts of the image, each on its own, next to the
+    /// output as NAME.PART.EXT: a comma list of ambient, diffuse, specular,
+    /// emission (with the background), traced (reflections and refraction); or
+    /// `all`. They add up to the image.
     #[arg(long, value_parser = parse_components)]
     aov: Option<ComponentSet>,
-    /// Brightness of PNG output: stops (e.g. 1.5, -1) or `auto`; overrides the scene.
+    /// Brightness of 8-bit output: stops (e.g. 1.5, -1) or `auto`.
     #[arg(long, value_parser = parse_exposure, allow_hyphen_values = true)]
     exposure: Option<Exposure>,
-    /// An OpenSCAD .csg model's spheres and cylinders: `exact` quadrics (seed
-    /// 003) or `faceted` as OpenSCAD's own mesh ($fn/$fa/$fs), to compare with
-    /// OpenSCAD pixel for pixel.
+    /// How 8-bit output rolls off light brighter than white: `neutral` (the
+    /// default: colours as the materials say, highlights compressed without
+    /// changing their hue), `agx`, `aces` (film-like contrast), or `none`
+    /// (clipped).
+    #[arg(long, value_parser = parse_tone)]
+    tonemap: Option<ToneCurve>,
+    /// An OpenSCAD .csg model's spheres and cylinders: `exact` (true curved
+    /// surfaces) or `faceted` as OpenSCAD's own mesh ($fn, $fa, $fs), to compare
+    /// with OpenSCAD pixel for pixel.
     #[arg(long, value_enum, default_value_t = GeometryArg::Exact)]
     geometry: GeometryArg,
     /// An OpenSCAD .csg model: skip nodes kage cannot render (linear_extrude,
     /// text, import, ...) with a warning instead of failing.
     #[arg(long)]
     skip_unsupported: bool,
-    /// A model file: which of its axes points up (default: its format's — z
+    /// A model file: which of its axes points up (default: its format's: z
     /// for STL and OpenSCAD, y for OBJ and glTF).
     #[arg(long, value_enum)]
     up: Option<UpArg>,
@@ -120,6 +132,48 @@ struct RenderArgs {
     /// OpenSCAD's default view).
     #[arg(long, value_enum, default_value_t = CameraArg::Framed)]
     camera: CameraArg,
+    /// Frame the model (a scene: its shadow casters) from the front, right,
+    /// top or iso (isometric) side.
+    #[arg(long, value_enum, conflicts_with = "orbit")]
+    view: Option<ViewArg>,
+    /// Frame the model from AZIMUTH,ELEVATION degrees: azimuth about the
+    /// vertical from the front (90: from the right), elevation above the
+    /// horizon (negative: from below). E.g. --orbit 30,20.
+    #[arg(long, value_parser = parse_orbit, allow_hyphen_values = true, value_name = "AZIMUTH,ELEVATION")]
+    orbit: Option<View>,
+    /// Put the camera's eye at X,Y,Z (world units, +y up).
+    #[arg(long, value_parser = parse_point, allow_hyphen_values = true, value_name = "X,Y,Z")]
+    eye: Option<Vec3>,
+    /// Point the camera at X,Y,Z.
+    #[arg(long, value_parser = parse_point, allow_hyphen_values = true, value_name = "X,Y,Z")]
+    target: Option<Vec3>,
+    /// Vertical field of view in degrees (0 to 180).
+    #[arg(long, value_parser = parse_fov)]
+    fov: Option<f32>,
+}
+
+/// `--view`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum ViewArg {
+    /// From the front (+z).
+    Front,
+    /// From the right (+x).
+    Right,
+    /// From above.
+    Top,
+    /// Isometric, front-right and above.
+    Iso,
+}
+
+impl ViewArg {
+    fn view(self) -> View {
+        match self {
+            ViewArg::Front => View::FRONT,
+            ViewArg::Right => View::RIGHT,
+            ViewArg::Top => View::TOP,
+            ViewArg::Iso => View::ISO,
+        }
+    }
 }
 
 /// `--up`.
@@ -204,6 +258,43 @@ fn parse_antialias(s: &str) -> Result<Antialias, String> {
     }
 }
 
+fn parse_tone(s: &str) -> Result<ToneCurve, String> {
+    ToneCurve::from_name(s).ok_or_else(|| {
+        let names: Vec<&str> = ToneCurve::NAMES.iter().map(|(n, _)| *n).collect();
+        format!("'{s}' is not a tone curve (expected one of {})", names.join(", "))
+    })
+}
+
+/// Comma-separated finite numbers, exactly `n` of them.
+fn parse_numbers(s: &str, n: usize, what: &str) -> Result<Vec<f32>, String> {
+    let values: Vec<f32> =
+        s.split(',').filter_map(|v| v.trim().parse::<f32>().ok()).filter(|v| v.is_finite()).collect();
+    if values.len() == n && s.split(',').count() == n {
+        Ok(values)
+    } else {
+        Err(format!("'{s}' is not {what}"))
+    }
+}
+
+fn parse_point(s: &str) -> Result<Vec3, String> {
+    parse_numbers(s, 3, "a point X,Y,Z (three numbers, e.g. 0,1.5,4)").map(|v| Vec3::new(v[0], v[1], v[2]))
+}
+
+fn parse_orbit(s: &str) -> Result<View, String> {
+    let v = parse_numbers(s, 2, "AZIMUTH,ELEVATION in degrees (e.g. 30,20)")?;
+    if v[1].abs() > 90.0 {
+        return Err(format!("elevation {} is not between -90 and 90 degrees", v[1]));
+    }
+    Ok(View { azimuth_deg: v[0], elevation_deg: v[1] })
+}
+
+fn parse_fov(s: &str) -> Result<f32, String> {
+    match s.parse::<f32>() {
+        Ok(v) if v > 0.0 && v < 180.0 => Ok(v),
+        _ => Err(format!("'{s}' is not a field of view between 0 and 180 degrees")),
+    }
+}
+
 fn parse_exposure(s: &str) -> Result<Exposure, String> {
     match s {
         "auto" => Ok(Exposure::Auto),
@@ -226,6 +317,15 @@ fn main() -> miette::Result<()> {
     }
 }
 
+fn camera_override(args: &RenderArgs) -> CameraOverride {
+    CameraOverride {
+        view: args.view.map(ViewArg::view).or(args.orbit),
+        eye: args.eye,
+        target: args.target,
+        fov_deg: args.fov,
+    }
+}
+
 fn load(args: &RenderArgs) -> kage::error::Result<Scene> {
     let is_model = |p: &Path| {
         let ext = p.extension().and_then(|e| e.to_str()).unwrap_or_default().to_ascii_lowercase();
@@ -243,21 +343,31 @@ fn load(args: &RenderArgs) -> kage::error::Result<Scene> {
         }),
         ground: !args.no_ground,
         file_camera: args.camera == CameraArg::File,
+        camera: camera_override(args),
     };
     let (width, height) = (args.width, args.height);
     let mut scene = match args.input.as_deref() {
+        Some(p) if is_model(p) => {
+            return model::scene_for_model_with(p, width.unwrap_or(960), height.unwrap_or(540), &options);
+        }
         None => demo_scene()?,
-        Some(p) if is_model(p) => file::scene_for_model_with(p, width.unwrap_or(960), height.unwrap_or(540), &options)?,
         Some(p) => file::load_scene(p)?,
     };
     scene.width = width.unwrap_or(scene.width);
     scene.height = height.unwrap_or(scene.height);
+    // A scene keeps its lights; the camera moves about what casts shadows
+    // (not the floor it stands on).
+    if let Some(bounds) = scene.caster_bounds().or_else(|| scene.bounds()) {
+        let aspect = scene.width as f32 / scene.height as f32;
+        scene.camera = options.camera.apply(scene.camera, bounds, aspect);
+    }
     Ok(scene)
 }
 
 fn render_command(args: &RenderArgs) -> kage::error::Result<()> {
     let mut scene = load(args)?;
     scene.antialias = args.antialias.unwrap_or(scene.antialias);
+    scene.tone = args.tonemap.unwrap_or(scene.tone);
     for w in &scene.warnings {
         eprintln!("warning: {w}");
     }
@@ -265,16 +375,20 @@ fn render_command(args: &RenderArgs) -> kage::error::Result<()> {
         return reference_command(args, &scene);
     }
     let aovs = args.aov.unwrap_or(ComponentSet::EMPTY);
-    let frame = render(
-        &scene,
-        &RenderOptions { threads: args.threads, ray_depth: args.ray_depth, aovs, ..RenderOptions::default() },
-    )?;
+    let options = RenderOptions { threads: args.threads, ray_depth: args.ray_depth, aovs, ..RenderOptions::default() };
+    let mut renderer = Renderer::new(&options)?;
+    let bar = Progress::new("passes");
+    renderer.render_reporting(&scene, &|done, total| bar.update(done as u64, total as u64))?;
+    bar.finish();
+    let frame = renderer.into_frame();
     let exposure = args.exposure.unwrap_or(scene.exposure).scale(&frame.image);
-    kage::output::write_image(&frame.image, &args.output, exposure)?;
+    kage::output::write_image(&frame.image, &args.output, exposure, scene.tone)?;
     for (c, image) in &frame.aovs {
-        // The same exposure as the final image, so the components add up to it.
+        // The same exposure and curve as the final image. (The parts add up
+        // before the curve; with a rolling curve their 8-bit images only
+        // roughly add up to the final one: .exr output adds up exactly.)
         let path = aov_path(&args.output, c.name());
-        kage::output::write_image(image, &path, exposure)?;
+        kage::output::write_image(image, &path, exposure, scene.tone)?;
         eprintln!("wrote {} ({} component)", path.display(), c.name());
     }
     if frame.visibility.items().iter().all(|i| i.is_none()) {
@@ -282,7 +396,7 @@ fn render_command(args: &RenderArgs) -> kage::error::Result<()> {
     }
     let s = frame.stats;
     eprintln!(
-        "wrote {} ({}x{}, {} triangles, {} solids, {} pass{}): visibility {:.1} ms, shadow maps {:.1} ms, shading {:.1} ms, traced {:.1} ms ({} pixels)",
+        "wrote {} ({}x{}, {} triangles, {} solids, {} pass{}): visibility {:.1} ms, shadow maps {:.1} ms, shading {:.1} ms, reflections and refraction {:.1} ms ({} pixels)",
         args.output.display(),
         scene.width,
         scene.height,
@@ -297,9 +411,37 @@ fn render_command(args: &RenderArgs) -> kage::error::Result<()> {
         s.traced_pixels
     );
     if let Antialias::Edge(_) = scene.antialias {
-        eprintln!("edge pass (seed 004): {:.1} ms, {} pixels blended", s.edge_ms, s.edge_blends);
+        eprintln!("antialiased edges: {:.1} ms, {} pixels blended", s.edge_ms, s.edge_blends);
     }
     Ok(())
+}
+
+/// A progress bar on standard error that shows itself only once the work has
+/// taken over half a second, and only on a terminal.
+struct Progress {
+    bar: indicatif::ProgressBar,
+    start: std::time::Instant,
+}
+
+impl Progress {
+    fn new(unit: &str) -> Progress {
+        let bar = indicatif::ProgressBar::hidden();
+        let template = format!("{{bar:40}} {{pos}}/{{len}} {unit}, {{elapsed}} (eta {{eta}})");
+        bar.set_style(indicatif::ProgressStyle::with_template(&template).expect("valid template"));
+        Progress { bar, start: std::time::Instant::now() }
+    }
+
+    fn update(&self, done: u64, total: u64) {
+        self.bar.set_length(total);
+        self.bar.set_position(done);
+        if self.bar.is_hidden() && done < total && self.start.elapsed().as_secs_f32() > 0.5 {
+            self.bar.set_draw_target(indicatif::ProgressDrawTarget::stderr());
+        }
+    }
+
+    fn finish(&self) {
+        self.bar.finish_and_clear();
+    }
 }
 
 fn compare_command(args: &CompareArgs) -> kage::error::Result<()> {
@@ -315,7 +457,7 @@ fn compare_command(args: &CompareArgs) -> kage::error::Result<()> {
     }
     if let Some(path) = &args.diff {
         let d = kage::compare::difference_image(&a, &b, args.diff_scale)?;
-        kage::output::write_image(&d, path, 1.0)?;
+        kage::output::write_image(&d, path, 1.0, ToneCurve::Clip)?;
         eprintln!("wrote {}", path.display());
     }
     Ok(())
@@ -350,7 +492,7 @@ fn reference_command(args: &RenderArgs, scene: &Scene) -> kage::error::Result<()
         eprintln!("interrupted: {rows} of {} rows traced; the rest of the image is black", scene.height);
     }
     let exposure = args.exposure.unwrap_or(scene.exposure).scale(&image);
-    kage::output::write_image(&image, &args.output, exposure)?;
+    kage::output::write_image(&image, &args.output, exposure, scene.tone)?;
     eprintln!(
         "wrote {} (ray-traced reference, {2}x{2} rays per pixel, {3}x{3} per area light, shadows {4}): {1:.2} s",
         args.output.display(),

@@ -16,13 +16,8 @@ pub fn to_report(e: Error) -> Report {
     match located {
         Some((loc, message)) => {
             let len = loc.span.len().max(1);
+            // No diagnostic code: the first line a user reads is the message.
             let diag = MietteDiagnostic::new(format!("{}: {}", loc, message))
-                .with_code(match e {
-                    Error::SceneSyntax { .. } => "kage::scene::syntax",
-                    Error::CsgSyntax { .. } => "kage::csg::syntax",
-                    Error::CsgInvalid { .. } => "kage::csg::invalid",
-                    _ => "kage::scene::invalid",
-                })
                 .with_label(LabeledSpan::at(loc.span.start..loc.span.start + len, "here"));
             let source = NamedSource::new(loc.path.display().to_string(), loc.text.to_string());
             Report::new(diag).with_source_code(source)

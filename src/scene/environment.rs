@@ -7,6 +7,7 @@ use std::sync::Arc;
 
 use glam::{Vec2, Vec3};
 
+use super::texture::Wrap;
 use super::Texture;
 
 /// An image surrounding the scene at infinity.
@@ -25,10 +26,65 @@ pub struct Environment {
 }
 
 impl Environment {
+    /// The environment of equirectangular image `map` (its wrap mode set to
+    /// [`Wrap::Longitude`]), scaled by `intensity`, turned by `rotation`
+    /// radians about +y, `visible` as the background or not.
+    #[must_use]
+    pub fn new(map: Arc<Texture>, intensity: f32, rotation: f32, visible: bool) -> Environment {
+        let mut map = Arc::unwrap_or_clone(map);
+        map.wrap = Wrap::Longitude;
+        Environment { map: Arc::new(map), intensity, rotation, visible }
+    }
+
     /// Light arriving from direction `dir` (need not be unit length).
     #[must_use]
     pub fn radiance(&self, dir: Vec3) -> Vec3 {
         self.map.sample(Self::uv(dir, self.rotation)) * self.intensity
+    }
+
+    /// A photo studio around the scene, for metals to mirror when a model
+    /// comes without an environment: a bright overhead softbox fading to a
+    /// mid-grey horizon, two tall strip lights left and right in front, a dark
+    /// floor below. Not visible as the background.
+    #[must_use]
+    pub fn studio() -> Environment {
+        let (w, h) = (256u32, 128u32);
+        let texels = (0..w * h)
+            .map(|i| {
+                let (u, v) = (((i % w) as f32 + 0.5) / w as f32, ((i / w) as f32 + 0.5) / h as f32);
+                let elevation = (0.5 - v) * std::f32::consts::PI; // +π/2 up
+                                                                  // Degrees round from the front (+z), which is u = 0.
+                let azimuth = (u - 0.5).abs() * 360.0 - 180.0;
+                let sky = if elevation > 0.0 {
+                    let e = elevation.sin();
+                    0.5 + 1.1 * smoothstep(0.75, 0.9, e)
+                } else {
+                    0.18 - 0.06 * (-elevation).sin()
+                };
+                let strip = (azimuth.abs() - 60.0).abs() < 9.0 && (0.0..0.75).contains(&elevation);
+                Vec3::splat(if strip { 2.0 } else { sky })
+            })
+            .collect();
+        Environment::new(Arc::new(Texture::from_texels(w, h, texels)), 1.0, 0.0, false)
+    }
+
+    /// Light arriving from around direction `dir`, filtered over the
+    /// directions `right` and `down` that the neighbouring pixels see (the
+    /// image level whose texels match that spread, so that a curved mirror
+    /// seen small does not alias the map into moiré).
+    #[must_use]
+    pub fn radiance_over(&self, dir: Vec3, right: Vec3, down: Vec3) -> Vec3 {
+        let uv = Self::uv(dir, self.rotation);
+        // A step across is sin(polar angle) as wide on the sphere as in the
+        // image: near the poles the image stretches a small spread of
+        // directions over many texels, which must not pick a coarse level.
+        let across = (uv.y * std::f32::consts::PI).sin();
+        let step = |other: Vec3| {
+            let d = Self::uv(other, self.rotation) - uv;
+            // Longitude goes round: the short way across the seam.
+            Vec2::new((d.x - d.x.round()) * across, d.y)
+        };
+        self.map.sample_footprint(uv, [step(right), step(down)]) * self.intensity
     }
 
     /// The image position of direction `dir` turned by `rotation` about +y.
@@ -42,9 +98,32 @@ impl Environment {
     }
 }
 
+fn smoothstep(lo: f32, hi: f32, x: f32) -> f32 {
+    let t = ((x - lo) / (hi - lo)).clamp(0.0, 1.0);
+    t * t * (3.0 - 2.0 * t)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_studio_is_bright_above_grey_at_the_horizon_dark_below() {
+        let s = Environment::studio();
+        let (up, side, down) =
+            (s.radiance(Vec3::Y).x, s.radiance(Vec3::new(0.0, 0.05, -1.0)).x, s.radiance(Vec3::NEG_Y).x);
+        assert!(up > 1.4 && (0.4..0.7).contains(&side) && down < 0.2, "up {up}, horizon {side}, down {down}");
+        // The strip lights stand 60° either side of the front (+z).
+        let strip = |deg: f32| s.radiance(Vec3::new(deg.to_radians().sin(), 0.3, deg.to_radians().cos())).x;
+        assert!(
+            strip(60.0) > 1.5 && strip(-60.0) > 1.5 && strip(0.0) < 1.0,
+            "{} {} {}",
+            strip(60.0),
+            strip(-60.0),
+            strip(0.0)
+        );
+        assert!(!s.visible);
+    }
 
     #[test]
     fn directions_map_to_the_expected_image_positions() {

@@ -23,6 +23,7 @@ use super::{
 use crate::camera::{Camera, Projection};
 use crate::csg::openscad::{CsgOptions, Geometry};
 use crate::error::{Error, Result, SourceLocation};
+use crate::image::ToneCurve;
 use crate::scene::material::Filter;
 use crate::scene::settings::{
     Antialias, EdgeFilter, EdgeMode, EdgeSelection, Exposure, Fog, FogMode, TranslucencyOrder, MAX_JITTER_SAMPLES,
@@ -70,6 +71,29 @@ struct ImageRec {
     antialias: Option<Spanned<AntialiasRec>>,
     #[serde(default)]
     translucency: TranslucencyRec,
+    #[serde(default)]
+    tonemap: ToneRec,
+}
+
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default)]
+#[serde(rename_all = "kebab-case")]
+enum ToneRec {
+    None,
+    #[default]
+    Neutral,
+    Agx,
+    Aces,
+}
+
+impl From<ToneRec> for ToneCurve {
+    fn from(r: ToneRec) -> Self {
+        match r {
+            ToneRec::None => ToneCurve::Clip,
+            ToneRec::Neutral => ToneCurve::Neutral,
+            ToneRec::Agx => ToneCurve::Agx,
+            ToneRec::Aces => ToneCurve::Aces,
+        }
+    }
 }
 
 #[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default)]
@@ -172,6 +196,7 @@ impl Default for ImageRec {
             exposure: ExposureRec::default(),
             antialias: None,
             translucency: TranslucencyRec::default(),
+            tonemap: ToneRec::default(),
         }
     }
 }
@@ -474,7 +499,7 @@ impl SceneFile {
         }
         // PNG and JPEG hold sRGB-encoded colours; EXR linear radiance (the loader knows).
         let map = load::texture(Path::new(r.map.get_ref()), true, assets)?;
-        Ok(Some(Environment { map, intensity: r.intensity, rotation: r.rotate.to_radians(), visible: r.background }))
+        Ok(Some(Environment::new(map, r.intensity, r.rotate.to_radians(), r.background)))
     }
 
     fn fog(&self) -> Result<Option<Fog>> {
@@ -502,7 +527,7 @@ impl SceneFile {
     }
 
     fn antialias(&self) -> Result<Antialias> {
-        let Some(rec) = &self.image.antialias else { return Ok(Antialias::None) };
+        let Some(rec) = &self.image.antialias else { return Ok(Antialias::default()) };
         let rec = rec.get_ref();
         let method = rec.method.get_ref().as_str();
         if method != "edge" {
@@ -581,6 +606,7 @@ impl SceneFile {
             objects: Vec::new(),
             warnings: Vec::new(),
             exposure: self.image.exposure.into(),
+            tone: self.image.tonemap.into(),
             antialias: self.antialias()?,
             fog: self.fog()?,
             environment: self.environment(assets)?,
@@ -909,28 +935,6 @@ pub fn add_model(scene: &mut Scene, model: &LoadedModel, label: &str, transform:
     }
 }
 
-/// A matte ground under `bounds` (kage's y-up world), four times their size,
-/// unless the camera looks at it from below.
-fn add_ground(scene: &mut Scene, (lo, hi): (Vec3, Vec3)) {
-    if scene.camera.eye.y <= lo.y {
-        return;
-    }
-    let size = 4.0 * (hi - lo).max_element().max(1e-3);
-    let centre = Vec3::new((lo.x + hi.x) * 0.5, lo.y, (lo.z + hi.z) * 0.5);
-    let placed = Affine3A::from_translation(centre) * Affine3A::from_scale(Vec3::splat(size));
-    scene.materials.push(Material {
-        name: "ground".into(),
-        ka: Vec3::splat(0.6),
-        kd: Vec3::splat(0.6),
-        ks: Vec3::ZERO,
-        ..Material::default()
-    });
-    let ground = Object::mesh("ground", Arc::new(shapes::plane()), placed, scene.materials.len() - 1);
-    // It lies under the model: its shadows fall on nothing, and in the key
-    // light's map it would widen the map fourfold around the model.
-    scene.objects.push(Object { casts_shadows: false, ..ground });
-}
-
 /// Reads and builds a scene file from disk.
 ///
 /// # Errors
@@ -941,85 +945,4 @@ pub fn load_scene(path: &Path) -> Result<Scene> {
     let text = std::fs::read_to_string(path).map_err(|source| Error::Read { path: path.to_path_buf(), source })?;
     let base = path.parent().unwrap_or(Path::new(".")).to_path_buf();
     SceneFile::parse(&text, path)?.build(&load::FileSystem { base })
-}
-
-/// How a lone model file becomes a scene ([`scene_for_model_with`]).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct ModelOptions {
-    /// How a `.csg` file is read.
-    pub csg: CsgOptions,
-    /// The model's up axis (`None`: its format's, [`LoadedModel::up`]).
-    pub up: Option<Up>,
-    /// Stand the model on a ground that catches its shadows.
-    pub ground: bool,
-    /// See the model through the file's own camera (a glTF camera, an
-    /// OpenSCAD camera sidecar, else OpenSCAD's default view) rather than one
-    /// that frames it.
-    pub file_camera: bool,
-}
-
-impl Default for ModelOptions {
-    fn default() -> Self {
-        ModelOptions { csg: CsgOptions::default(), up: None, ground: true, file_camera: false }
-    }
-}
-
-/// A scene showing one model file, framed automatically, on a ground.
-///
-/// # Errors
-///
-/// As [`scene_for_model_with`].
-pub fn scene_for_model(path: &Path, width: u32, height: u32) -> Result<Scene> {
-    scene_for_model_with(path, width, height, &ModelOptions::default())
-}
-
-/// A scene showing one model file as `options` say: turned so that its up
-/// axis is kage's +y, seen by a camera that frames it (or the file's own),
-/// lit by a key light and a dim fill (or the file's own lights), and standing
-/// on a ground that catches its shadows (left out when the camera looks from
-/// below it).
-///
-/// # Errors
-///
-/// What loading the model fails with ([`load::model_with`]), or
-/// [`Error::Scene`] when it holds nothing to draw.
-pub fn scene_for_model_with(path: &Path, width: u32, height: u32, options: &ModelOptions) -> Result<Scene> {
-    let base = path.parent().unwrap_or(Path::new(".")).to_path_buf();
-    let fs = load::FileSystem { base };
-    let name = Path::new(path.file_name().unwrap_or(path.as_os_str()));
-    let model = load::model_with(name, &fs, &options.csg)?;
-    let turn = options.up.unwrap_or(model.up).turn();
-    let mut scene = Scene::new(width, height, framing((Vec3::ZERO, Vec3::ONE), 1.0).0);
-    scene.background = default_background().into();
-    add_model(&mut scene, &model, &path.display().to_string(), turn, None);
-    let bounds = scene.bounds().ok_or_else(|| Error::Scene(format!("{}: the model is empty", path.display())))?;
-    let (camera, mut lights) = framing(bounds, width as f32 / height as f32);
-    scene.camera = match model.camera.filter(|_| options.file_camera) {
-        Some(own) => own.transformed(&turn),
-        None => camera,
-    };
-    if !model.solids.is_empty() {
-        // Shadow maps of solids are drawn by the same scanline walk as the
-        // view, texel by texel: the key light's four jittered maps at 512²,
-        // fitted to the model alone (the ground casts nothing), so the model
-        // spans the map (their average hides the coarser texels), and none
-        // for the fill light, whose map fitted to the whole view would cost
-        // more than the rest of the frame.
-        lights[0].shadow.resolution = 512;
-        lights.iter_mut().skip(1).for_each(|l| l.shadow = ShadowSettings::NONE);
-    }
-    if options.ground {
-        add_ground(&mut scene, bounds);
-    }
-    scene.lights = if model.lights.is_empty() {
-        lights
-    } else {
-        model.lights.iter().map(|l| Light { kind: l.kind.transformed(&turn), ..l.clone() }).collect()
-    };
-    if !model.lights.is_empty() {
-        // The file's lights are in physical units (candela, lux): expose for them.
-        scene.exposure = Exposure::Auto;
-    }
-    scene.validate()?;
-    Ok(scene)
 }

@@ -5,10 +5,12 @@
 pub mod demo;
 pub mod environment;
 pub mod file;
+pub mod framing;
 pub mod light;
 pub mod load;
 pub mod material;
 pub mod mesh;
+pub mod model;
 pub mod settings;
 pub mod texture;
 
@@ -17,15 +19,17 @@ use std::sync::Arc;
 use glam::{Affine3A, Vec3};
 
 pub use environment::Environment;
+pub use framing::framing;
 pub use light::{Falloff, Light, LightKind, ShadowMethod, ShadowSettings};
 pub use material::{ComponentMaps, Material};
 pub use mesh::Mesh;
 pub use settings::{Antialias, EdgeFilter, EdgeMode, EdgeSelection, Exposure, Fog, FogMode, TranslucencyOrder, Up};
 pub use texture::Texture;
 
-use crate::camera::{Camera, Projection};
+use crate::camera::Camera;
 use crate::csg::CsgSolid;
 use crate::error::{Error, Result};
+use crate::image::ToneCurve;
 
 /// Largest image side kage accepts, in pixels.
 pub const MAX_IMAGE_SIDE: u32 = 16_384;
@@ -176,6 +180,8 @@ pub struct Scene {
     pub background: Vec3,
     /// Brightness of 8-bit output.
     pub exposure: Exposure,
+    /// How 8-bit output rolls off light above white.
+    pub tone: ToneCurve,
     /// How edges are antialiased.
     pub antialias: Antialias,
     /// Fog (seed 002 §3.5), if any.
@@ -226,6 +232,7 @@ impl Scene {
             height,
             background: Vec3::new(0.1, 0.1, 0.15),
             exposure: Exposure::default(),
+            tone: ToneCurve::default(),
             antialias: Antialias::default(),
             fog: None,
             environment: None,
@@ -290,49 +297,4 @@ impl Scene {
     pub fn triangle_count(&self) -> usize {
         self.objects.iter().filter_map(Object::triangles).map(|m| m.triangles.len()).sum()
     }
-}
-
-/// A camera and lights that show everything inside `bounds`: the camera looks at
-/// the centre from above and in front, far enough that the bounding sphere fits the
-/// vertical field of view; a key light and a dim fill light.
-#[must_use]
-pub fn framing(bounds: (Vec3, Vec3), aspect: f32) -> (Camera, Vec<Light>) {
-    let (lo, hi) = bounds;
-    let c = (lo + hi) * 0.5;
-    let r = ((hi - lo).length() * 0.5).max(1e-3);
-    let fov_y_deg: f32 = 40.0;
-    let half_v = fov_y_deg.to_radians() * 0.5;
-    let half = half_v.min((half_v.tan() * aspect).atan());
-    let dist = 1.05 * r / half.sin();
-    let eye = c + dist * Vec3::new(0.45, 0.5, 1.0).normalize();
-    let camera = Camera {
-        eye,
-        target: c,
-        up: Vec3::Y,
-        near: (dist - r).max(dist * 1e-3) * 0.5,
-        far: (dist + r) * 2.0,
-        projection: Projection::Perspective { fov_y_deg },
-        shift: glam::Vec2::ZERO,
-    };
-    let key = Light {
-        kind: LightKind::Point { position: c + r * Vec3::new(1.5, 3.0, 1.2) },
-        color: Vec3::ONE,
-        intensity: 0.85,
-        ambient: 0.12,
-        size: 0.05 * r,
-        falloff: Falloff::None,
-        // Four jittered maps: soft enough for so small a light, quick to preview.
-        shadow: ShadowSettings { samples: 4, ..ShadowSettings::default() },
-        ..Light::default()
-    };
-    let fill = Light {
-        kind: LightKind::Directional { direction: Vec3::new(1.0, -0.3, 0.6).normalize() },
-        color: Vec3::new(0.75, 0.8, 1.0),
-        intensity: 0.3,
-        ambient: 0.0,
-        size: 0.0,
-        falloff: Falloff::None,
-        ..Light::default()
-    };
-    (camera, vec![key, fill])
 }

@@ -71,16 +71,23 @@ impl Exposure {
     }
 }
 
-/// How a frame is antialiased.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+/// How a frame is antialiased. The default is the edge pass with its default
+/// mode: silhouettes, boundaries and creases blended by coverage, at about the
+/// cost of one more shading pass over the edge pixels.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Antialias {
     /// One sample at each pixel centre.
-    #[default]
     None,
     /// `n` frames with sub-pixel jitter, averaged (n = 1 is one centred frame).
     Jitter(u32),
     /// One frame, then the edge pass (seed 004).
     Edge(EdgeMode),
+}
+
+impl Default for Antialias {
+    fn default() -> Self {
+        Antialias::Edge(EdgeMode::default())
+    }
 }
 
 /// Most jittered passes one frame may take.

@@ -16,13 +16,24 @@ pub enum Wrap {
     Clamp,
     /// The image tiles, every other copy mirrored.
     Mirror,
+    /// An equirectangular map: tiles across (longitude goes round), the top
+    /// and bottom rows extend (latitude stops at the poles).
+    Longitude,
 }
 
 impl Wrap {
+    /// The modes across (u) and down (v).
+    fn axes(self) -> (Wrap, Wrap) {
+        match self {
+            Wrap::Longitude => (Wrap::Repeat, Wrap::Clamp),
+            w => (w, w),
+        }
+    }
+
     /// Texel index `i` of a row of `n`, wrapped.
     fn index(self, i: i64, n: i64) -> i64 {
         match self {
-            Wrap::Repeat => i.rem_euclid(n),
+            Wrap::Repeat | Wrap::Longitude => i.rem_euclid(n),
             Wrap::Clamp => i.clamp(0, n - 1),
             Wrap::Mirror => {
                 let k = i.rem_euclid(2 * n);
@@ -64,8 +75,9 @@ impl Level {
         }
         let (x0, y0) = (x.floor(), y.floor());
         let (fx, fy) = (x - x0, y - y0);
-        let [i0, i1] = wrap.pair(x0 as i64, w);
-        let [j0, j1] = wrap.pair(y0 as i64, h).map(|j| j * w as usize);
+        let (across, down) = wrap.axes();
+        let [i0, i1] = across.pair(x0 as i64, w);
+        let [j0, j1] = down.pair(y0 as i64, h).map(|j| j * w as usize);
         let at = |i: usize, j: usize| self.texels[j + i];
         let top = at(i0, j0).lerp(at(i1, j0), fx);
         let bottom = at(i0, j1).lerp(at(i1, j1), fx);
@@ -133,6 +145,12 @@ impl Texture {
             levels.push(next);
         }
         Texture { levels, wrap: Wrap::Repeat }
+    }
+
+    /// Width and height of the finest level, in texels.
+    #[must_use]
+    pub fn size(&self) -> (u32, u32) {
+        (self.levels[0].width, self.levels[0].height)
     }
 
     /// Bilinear sample of the finest level at `uv` (origin top-left, texel centres

@@ -3,6 +3,9 @@
 //! mirror direction R = 2(N·V)N − V at each surface whose material has a Km — a
 //! reflection with no ray traced, which is all the paper's hardware could do.
 //! The same pass writes the environment as the background where it is visible.
+//! Each pixel's lookup is filtered over the directions its neighbours see (the
+//! map's mip level matching that spread): a curved mirror seen small shows the
+//! map's average there, not moiré.
 
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
@@ -31,15 +34,34 @@ pub fn add_reflection_map(scene: &Scene, vb: &VisibilityBuffer, targets: &mut [T
         let rows = t.image.pixels_mut().par_chunks_mut(w).zip(vb.items().par_chunks(w));
         rows.enumerate().for_each(|(y, (out, items))| {
             for (x, (px, &item)) in out.iter_mut().zip(items).enumerate() {
-                let ray = || rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
+                let (x, y) = (x as u32, y as u32);
+                let ray = |x: u32, y: u32| rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
                 if item.is_none() {
                     if background && env.visible {
-                        *px += env.radiance(ray().dir);
+                        let dir = |x: u32, y: u32| ray(x, y).dir.normalize();
+                        *px += env.radiance_over(dir(x, y), dir(x + 1, y), dir(x, y + 1));
                     }
                     continue;
                 }
                 if reflection && reflecting[item.material(scene)] {
-                    *px += reflection_map(scene, &frames.surface_at(scene, vb, x as u32, y as u32, &ray()));
+                    let s = frames.surface_at(scene, vb, x, y, &ray(x, y));
+                    let mirror = |x: u32, y: u32| mirror_direction(&frames.surface_at(scene, vb, x, y, &ray(x, y)));
+                    let r = mirror_direction(&s);
+                    // The spread of mirror directions to the pixels beside and
+                    // below, taken from the other side where they show another object.
+                    let beside = |dx: i32, dy: i32| {
+                        let at = |k: i32| (x as i32 + k * dx, y as i32 + k * dy);
+                        [1, -1].into_iter().map(at).find(|&(nx, ny)| {
+                            nx >= 0
+                                && ny >= 0
+                                && (nx as u32) < vb.width()
+                                && (ny as u32) < vb.height()
+                                && vb.item(nx as u32, ny as u32).object == item.object
+                        })
+                    };
+                    let spread = |n: Option<(i32, i32)>| n.map_or(r, |(nx, ny)| mirror(nx as u32, ny as u32));
+                    let km = scene.materials[s.material].km;
+                    *px += km * env.radiance_over(r, spread(beside(1, 0)), spread(beside(0, 1)));
                 }
             }
         });
@@ -47,14 +69,21 @@ pub fn add_reflection_map(scene: &Scene, vb: &VisibilityBuffer, targets: &mut [T
 }
 
 /// Ie at one surface point: Km times the environment in the view's mirror
-/// direction R = 2(N·V)N − V (zero without an environment or a Km).
+/// direction R = 2(N·V)N − V (zero without an environment or a Km), one
+/// lookup of the map's finest level (a sample, not a pixel: the frame's pass
+/// filters over each pixel's spread of directions).
 #[must_use]
 pub fn reflection_map(scene: &Scene, s: &SurfacePoint) -> Vec3 {
     let km = scene.materials[s.material].km;
     match &scene.environment {
-        Some(env) if km.max_element() > 0.0 => km * env.radiance(2.0 * s.normal.dot(s.to_eye) * s.normal - s.to_eye),
+        Some(env) if km.max_element() > 0.0 => km * env.radiance(mirror_direction(s)),
         _ => Vec3::ZERO,
     }
+}
+
+/// R = 2(N·V)N − V.
+fn mirror_direction(s: &SurfacePoint) -> Vec3 {
+    2.0 * s.normal.dot(s.to_eye) * s.normal - s.to_eye
 }
 
 /// What the first pass writes where no object is seen in a target holding the

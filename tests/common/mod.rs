@@ -9,11 +9,12 @@ use std::sync::Arc;
 use glam::{Affine3A, Vec3};
 use kage::camera::{Camera, Projection};
 use kage::scene::mesh::NormalMode;
-use kage::scene::{Falloff, Light, LightKind, Material, Mesh, Object, Scene};
+use kage::scene::{Antialias, Falloff, Light, LightKind, Material, Mesh, Object, Scene};
 use rand::rngs::StdRng;
 use rand::Rng;
 
-/// A scene of one object holding `mesh`, seen by `camera`.
+/// A scene of one object holding `mesh`, seen by `camera`, one sample at each
+/// pixel centre (no antialiasing), as the ray caster samples it.
 pub fn scene_with(mesh: Mesh, camera: Camera, width: u32, height: u32, two_sided: bool) -> Scene {
     Scene {
         width,
@@ -33,10 +34,11 @@ pub fn scene_with(mesh: Mesh, camera: Camera, width: u32, height: u32, two_sided
         objects: vec![Object::mesh("soup", Arc::new(mesh), Affine3A::IDENTITY, 0)],
         warnings: Vec::new(),
         exposure: Default::default(),
-        antialias: Default::default(),
+        antialias: Antialias::None,
         fog: None,
         environment: None,
         translucency: Default::default(),
+        tone: Default::default(),
     }
 }
 

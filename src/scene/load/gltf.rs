@@ -2,9 +2,16 @@
 //! `KHR_lights_punctual` lights.
 //!
 //! Metallic-roughness materials map onto seed 002's Phong coefficients:
-//! Kd = base colour · (1 − metallic), Ka = Kd, Ks = mix(0.04, base colour, metallic),
-//! n = 2/α² − 2 with α = roughness² (the Blinn-Phong exponent of equal lobe width),
-//! Ke = emissive; the base-colour texture multiplies Kd and Ka, the emissive texture Ke.
+//! Kd = base colour · (1 − metallic), Ka = Kd · occlusion, Ks = mix(0.04, base
+//! colour, metallic), Km = base colour · metallic (a metal mirrors the
+//! environment: a lone model gets a studio one), n = 2/α² − 2 with α =
+//! roughness² (the Blinn-Phong exponent of equal lobe width), Ke = emissive.
+//! The base-colour texture multiplies Kd and Ka; with a metallic-roughness or
+//! occlusion texture, Kd, Ka and Ks are baked into textures texel by texel
+//! (Km and n take the material's mean). `KHR_materials_transmission` makes
+//! Kt = base colour · transmission (Kd scaled by what is not transmitted),
+//! `KHR_materials_ior` the index of refraction. Buffers and images may be
+//! files, GLB chunks or `data:` URIs. Normal textures are not used.
 
 use std::path::Path;
 use std::sync::Arc;
@@ -107,48 +114,202 @@ impl Context<'_> {
     fn material(&self, m: &gltf::Material) -> Result<Material, String> {
         let pbr = m.pbr_metallic_roughness();
         let [r, g, b, a] = pbr.base_color_factor();
-        let base = Vec3::new(r, g, b);
-        let metal = pbr.metallic_factor().clamp(0.0, 1.0);
-        let alpha = pbr.roughness_factor().clamp(0.05, 1.0).powi(2);
-        let kd = base * (1.0 - metal);
-        let base_map = pbr.base_color_texture().map(|t| self.texture(&t.texture())).transpose()?;
-        Ok(Material {
-            name: m.name().unwrap_or("gltf").to_string(),
-            ka: kd,
-            kd,
-            ks: Vec3::splat(0.04).lerp(base, metal),
-            shininess: (2.0 / (alpha * alpha) - 2.0).clamp(1.0, 2048.0),
-            ke: Vec3::from(m.emissive_factor()),
-            maps: ComponentMaps {
-                ambient: base_map.iter().cloned().collect(),
-                diffuse: base_map.into_iter().collect(),
-                specular: Vec::new(),
-                emission: m.emissive_texture().map(|t| self.texture(&t.texture())).transpose()?.into_iter().collect(),
-                filter: Default::default(),
-            },
-            two_sided: m.double_sided(),
-            // BLEND materials are translucent with the base colour's alpha; MASK and
-            // OPAQUE ones are drawn opaque (alpha cut-outs are not supported).
-            opacity: if m.alpha_mode() == gltf::material::AlphaMode::Blend { a.clamp(0.0, 1.0) } else { 1.0 },
-            ..Material::default()
-        })
+        let surface = Surface {
+            base: Vec3::new(r, g, b),
+            base_map: pbr.base_color_texture().map(|t| self.texture(&t.texture(), true)).transpose()?,
+            metal: pbr.metallic_factor().clamp(0.0, 1.0),
+            roughness: pbr.roughness_factor().clamp(0.0, 1.0),
+            metal_roughness_map: pbr
+                .metallic_roughness_texture()
+                .map(|t| self.texture(&t.texture(), false))
+                .transpose()?,
+            occlusion: m
+                .occlusion_texture()
+                .map(|t| Ok::<_, String>((self.texture(&t.texture(), false)?, t.strength().clamp(0.0, 1.0))))
+                .transpose()?,
+        };
+        let transmission = m.transmission().map_or(0.0, |t| t.transmission_factor().clamp(0.0, 1.0));
+        let mut out = surface.material();
+        out.name = m.name().unwrap_or("gltf").to_string();
+        out.ke = Vec3::from(m.emissive_factor());
+        out.maps.emission =
+            m.emissive_texture().map(|t| self.texture(&t.texture(), true)).transpose()?.into_iter().collect();
+        out.two_sided = m.double_sided();
+        // BLEND materials are translucent with the base colour's alpha; MASK and
+        // OPAQUE ones are drawn opaque (alpha cut-outs are not supported).
+        out.opacity = if m.alpha_mode() == gltf::material::AlphaMode::Blend { a.clamp(0.0, 1.0) } else { 1.0 };
+        if transmission > 0.0 {
+            // Light through the surface, tinted by the base colour, bent by
+            // the index of refraction; what goes through is not diffused.
+            out.kt = surface.base * transmission;
+            out.kd *= 1.0 - transmission;
+            out.ka *= 1.0 - transmission;
+            out.kr = Vec3::splat(0.04 * transmission);
+        }
+        out.ior = m.ior().filter(|n| n.is_finite() && *n >= 1.0).unwrap_or(1.5);
+        Ok(out)
     }
 
-    fn texture(&self, t: &gltf::Texture) -> Result<Arc<Texture>, String> {
+    fn texture(&self, t: &gltf::Texture, srgb: bool) -> Result<Arc<Texture>, String> {
         let bytes = match t.source().source() {
             gltf::image::Source::View { view, .. } => {
                 let data = &self.buffers[view.buffer().index()].0;
                 data.get(view.offset()..view.offset() + view.length()).ok_or("image view outside its buffer")?.to_vec()
             }
-            gltf::image::Source::Uri { uri, .. } if uri.starts_with("data:") => {
-                return Err("data-URI images are not supported; use a .glb or an image file".into())
-            }
+            gltf::image::Source::Uri { uri, .. } if uri.starts_with("data:") => data_uri(uri)?,
             gltf::image::Source::Uri { uri, .. } => {
-                return crate::scene::load::texture(&self.dir.join(uri), true, self.assets).map_err(|e| e.to_string())
+                let path = self.dir.join(percent_decoded(uri));
+                return crate::scene::load::texture(&path, srgb, self.assets).map_err(|e| e.to_string());
             }
         };
-        Texture::decode(&bytes, true).map(Arc::new).map_err(|e| format!("embedded image {}: {e}", t.index()))
+        Texture::decode(&bytes, srgb).map(Arc::new).map_err(|e| format!("embedded image {}: {e}", t.index()))
     }
+}
+
+/// A metallic-roughness surface, factors and textures as the file gives
+/// them, before it becomes kage's Phong coefficients.
+struct Surface {
+    base: Vec3,
+    base_map: Option<Arc<Texture>>,
+    metal: f32,
+    roughness: f32,
+    /// Roughness in green, metalness in blue (linear).
+    metal_roughness_map: Option<Arc<Texture>>,
+    /// Occlusion in red (linear), with its strength.
+    occlusion: Option<(Arc<Texture>, f32)>,
+}
+
+impl Surface {
+    /// Base colour, metalness, roughness and occlusion at `uv`.
+    fn at(&self, uv: Vec2) -> (Vec3, f32, f32, f32) {
+        let base = self.base * self.base_map.as_ref().map_or(Vec3::ONE, |t| t.sample(uv));
+        let mr = self.metal_roughness_map.as_ref().map_or(Vec3::ONE, |t| t.sample(uv));
+        let occlusion = self.occlusion.as_ref().map_or(1.0, |(t, strength)| 1.0 + strength * (t.sample(uv).x - 1.0));
+        (base, (self.metal * mr.z).clamp(0.0, 1.0), (self.roughness * mr.y).clamp(0.0, 1.0), occlusion)
+    }
+
+    /// Kd = base · (1 − metal), Ka = Kd · occlusion, Ks = mix(0.04, base,
+    /// metal), Km = base · metal (the environment a metal mirrors); with a
+    /// metallic-roughness or occlusion texture each is a texture baked texel by
+    /// texel, else the base-colour texture multiplies Kd and Ka. The Phong
+    /// exponent comes from the mean roughness.
+    fn material(&self) -> Material {
+        let Some(size) = self.baked_size() else {
+            let kd = self.base * (1.0 - self.metal);
+            return Material {
+                ka: kd,
+                kd,
+                ks: Vec3::splat(0.04).lerp(self.base, self.metal),
+                km: self.base * self.metal,
+                shininess: shininess(self.roughness),
+                maps: ComponentMaps {
+                    ambient: self.base_map.iter().cloned().collect(),
+                    diffuse: self.base_map.iter().cloned().collect(),
+                    ..ComponentMaps::default()
+                },
+                ..Material::default()
+            };
+        };
+        let diffuse = bake(size, |uv| {
+            let (base, metal, _, _) = self.at(uv);
+            base * (1.0 - metal)
+        });
+        let ambient = bake(size, |uv| {
+            let (base, metal, _, occlusion) = self.at(uv);
+            base * (1.0 - metal) * occlusion
+        });
+        let specular = bake(size, |uv| {
+            let (base, metal, _, _) = self.at(uv);
+            Vec3::splat(0.04).lerp(base, metal)
+        });
+        // Km and the exponent take one value per material: their means.
+        let (w, h) = size;
+        let n = 64usize;
+        let samples = (0..n * n).map(|i| Vec2::new((i % n) as f32 + 0.5, (i / n) as f32 + 0.5) / n as f32);
+        let (mirror, rough) = samples.fold((Vec3::ZERO, 0.0), |(m, r), uv| {
+            let (base, metal, roughness, _) = self.at(uv);
+            (m + base * metal, r + roughness)
+        });
+        let count = (n * n) as f32;
+        debug_assert!(w > 0 && h > 0);
+        Material {
+            ka: Vec3::ONE,
+            kd: Vec3::ONE,
+            ks: Vec3::ONE,
+            km: mirror / count,
+            shininess: shininess(rough / count),
+            maps: ComponentMaps {
+                ambient: vec![ambient],
+                diffuse: vec![diffuse],
+                specular: vec![specular],
+                ..ComponentMaps::default()
+            },
+            ..Material::default()
+        }
+    }
+
+    /// The size of the largest texture when a texture varies more than the
+    /// base colour (metalness, roughness or occlusion); `None` otherwise.
+    fn baked_size(&self) -> Option<(u32, u32)> {
+        if self.metal_roughness_map.is_none() && self.occlusion.is_none() {
+            return None;
+        }
+        let maps = [self.base_map.as_ref(), self.metal_roughness_map.as_ref(), self.occlusion.as_ref().map(|(t, _)| t)];
+        maps.into_iter().flatten().map(|t| t.size()).reduce(|a, b| (a.0.max(b.0), a.1.max(b.1)))
+    }
+}
+
+/// n = 2/α² − 2 with α = roughness², the Blinn-Phong exponent whose lobe is
+/// as wide as the microfacet distribution's.
+fn shininess(roughness: f32) -> f32 {
+    let alpha = roughness.clamp(0.05, 1.0).powi(2);
+    (2.0 / (alpha * alpha) - 2.0).clamp(1.0, 2048.0)
+}
+
+/// A `width × height` texture of `f` at each texel centre's uv.
+fn bake((width, height): (u32, u32), f: impl Fn(Vec2) -> Vec3 + Sync) -> Arc<Texture> {
+    use rayon::prelude::*;
+    let texels = (0..width * height)
+        .into_par_iter()
+        .map(|i| {
+            f(Vec2::new((i % width) as f32 + 0.5, (i / width) as f32 + 0.5) / Vec2::new(width as f32, height as f32))
+        })
+        .collect();
+    Arc::new(Texture::from_texels(width, height, texels))
+}
+
+/// The bytes of a `data:[<media type>][;base64],<data>` URI.
+fn data_uri(uri: &str) -> Result<Vec<u8>, String> {
+    use base64::Engine as _;
+    let (head, data) = uri.split_once(',').ok_or("a data URI without ','")?;
+    if head.ends_with(";base64") {
+        base64::engine::general_purpose::STANDARD
+            .decode(data.trim())
+            .map_err(|e| format!("a data URI's base64 does not decode: {e}"))
+    } else {
+        Ok(percent_decoded(data).into_bytes())
+    }
+}
+
+/// `%20`-style escapes of a URI decoded (glTF URIs are URI references).
+fn percent_decoded(uri: &str) -> String {
+    let bytes = uri.as_bytes();
+    let mut out = Vec::with_capacity(bytes.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        let hex = |b: u8| (b as char).to_digit(16);
+        match (bytes[i], bytes.get(i + 1).copied().and_then(hex), bytes.get(i + 2).copied().and_then(hex)) {
+            (b'%', Some(h), Some(l)) => {
+                out.push((h * 16 + l) as u8);
+                i += 3;
+            }
+            (b, _, _) => {
+                out.push(b);
+                i += 1;
+            }
+        }
+    }
+    String::from_utf8_lossy(&out).into_owned()
 }
 
 fn camera(cam: &gltf::Camera, at: Affine3A) -> Option<Camera> {

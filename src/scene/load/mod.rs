@@ -36,6 +36,11 @@ pub trait AssetSource: Sync {
     fn base_dir(&self) -> Option<&Path> {
         None
     }
+    /// A file that exists under `path` spelled in another letter case (files
+    /// named on one system and unpacked on another), if there is exactly one.
+    fn find_ignoring_case(&self, _path: &Path) -> Option<PathBuf> {
+        None
+    }
 }
 
 /// Files on disk, relative to a base folder (the scene file's).
@@ -54,6 +59,30 @@ impl AssetSource for FileSystem {
     }
     fn base_dir(&self) -> Option<&Path> {
         Some(&self.base)
+    }
+    fn find_ignoring_case(&self, path: &Path) -> Option<PathBuf> {
+        let mut found = PathBuf::new();
+        for part in path.components() {
+            let std::path::Component::Normal(name) = part else {
+                found.push(part);
+                continue;
+            };
+            if self.base.join(&found).join(name).exists() {
+                found.push(name);
+                continue;
+            }
+            let want = name.to_str()?.to_lowercase();
+            let mut matches = std::fs::read_dir(self.base.join(&found))
+                .ok()?
+                .filter_map(|e| e.ok()?.file_name().into_string().ok())
+                .filter(|n| n.to_lowercase() == want);
+            let first = matches.next()?;
+            if matches.next().is_some() {
+                return None; // ambiguous
+            }
+            found.push(first);
+        }
+        Some(found)
     }
 }
 
@@ -210,6 +239,45 @@ pub fn texture(path: &Path, srgb: bool, assets: &dyn AssetSource) -> Result<Arc<
     Texture::decode(&bytes, srgb)
         .map(Arc::new)
         .map_err(|message| Error::TextureLoad { path: assets.display_path(path), message })
+}
+
+/// A colour (`srgb`) or data texture a model names, found in another letter
+/// case when the exact name is absent. A texture that cannot be found or
+/// decoded is a warning in `warnings` and comes out as [`placeholder`], so
+/// the model still renders and the surface shows what is missing.
+pub fn texture_or_placeholder(
+    path: &Path,
+    srgb: bool,
+    assets: &dyn AssetSource,
+    warnings: &mut Vec<String>,
+) -> Arc<Texture> {
+    match texture(path, srgb, assets) {
+        Ok(t) => return t,
+        Err(Error::Read { source, .. }) if source.kind() == io::ErrorKind::NotFound => {
+            if let Some(other) = assets.find_ignoring_case(path) {
+                match texture(&other, srgb, assets) {
+                    Ok(t) => return t,
+                    Err(e) => warnings.push(format!("{e}; drawn as a magenta checker")),
+                }
+            } else {
+                warnings.push(format!(
+                    "texture {} not found; drawn as a magenta checker",
+                    assets.display_path(path).display()
+                ));
+            }
+        }
+        Err(e) => warnings.push(format!("{e}; drawn as a magenta checker")),
+    }
+    placeholder()
+}
+
+/// The stand-in for a missing texture: an 8 × 8 magenta and grey checker,
+/// unmistakable on any model.
+#[must_use]
+pub fn placeholder() -> Arc<Texture> {
+    let texels =
+        (0..64).map(|i| if (i % 8 + i / 8) % 2 == 0 { Vec3::new(1.0, 0.0, 1.0) } else { Vec3::splat(0.2) }).collect();
+    Arc::new(Texture::from_texels(8, 8, texels))
 }
 
 /// Builds a checked mesh, turning problems into a message for the loader's error and

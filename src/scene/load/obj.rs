@@ -2,7 +2,9 @@
 //!
 //! Polygons are fan-triangulated; OBJ's texture v runs upwards, kage's downwards, so
 //! v is flipped. A missing `.mtl` file is a warning (many OBJs name one they never
-//! shipped); a missing texture named by an `.mtl` is an error.
+//! shipped); a texture named by an `.mtl` is looked up in another letter case
+//! when the exact name is absent, and one not found at all is a warning and a
+//! magenta checker. [`material`] documents how `illum` maps to kage's materials.
 
 use std::io::Cursor;
 use std::path::Path;
@@ -28,7 +30,7 @@ pub fn load(bytes: &[u8], path: &Path, assets: &dyn AssetSource) -> Result<Loade
         out.warnings.push(format!("{}: materials not loaded ({e}); using the default material", path.display()));
         Vec::new()
     });
-    let materials: Vec<Material> = materials.iter().map(|m| material(m, dir, assets)).collect::<Result<_, _>>()?;
+    let materials: Vec<Material> = materials.iter().map(|m| material(m, dir, assets, &mut out.warnings)).collect();
     let mut first_error = None;
     for m in models {
         let built = mesh(&m.mesh);
@@ -56,16 +58,49 @@ fn mesh(m: &tobj::Mesh) -> Result<(Mesh, crate::scene::mesh::MeshRepairs), Strin
     Mesh::new(v3(&m.positions), v3(&m.normals), uvs, triangles, NormalMode::Smooth)
 }
 
-fn material(m: &tobj::Material, dir: &Path, assets: &dyn AssetSource) -> Result<Material, String> {
+/// A `.mtl` material as kage's. The illumination model `illum` says which of
+/// `Ks`, `Tf`, `d` and `Ni` mean what:
+///
+/// | `illum` | meaning (MTL) | kage |
+/// |---|---|---|
+/// | 0, 1 | colour, no highlight | `ks` = 0 |
+/// | 2 | highlight | Phong `ks` = `Ks` |
+/// | 3, 5 | ray-traced reflection (5: with Fresnel) | `kr` = `Ks` |
+/// | 4 | glass: see-through, ray-traced reflection | `kr` = `Ks`, opacity `d` |
+/// | 6, 7 | refraction (7: with Fresnel) | `kr` = `Ks`, `kt` = `Tf` × (1 − max `Ks`), `ior` = `Ni` |
+/// | 8 | reflection from a map, not traced | `km` = `Ks` (the environment) |
+/// | 9 | glass, reflection from a map | `km` = `Ks`, opacity `d` |
+///
+/// Without `illum`, or for any other value, it is model 2. kage has no Fresnel
+/// term: models 5 and 7 reflect `Ks` at every angle. Every model takes its
+/// opacity from `d` (or 1 − `Tr` when `d` is absent; 0 is read as opaque outside
+/// the glass models 4 and 9); `Ke` is the emission.
+fn material(m: &tobj::Material, dir: &Path, assets: &dyn AssetSource, warnings: &mut Vec<String>) -> Material {
     let d = Material::default();
     let v = |c: Option<[f32; 3]>, default: Vec3| c.map_or(default, Vec3::from);
-    let map = |name: &Option<String>| -> Result<_, String> {
-        name.as_ref()
-            .map(|n| crate::scene::load::texture(&dir.join(n.trim()), true, assets).map_err(|e| e.to_string()))
-            .transpose()
+    let mut map = |name: &Option<String>| -> Vec<_> {
+        name.iter().map(|n| super::texture_or_placeholder(&dir.join(n.trim()), true, assets, warnings)).collect()
     };
     let kd = v(m.diffuse, d.kd);
-    Ok(Material {
+    let ks = v(m.specular, d.ks);
+    let extra = |key: &str| {
+        m.unknown_param.get(key).map(|v| v.split_whitespace().filter_map(|w| w.parse::<f32>().ok()).collect::<Vec<_>>())
+    };
+    let tf = match extra("Tf").as_deref() {
+        Some([r, g, b, ..]) => Vec3::new(*r, *g, *b),
+        Some([t]) => Vec3::splat(*t),
+        _ => Vec3::ONE,
+    };
+    let dissolve = m.dissolve.or_else(|| match extra("Tr").as_deref() {
+        Some([t, ..]) => Some(1.0 - t),
+        _ => None,
+    });
+    let opacity = dissolve.filter(|o| o.is_finite()).map_or(1.0, |o| o.clamp(0.0, 1.0));
+    let ior = m.optical_density.filter(|n| n.is_finite() && *n >= 1.0).unwrap_or(d.ior);
+    let diffuse = map(&m.diffuse_texture);
+    // Ka follows Kd, so an untextured ambient would flatten a textured surface.
+    let ambient = if m.ambient_texture.is_some() { map(&m.ambient_texture) } else { diffuse.clone() };
+    let mut out = Material {
         name: m.name.clone(),
         // Many exporters write Ka = 0 or 1 regardless; treat ambient as following Kd
         // unless the file gives a non-black, non-white value.
@@ -74,18 +109,29 @@ fn material(m: &tobj::Material, dir: &Path, assets: &dyn AssetSource) -> Result<
             _ => kd,
         },
         kd,
-        ks: v(m.specular, d.ks),
+        ks,
         shininess: m.shininess.unwrap_or(d.shininess).max(1.0),
-        ke: Vec3::ZERO,
+        ke: v(m.emissive, Vec3::ZERO).max(Vec3::ZERO),
         maps: crate::scene::ComponentMaps {
-            // Ka follows Kd, so an untextured ambient would flatten a textured surface.
-            ambient: map(&m.ambient_texture.clone().or_else(|| m.diffuse_texture.clone()))?.into_iter().collect(),
-            diffuse: map(&m.diffuse_texture)?.into_iter().collect(),
-            specular: map(&m.specular_texture)?.into_iter().collect(),
+            ambient,
+            diffuse,
+            specular: map(&m.specular_texture),
             emission: Vec::new(),
             filter: Default::default(),
         },
         two_sided: false,
         ..Material::default()
-    })
+    };
+    match m.illumination_model {
+        Some(0 | 1) => out.ks = Vec3::ZERO,
+        Some(3 | 5) => out.kr = ks,
+        Some(4) => (out.kr, out.opacity) = (ks, opacity),
+        Some(6 | 7) => (out.kr, out.kt, out.ior) = (ks, tf * (1.0 - ks.max_element()).max(0.0), ior),
+        Some(8) => out.km = ks,
+        Some(9) => (out.km, out.opacity) = (ks, opacity),
+        // A dissolve of 0 on an opaque model is an exporter's slip far more
+        // often than an invisible surface.
+        _ => out.opacity = if opacity > 0.0 { opacity } else { 1.0 },
+    }
+    out
 }
