@@ -343,7 +343,12 @@ fn a_floor_that_casts_no_shadow_leaves_the_map_to_the_casters_and_still_receives
         ShadowTerm::build(&scene, &scene.lights[0]).lit(under_box, 1.0) < 0.5,
         "the floor under the box is shadowed"
     );
+    // A floor that casts, under everything and lit from above, casts onto
+    // nothing: it is found and left out all the same.
     scene.objects[0].casts_shadows = true;
+    assert!(matches!(ShadowTerm::build(&scene, &scene.lights[0]), ShadowTerm::Map(..)), "a cone around the box");
+    // Lit from below, it shadows what stands on it: it widens the map.
+    scene.lights[0].kind = LightKind::Point { position: Vec3::new(0.5, -4.0, 0.8) };
     assert!(matches!(ShadowTerm::build(&scene, &scene.lights[0]), ShadowTerm::Cube(..)), "the floor widens the map");
 }
 

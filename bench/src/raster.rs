@@ -186,7 +186,9 @@ fn peer_light(c: Vec3, r: f32, mode: &str) -> Result<Light> {
         "shadow1" | "shadow4" => (
             LightKind::Spot { position, direction: (c - position).normalize(), inner: half, outer: half },
             ShadowSettings {
+                // The peer's fixed map size, like for like.
                 resolution: 2048,
+                by_need: false,
                 pcf: if mode == "shadow4" { 2 } else { 1 },
                 ..ShadowSettings::default()
             },

@@ -729,7 +729,9 @@ impl SceneFile {
                 None => Ok(None),
             }
         };
-        s.resolution = count(&r.resolution, 16, 16384, "shadow resolution")?.unwrap_or(s.resolution);
+        if let Some(n) = count(&r.resolution, 16, 16384, "shadow resolution")? {
+            (s.resolution, s.by_need) = (n, false);
+        }
         s.pcf = count(&r.pcf, 1, 15, "pcf")?.unwrap_or(s.pcf);
         s.samples = count(&r.samples, 1, 256, "shadow samples")?.unwrap_or(s.samples);
         for (v, slot) in [(r.bias, &mut s.bias), (r.slope, &mut s.slope)] {

@@ -109,8 +109,14 @@ pub enum ShadowMethod {
 pub struct ShadowSettings {
     /// The technique.
     pub method: ShadowMethod,
-    /// Texels along each side of a shadow map (each face, for a cube).
+    /// Texels along each side of a shadow map (a cube's faces take half):
+    /// exactly, or at most when `by_need` is set.
     pub resolution: u32,
+    /// Choose the resolution by need, up to `resolution`: two texels across a
+    /// pixel where the shadows fall (the shadow casters' centre, as the camera
+    /// sees it; half of one for a soft light's jittered maps; more for a light
+    /// low over the floor), to the nearest power of two, at least 512.
+    pub by_need: bool,
     /// Constant depth bias, in shadow-map texels (world size of one texel at the
     /// receiver's distance): against acne from depth quantisation.
     pub bias: f32,
@@ -127,7 +133,15 @@ pub struct ShadowSettings {
 
 impl Default for ShadowSettings {
     fn default() -> Self {
-        ShadowSettings { method: ShadowMethod::Map, resolution: 2048, bias: 1.0, slope: 1.5, pcf: 1, samples: 8 }
+        ShadowSettings {
+            method: ShadowMethod::Map,
+            resolution: 2048,
+            by_need: true,
+            bias: 1.0,
+            slope: 1.5,
+            pcf: 1,
+            samples: 8,
+        }
     }
 }
 
@@ -175,8 +189,15 @@ impl Light {
 
 impl ShadowSettings {
     /// No shadows.
-    pub const NONE: ShadowSettings =
-        ShadowSettings { method: ShadowMethod::None, resolution: 2048, bias: 1.0, slope: 1.5, pcf: 1, samples: 8 };
+    pub const NONE: ShadowSettings = ShadowSettings {
+        method: ShadowMethod::None,
+        resolution: 2048,
+        by_need: true,
+        bias: 1.0,
+        slope: 1.5,
+        pcf: 1,
+        samples: 8,
+    };
 }
 
 /// Light arriving at a point: unit direction towards the light and the radiance

@@ -272,10 +272,27 @@ impl Scene {
 
     /// World-space bounds of the objects that cast shadows: what a light's
     /// shadow map must hold (a receiver outside it is lit, as nothing between
-    /// it and the light is outside it either).
+    /// it and the light is outside it either). A floor is left out: a flat
+    /// object lying under every other caster, with every light above it, casts
+    /// onto nothing (what it hides from a light lies below it).
     #[must_use]
     pub fn caster_bounds(&self) -> Option<(Vec3, Vec3)> {
-        Self::union_of(self.objects.iter().filter(|o| o.casts_shadows))
+        let casters: Vec<(Vec3, Vec3)> =
+            self.objects.iter().filter(|o| o.casts_shadows).filter_map(Object::world_bounds).collect();
+        let union = |boxes: &mut dyn Iterator<Item = (Vec3, Vec3)>| boxes.reduce(|(a, b), (c, d)| (a.min(c), b.max(d)));
+        let (lo, hi) = union(&mut casters.iter().copied())?;
+        let eps = 1e-4 * (hi - lo).max_element().max(f32::MIN_POSITIVE);
+        let flat_floor = |b: &(Vec3, Vec3)| {
+            let top = b.1.y;
+            b.1.y - b.0.y <= eps
+                && casters.iter().all(|c| std::ptr::eq(c, b) || c.0.y >= top - eps)
+                && self.lights.iter().all(|l| match l.kind {
+                    LightKind::Point { position } | LightKind::Spot { position, .. } => position.y > top + eps,
+                    LightKind::Directional { direction } => direction.y < 0.0,
+                })
+        };
+        let mut rest = casters.iter().filter(|b| !flat_floor(b)).copied();
+        union(&mut rest).or(Some((lo, hi)))
     }
 
     fn union_of<'a>(objects: impl Iterator<Item = &'a Object>) -> Option<(Vec3, Vec3)> {

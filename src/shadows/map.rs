@@ -44,11 +44,25 @@ impl DepthMap {
     pub fn render(scene: &Scene, camera: &Camera, resolution: u32, mut depth: VisibilityBuffer) -> DepthMap {
         depth.resize(resolution, resolution);
         rasterize_casters(scene, camera, Faces::All, &mut depth);
+        DepthMap::of(camera, depth)
+    }
+
+    /// A map of `camera` with nothing drawn in it (every point it holds is
+    /// lit), in `depth` (made one texel).
+    #[must_use]
+    pub fn empty(camera: &Camera, mut depth: VisibilityBuffer) -> DepthMap {
+        depth.resize(1, 1);
+        depth.clear();
+        DepthMap::of(camera, depth)
+    }
+
+    /// The map of `camera` whose depths `depth` holds (square).
+    fn of(camera: &Camera, depth: VisibilityBuffer) -> DepthMap {
+        let resolution = depth.width();
         let (ortho, texel) = match camera.projection {
             Projection::Perspective { fov_y_deg } => (false, 2.0 * (fov_y_deg.to_radians() * 0.5).tan()),
             Projection::Orthographic { height } => (true, height),
         };
-        let (near, far) = (camera.near, camera.far);
         DepthMap {
             view_proj: camera.view_projection(1.0),
             eye: camera.eye,
@@ -56,8 +70,8 @@ impl DepthMap {
             resolution,
             texel: texel / resolution as f32,
             ortho,
-            near,
-            far,
+            near: camera.near,
+            far: camera.far,
             depth,
         }
     }
