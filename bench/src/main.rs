@@ -11,6 +11,7 @@ mod aa;
 mod csg;
 mod raster;
 mod rays;
+mod share;
 
 use std::path::PathBuf;
 
@@ -51,6 +52,10 @@ enum Command {
     /// Time to image of `kage render NAME.csg` beside OpenSCAD's preview, and
     /// frames per second when only the camera moves.
     CsgPreview(csg::PreviewArgs),
+    /// The shadow maps' share of a frame on the demo, a glTF truck, a scanned
+    /// mesh and the median corpus OpenSCAD model, as `kage render FILE` sets
+    /// them up.
+    ShadowShare(share::ShareArgs),
 }
 
 /// What every table takes.
@@ -110,5 +115,6 @@ fn main() -> miette::Result<()> {
         Command::Csg(args) => csg::run(&args),
         Command::CsgRandom(args) => csg::run_random(&args),
         Command::CsgPreview(args) => csg::run_preview(&args),
+        Command::ShadowShare(args) => share::run(&args),
     }
 }
