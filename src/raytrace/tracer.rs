@@ -135,8 +135,9 @@ impl<'a, L: LightRays> Tracer<'a, L> {
         let d = ray.dir;
         let mut out = Vec3::ZERO;
         if m.kr.max_element() > 0.0 {
-            let r = reflect(d, s.normal);
-            out += m.kr * self.radiance(&Ray { origin: s.position + s.normal * self.epsilon, dir: r }, depth - 1);
+            let n = facing(d, s.normal);
+            let r = reflect(d, n);
+            out += m.kr * self.radiance(&Ray { origin: s.position + n * self.epsilon, dir: r }, depth - 1);
         }
         if m.kt.max_element() > 0.0 {
             // Entering when the ray meets the front (outward) side of the surface.
@@ -150,6 +151,22 @@ impl<'a, L: LightRays> Tracer<'a, L> {
         }
         out
     }
+}
+
+/// The shading normal `n` of a surface seen along `d`, tilted (when it must)
+/// until it faces the ray by at least 1°: near a smooth mesh's silhouette the
+/// interpolated normal can face away from the eye, and the mirror direction
+/// about it would run into the surface — the outline's pixels would mirror the
+/// object's own inside, dark.
+#[must_use]
+pub fn facing(d: Vec3, n: Vec3) -> Vec3 {
+    const MIN_COS: f32 = 0.017; // cos 89°
+    let d = d.normalize_or_zero();
+    let cos = -d.dot(n);
+    if cos >= MIN_COS {
+        return n;
+    }
+    (n + (cos - MIN_COS) * d).normalize_or(n)
 }
 
 /// The mirror direction of unit `d` about unit normal `n`.
@@ -170,4 +187,22 @@ pub fn refract(d: Vec3, n: Vec3, eta: f32) -> Option<Vec3> {
     }
     let cos_t = (1.0 - sin2_t).sqrt();
     Some((eta * d + (eta * cos_i - cos_t) * n).normalize())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_normal_facing_away_is_tilted_until_the_mirror_ray_leaves_the_surface() {
+        let d = Vec3::new(1.0, -0.02, 0.0).normalize(); // grazing, slightly down
+        let away = Vec3::new(0.2, 0.98, 0.0).normalize(); // interpolated, facing away (d·n > 0)
+        assert!(d.dot(away) > 0.0);
+        let n = facing(d, away);
+        assert!((-d.dot(n) - 0.017).abs() < 1e-3, "faces the ray by 1°: {}", -d.dot(n));
+        assert!(reflect(d, n).dot(n) > 0.0, "the mirror ray leaves on the eye's side");
+        assert!(reflect(d, away).dot(away) < 0.0, "about the untilted normal it would enter the surface");
+        let towards = Vec3::new(-0.6, 0.8, 0.0);
+        assert_eq!(facing(d, towards), towards, "a normal that faces the ray is kept");
+    }
 }
