@@ -113,3 +113,75 @@ fn a_lone_model_stands_on_a_ground_that_catches_its_shadow() {
         scene_for_model_with(&stl, 160, 120, &ModelOptions { ground: false, ..ModelOptions::default() }).unwrap();
     assert!(bare.objects.iter().all(|o| o.name != "ground"));
 }
+
+/// An open box (five walls facing inwards, no wall towards +x) with a glowing
+/// panel under its top, as a Cornell box is modelled: it is seen through its
+/// open side, with no ground, lit from the panel.
+#[test]
+fn an_open_box_is_seen_through_its_open_side_and_lit_from_within() {
+    let dir = scratch("open-box");
+    let v = Vec3::new;
+    // Inward-facing quads (counter-clockwise seen from inside).
+    let walls = [
+        [v(0., 0., 0.), v(0., 0., 1.), v(1., 0., 1.), v(1., 0., 0.)], // floor, up
+        [v(0., 1., 0.), v(1., 1., 0.), v(1., 1., 1.), v(0., 1., 1.)], // top, down
+        [v(0., 0., 0.), v(1., 0., 0.), v(1., 1., 0.), v(0., 1., 0.)], // z = 0, towards +z
+        [v(0., 0., 1.), v(0., 1., 1.), v(1., 1., 1.), v(1., 0., 1.)], // z = 1, towards −z
+        [v(0., 0., 0.), v(0., 1., 0.), v(0., 1., 1.), v(0., 0., 1.)], // x = 0, towards +x
+    ];
+    let panel = [v(0.4, 0.98, 0.4), v(0.6, 0.98, 0.4), v(0.6, 0.98, 0.6), v(0.4, 0.98, 0.6)]; // facing down
+    let mut obj = String::from("mtllib box.mtl\nusemtl white\n");
+    let mut n = 1;
+    for (k, q) in walls.iter().chain([&panel]).enumerate() {
+        if k == walls.len() {
+            obj += "usemtl glow\n";
+        }
+        q.iter().for_each(|p| obj += &format!("v {} {} {}\n", p.x, p.y, p.z));
+        obj += &format!("f {} {} {} {}\n", n, n + 1, n + 2, n + 3);
+        n += 4;
+    }
+    std::fs::write(dir.join("box.obj"), obj).unwrap();
+    std::fs::write(dir.join("box.mtl"), "newmtl white\nKd 0.7 0.7 0.7\nnewmtl glow\nKd 0.8 0.8 0.8\nKe 10 10 10\n")
+        .unwrap();
+    let scene = scene_for_model(&dir.join("box.obj"), 160, 120).unwrap();
+    let cam = scene.camera;
+    assert!(cam.eye.x > 1.0 && (cam.eye.y - 0.5).abs() < 0.05 && (cam.eye.z - 0.5).abs() < 0.05, "eye {}", cam.eye);
+    assert!(scene.objects.iter().all(|o| o.name != "ground"), "a box has its own floor");
+    let inside = |p: Vec3| p.cmpge(Vec3::ZERO).all() && p.cmple(Vec3::ONE).all();
+    let light = scene.lights.iter().find_map(|l| match l.kind {
+        kage::scene::LightKind::Point { position } if inside(position) => Some(position),
+        _ => None,
+    });
+    assert!(light.is_some_and(|p| p.y > 0.9), "a light at the panel: {light:?}");
+    // The back wall (x = 0) shows through the opening, lit.
+    let options = RenderOptions { aovs: ComponentSet::only(Component::Diffuse), ..RenderOptions::default() };
+    let frame = render(&scene, &options).unwrap();
+    let (x, y) = (scene.width / 2, scene.height / 2);
+    assert!(!frame.visibility.item(x, y).is_none(), "the centre sees into the box");
+    assert!(frame.aovs[0].1.get(x, y).max_element() > 0.1, "the back wall is lit: {}", frame.aovs[0].1.get(x, y));
+}
+
+/// The Cornell box of the shared corpus, dropped in: seen through its open
+/// front (+z), lit by its ceiling light (material `light`, `Ke 17 12 4`).
+#[test]
+fn the_cornell_box_is_seen_through_its_open_front() {
+    let path =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/scenes/cornell-box/CornellBox-Original.obj");
+    if !path.exists() {
+        eprintln!("skipped: {} is absent", path.display());
+        return;
+    }
+    let scene = scene_for_model(&path, 160, 120).unwrap();
+    let (lo, hi) = scene.bounds().unwrap();
+    let cam = scene.camera;
+    assert!(cam.eye.z > hi.z && (cam.eye.x - (lo.x + hi.x) * 0.5).abs() < 0.05 * (hi.x - lo.x), "eye {}", cam.eye);
+    let lit_from_ceiling = scene.lights.iter().any(|l| match l.kind {
+        kage::scene::LightKind::Point { position } => position.y > lo.y + 0.9 * (hi.y - lo.y) && position.y < hi.y,
+        _ => false,
+    });
+    assert!(
+        lit_from_ceiling,
+        "a light under the ceiling: {:?}",
+        scene.lights.iter().map(|l| l.kind).collect::<Vec<_>>()
+    );
+}

@@ -8,10 +8,11 @@ use std::sync::Arc;
 use glam::{Affine3A, Vec3};
 
 use super::file::add_model;
-use super::framing::{framed_camera, light_rig, CameraOverride, View, FRAMING_FOV_DEG};
+use super::framing::{fit_depth, framed_camera, light_rig, CameraOverride, View, FRAMING_FOV_DEG};
 use super::load;
 use super::mesh::shapes;
-use super::{Environment, Exposure, Light, Material, Object, Scene, ShadowSettings, Up};
+use super::{Environment, Exposure, Falloff, Light, LightKind, Material, Object, Scene, ShadowSettings, Up};
+use crate::camera::{Camera, Projection};
 use crate::csg::openscad::CsgOptions;
 use crate::error::{Error, Result};
 
@@ -80,7 +81,8 @@ pub fn scene_for_model(path: &Path, width: u32, height: u32) -> Result<Scene> {
 /// axis is kage's +y, seen by a camera that frames it (or the file's own),
 /// lit by a key light and a dim fill (or the file's own lights), and standing
 /// on a ground that catches its shadows (left out when the camera looks from
-/// below it).
+/// below it). A room or open box is seen through its open side instead, lit
+/// from within, with no ground.
 ///
 /// # Errors
 ///
@@ -97,12 +99,19 @@ pub fn scene_for_model_with(path: &Path, width: u32, height: u32, options: &Mode
         Scene::new(width, height, framed_camera((Vec3::ZERO, Vec3::ONE), 1.0, View::DEFAULT, FRAMING_FOV_DEG));
     add_model(&mut scene, &model, &path.display().to_string(), turn, None);
     let bounds = scene.bounds().ok_or_else(|| Error::Scene(format!("{}: the model is empty", path.display())))?;
-    let camera = match model.camera.filter(|_| options.file_camera) {
-        Some(own) => own.transformed(&turn),
-        None => framed_camera(bounds, aspect, View::DEFAULT, FRAMING_FOV_DEG),
+    let interior = Interior::of(&scene, bounds);
+    let camera = match (model.camera.filter(|_| options.file_camera), &interior) {
+        (Some(own), _) => own.transformed(&turn),
+        (None, Some(inside)) => inside.camera(bounds, aspect),
+        (None, None) => framed_camera(bounds, aspect, View::DEFAULT, FRAMING_FOV_DEG),
     };
     scene.camera = options.camera.apply(camera, bounds, aspect);
     let mut lights = light_rig(bounds, &scene.camera);
+    if let Some(inside) = &interior {
+        // Lit from within: by its glowing surfaces, else from under its top;
+        // the rig's fill stays, from the camera's side.
+        lights.splice(0..1, inside.lights(&mut scene, bounds));
+    }
     if !model.solids.is_empty() {
         // Shadow maps of solids are drawn by the same scanline walk as the
         // view, texel by texel: the key light's four jittered maps at 512²,
@@ -113,7 +122,7 @@ pub fn scene_for_model_with(path: &Path, width: u32, height: u32, options: &Mode
         lights[0].shadow.resolution = 512;
         lights.iter_mut().skip(1).for_each(|l| l.shadow = ShadowSettings::NONE);
     }
-    if options.ground {
+    if options.ground && interior.is_none() {
         add_ground(&mut scene, bounds);
     }
     scene.lights = if model.lights.is_empty() {
@@ -131,4 +140,130 @@ pub fn scene_for_model_with(path: &Path, width: u32, height: u32, options: &Mode
     }
     scene.validate()?;
     Ok(scene)
+}
+
+/// A model that is a room or an open box (a Cornell box): most of its surface
+/// faces inwards, and one side has no wall. It is seen through that side,
+/// level, needs no ground (it has its floor), and is lit from inside.
+struct Interior {
+    /// The open side: the outward direction of the bounds' face with no wall.
+    open: Vec3,
+}
+
+impl Interior {
+    /// Share of the surface that must face the bounds' centre.
+    const INWARD_SHARE: f32 = 0.6;
+
+    /// `Some` when `scene`'s mesh objects within `bounds` make an interior.
+    fn of(scene: &Scene, bounds: (Vec3, Vec3)) -> Option<Interior> {
+        let (lo, hi) = bounds;
+        let (centre, extent) = ((lo + hi) * 0.5, (hi - lo).max_element().max(f32::MIN_POSITIVE));
+        // The four upright sides, by outward direction.
+        let sides = [Vec3::Z, Vec3::X, Vec3::NEG_Z, Vec3::NEG_X];
+        let (mut total, mut inward, mut walls) = (0.0, 0.0, [0.0f32; 4]);
+        for_each_triangle(scene, |[a, b, c]| {
+            let cross = (b - a).cross(c - a);
+            let (area, n) = (cross.length() * 0.5, cross.normalize_or_zero());
+            let mid = (a + b + c) / 3.0;
+            total += area;
+            inward += if n.dot(centre - mid) > 0.0 { area } else { 0.0 };
+            for (k, out) in sides.iter().enumerate() {
+                let face = if out.dot(Vec3::ONE) > 0.0 { hi.dot(*out) } else { lo.dot(*out) };
+                if (mid.dot(*out) - face).abs() < 0.02 * extent && n.dot(*out).abs() > 0.9 {
+                    walls[k] += area;
+                }
+            }
+        });
+        let most = walls.iter().copied().fold(0.0, f32::max);
+        let (open, least) = walls.iter().copied().enumerate().min_by(|a, b| a.1.total_cmp(&b.1))?;
+        let is_interior = total > 0.0 && inward > Self::INWARD_SHARE * total && least < 0.1 * most;
+        is_interior.then_some(Interior { open: sides[open] })
+    }
+
+    /// A level camera outside the open side, looking at the centre, as far
+    /// out as the opening needs to fill the view.
+    fn camera(&self, (lo, hi): (Vec3, Vec3), aspect: f32) -> Camera {
+        let (centre, size) = ((lo + hi) * 0.5, hi - lo);
+        let across = if self.open.x != 0.0 { size.z } else { size.x };
+        let half = (FRAMING_FOV_DEG.to_radians() * 0.5).tan();
+        let back = 1.05 * (size.y * 0.5 / half).max(across * 0.5 / (half * aspect));
+        let depth = size.dot(self.open.abs());
+        let eye = centre + self.open * (depth * 0.5 + back);
+        let camera = Camera {
+            eye,
+            target: centre,
+            up: Vec3::Y,
+            near: 1.0,
+            far: 2.0,
+            projection: Projection::Perspective { fov_y_deg: FRAMING_FOV_DEG },
+            shift: glam::Vec2::ZERO,
+        };
+        fit_depth(camera, (lo, hi))
+    }
+
+    /// The lights inside: one soft light at each glowing surface (a material
+    /// with emission), just off it, in its colour — those surfaces then cast
+    /// no shadow of their own —; without any, one under the top's centre.
+    fn lights(&self, scene: &mut Scene, (lo, hi): (Vec3, Vec3)) -> Vec<Light> {
+        let extent = (hi - lo).max_element();
+        let mut lights = Vec::new();
+        for o in 0..scene.objects.len() {
+            let ke = scene.materials[scene.objects[o].material].ke;
+            if ke.max_element() <= 0.0 {
+                continue;
+            }
+            let (mut area, mut centre, mut normal) = (0.0, Vec3::ZERO, Vec3::ZERO);
+            for_each_triangle_of(&scene.objects[o], |[a, b, c]| {
+                let cross = (b - a).cross(c - a);
+                area += cross.length() * 0.5;
+                centre += (a + b + c) / 3.0 * cross.length() * 0.5;
+                normal += cross;
+            });
+            if area <= 0.0 {
+                continue;
+            }
+            scene.objects[o].casts_shadows = false;
+            let normal = normal.normalize_or(Vec3::NEG_Y);
+            lights.push(Light {
+                kind: LightKind::Point { position: centre / area + normal * 1e-3 * extent },
+                color: ke / ke.max_element(),
+                size: (area / std::f32::consts::PI).sqrt(),
+                ..Self::key()
+            });
+        }
+        if lights.is_empty() {
+            let top = Vec3::new((lo.x + hi.x) * 0.5, lo.y + 0.9 * (hi.y - lo.y), (lo.z + hi.z) * 0.5);
+            lights.push(Light { kind: LightKind::Point { position: top }, size: 0.05 * extent, ..Self::key() });
+        }
+        let share = 1.0 / lights.len() as f32;
+        lights.iter_mut().for_each(|l| (l.intensity, l.ambient) = (l.intensity * share, l.ambient * share));
+        lights
+    }
+
+    /// A key light inside: white, soft (four jittered maps), carrying the ambient term.
+    fn key() -> Light {
+        Light {
+            kind: LightKind::Point { position: Vec3::ZERO },
+            color: Vec3::ONE,
+            intensity: 0.9,
+            ambient: 0.12,
+            size: 0.0,
+            falloff: Falloff::None,
+            shadow: ShadowSettings { samples: 4, ..ShadowSettings::default() },
+            ..Light::default()
+        }
+    }
+}
+
+/// Calls `f` with every triangle of `scene`'s mesh objects, in world space.
+fn for_each_triangle(scene: &Scene, mut f: impl FnMut([Vec3; 3])) {
+    scene.objects.iter().for_each(|o| for_each_triangle_of(o, &mut f));
+}
+
+/// Calls `f` with every triangle of mesh object `o`, in world space.
+fn for_each_triangle_of(o: &Object, mut f: impl FnMut([Vec3; 3])) {
+    let Some(mesh) = o.triangles() else { return };
+    for t in &mesh.triangles {
+        f(t.map(|i| o.transform.transform_point3(mesh.positions[i as usize])));
+    }
 }
