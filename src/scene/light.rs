@@ -133,15 +133,7 @@ pub struct ShadowSettings {
 
 impl Default for ShadowSettings {
     fn default() -> Self {
-        ShadowSettings {
-            method: ShadowMethod::Map,
-            resolution: 2048,
-            by_need: true,
-            bias: 1.0,
-            slope: 1.5,
-            pcf: 1,
-            samples: 8,
-        }
+        ShadowSettings::MAP
     }
 }
 
@@ -188,9 +180,10 @@ impl Light {
 }
 
 impl ShadowSettings {
-    /// No shadows.
-    pub const NONE: ShadowSettings = ShadowSettings {
-        method: ShadowMethod::None,
+    /// A shadow map sized by need up to 2048², eight jittered maps for a
+    /// light with a size, biases of 1 and 1.5 texels, no PCF: the default.
+    pub const MAP: ShadowSettings = ShadowSettings {
+        method: ShadowMethod::Map,
         resolution: 2048,
         by_need: true,
         bias: 1.0,
@@ -198,6 +191,9 @@ impl ShadowSettings {
         pcf: 1,
         samples: 8,
     };
+
+    /// No shadows.
+    pub const NONE: ShadowSettings = ShadowSettings { method: ShadowMethod::None, ..ShadowSettings::MAP };
 }
 
 /// Light arriving at a point: unit direction towards the light and the radiance

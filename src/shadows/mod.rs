@@ -53,19 +53,23 @@ impl ShadowTerm {
         let settings = light.shadow;
         let view = *pool.view(scene);
         let (w, h) = (scene.width, scene.height);
-        let size = |cam: &Camera| map_resolution(&settings, &view, (w, h), cam, bounds);
-        let map = |cam: Camera, pool: &mut MapPool| DepthMap::render(scene, &cam, size(&cam), pool.take());
+        let map = |cam: Camera, most: u32, pool: &mut MapPool| {
+            let res = map_resolution(&settings, most, &view, (w, h), &cam, bounds);
+            DepthMap::render(scene, &cam, res, pool.take())
+        };
+        // A cube's six faces take half the resolution: 1.5 single maps of memory.
+        let (single, face) = (settings.resolution.max(1), (settings.resolution / 2).max(16));
         match placement(light, bounds) {
             Placement::None => ShadowTerm::Unshadowed,
             Placement::Cone { eye, axis, fov_y_deg } => {
                 let cam = light_camera(eye, axis, Projection::Perspective { fov_y_deg }, bounds);
-                ShadowTerm::Map(map(cam, pool), settings)
+                ShadowTerm::Map(map(cam, single, pool), settings)
             }
             Placement::Cube { eye } => {
                 let faces = [Vec3::X, Vec3::NEG_X, Vec3::Y, Vec3::NEG_Y, Vec3::Z, Vec3::NEG_Z].map(|axis| {
                     let cam = light_camera(eye, axis, Projection::Perspective { fov_y_deg: 90.0 }, bounds);
                     if face_sees(eye, axis, bounds) {
-                        map(cam, pool)
+                        map(cam, face, pool)
                     } else {
                         // No caster in this face's pyramid: nothing to draw.
                         DepthMap::empty(&cam, pool.take())
@@ -75,7 +79,7 @@ impl ShadowTerm {
             }
             Placement::Parallel { direction } => {
                 let aspect = w as f32 / h as f32;
-                ShadowTerm::Map(map(fitted_orthographic(&view, aspect, direction, bounds), pool), settings)
+                ShadowTerm::Map(map(fitted_orthographic(&view, aspect, direction, bounds), single, pool), settings)
             }
         }
     }
@@ -351,8 +355,8 @@ const MIN_NEEDED_RESOLUTION: u32 = 512;
 
 /// Texels along a side of the map `light_cam` renders for a light with
 /// `settings`, in a frame of `size` pixels seen through `view`, of casters
-/// within `bounds`: the configured resolution (a cube face: half of it), or
-/// by need at most that — two texels across a pixel at the casters' centre,
+/// within `bounds`: `most` (the configured resolution; a cube face: half of
+/// it), or by need at most that — two texels across a pixel at the casters' centre,
 /// where their shadows fall (with one, shadow maps and shadow rays disagree on
 /// 1.3% of the lit tests of the CAD example, against under 0.5%), half of one
 /// for a soft light's jittered maps (their average hides the coarser texels), more
@@ -360,13 +364,12 @@ const MIN_NEEDED_RESOLUTION: u32 = 512;
 /// nearest power of two, so a camera moving a little keeps a kept map's size.
 fn map_resolution(
     settings: &ShadowSettings,
+    most: u32,
     view: &Camera,
     size: (u32, u32),
     light_cam: &Camera,
     bounds: (Vec3, Vec3),
 ) -> u32 {
-    let cube_face = matches!(light_cam.projection, Projection::Perspective { fov_y_deg } if fov_y_deg == 90.0);
-    let most = if cube_face { (settings.resolution / 2).max(16) } else { settings.resolution.max(1) };
     if !settings.by_need {
         return most;
     }
