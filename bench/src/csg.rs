@@ -316,10 +316,11 @@ pub fn run_preview(preview: &PreviewArgs) -> Result<()> {
     let out = std::env::temp_dir().join(format!("kage-bench-{}.png", std::process::id()));
     let (w, h) = (args.width, args.height);
     println!(
-        "| model | kage s (640x480, process) | OpenSCAD preview s | OpenSCAD / kage | fps {w}x{h} | fps, no shadows |"
+        "| model | kage s (640x480, process) | OpenSCAD preview s | OpenSCAD / kage | fps {w}x{h} | fps, no shadows | fps, aliased |"
     );
-    println!("|---|---:|---:|---:|---:|---:|");
+    println!("|---|---:|---:|---:|---:|---:|---:|");
     let (mut ratios, mut fps_shadowed, mut fps_plain_all) = (Vec::new(), Vec::new(), Vec::new());
+    let mut fps_aliased_all = Vec::new();
     for path in corpus(&dir, &preview.models)? {
         let name = path.file_stem().and_then(|s| s.to_str()).unwrap_or_default().to_string();
         let mut runs: Vec<f64> = (0..3)
@@ -345,12 +346,16 @@ pub fn run_preview(preview: &PreviewArgs) -> Result<()> {
         let mut plain = scene.clone();
         plain.lights.iter_mut().for_each(|l| l.shadow = kage::scene::ShadowSettings::NONE);
         let fps_plain = orbit_fps(&plain, args.frames.max(3))?;
+        // As a viewer would draw while the camera moves: no edge pass.
+        let aliased = kage::Scene { antialias: kage::scene::Antialias::None, ..scene.clone() };
+        let fps_aliased = orbit_fps(&aliased, args.frames.max(3))?;
         fps_shadowed.push(fps);
         fps_plain_all.push(fps_plain);
+        fps_aliased_all.push(fps_aliased);
         let ratio = theirs.map(|t| t / kage_s);
         ratios.extend(ratio);
         println!(
-            "| {name} | {kage_s:.2} | {} | {} | {fps:.1} | {fps_plain:.1} |",
+            "| {name} | {kage_s:.2} | {} | {} | {fps:.1} | {fps_plain:.1} | {fps_aliased:.1} |",
             theirs.map_or("-".into(), |t| format!("{t:.2}")),
             ratio.map_or("-".into(), |r| format!("{r:.1}"))
         );
@@ -361,13 +366,15 @@ pub fn run_preview(preview: &PreviewArgs) -> Result<()> {
          clock of the whole process, median of 3. OpenSCAD 2021.01: its preview PNG at 640x480 (no shadows), from \
          peers/openscad/TIMINGS.md (taken on the workplace's standard machine). Orbit: the camera turns 3° about \
          the model per \
-         frame, median of {} frames of a reused renderer ({} threads). Medians: OpenSCAD / kage {:.1}, fps with \
-         shadows {:.1}, without {:.1}.",
+         frame, median of {} frames of a reused renderer ({} threads), as `kage render` sets the model up (the \
+         edge pass on); aliased: shadows on, no edge pass. Medians: OpenSCAD / kage {:.1}, fps with shadows \
+         {:.1}, without {:.1}, aliased {:.1}.",
         args.frames.max(3),
         rayon::current_num_threads(),
         median(&mut ratios),
         median(&mut fps_shadowed),
-        median(&mut fps_plain_all)
+        median(&mut fps_plain_all),
+        median(&mut fps_aliased_all)
     );
     Ok(())
 }
