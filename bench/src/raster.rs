@@ -168,6 +168,8 @@ fn peer_scene(path: &Path, width: u32, height: u32, mode: &str) -> Result<Scene>
         shift: glam::Vec2::ZERO,
     };
     let mut scene = Scene::new(width, height, camera);
+    // The peers draw aliased frames: so does the row compared with them.
+    scene.antialias = kage::scene::Antialias::None;
     scene.lights = vec![peer_light(c, r, mode)?];
     scene.materials = vec![material];
     add_model(&mut scene, &model, "peer", Affine3A::IDENTITY, Some(0));

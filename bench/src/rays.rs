@@ -160,6 +160,8 @@ pub fn run_hybrid(args: &HybridArgs) -> Result<()> {
         let path = repository().join("examples/scenes").join(name);
         let mut scene = kage::scene::file::load_scene(&path).map_err(|e| miette!("{e}"))?;
         (scene.width, scene.height) = (args.width, args.height);
+        // The full trace casts one ray per pixel: the hybrid draws aliased too.
+        scene.antialias = kage::scene::Antialias::None;
         Ok::<Scene, miette::Report>(scene)
     };
     let showroom = load("showroom.toml")?;
