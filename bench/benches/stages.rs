@@ -17,13 +17,15 @@ use kage::shadows::{MapPool, ShadowTerm};
 use kage::visibility::{rasterize, solids, VisibilityBuffer};
 use kage::{RenderOptions, Renderer};
 
+/// The demo, aliased (the edge pass has its own row).
 fn demo() -> Scene {
-    demo_scene().expect("the demo loads")
+    Scene { antialias: Antialias::None, ..demo_scene().expect("the demo loads") }
 }
 
+/// An example scene, aliased.
 fn example(name: &str) -> Scene {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/scenes").join(name);
-    file::load_scene(&path).expect("the example loads")
+    Scene { antialias: Antialias::None, ..file::load_scene(&path).expect("the example loads") }
 }
 
 /// The demo's visibility buffer, for the stages that read one.
@@ -93,7 +95,9 @@ fn traced_term(c: &mut Criterion) {
 
 fn csg_walk(c: &mut Criterion) {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/data/csg/ex001_sphere_minus_cylinders.csg");
-    let scene = model::scene_for_model(&path, 1280, 720).expect("the part loads");
+    // The part seen through its OpenSCAD camera sidecar.
+    let sidecar = model::ModelOptions { file_camera: true, ..Default::default() };
+    let scene = model::scene_for_model_with(&path, 1280, 720, &sidecar).expect("the part loads");
     let object = scene.objects.iter().find(|o| o.solid().is_some()).expect("a solid");
     let solid = object.solid().expect("a solid").transformed(&object.transform);
     let prepared = solids::PreparedSolid::new(&solid, solids::CsgMethod::Segments).expect("no expansion");
