@@ -160,17 +160,7 @@ pub fn light_rig(bounds: (Vec3, Vec3), camera: &Camera) -> Vec<Light> {
     let side = |turn: f32, up: f32| {
         View { azimuth_deg: azimuth + turn, elevation_deg: if below { -up } else { up } }.direction()
     };
-    let key = Light {
-        kind: LightKind::Point { position: c + 3.56 * r * side(27.0, 57.0) },
-        color: Vec3::ONE,
-        intensity: 0.85,
-        ambient: 0.12,
-        size: 0.05 * r,
-        falloff: Falloff::None,
-        // Four jittered maps: soft enough for so small a light, quick to preview.
-        shadow: ShadowSettings { samples: 4, ..ShadowSettings::default() },
-        ..Light::default()
-    };
+    let key = key_light(c + 3.56 * r * side(27.0, 57.0), 0.05 * r);
     let fill = Light {
         kind: LightKind::Directional { direction: -side(-70.0, 15.0) },
         color: Vec3::new(0.75, 0.8, 1.0),
@@ -182,6 +172,23 @@ pub fn light_rig(bounds: (Vec3, Vec3), camera: &Camera) -> Vec<Light> {
         ..Light::default()
     };
     vec![key, fill]
+}
+
+/// The rig's key light at `position` with radius `size`: white, carrying the
+/// ambient term, its soft shadow from four jittered maps (soft enough for a
+/// small light, quick to preview).
+#[must_use]
+pub fn key_light(position: Vec3, size: f32) -> Light {
+    Light {
+        kind: LightKind::Point { position },
+        color: Vec3::ONE,
+        intensity: 0.85,
+        ambient: 0.12,
+        size,
+        falloff: Falloff::None,
+        shadow: ShadowSettings { samples: 4, ..ShadowSettings::default() },
+        ..Light::default()
+    }
 }
 
 /// A camera and lights that show everything inside `bounds`: the camera

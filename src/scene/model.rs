@@ -8,10 +8,10 @@ use std::sync::Arc;
 use glam::{Affine3A, Vec3};
 
 use super::file::add_model;
-use super::framing::{fit_depth, framed_camera, light_rig, CameraOverride, View, FRAMING_FOV_DEG};
+use super::framing::{fit_depth, framed_camera, key_light, light_rig, CameraOverride, View, FRAMING_FOV_DEG};
 use super::load;
 use super::mesh::shapes;
-use super::{Environment, Exposure, Falloff, Light, LightKind, Material, Object, Scene, ShadowSettings, Up};
+use super::{Environment, Exposure, Light, Material, Object, Scene, ShadowSettings, Up};
 use crate::camera::{Camera, Projection};
 use crate::csg::openscad::CsgOptions;
 use crate::error::{Error, Result};
@@ -225,33 +225,23 @@ impl Interior {
             scene.objects[o].casts_shadows = false;
             let normal = normal.normalize_or(Vec3::NEG_Y);
             lights.push(Light {
-                kind: LightKind::Point { position: centre / area + normal * 1e-3 * extent },
                 color: ke / ke.max_element(),
-                size: (area / std::f32::consts::PI).sqrt(),
-                ..Self::key()
+                ..Self::key(centre / area + normal * 1e-3 * extent, (area / std::f32::consts::PI).sqrt())
             });
         }
         if lights.is_empty() {
             let top = Vec3::new((lo.x + hi.x) * 0.5, lo.y + 0.9 * (hi.y - lo.y), (lo.z + hi.z) * 0.5);
-            lights.push(Light { kind: LightKind::Point { position: top }, size: 0.05 * extent, ..Self::key() });
+            lights.push(Self::key(top, 0.05 * extent));
         }
         let share = 1.0 / lights.len() as f32;
         lights.iter_mut().for_each(|l| (l.intensity, l.ambient) = (l.intensity * share, l.ambient * share));
         lights
     }
 
-    /// A key light inside: white, soft (four jittered maps), carrying the ambient term.
-    fn key() -> Light {
-        Light {
-            kind: LightKind::Point { position: Vec3::ZERO },
-            color: Vec3::ONE,
-            intensity: 0.9,
-            ambient: 0.12,
-            size: 0.0,
-            falloff: Falloff::None,
-            shadow: ShadowSettings { samples: 4, ..ShadowSettings::default() },
-            ..Light::default()
-        }
+    /// A key light inside: the rig's, a little brighter (walls hold in what
+    /// the fill from outside would add).
+    fn key(position: Vec3, size: f32) -> Light {
+        Light { intensity: 0.9, ..key_light(position, size) }
     }
 }
 

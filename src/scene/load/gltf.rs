@@ -210,20 +210,13 @@ impl Surface {
                 ..Material::default()
             };
         };
-        let diffuse = bake(size, |uv| {
-            let (base, metal, _, _) = self.at(uv);
-            base * (1.0 - metal)
-        });
-        let ambient = bake(size, |uv| {
+        // One lookup of the textures per texel, for all three maps.
+        let [diffuse, ambient, specular] = bake(size, |uv| {
             let (base, metal, _, occlusion) = self.at(uv);
-            base * (1.0 - metal) * occlusion
-        });
-        let specular = bake(size, |uv| {
-            let (base, metal, _, _) = self.at(uv);
-            Vec3::splat(0.04).lerp(base, metal)
+            let kd = base * (1.0 - metal);
+            [kd, kd * occlusion, Vec3::splat(0.04).lerp(base, metal)]
         });
         // Km and the exponent take one value per material: their means.
-        let (w, h) = size;
         let n = 64usize;
         let samples = (0..n * n).map(|i| Vec2::new((i % n) as f32 + 0.5, (i / n) as f32 + 0.5) / n as f32);
         let (mirror, rough) = samples.fold((Vec3::ZERO, 0.0), |(m, r), uv| {
@@ -231,7 +224,6 @@ impl Surface {
             (m + base * metal, r + roughness)
         });
         let count = (n * n) as f32;
-        debug_assert!(w > 0 && h > 0);
         Material {
             ka: Vec3::ONE,
             kd: Vec3::ONE,
@@ -266,16 +258,17 @@ fn shininess(roughness: f32) -> f32 {
     (2.0 / (alpha * alpha) - 2.0).clamp(1.0, 2048.0)
 }
 
-/// A `width × height` texture of `f` at each texel centre's uv.
-fn bake((width, height): (u32, u32), f: impl Fn(Vec2) -> Vec3 + Sync) -> Arc<Texture> {
+/// Three `width × height` textures of `f`'s three values at each texel
+/// centre's uv.
+fn bake((width, height): (u32, u32), f: impl Fn(Vec2) -> [Vec3; 3] + Sync) -> [Arc<Texture>; 3] {
     use rayon::prelude::*;
-    let texels = (0..width * height)
+    let texels: Vec<[Vec3; 3]> = (0..width * height)
         .into_par_iter()
         .map(|i| {
             f(Vec2::new((i % width) as f32 + 0.5, (i / width) as f32 + 0.5) / Vec2::new(width as f32, height as f32))
         })
         .collect();
-    Arc::new(Texture::from_texels(width, height, texels))
+    std::array::from_fn(|k| Arc::new(Texture::from_texels(width, height, texels.iter().map(|t| t[k]).collect())))
 }
 
 /// The bytes of a `data:[<media type>][;base64],<data>` URI.
