@@ -18,6 +18,7 @@ use glam::{Vec2, Vec3};
 
 use crate::error::{Error, Result};
 use crate::image::LinearImage;
+use crate::raytrace::traced::Refine;
 use crate::raytrace::{traced, TraceCache};
 use crate::resolve::edges::{EdgeOptions, EdgePass};
 use crate::resolve::jitter;
@@ -73,6 +74,9 @@ pub struct FrameStats {
     pub traced_ms: f64,
     /// Pixels that spawned secondary rays, summed over passes.
     pub traced_pixels: usize,
+    /// Traced pixels traced again at sub-pixel points where what they show
+    /// has an edge (edge-antialiased frames: [`crate::raytrace::traced::Refine`]).
+    pub traced_refined: usize,
     /// Whether this frame built a BVH for its traced term (false when it had none
     /// or reused the last frame's: same meshes, same transforms).
     pub bvh_built: bool,
@@ -353,8 +357,10 @@ fn render_pass(scene: &Scene, frame: &mut Frame, scratch: &mut Scratch, ray_dept
     stats.add_lit(&lit);
     stats.add(Stage::Edges, planned);
     let builds = trace.builds();
-    stats.traced_pixels +=
-        stats.timed(Stage::Traced, || traced_term(scene, vb, &mut images, subpixel, ray_depth, trace));
+    let refine = if edges.is_some() { Refine::Contrast } else { Refine::Never };
+    let (traced, refined) =
+        stats.timed(Stage::Traced, || traced_term(scene, vb, &mut images, subpixel, ray_depth, refine, trace));
+    (stats.traced_pixels, stats.traced_refined) = (stats.traced_pixels + traced, stats.traced_refined + refined);
     let targets = &mut images.targets;
     stats.bvh_built |= trace.builds() > builds;
     // Translucent surfaces are drawn last, over everything opaque (seed 002 §3.4).
@@ -411,21 +417,22 @@ impl<'a> PassImages<'a> {
 
 /// Seed 002 §4's traced term, at the pixels (into the frame's image, through
 /// the traced component's own image when it is requested, which then joins the
-/// targets) and at the edge pass's sub-pixel samples; returns the pixels
-/// traced.
+/// targets) and at the edge pass's sub-pixel samples, the pixels refined as
+/// `refine` says; returns the pixels traced and refined.
 fn traced_term(
     scene: &Scene,
     vb: &VisibilityBuffer,
     images: &mut PassImages,
     subpixel: &mut SubpixelShading,
     ray_depth: u32,
+    refine: Refine,
     trace: &mut TraceCache,
-) -> usize {
+) -> (usize, usize) {
     let pixels = match images.traced.take() {
-        None => traced::add_traced(scene, vb, images.targets[0].image, ray_depth, trace),
+        None => traced::add_traced(scene, vb, images.targets[0].image, ray_depth, trace, refine),
         Some(own) => {
             own.pixels_mut().fill(Vec3::ZERO);
-            let n = traced::add_traced(scene, vb, own, ray_depth, trace);
+            let n = traced::add_traced(scene, vb, own, ray_depth, trace, refine);
             jitter::accumulate(images.targets[0].image, own, 1.0);
             images.targets.push(Target { parts: ComponentSet::only(Component::Traced), image: own });
             n

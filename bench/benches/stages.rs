@@ -88,7 +88,7 @@ fn traced_term(c: &mut Criterion) {
     let mut group = c.benchmark_group("traced");
     group.sample_size(20);
     group.bench_function("reflections, BVH kept", |b| {
-        b.iter(|| black_box(traced::add_traced(&scene, &vb, &mut image, 4, &mut cache)))
+        b.iter(|| black_box(traced::add_traced(&scene, &vb, &mut image, 4, &mut cache, traced::Refine::Never)))
     });
     group.finish();
 }

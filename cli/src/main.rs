@@ -90,7 +90,8 @@ struct RenderArgs {
     #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(0..=16))]
     ray_depth: u32,
     /// Antialiasing. `edge` (the default): smooths outlines and creases in one
-    /// extra step, about 1.0-1.3x the time of a frame; `edge:all` smooths every
+    /// extra step, about 1.0-1.3x the time of a frame, and traces mirrors and
+    /// glass again where what they show has an edge; `edge:all` smooths every
     /// triangle edge, `edge:paper` blends as the original edge-pass paper does.
     /// `jitter:N`: renders N slightly shifted frames and averages them (also
     /// smooths shadows, textures and reflections; N times the time). `none`: off.
@@ -396,7 +397,7 @@ fn render_command(args: &RenderArgs) -> kage::error::Result<()> {
     }
     let s = frame.stats;
     eprintln!(
-        "wrote {} ({}x{}, {} triangles, {} solids, {} pass{}): visibility {:.1} ms, shadow maps {:.1} ms, shading {:.1} ms, reflections and refraction {:.1} ms ({} pixels)",
+        "wrote {} ({}x{}, {} triangles, {} solids, {} pass{}): visibility {:.1} ms, shadow maps {:.1} ms, shading {:.1} ms, reflections and refraction {:.1} ms ({} pixels, {} refined)",
         args.output.display(),
         scene.width,
         scene.height,
@@ -408,7 +409,8 @@ fn render_command(args: &RenderArgs) -> kage::error::Result<()> {
         s.shadow_ms,
         s.shading_ms,
         s.traced_ms,
-        s.traced_pixels
+        s.traced_pixels,
+        s.traced_refined
     );
     if let Antialias::Edge(_) = scene.antialias {
         eprintln!("antialiased edges: {:.1} ms, {} pixels blended", s.edge_ms, s.edge_blends);

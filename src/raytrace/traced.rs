@@ -7,8 +7,20 @@
 //! (and the shadow rays seen in them), traced through the BVH to `depth` bounces;
 //! their light, shaded by the [`Tracer`] with one shadow ray per light, is added
 //! to the image.
+//!
+//! Beyond the paper: what a mirror shows is aliased like any image sampled once
+//! per pixel (a reflected horizon in steps, a thin seam as dots), and neither
+//! the polygon pass nor the edge pass sees it. With [`Refine::Contrast`] (the
+//! edge-antialiased frame's), a traced pixel whose value differs from a
+//! neighbour's by more than [`REFINE_CONTRAST`] is traced again at four points
+//! of a rotated grid and the five samples averaged (adaptive supersampling,
+//! Whitted 1980): only the edges inside reflections pay. On `reflections.toml`
+//! at 960×540 it refines 8,677 of 341,834 traced pixels, the traced term takes
+//! about 1.25× as long, and inside the chrome ball the error against a 16-ray
+//! ray-traced truth falls from 0.037 to 0.013 RMSE (at 320×180: the test
+//! `reflections_are_refined_where_what_they_show_has_edges`).
 
-use glam::Vec2;
+use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
 use super::tracer::{ShadowRay, Tracer};
@@ -16,11 +28,32 @@ use super::TraceCache;
 use crate::image::LinearImage;
 use crate::scene::Scene;
 use crate::shading::subpixel::SampleSurface;
-use crate::shading::{ObjectFrames, SubpixelShading};
+use crate::shading::{normal_map, ObjectFrames, SubpixelShading};
 use crate::visibility::VisibilityBuffer;
 
-/// Adds traced reflection and refraction to `image`; returns how many pixels were
-/// traced (0, without building a BVH, when no material reflects or refracts). The
+/// Linear difference (in any channel) between neighbouring traced pixels above
+/// which both are traced again at sub-pixel points.
+pub const REFINE_CONTRAST: f32 = 0.05;
+
+/// Offsets from the pixel centre of the extra samples of a refined pixel: a
+/// rotated 2 × 2 grid (no two share a row or a column).
+const REFINE_OFFSETS: [Vec2; 4] =
+    [Vec2::new(-0.375, -0.125), Vec2::new(0.125, -0.375), Vec2::new(0.375, 0.125), Vec2::new(-0.125, 0.375)];
+
+/// Whether traced pixels are refined where what they show has edges.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Refine {
+    /// One sample per pixel, at its centre (an aliased frame, or one of
+    /// several jittered frames, whose average antialiases).
+    Never,
+    /// Pixels that differ from a neighbour by more than [`REFINE_CONTRAST`]
+    /// get four more samples.
+    Contrast,
+}
+
+/// Adds traced reflection and refraction to `image`, refined as `refine`
+/// says; returns how many pixels were traced (0, without building a BVH, when
+/// no material reflects or refracts) and how many of them were refined. The
 /// BVH comes from `cache` (built there when the geometry changed).
 pub fn add_traced(
     scene: &Scene,
@@ -28,31 +61,77 @@ pub fn add_traced(
     image: &mut LinearImage,
     depth: u32,
     cache: &mut TraceCache,
-) -> usize {
+    refine: Refine,
+) -> (usize, usize) {
     if depth == 0 || !scene.materials.iter().any(|m| m.traces()) {
-        return 0;
+        return (0, 0);
     }
     let trace = cache.get(scene);
     let frames = ObjectFrames::new(scene);
     let tracer = Tracer::new(scene, trace, &frames, ShadowRay);
-    let w = vb.width() as usize;
-    let rays = scene.camera.pixel_rays(Vec2::new(w as f32, vb.height() as f32));
-    let rows = image.pixels_mut().par_chunks_mut(w).zip(vb.items().par_chunks(w));
-    rows.enumerate()
-        .map(|(y, (out, items))| {
-            let mut traced = 0;
-            for (x, (px, &item)) in out.iter_mut().zip(items).enumerate() {
-                if item.is_none() || !scene.materials[item.material(scene)].traces() {
-                    continue;
-                }
-                let ray = rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
-                let s = frames.surface_at(scene, vb, x as u32, y as u32, &ray);
-                *px += tracer.bounces(&ray, &s, depth);
-                traced += 1;
+    let (w, h) = (vb.width() as usize, vb.height() as usize);
+    let rays = scene.camera.pixel_rays(Vec2::new(w as f32, h as f32));
+    let traces = |x: usize, y: usize| {
+        let item = vb.item(x as u32, y as u32);
+        !item.is_none() && scene.materials[item.material(scene)].traces()
+    };
+    let sample = |x: usize, y: usize, offset: Vec2| {
+        let ray = rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5) + offset);
+        let mut s = frames.surface_at(scene, vb, x as u32, y as u32, &ray);
+        normal_map::apply(&scene.materials[s.material], &mut s);
+        tracer.bounces(&ray, &s, depth)
+    };
+    // NaN marks the pixels that trace nothing.
+    let mut traced = vec![Vec3::NAN; w * h];
+    traced.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+        for (x, out) in row.iter_mut().enumerate() {
+            if traces(x, y) {
+                *out = sample(x, y, Vec2::ZERO);
             }
-            traced
+        }
+    });
+    let count = traced.par_iter().filter(|t| !t.x.is_nan()).count();
+    let refined = match refine {
+        Refine::Never => 0,
+        Refine::Contrast => refine_edges(&mut traced, w, sample),
+    };
+    image.pixels_mut().par_iter_mut().zip(traced.par_iter()).filter(|(_, t)| !t.x.is_nan()).for_each(|(px, t)| {
+        *px += *t;
+    });
+    (count, refined)
+}
+
+/// Traces again, at [`REFINE_OFFSETS`], every traced pixel of `traced` (rows
+/// of `w`; NaN: not traced) that differs from its right or lower traced
+/// neighbour by more than [`REFINE_CONTRAST`], both of the pair, through
+/// `sample(x, y, offset)`; each refined pixel becomes the mean of its five
+/// samples. Returns how many were refined.
+fn refine_edges(traced: &mut [Vec3], w: usize, sample: impl Fn(usize, usize, Vec2) -> Vec3 + Sync) -> usize {
+    let h = traced.len() / w.max(1);
+    let differs = |a: Vec3, b: Vec3| !a.x.is_nan() && !b.x.is_nan() && (a - b).abs().max_element() > REFINE_CONTRAST;
+    let marked: Vec<bool> = (0..w * h)
+        .into_par_iter()
+        .map(|i| {
+            let (x, y) = (i % w, i / w);
+            let t = traced[i];
+            let near = [
+                (x > 0).then(|| i - 1),
+                (x + 1 < w).then(|| i + 1),
+                (y > 0).then(|| i - w),
+                (y + 1 < h).then(|| i + w),
+            ];
+            near.into_iter().flatten().any(|j| differs(t, traced[j]))
         })
-        .sum()
+        .collect();
+    traced.par_chunks_mut(w).zip(marked.par_chunks(w)).enumerate().for_each(|(y, (row, marks))| {
+        for (x, (t, &m)) in row.iter_mut().zip(marks).enumerate() {
+            if m {
+                let extra: Vec3 = REFINE_OFFSETS.iter().map(|&o| sample(x, y, o)).sum();
+                *t = (*t + extra) / (1 + REFINE_OFFSETS.len()) as f32;
+            }
+        }
+    });
+    marked.iter().filter(|&&m| m).count()
 }
 
 /// The traced term at every sub-pixel sample of `subpixel` whose surface

@@ -10,7 +10,7 @@ use glam::Vec3;
 use super::TraceScene;
 use crate::camera::Ray;
 use crate::scene::{Light, LightKind, Scene};
-use crate::shading::phong::{self, Coefficients, Components};
+use crate::shading::phong::{self, Components};
 use crate::shading::reflection_map::reflection_map;
 use crate::shading::{ObjectFrames, SurfacePoint};
 
@@ -88,12 +88,13 @@ impl<'a, L: LightRays> Tracer<'a, L> {
 
     fn through_layers(&self, ray: &Ray, depth: u32, layers: u32) -> Vec3 {
         let Some(hit) = self.trace.intersect(ray, f32::INFINITY) else { return self.scene.background_along(ray.dir) };
-        let s = match hit.item.primitive() {
+        let mut s = match hit.item.primitive() {
             // A solid: its tangent plane at the hit, which the ray meets there.
             Some(_) => ObjectFrames::tangent(self.scene, hit.item, ray.at(hit.t), hit.normal).surface(ray),
             None => self.frames.prepare(self.scene, hit.item).surface(ray),
         };
         let material = &self.scene.materials[s.material];
+        let k = phong::sample_maps(material, &mut s);
         let behind = || {
             let next = Ray { origin: s.position + ray.dir * self.epsilon, dir: ray.dir };
             if layers > 0 {
@@ -105,7 +106,6 @@ impl<'a, L: LightRays> Tracer<'a, L> {
         if material.translucent() && !material.two_sided && !s.front {
             return behind(); // a culled back face, as the polygon pass draws it
         }
-        let k = Coefficients::at(material, &s);
         let mut acc = Components { emission: k.parts().3, ..Default::default() };
         for (i, light) in self.scene.lights.iter().enumerate() {
             if light.only.as_ref().is_some_and(|o| !o.contains(&(hit.item.object as usize))) {

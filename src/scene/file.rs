@@ -791,6 +791,7 @@ impl SceneFile {
                 diffuse: texture(&r.kd_map, true)?,
                 specular: texture(&r.ks_map, true)?,
                 emission: texture(&r.ke_map, true)?,
+                normal: None,
                 filter: match r.filter {
                     FilterRec::Trilinear => Filter::Trilinear,
                     FilterRec::Bilinear => Filter::Bilinear,

@@ -71,8 +71,22 @@ pub struct ComponentMaps {
     pub specular: Vec<Arc<Texture>>,
     /// Multiply Ke.
     pub emission: Vec<Arc<Texture>>,
+    /// Tilts the shading normal (glTF's `normalTexture`).
+    pub normal: Option<NormalMap>,
     /// How the maps are filtered.
     pub filter: Filter,
+}
+
+/// A tangent-space normal map as glTF defines it: red, green and blue hold x,
+/// y and z of the normal in [−1, 1] mapped to [0, 1] (linear, not sRGB),
+/// with x along increasing texture u, y along decreasing v (up the image) and
+/// z out of the surface; `scale` multiplies x and y.
+#[derive(Debug, Clone)]
+pub struct NormalMap {
+    /// The map.
+    pub texture: Arc<Texture>,
+    /// How strongly it tilts the normal: 1 as painted, 0 not at all.
+    pub scale: f32,
 }
 
 /// Texture filtering.

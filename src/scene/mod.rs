@@ -21,7 +21,7 @@ use glam::{Affine3A, Vec3};
 pub use environment::Environment;
 pub use framing::framing;
 pub use light::{Falloff, Light, LightKind, ShadowMethod, ShadowSettings};
-pub use material::{ComponentMaps, Material};
+pub use material::{ComponentMaps, Material, NormalMap};
 pub use mesh::Mesh;
 pub use settings::{Antialias, EdgeFilter, EdgeMode, EdgeSelection, Exposure, Fog, FogMode, TranslucencyOrder, Up};
 pub use texture::Texture;
@@ -65,6 +65,9 @@ impl Body {
         }
     }
 }
+
+/// An axis-aligned box: its lowest and highest corners.
+type Bounds = (Vec3, Vec3);
 
 /// What a scene's geometry was when a cache was filled: every object's body
 /// (a clone of its `Arc`: while held, no one can change that geometry in
@@ -277,22 +280,48 @@ impl Scene {
     /// onto nothing (what it hides from a light lies below it).
     #[must_use]
     pub fn caster_bounds(&self) -> Option<(Vec3, Vec3)> {
-        let casters: Vec<(Vec3, Vec3)> =
-            self.objects.iter().filter(|o| o.casts_shadows).filter_map(Object::world_bounds).collect();
+        let (casters, floors) = self.casters_and_floors();
         let union = |boxes: &mut dyn Iterator<Item = (Vec3, Vec3)>| boxes.reduce(|(a, b), (c, d)| (a.min(c), b.max(d)));
-        let (lo, hi) = union(&mut casters.iter().copied())?;
+        let (lo, hi) = union(&mut casters.iter().map(|&(_, b)| b))?;
+        let mut rest = casters.iter().filter(|(i, _)| !floors.contains(i)).map(|&(_, b)| b);
+        union(&mut rest).or(Some((lo, hi)))
+    }
+
+    /// Per object, whether shadow maps draw it: it casts shadows and is not a
+    /// floor ([`Scene::caster_bounds`]'s: what a floor hides from a light lies
+    /// below it, so leaving it out changes no shadow, and spares a map the
+    /// texels it would fill — most of a spot light's map, in the demo).
+    #[must_use]
+    pub fn map_casters(&self) -> Vec<bool> {
+        let (_, floors) = self.casters_and_floors();
+        self.objects.iter().enumerate().map(|(i, o)| o.casts_shadows && !floors.contains(&i)).collect()
+    }
+
+    /// The shadow casters (object index and world bounds), and which of them
+    /// are floors: flat, lying under every other caster, every light above.
+    fn casters_and_floors(&self) -> (Vec<(usize, Bounds)>, Vec<usize>) {
+        let casters: Vec<(usize, Bounds)> = self
+            .objects
+            .iter()
+            .enumerate()
+            .filter(|(_, o)| o.casts_shadows)
+            .filter_map(|(i, o)| Some((i, o.world_bounds()?)))
+            .collect();
+        let Some((lo, hi)) = casters.iter().map(|&(_, b)| b).reduce(|(a, b), (c, d)| (a.min(c), b.max(d))) else {
+            return (casters, Vec::new());
+        };
         let eps = 1e-4 * (hi - lo).max_element().max(f32::MIN_POSITIVE);
-        let flat_floor = |b: &(Vec3, Vec3)| {
+        let flat_floor = |&(i, b): &(usize, Bounds)| {
             let top = b.1.y;
             b.1.y - b.0.y <= eps
-                && casters.iter().all(|c| std::ptr::eq(c, b) || c.0.y >= top - eps)
+                && casters.iter().all(|&(j, c)| j == i || c.0.y >= top - eps)
                 && self.lights.iter().all(|l| match l.kind {
                     LightKind::Point { position } | LightKind::Spot { position, .. } => position.y > top + eps,
                     LightKind::Directional { direction } => direction.y < 0.0,
                 })
         };
-        let mut rest = casters.iter().filter(|b| !flat_floor(b)).copied();
-        union(&mut rest).or(Some((lo, hi)))
+        let floors = casters.iter().filter(|c| flat_floor(c)).map(|&(i, _)| i).collect();
+        (casters, floors)
     }
 
     fn union_of<'a>(objects: impl Iterator<Item = &'a Object>) -> Option<(Vec3, Vec3)> {

@@ -131,6 +131,8 @@ pub struct Block {
     ke: Gather,
     shininess: [f32; LANES],
     textured: [bool; LANES],
+    /// ∂P/∂u and ∂P/∂v of each lane's triangle (for its normal map).
+    tangents: [[Vec3; 2]; LANES],
     /// Which lanes hold a pixel that sees something.
     pub live: [bool; LANES],
 }
@@ -159,6 +161,7 @@ impl Block {
         self.material[i] = tri.material;
         self.live[i] = true;
         self.textured[i] = k.is_none();
+        self.tangents[i] = g.tangents;
         if let Some(k) = k {
             self.set_coefficients(i, k);
         }
@@ -204,13 +207,13 @@ impl Block {
         rays: &RowRays,
         x0: usize,
         lighting: &Lighting,
-        coefficients_at: impl Fn(&SurfacePoint) -> Coefficients,
+        coefficients_at: impl Fn(&mut SurfacePoint) -> Coefficients,
         blend: Blend,
         out: &mut [Vec3],
     ) {
         let mut inputs = self.inputs();
-        let s = surface(&inputs, rays, x0);
-        if self.sample_textures(&inputs, &s, rays, x0, &coefficients_at) {
+        let mut s = surface(&inputs, rays, x0);
+        if self.sample_textures(&inputs, &mut s, rays, x0, &coefficients_at) {
             let textured = self.inputs();
             (inputs.ka, inputs.kd, inputs.ks, inputs.ke) = (textured.ka, textured.kd, textured.ks, textured.ke);
             (inputs.shininess, inputs.whole) = (textured.shininess, textured.whole);
@@ -223,16 +226,17 @@ impl Block {
         }
     }
 
-    /// Samples the maps of textured lanes; false if there were none. Each lane's
-    /// footprint comes from ray differentials: the same triangle's plane met by
-    /// the rays one pixel to the right and one row below.
+    /// Samples the maps of textured lanes (their normal maps tilt `s`'s
+    /// normals); false if there were none. Each lane's footprint comes from ray
+    /// differentials: the same triangle's plane met by the rays one pixel to the
+    /// right and one row below.
     fn sample_textures(
         &mut self,
         inputs: &LaneInputs,
-        s: &LaneSurface,
+        s: &mut LaneSurface,
         rays: &RowRays,
         x0: usize,
-        at: &impl Fn(&SurfacePoint) -> Coefficients,
+        at: &impl Fn(&mut SurfacePoint) -> Coefficients,
     ) -> bool {
         if !self.textured.iter().zip(&self.live).any(|(t, l)| *t && *l) {
             return false;
@@ -245,22 +249,30 @@ impl Block {
         let (uu, vv) = uv_of(s);
         let (ur, vr) = uv_of(&surface(inputs, rays, x0 + 1));
         let (ud, vd) = uv_of(&surface(inputs, &rays.below(), x0));
+        let mut normals = Gather::default();
         for i in 0..LANES {
+            let normal = s.n.lane(i);
+            normals.set(i, normal);
             if self.textured[i] && self.live[i] {
                 let uv = Vec2::new(uu[i], vv[i]);
-                let point = SurfacePoint {
+                let to_eye = s.v.lane(i);
+                let geometric = inputs.geometric.lane(i);
+                let mut point = SurfacePoint {
                     position: s.p.lane(i),
-                    normal: s.n.lane(i),
-                    to_eye: s.v.lane(i),
+                    normal,
+                    to_eye,
                     uv,
                     duv: [Vec2::new(ur[i], vr[i]) - uv, Vec2::new(ud[i], vd[i]) - uv],
+                    tangents: self.tangents[i],
                     material: self.material[i],
-                    front: true, // maps do not depend on the side
+                    front: geometric.dot(to_eye) >= 0.0,
                 };
-                let k = at(&point);
+                let k = at(&mut point);
                 self.set_coefficients(i, &k);
+                normals.set(i, point.normal);
             }
         }
+        s.n = normals.load();
         true
     }
 }

@@ -4,7 +4,8 @@
 //!
 //! `passes.rs` decides which lights share a pass ([`shade_lit`] runs a frame's);
 //! [`shade_pass`] runs one, eight pixels at a time (`lanes.rs`); `phong.rs` is the
-//! scalar statement of eq. 1 the lanes are tested against; `reflection_map.rs`,
+//! scalar statement of eq. 1 the lanes are tested against (with
+//! `normal_map.rs`, the maps that tilt its normal); `reflection_map.rs`,
 //! `fog.rs` and `translucency.rs` are the once-per-frame passes of §3.4, §3.5 and
 //! eq. 4's Ie.
 
@@ -13,6 +14,7 @@ pub(crate) mod fog;
 // inlined otherwise into the shading row loop, and shadowed passes ran about
 // 5% slower (`kage-bench raster`, kept-map rows, two builds alternated).
 pub mod lanes;
+pub(crate) mod normal_map;
 pub(crate) mod passes;
 pub(crate) mod phong;
 pub(crate) mod reflection_map;
@@ -71,7 +73,7 @@ pub fn shade_pass(scene: &Scene, vb: &VisibilityBuffer, image: &mut LinearImage,
     let frames = ObjectFrames::new(scene);
     let rays = scene.camera.pixel_rays(Vec2::new(w as f32, vb.height() as f32));
     let constants: Vec<Option<Coefficients>> = scene.materials.iter().map(Coefficients::constant).collect();
-    let sample = |s: &SurfacePoint| Coefficients::at(&scene.materials[s.material], s);
+    let sample = |s: &mut SurfacePoint| phong::sample_maps(&scene.materials[s.material], s);
     let (lighting, blend) = (&pass.lighting, pass.blend);
     // Whole rows of what a replacing pass writes where it shades nothing, copied
     // from (a block copy is faster than writing one 12-byte pixel at a time).
@@ -209,7 +211,7 @@ pub fn shade_into_scalar(scene: &Scene, vb: &VisibilityBuffer, image: &mut Linea
             let mut s = at(0.0, 0.0);
             // Ray differentials: the same triangle met one pixel right and one below.
             s.duv = [at(1.0, 0.0).uv - s.uv, at(0.0, 1.0).uv - s.uv];
-            let k = Coefficients::at(&scene.materials[s.material], &s);
+            let k = phong::sample_maps(&scene.materials[s.material], &mut s);
             let mut acc = Components { emission: k.parts().3, ..Default::default() };
             for (light, terms) in lights.iter().map(|l| &l.light).zip(&terms) {
                 if light.only.as_ref().is_some_and(|o| !o.contains(&(item.object as usize))) {

@@ -97,7 +97,7 @@ fn terms(
     stats: &mut PassStats,
 ) -> Vec<ShadowTerm> {
     let t = Instant::now();
-    let terms = light.samples.iter().map(|s| pool.term(scene, s, bounds)).collect();
+    let terms = pool.terms(scene, &light.samples, bounds);
     stats.shadow_ms += t.elapsed().as_secs_f64() * 1e3;
     terms
 }

@@ -156,12 +156,15 @@ impl Coefficients {
     }
 
     /// The coefficients of a material without maps (`None` if it has any: then they
-    /// vary over the surface and [`Coefficients::at`] samples them per point).
+    /// vary over the surface and [`sample_maps`] samples them per point).
     #[must_use]
     pub fn constant(m: &Material) -> Option<Self> {
         let maps = &m.maps;
-        let none =
-            maps.ambient.is_empty() && maps.diffuse.is_empty() && maps.specular.is_empty() && maps.emission.is_empty();
+        let none = maps.ambient.is_empty()
+            && maps.diffuse.is_empty()
+            && maps.specular.is_empty()
+            && maps.emission.is_empty()
+            && maps.normal.is_none();
         none.then_some(Coefficients { ka: m.ka, kd: m.kd, ks: m.ks, ke: m.ke, n: m.shininess })
     }
 
@@ -192,6 +195,14 @@ impl Coefficients {
             n: m.shininess,
         }
     }
+}
+
+/// Samples every map of `m` at `s`: the normal map tilts `s.normal`
+/// ([`super::normal_map`]), the colour maps give the coefficients.
+#[must_use]
+pub fn sample_maps(m: &Material, s: &mut SurfacePoint) -> Coefficients {
+    super::normal_map::apply(m, s);
+    Coefficients::at(m, s)
 }
 
 /// Adds light `light`'s ambient, diffuse and specular terms at `s` to `acc`, with

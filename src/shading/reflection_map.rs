@@ -44,8 +44,13 @@ pub fn add_reflection_map(scene: &Scene, vb: &VisibilityBuffer, targets: &mut [T
                     continue;
                 }
                 if reflection && reflecting[item.material(scene)] {
-                    let s = frames.surface_at(scene, vb, x, y, &ray(x, y));
-                    let mirror = |x: u32, y: u32| mirror_direction(&frames.surface_at(scene, vb, x, y, &ray(x, y)));
+                    let surface = |x: u32, y: u32| {
+                        let mut s = frames.surface_at(scene, vb, x, y, &ray(x, y));
+                        super::normal_map::apply(&scene.materials[s.material], &mut s);
+                        s
+                    };
+                    let s = surface(x, y);
+                    let mirror = |x: u32, y: u32| mirror_direction(&surface(x, y));
                     let r = mirror_direction(&s);
                     // The spread of mirror directions to the pixels beside and
                     // below, taken from the other side where they show another object.

@@ -21,7 +21,7 @@ use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
 use super::lanes::{Lighting, LANES};
-use super::phong::{Coefficients, Component, ComponentSet, Components};
+use super::phong::{self, Coefficients, Component, ComponentSet, Components};
 use super::reflection_map::reflection_map;
 use super::surface::{ObjectFrames, SurfacePoint};
 use super::TriangleCache;
@@ -102,7 +102,7 @@ impl SubpixelSample {
             // below (ray differentials, as the passes take them).
             let uv = |dx: f32, dy: f32| surface.uv(&rays.ray(self.at + Vec2::new(dx, dy)));
             point.duv = [uv(1.0, 0.0) - point.uv, uv(0.0, 1.0) - point.uv];
-            Coefficients::at(material, &point)
+            phong::sample_maps(material, &mut point)
         });
         Some(SampleSurface { ray, point, coefficients, object: item.object })
     }

@@ -29,6 +29,10 @@ pub struct SurfacePoint {
     /// Texture-space steps to the neighbouring pixels' points (right, below), for
     /// mip-level selection; zero where unknown (secondary rays): finest level.
     pub duv: [Vec2; 2],
+    /// World-space change of the position per unit of texture u and of v
+    /// (∂P/∂u, ∂P/∂v): the tangent frame a normal map is painted in; zero
+    /// without texture coordinates.
+    pub tangents: [Vec3; 2],
     /// Index into `Scene::materials`.
     pub material: usize,
     /// Whether the eye sees the front (counter-clockwise, outward) side.
@@ -104,6 +108,7 @@ impl ObjectFrames {
             geometric: normal,
             normals: [normal; 3],
             uvs: None,
+            tangents: [Vec3::ZERO; 2],
             material: item.material(scene),
         }
     }
@@ -123,6 +128,7 @@ impl ObjectFrames {
         let [a, b, c] = self.triangle(scene, item);
         let (_, nm) = self.frames[item.object as usize];
         let (e1, e2) = (b - a, c - a);
+        let uvs = (!mesh.uvs.is_empty()).then(|| idx.map(|i| mesh.uvs[i]));
         PreparedTriangle {
             item,
             a,
@@ -130,7 +136,8 @@ impl ObjectFrames {
             e2,
             geometric: e1.cross(e2).normalize_or(Vec3::Y),
             normals: idx.map(|i| Vec3::from(nm * glam::Vec3A::from(mesh.normals[i]))),
-            uvs: (!mesh.uvs.is_empty()).then(|| idx.map(|i| mesh.uvs[i])),
+            uvs,
+            tangents: uvs.map_or([Vec3::ZERO; 2], |uv| position_derivatives(e1, e2, uv)),
             material: object.material,
         }
     }
@@ -147,6 +154,7 @@ pub struct PreparedTriangle {
     geometric: Vec3,
     normals: [Vec3; 3],
     uvs: Option<[Vec2; 3]>,
+    tangents: [Vec3; 2],
     /// Index into `Scene::materials`.
     pub material: usize,
 }
@@ -166,6 +174,8 @@ pub struct TriangleGeometry {
     pub normals: [Vec3; 3],
     /// Vertex texture coordinates, if the mesh has them.
     pub uvs: Option<[Vec2; 3]>,
+    /// ∂P/∂u and ∂P/∂v over the triangle ([`SurfacePoint::tangents`]).
+    pub tangents: [Vec3; 2],
 }
 
 impl PreparedTriangle {
@@ -179,6 +189,7 @@ impl PreparedTriangle {
             geometric: self.geometric,
             normals: self.normals,
             uvs: self.uvs,
+            tangents: self.tangents,
         }
     }
 
@@ -215,10 +226,26 @@ impl PreparedTriangle {
             to_eye,
             uv,
             duv: [Vec2::ZERO; 2],
+            tangents: self.tangents,
             material: self.material,
             front,
         }
     }
+}
+
+/// ∂P/∂u and ∂P/∂v of the triangle with edges `e1`, `e2` (from its first
+/// vertex) and texture coordinates `uv` at its vertices: the solution of
+/// e1 = Δu₁·∂P/∂u + Δv₁·∂P/∂v, e2 = Δu₂·∂P/∂u + Δv₂·∂P/∂v; zero where the
+/// texture coordinates do not span the triangle.
+#[must_use]
+pub fn position_derivatives(e1: Vec3, e2: Vec3, uv: [Vec2; 3]) -> [Vec3; 2] {
+    let (d1, d2) = (uv[1] - uv[0], uv[2] - uv[0]);
+    let det = d1.x * d2.y - d2.x * d1.y;
+    if !det.is_normal() {
+        return [Vec3::ZERO; 2];
+    }
+    let inv = 1.0 / det;
+    [(e1 * d2.y - e2 * d1.y) * inv, (e2 * d1.x - e1 * d2.x) * inv]
 }
 
 /// Intersects the ray with the PLANE of triangle (a, a + e1, a + e2) —

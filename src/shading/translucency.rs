@@ -65,7 +65,7 @@ pub fn composite(scene: &Scene, mut fragments: Vec<Fragment>, targets: &mut [Tar
     let mut layers = prepare(scene, &fragments, &weights, w, h);
     let bounds = scene.bounds().unwrap_or_default();
     for FrameLight { light, samples } in &frame_lights(scene) {
-        let terms: Vec<ShadowTerm> = samples.iter().map(|s| ShadowTerm::build_within(scene, s, bounds, pool)).collect();
+        let terms = pool.terms(scene, samples, bounds);
         layers.par_iter_mut().filter(|l| light.only.as_ref().is_none_or(|o| o.contains(&l.object))).for_each(|l| {
             let s = &l.surface;
             let cos = s.normal.dot(light.incident(s.position).to_light);
@@ -104,8 +104,8 @@ fn prepare(scene: &Scene, fragments: &[Fragment], weights: &[f32], w: u32, h: u3
         .zip(weights.par_iter())
         .map(|(f, &weight)| {
             let (x, y) = (f.pixel % w, f.pixel / w);
-            let surface = frames.surface(scene, f.item, &rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5)));
-            let k = Coefficients::at(&scene.materials[surface.material], &surface);
+            let mut surface = frames.surface(scene, f.item, &rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5)));
+            let k = phong::sample_maps(&scene.materials[surface.material], &mut surface);
             let fog = scene.fog.map_or(0.0, |fog| fog.amount_at(&scene.camera, surface.position));
             let lit = Components { emission: k.parts().3, ..Default::default() };
             Layer { pixel: f.pixel as usize, weight, surface, k, object: f.item.object as usize, fog, lit }

@@ -14,7 +14,7 @@ use wide::f32x8;
 use crate::scene::{Scene, ShadowSettings};
 
 use crate::camera::{Camera, Projection};
-use crate::visibility::{rasterize_casters, Faces, VisibilityBuffer};
+use crate::visibility::{rasterize_casters, VisibilityBuffer, Workers};
 
 /// Largest tan θ the slope bias uses (θ ≈ 84°); beyond it the bias would push
 /// shadows off their casters.
@@ -37,13 +37,21 @@ pub struct DepthMap {
 }
 
 impl DepthMap {
-    /// Renders the depth of every object of `scene` that casts shadows seen by
-    /// `camera` into a square map of `resolution` texels, held in `depth` (a
-    /// depth-only buffer, resized).
+    /// Renders the depth of the objects of `scene` that `casters` marks
+    /// ([`Scene::map_casters`]) seen by `camera` into a square map of
+    /// `resolution` texels, held in `depth` (a depth-only buffer, resized),
+    /// its meshes drawn on `workers`.
     #[must_use]
-    pub fn render(scene: &Scene, camera: &Camera, resolution: u32, mut depth: VisibilityBuffer) -> DepthMap {
+    pub fn render(
+        scene: &Scene,
+        camera: &Camera,
+        resolution: u32,
+        casters: &[bool],
+        workers: Workers,
+        mut depth: VisibilityBuffer,
+    ) -> DepthMap {
         depth.resize(resolution, resolution);
-        rasterize_casters(scene, camera, Faces::All, &mut depth);
+        rasterize_casters(scene, camera, casters, workers, &mut depth);
         DepthMap::of(camera, depth)
     }
 

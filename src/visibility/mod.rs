@@ -18,7 +18,7 @@ use glam::Vec3;
 
 use crate::scene::{Body, Scene};
 
-pub use raster::{fragments, rasterize, rasterize_casters, Faces, Fragment, RasterStats};
+pub use raster::{fragments, rasterize, rasterize_casters, Faces, Fragment, RasterStats, Workers};
 
 /// What a pixel sees: an object and one of its triangles, or one primitive of a
 /// CSG solid (seed 003: item id = object + primitive).

@@ -15,7 +15,7 @@ use super::clip::{ClipPlanes, MAX_CLIPPED};
 use super::scan::{column_range, row_range, scan_triangle, signed_area2, FixedPoint, SpanSink, ONE};
 use super::{ItemId, VisibilityBuffer};
 use crate::camera::Camera;
-use crate::scene::{Material, Object, Scene};
+use crate::scene::{Material, Scene};
 
 /// Rows per band: the unit of parallel work and of binning.
 pub const BAND_ROWS: usize = 16;
@@ -103,7 +103,23 @@ struct PolygonPass<'a> {
     viewport: Viewport,
     width: i64,
     height: i64,
+    /// Rows per band: [`BAND_ROWS`], or the whole image on one worker.
+    band_rows: usize,
     bands: usize,
+    workers: Workers,
+}
+
+/// How a polygon pass runs (what it draws is the same either way, bit for bit).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Workers {
+    /// On every worker: the image cut into bands of 16 rows drawn in
+    /// parallel, each triangle binned into the bands it touches.
+    All,
+    /// On the calling thread, the image as one band: for passes that run
+    /// beside others (the jittered shadow maps of an area light, one per
+    /// worker), where binning and drawing a triangle once per band it touches
+    /// cost more than they share out.
+    One,
 }
 
 /// Which faces a polygon pass draws.
@@ -121,18 +137,29 @@ pub enum Faces {
 /// ([`super::solids::draw_solids`]; solids are drawn opaque whatever their
 /// material). Translucent meshes are left to [`fragments`].
 pub fn rasterize(scene: &Scene, vb: &mut VisibilityBuffer) -> RasterStats {
-    let pass = PolygonPass::new(scene, &scene.camera, Faces::AsMaterials, vb.width(), vb.height());
+    let pass = PolygonPass::new(scene, &scene.camera, Faces::AsMaterials, Workers::All, vb.width(), vb.height());
     let stats = pass.draw(&chunks(scene, |_, m| !m.translucent()), vb);
     RasterStats { solids: super::solids::draw_solids(scene, &scene.camera, |_| true, vb), ..stats }
 }
 
-/// Draws every object of `scene` that casts shadows ([`Object::casts_shadows`]),
-/// opaque or not, seen by `camera` (a light's, for a shadow map), drawing
-/// `faces`, into `vb`.
-pub fn rasterize_casters(scene: &Scene, camera: &Camera, faces: Faces, vb: &mut VisibilityBuffer) -> RasterStats {
-    let pass = PolygonPass::new(scene, camera, faces, vb.width(), vb.height());
-    let stats = pass.draw(&chunks(scene, |o, _| o.casts_shadows), vb);
-    RasterStats { solids: super::solids::draw_solids(scene, camera, |o| o.casts_shadows, vb), ..stats }
+/// Draws the objects of `scene` that `casters` marks (per object: those
+/// shadow maps draw, [`Scene::map_casters`]), opaque or not, front and back
+/// faces (open meshes cast too), seen by `camera` (a light's, for a shadow
+/// map), into `vb`, its meshes on `workers`.
+///
+/// # Panics
+///
+/// If `casters` is shorter than the scene's objects.
+pub fn rasterize_casters(
+    scene: &Scene,
+    camera: &Camera,
+    casters: &[bool],
+    workers: Workers,
+    vb: &mut VisibilityBuffer,
+) -> RasterStats {
+    let pass = PolygonPass::new(scene, camera, Faces::All, workers, vb.width(), vb.height());
+    let stats = pass.draw(&chunks(scene, |i, _| casters[i]), vb);
+    RasterStats { solids: super::solids::draw_solids(scene, camera, |i| casters[i], vb), ..stats }
 }
 
 /// A sample of a translucent surface at a pixel centre.
@@ -157,18 +184,18 @@ pub fn fragments(scene: &Scene, opaque: &VisibilityBuffer) -> Vec<Fragment> {
         return Vec::new();
     }
     let (w, h) = (opaque.width(), opaque.height());
-    let pass = PolygonPass::new(scene, &scene.camera, Faces::AsMaterials, w, h);
+    let pass = PolygonPass::new(scene, &scene.camera, Faces::AsMaterials, Workers::All, w, h);
     let bins: Vec<ChunkBins> = chunks.par_iter().map(|c| pass.bin(c)).collect();
-    let band_len = w as usize * BAND_ROWS;
+    let band_len = w as usize * pass.band_rows;
     let bands = opaque.depths().par_chunks(band_len).enumerate();
     let per_band: Vec<Vec<Fragment>> = bands
         .map(|(band, depth)| {
-            let row0 = (band * BAND_ROWS) as i64;
+            let row0 = (band * pass.band_rows) as i64;
             let mut sink = FragmentSink {
                 opaque: depth,
                 width: pass.width,
                 row0,
-                plane: DepthPlane::default(),
+                plane: LazyPlane::default(),
                 item: ItemId::NONE,
                 out: Vec::new(),
             };
@@ -180,7 +207,7 @@ pub fn fragments(scene: &Scene, opaque: &VisibilityBuffer) -> Vec<Fragment> {
 }
 
 impl<'a> PolygonPass<'a> {
-    fn new(scene: &'a Scene, camera: &Camera, faces: Faces, width: u32, height: u32) -> Self {
+    fn new(scene: &'a Scene, camera: &Camera, faces: Faces, workers: Workers, width: u32, height: u32) -> Self {
         let (w, h) = (width as usize, height as usize);
         let view_proj = camera.view_projection(w as f32 / h as f32);
         let planes = ClipPlanes::new(
@@ -189,7 +216,12 @@ impl<'a> PolygonPass<'a> {
             1.0 + 2.0 * GUARD_PX as f64 / h as f64,
         );
         let viewport = Viewport { width: w as f32, height: h as f32 };
-        let projected = scene.objects.iter().map(|o| project(scene, o, view_proj, &planes, viewport, faces)).collect();
+        let projected =
+            scene.objects.iter().map(|o| project(scene, o, view_proj, &planes, viewport, faces, workers)).collect();
+        let band_rows = match workers {
+            Workers::All => BAND_ROWS,
+            Workers::One => h.max(1),
+        };
         PolygonPass {
             scene,
             projected,
@@ -197,25 +229,32 @@ impl<'a> PolygonPass<'a> {
             viewport,
             width: w as i64,
             height: h as i64,
-            bands: h.div_ceil(BAND_ROWS),
+            band_rows,
+            bands: h.div_ceil(band_rows),
+            workers,
         }
     }
 
     /// Bins `chunks` and draws them into `vb`, bands in parallel, each band
     /// clearing its own rows first.
     fn draw(&self, chunks: &[Chunk], vb: &mut VisibilityBuffer) -> RasterStats {
-        let bins: Vec<ChunkBins> = chunks.par_iter().map(|c| self.bin(c)).collect();
-        let (w, row0) = (self.width, |band: usize| (band * BAND_ROWS) as i64);
+        let bins: Vec<ChunkBins> = match self.workers {
+            Workers::All => chunks.par_iter().map(|c| self.bin(c)).collect(),
+            Workers::One => chunks.iter().map(|c| self.bin(c)).collect(),
+        };
+        let (w, row0) = (self.width, |band: usize| (band * self.band_rows) as i64);
         let (depth, items) = vb.parts_mut();
-        let band_len = w as usize * BAND_ROWS;
+        let band_len = w as usize * self.band_rows;
         let draw = |band: usize, depth: &mut [f32], items: &mut [ItemId]| {
             depth.fill(0.0);
             items.fill(ItemId::NONE);
-            let (plane, item) = (DepthPlane::default(), ItemId::NONE);
+            let (plane, item) = (LazyPlane::default(), ItemId::NONE);
             let mut sink = DepthSink { depth, items, width: w, row0: row0(band), plane, item };
             self.draw_band(band, &mut sink, chunks, &bins);
         };
-        if items.is_empty() {
+        if self.workers == Workers::One {
+            draw(0, depth, items);
+        } else if items.is_empty() {
             depth.par_chunks_mut(band_len).enumerate().for_each(|(band, d)| draw(band, d, &mut []));
         } else {
             let bands = depth.par_chunks_mut(band_len).zip(items.par_chunks_mut(band_len)).enumerate();
@@ -238,17 +277,19 @@ fn project(
     planes: &ClipPlanes,
     viewport: Viewport,
     faces: Faces,
+    workers: Workers,
 ) -> Projected {
     let m = view_proj * Mat4::from(object.transform);
     let positions = object.triangles().map_or(&[][..], |m| &m.positions[..]);
-    let (outcode, screen) = positions
-        .par_iter()
-        .map(|p| {
-            let c: Vec4 = m * p.extend(1.0);
-            let code = planes.outcode(c);
-            (code, if code == 0 { viewport.to_screen(c.as_dvec4()) } else { ScreenVertex::default() })
-        })
-        .unzip();
+    let vertex = |p: &glam::Vec3| {
+        let c: Vec4 = m * p.extend(1.0);
+        let code = planes.outcode(c);
+        (code, if code == 0 { viewport.to_screen(c.as_dvec4()) } else { ScreenVertex::default() })
+    };
+    let (outcode, screen) = match workers {
+        Workers::All => positions.par_iter().map(vertex).unzip(),
+        Workers::One => positions.iter().map(vertex).unzip(),
+    };
     Projected {
         to_clip: view_proj.as_dmat4() * Mat4::from(object.transform).as_dmat4(),
         outcode,
@@ -257,10 +298,11 @@ fn project(
     }
 }
 
-/// The objects whose material `include` accepts, cut into chunks.
-fn chunks(scene: &Scene, include: impl Fn(&Object, &Material) -> bool) -> Vec<Chunk> {
+/// The objects that `include` accepts (given each one's index and material),
+/// cut into chunks.
+fn chunks(scene: &Scene, include: impl Fn(usize, &Material) -> bool) -> Vec<Chunk> {
     let mut out = Vec::new();
-    for (object, o) in scene.objects.iter().enumerate().filter(|(_, o)| include(o, &scene.materials[o.material])) {
+    for (object, o) in scene.objects.iter().enumerate().filter(|(i, o)| include(*i, &scene.materials[o.material])) {
         let Some(mesh) = o.triangles() else { continue };
         let n = mesh.triangles.len() as u32;
         out.extend(
@@ -331,13 +373,13 @@ impl PolygonPass<'_> {
         if rows.is_empty() || cols.is_empty() {
             return None;
         }
-        Some(rows.start as usize / BAND_ROWS..(rows.end as usize - 1) / BAND_ROWS + 1)
+        Some(rows.start as usize / self.band_rows..(rows.end as usize - 1) / self.band_rows + 1)
     }
 
     /// Scan-converts the triangles binned into `band` into `sink`, in scene order.
     fn draw_band(&self, band: usize, sink: &mut impl BandSink, chunks: &[Chunk], bins: &[ChunkBins]) {
-        let row0 = (band * BAND_ROWS) as i64;
-        let rows = row0..(row0 + BAND_ROWS as i64).min(self.height);
+        let row0 = (band * self.band_rows) as i64;
+        let rows = row0..(row0 + self.band_rows as i64).min(self.height);
         for (chunk, bin) in chunks.iter().zip(bins) {
             let p = &self.projected[chunk.object];
             let tris = &self.scene.objects[chunk.object].triangles().expect("chunks hold meshes").triangles;
@@ -347,7 +389,7 @@ impl PolygonPass<'_> {
                 } else {
                     (tris[entry as usize].map(|i| p.screen[i as usize]), entry)
                 };
-                sink.triangle(ItemId { object: chunk.object as u32, triangle: t }, DepthPlane::new(&v));
+                sink.triangle(ItemId { object: chunk.object as u32, triangle: t }, v);
                 scan_triangle(&v.map(ScreenVertex::point), rows.clone(), sink);
             }
         }
@@ -378,14 +420,42 @@ impl DepthPlane {
     }
 }
 
+/// A triangle's depth plane, worked out at its first span: most triangles of
+/// a dense mesh in a shadow map cover no texel centre and need none (two
+/// divisions saved each).
+#[derive(Debug, Clone, Copy)]
+enum LazyPlane {
+    Vertices([ScreenVertex; 3]),
+    Plane(DepthPlane),
+}
+
+impl Default for LazyPlane {
+    fn default() -> Self {
+        LazyPlane::Plane(DepthPlane::default())
+    }
+}
+
+impl LazyPlane {
+    fn get(&mut self) -> DepthPlane {
+        match *self {
+            LazyPlane::Plane(p) => p,
+            LazyPlane::Vertices(v) => {
+                let p = DepthPlane::new(&v);
+                *self = LazyPlane::Plane(p);
+                p
+            }
+        }
+    }
+}
+
 /// Where a band's spans go: told each triangle before its spans.
 trait BandSink: SpanSink {
-    fn triangle(&mut self, item: ItemId, plane: DepthPlane);
+    fn triangle(&mut self, item: ItemId, v: [ScreenVertex; 3]);
 }
 
 impl BandSink for DepthSink<'_> {
-    fn triangle(&mut self, item: ItemId, plane: DepthPlane) {
-        (self.item, self.plane) = (item, plane);
+    fn triangle(&mut self, item: ItemId, v: [ScreenVertex; 3]) {
+        (self.item, self.plane) = (item, LazyPlane::Vertices(v));
     }
 }
 
@@ -394,24 +464,25 @@ struct FragmentSink<'a> {
     opaque: &'a [f32],
     width: i64,
     row0: i64,
-    plane: DepthPlane,
+    plane: LazyPlane,
     item: ItemId,
     out: Vec<Fragment>,
 }
 
 impl BandSink for FragmentSink<'_> {
-    fn triangle(&mut self, item: ItemId, plane: DepthPlane) {
-        (self.item, self.plane) = (item, plane);
+    fn triangle(&mut self, item: ItemId, v: [ScreenVertex; 3]) {
+        (self.item, self.plane) = (item, LazyPlane::Vertices(v));
     }
 }
 
 impl SpanSink for FragmentSink<'_> {
     fn span(&mut self, y: i64, x0: i64, x1: i64) {
         let (x0, x1) = (x0.max(0), x1.min(self.width));
-        let row_z = self.plane.c + self.plane.dy * y as f64;
+        let plane = self.plane.get();
+        let row_z = plane.c + plane.dy * y as f64;
         let base = (y - self.row0) * self.width;
         for x in x0..x1 {
-            let z = (row_z + self.plane.dx * x as f64) as f32;
+            let z = (row_z + plane.dx * x as f64) as f32;
             if z > self.opaque[(base + x) as usize] {
                 let pixel = (y * self.width + x) as u32;
                 self.out.push(Fragment { pixel, depth: z, item: self.item });
@@ -427,7 +498,7 @@ struct DepthSink<'a> {
     items: &'a mut [ItemId],
     width: i64,
     row0: i64,
-    plane: DepthPlane,
+    plane: LazyPlane,
     item: ItemId,
 }
 
@@ -438,18 +509,19 @@ impl SpanSink for DepthSink<'_> {
             return;
         }
         let base = ((y - self.row0) * self.width) as usize;
-        let row_z = self.plane.c + self.plane.dy * y as f64;
+        let plane = self.plane.get();
+        let row_z = plane.c + plane.dy * y as f64;
         let depth = &mut self.depth[base + x0 as usize..base + x1 as usize];
         if self.items.is_empty() {
             for (k, d) in depth.iter_mut().enumerate() {
-                let z = (row_z + self.plane.dx * (x0 + k as i64) as f64) as f32;
+                let z = (row_z + plane.dx * (x0 + k as i64) as f64) as f32;
                 *d = d.max(z);
             }
             return;
         }
         let items = &mut self.items[base + x0 as usize..base + x1 as usize];
         for (k, (d, it)) in depth.iter_mut().zip(items.iter_mut()).enumerate() {
-            let z = (row_z + self.plane.dx * (x0 + k as i64) as f64) as f32;
+            let z = (row_z + plane.dx * (x0 + k as i64) as f64) as f32;
             if z > *d {
                 *d = z;
                 *it = self.item;

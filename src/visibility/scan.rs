@@ -77,14 +77,15 @@ impl EdgeDda {
         EdgeDda { x, rem: x * d - n, step_x: s.div_euclid(d), step_rem: s.rem_euclid(d), d }
     }
 
-    /// Moves to the next row.
+    /// Moves to the next row. Without a branch: whether the remainder
+    /// borrows is as good as random from row to row, and a mispredicted
+    /// branch per edge and row cost more than the arithmetic.
+    #[inline(always)]
     fn step(&mut self) {
-        self.x += self.step_x;
         self.rem -= self.step_rem;
-        if self.rem < 0 {
-            self.x += 1;
-            self.rem += self.d;
-        }
+        let borrow = self.rem >> 63; // −1 when the remainder went below zero, else 0
+        self.x += self.step_x - borrow;
+        self.rem += self.d & borrow;
     }
 }
 
@@ -112,8 +113,80 @@ pub fn column_range(v: &[FixedPoint; 3]) -> Range<i64> {
     first_centre_from(lo)..first_centre_from(hi)
 }
 
+/// Most pixel centres in a triangle's bounding box for which [`scan_triangle`]
+/// tests each centre against the three edges instead of walking them: the
+/// walkers' set-up costs six 64-bit divisions, and most triangles of a dense
+/// mesh in a shadow map cover a texel or none. Measured on the jittered shadow
+/// maps of a lone Stanford bunny (512², 69,451 triangles) and of the demo
+/// (1024², 30,586), against walking every triangle: at 6 centres 0.91× and
+/// 1.0× the time; at 16, 0.91× and 1.05×; at 48, 0.92× and 1.26× (the demo's
+/// triangles, a few rows tall, walk faster than their boxes test).
+const SMALL_BOX_CENTRES: i64 = 6;
+
 /// Emits the spans of triangle `v` on the rows in `rows` (any vertex order).
 pub fn scan_triangle(v: &[FixedPoint; 3], rows: Range<i64>, sink: &mut impl SpanSink) {
+    let box_rows = row_range(v);
+    let (start, end) = (box_rows.start.max(rows.start), box_rows.end.min(rows.end));
+    if start >= end {
+        return;
+    }
+    let cols = column_range(v);
+    if (end - start) * (cols.end - cols.start) <= SMALL_BOX_CENTRES {
+        scan_small(v, start..end, cols, sink);
+    } else {
+        scan_walking(v, rows, sink);
+    }
+}
+
+/// [`scan_triangle`] for a triangle whose bounding box holds few pixel centres
+/// (rows `rows`, columns `cols`): each centre tested against the three edge
+/// functions, with the same top-left rule the walkers follow, so both give the
+/// same pixels.
+fn scan_small(v: &[FixedPoint; 3], rows: Range<i64>, cols: Range<i64>, sink: &mut impl SpanSink) {
+    let area = signed_area2(v);
+    if area == 0 || cols.is_empty() {
+        return;
+    }
+    // Clockwise on screen (positive area): the interior has every edge function
+    // positive; a centre on an edge belongs to the triangle when the edge is a
+    // left one (running up the screen) or a top one (horizontal, towards +x).
+    let v = if area < 0 { [v[0], v[2], v[1]] } else { *v };
+    let edges = [0, 1, 2].map(|i| {
+        let (a, b) = (v[i], v[(i + 1) % 3]);
+        let owns_ties = b.y < a.y || (b.y == a.y && b.x > a.x);
+        // e(p) = (b.x − a.x)(p.y − a.y) − (b.y − a.y)(p.x − a.x), made > 0
+        // exactly where the centre belongs (ties shifted by one unit).
+        let (ex, ey) = (-(b.y - a.y) * ONE, (b.x - a.x) * ONE);
+        let at = |x: i64, y: i64| (b.x - a.x) * (y * ONE + HALF - a.y) - (b.y - a.y) * (x * ONE + HALF - a.x);
+        (at(cols.start, rows.start) + i64::from(owns_ties), ex, ey)
+    });
+    let mut row_e = edges.map(|(e, _, _)| e);
+    for y in rows {
+        let mut e = row_e;
+        let mut first = None;
+        let mut last = cols.start;
+        for x in cols.clone() {
+            if e.iter().all(|&e| e > 0) {
+                first.get_or_insert(x);
+                last = x + 1;
+            } else if first.is_some() {
+                break; // a row of a convex shape is one run
+            }
+            for (k, e) in e.iter_mut().enumerate() {
+                *e += edges[k].1;
+            }
+        }
+        if let Some(first) = first {
+            sink.span(y, first, last);
+        }
+        for (k, e) in row_e.iter_mut().enumerate() {
+            *e += edges[k].2;
+        }
+    }
+}
+
+/// [`scan_triangle`] by the exact edge walkers.
+fn scan_walking(v: &[FixedPoint; 3], rows: Range<i64>, sink: &mut impl SpanSink) {
     let mut s = *v;
     s.sort_unstable_by_key(|p| (p.y, p.x));
     let [a, b, c] = s;
@@ -156,35 +229,90 @@ mod tests {
     }
 
     fn covered(v: &[FixedPoint; 3]) -> Vec<(i64, i64)> {
+        covered_by(v, |v, mut sink| scan_triangle(v, -100..100, &mut sink))
+    }
+
+    fn covered_by(
+        v: &[FixedPoint; 3],
+        scan: impl Fn(&[FixedPoint; 3], &mut dyn FnMut(i64, i64, i64)),
+    ) -> Vec<(i64, i64)> {
         let mut out = Vec::new();
-        scan_triangle(v, -100..100, &mut |y, x0, x1| out.extend((x0..x1).map(|x| (x, y))));
+        scan(v, &mut |y, x0, x1| out.extend((x0..x1).map(|x| (x, y))));
         out.sort_unstable();
         out
     }
 
+    /// Random triangles with corners on a grid of `step` pixels within `reach`
+    /// of the origin (a coarse grid puts pixel centres on edges and corners).
+    fn random_triangles(count: usize, reach: f64, step: f64, mut seed: u64) -> Vec<[FixedPoint; 3]> {
+        let cells = (2.0 * reach / step) as u64;
+        let mut rnd = move || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            ((seed >> 33) % cells) as f64 * step - reach
+        };
+        (0..count).map(|_| [fp(rnd(), rnd()), fp(rnd(), rnd()), fp(rnd(), rnd())]).collect()
+    }
+
+    fn oracle(v: &[FixedPoint; 3]) -> Vec<(i64, i64)> {
+        let mut want = Vec::new();
+        for y in -12..12 {
+            for x in -12..12 {
+                if inside_tl(v, x, y) {
+                    want.push((x, y));
+                }
+            }
+        }
+        want.sort_unstable();
+        want
+    }
+
     #[test]
     fn matches_edge_function_oracle_on_small_triangles() {
-        let mut seed = 12345u64;
-        let mut rnd = || {
-            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            ((seed >> 33) % 2000) as f64 / 100.0 - 10.0
-        };
-        for _ in 0..300 {
-            let v = [fp(rnd(), rnd()), fp(rnd(), rnd()), fp(rnd(), rnd())];
+        for v in random_triangles(300, 10.0, 0.01, 12345) {
             if signed_area2(&v) == 0 {
                 continue;
             }
-            let got = covered(&v);
-            let mut want = Vec::new();
-            for y in -12..12 {
-                for x in -12..12 {
-                    if inside_tl(&v, x, y) {
-                        want.push((x, y));
-                    }
+            assert_eq!(covered(&v), oracle(&v), "{v:?}");
+        }
+    }
+
+    /// The edge walkers and the per-centre test give the same pixels whatever
+    /// the triangle's size, and both the oracle's, on grids that make ties
+    /// common (half and quarter pixels) and on a fine one.
+    #[test]
+    fn walkers_and_centre_tests_cover_the_same_pixels() {
+        let sets = [(3.0, 0.25, 1), (3.0, 0.5, 2), (10.0, 0.5, 3), (2.0, 0.01, 4), (10.0, 0.01, 5)];
+        let mut ties = 0;
+        for (reach, step, seed) in sets {
+            for v in random_triangles(400, reach, step, seed) {
+                if signed_area2(&v) == 0 {
+                    continue;
                 }
+                let walked = covered_by(&v, |v, mut sink| scan_walking(v, -100..100, &mut sink));
+                let tested = covered_by(&v, |v, mut sink| scan_small(v, row_range(v), column_range(v), &mut sink));
+                let want = oracle(&v);
+                assert_eq!(walked, want, "walkers, {v:?}");
+                assert_eq!(tested, want, "centre tests, {v:?}");
+                let on_edge = |&(x, y): &(i64, i64)| {
+                    let p = FixedPoint { x: x * ONE + HALF, y: y * ONE + HALF };
+                    (0..3).any(|i| signed_area2(&[v[i], v[(i + 1) % 3], p]) == 0)
+                };
+                ties += want.iter().filter(|p| on_edge(p)).count();
             }
-            want.sort_unstable();
-            assert_eq!(got, want, "{v:?}");
+        }
+        assert!(ties > 200, "only {ties} covered centres lie on an edge");
+    }
+
+    /// A band's rows of a triangle are the rows of the whole triangle in it.
+    #[test]
+    fn a_band_gets_its_rows_of_the_triangle() {
+        for v in random_triangles(200, 4.0, 0.25, 6) {
+            let whole = covered(&v);
+            for band in [-4..-1, -1..2, 2..3] {
+                let got = covered_by(&v, |v, mut sink| scan_triangle(v, band.clone(), &mut sink));
+                let want: Vec<_> = whole.iter().copied().filter(|(_, y)| band.contains(y)).collect();
+                assert_eq!(got, want, "{v:?} rows {band:?}");
+            }
         }
     }
 

@@ -10,8 +10,10 @@
 //! occlusion texture, Kd, Ka and Ks are baked into textures texel by texel
 //! (Km and n take the material's mean). `KHR_materials_transmission` makes
 //! Kt = base colour · transmission (Kd scaled by what is not transmitted),
-//! `KHR_materials_ior` the index of refraction. Buffers and images may be
-//! files, GLB chunks or `data:` URIs. Normal textures are not used.
+//! `KHR_materials_ior` the index of refraction. The normal texture tilts the
+//! shading normal (`shading/normal_map.rs`: tangents from the texture
+//! coordinates; a `TANGENT` attribute is not read). Buffers and images may be
+//! files, GLB chunks or `data:` URIs.
 
 use std::path::Path;
 use std::sync::Arc;
@@ -21,7 +23,7 @@ use glam::{Affine3A, Mat4, Vec2, Vec3};
 use super::{checked, AssetSource, LoadedModel, Part};
 use crate::camera::{Camera, Projection};
 use crate::scene::mesh::{Mesh, NormalMode};
-use crate::scene::{ComponentMaps, Falloff, Light, LightKind, Material, Texture};
+use crate::scene::{ComponentMaps, Falloff, Light, LightKind, Material, NormalMap, Texture};
 
 struct Context<'a> {
     doc: gltf::Document,
@@ -134,6 +136,11 @@ impl Context<'_> {
         out.ke = Vec3::from(m.emissive_factor());
         out.maps.emission =
             m.emissive_texture().map(|t| self.texture(&t.texture(), true)).transpose()?.into_iter().collect();
+        out.maps.normal = m
+            .normal_texture()
+            .map(|t| Ok::<_, String>(NormalMap { texture: self.texture(&t.texture(), false)?, scale: t.scale() }))
+            .transpose()?
+            .filter(|n| n.scale.is_finite() && n.scale != 0.0);
         out.two_sided = m.double_sided();
         // BLEND materials are translucent with the base colour's alpha; MASK and
         // OPAQUE ones are drawn opaque (alpha cut-outs are not supported).

@@ -117,6 +117,7 @@ fn material(m: &tobj::Material, dir: &Path, assets: &dyn AssetSource, warnings: 
             diffuse,
             specular: map(&m.specular_texture),
             emission: Vec::new(),
+            normal: None,
             filter: Default::default(),
         },
         two_sided: false,

@@ -75,7 +75,7 @@ use crate::camera::{Camera, PixelRays, RowLine};
 use crate::csg::occupancy::{OccupancyTree, Occupied};
 use crate::csg::outline::{screen_point, Extent, Outline};
 use crate::csg::{Crossing, CsgCaster, CsgSolid, FacesOnScreen, Hit, Primitive, SpanScratch};
-use crate::scene::{Object, Scene};
+use crate::scene::Scene;
 use crate::visibility::{ItemId, VisibilityBuffer};
 use block::BlockOrder;
 use bounds::BoundingLeaves;
@@ -275,7 +275,7 @@ enum Reuse {
     Never,
 }
 
-/// Draws every solid of `scene` that `include` takes, seen by `camera`, into
+/// Draws every solid of `scene` whose object index `include` takes, seen by `camera`, into
 /// `vb` (after its polygons): where a solid's visible surface lies nearer than
 /// what the pixel holds and between the near and far planes, the pixel takes
 /// its depth, its item (object + primitive) and its outward normal. A
@@ -284,14 +284,14 @@ enum Reuse {
 pub fn draw_solids(
     scene: &Scene,
     camera: &Camera,
-    include: impl Fn(&Object) -> bool,
+    include: impl Fn(usize) -> bool,
     vb: &mut VisibilityBuffer,
 ) -> usize {
     let (width, height) = (vb.width(), vb.height());
     let w = width as usize;
     let far = camera.far_plane_factor();
     let mut drawn = 0;
-    for (object, o) in scene.objects.iter().enumerate().filter(|(_, o)| include(o)) {
+    for (object, o) in scene.objects.iter().enumerate().filter(|(i, _)| include(*i)) {
         let Some(solid) = o.solid() else { continue };
         let world = solid.transformed(&o.transform);
         let (depth, items, normals) = vb.solid_parts_mut();
