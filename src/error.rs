@@ -156,6 +156,15 @@ pub enum Error {
         /// Width and height of the second.
         b: (u32, u32),
     },
+    /// An input file of a kind kage does not read.
+    #[error(
+        "{}: not a file kage reads (a scene .toml, or a model: .obj, .stl, .gltf, .glb, .csg)",
+        path.display()
+    )]
+    UnknownInput {
+        /// The file.
+        path: PathBuf,
+    },
     /// The output image could not be written.
     #[error("cannot write {}: {message}", path.display())]
     Output {

@@ -42,6 +42,25 @@ pub fn write_image(image: &LinearImage, path: &Path, exposure: f32, tone: ToneCu
     }
 }
 
+/// Checks, before any work, that [`write_image`] can write `path`: a known
+/// image extension, and a folder that exists.
+///
+/// # Errors
+///
+/// [`Error::Output`] naming what is wrong.
+pub fn check_output(path: &Path) -> Result<()> {
+    let fail = |message: String| Error::Output { path: path.to_path_buf(), message };
+    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or_default().to_ascii_lowercase();
+    if !matches!(ext.as_str(), "png" | "jpg" | "jpeg" | "exr" | "pfm") {
+        return Err(fail(format!("unknown image format '.{ext}' (use .png, .jpg, .exr or .pfm)")));
+    }
+    let folder = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    if !folder.is_dir() {
+        return Err(fail(format!("the folder {} does not exist", folder.display())));
+    }
+    Ok(())
+}
+
 /// Portable float map: little-endian RGB floats, rows bottom to top.
 #[must_use]
 pub fn pfm_bytes(image: &LinearImage) -> Vec<u8> {

@@ -352,7 +352,8 @@ fn load(args: &RenderArgs) -> kage::error::Result<Scene> {
             return model::scene_for_model_with(p, width.unwrap_or(960), height.unwrap_or(540), &options);
         }
         None => demo_scene()?,
-        Some(p) => file::load_scene(p)?,
+        Some(p) if p.extension().is_some_and(|e| e.eq_ignore_ascii_case("toml")) => file::load_scene(p)?,
+        Some(p) => return Err(kage::Error::UnknownInput { path: p.to_path_buf() }),
     };
     scene.width = width.unwrap_or(scene.width);
     scene.height = height.unwrap_or(scene.height);
@@ -366,6 +367,8 @@ fn load(args: &RenderArgs) -> kage::error::Result<Scene> {
 }
 
 fn render_command(args: &RenderArgs) -> kage::error::Result<()> {
+    // Cheap checks first: a bad output path is found before the render.
+    kage::output::check_output(&args.output)?;
     let mut scene = load(args)?;
     scene.antialias = args.antialias.unwrap_or(scene.antialias);
     scene.tone = args.tonemap.unwrap_or(scene.tone);

@@ -283,3 +283,36 @@ fn exposure_on_the_command_line() {
     assert!(!ok);
     assert!(err.contains("neither a number of stops nor 'auto'"));
 }
+
+/// An error on a line too long to show (past column 65,535 the report
+/// formatter itself failed) is reported with its location, exit code 1, and
+/// no source excerpt; a short line still shows its excerpt.
+#[test]
+fn an_error_on_a_very_long_line_is_reported_not_a_crash() {
+    let regressions = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/regressions");
+    for (file, at) in [("csg/col70000.csg", ":1:70001"), ("scene/col70000.toml", ":1:70006")] {
+        let out = scratch("long-line").join("x.png");
+        let got = run(&["render", regressions.join(file).to_str().unwrap(), "-o", out.to_str().unwrap()]);
+        let stderr = String::from_utf8_lossy(&got.stderr);
+        assert_eq!(got.status.code(), Some(1), "{file}: {stderr}");
+        assert!(stderr.contains(at) && !stderr.contains("panicked"), "{file}: {stderr}");
+        assert!(stderr.len() < 2000, "{file}: the report quotes the line ({} bytes)", stderr.len());
+    }
+}
+
+/// Cheap checks come first: an output the render could not write is refused
+/// before rendering, and an input of a kind kage does not read is named as
+/// such (not parsed as a scene).
+#[test]
+fn a_bad_output_or_an_unknown_input_is_refused_before_the_render() {
+    let dir = scratch("cheap-checks");
+    let missing = dir.join("no-such-folder").join("x.png");
+    let (ok, stderr) = kage(&["render", "-o", missing.to_str().unwrap()]);
+    assert!(!ok && stderr.contains("no-such-folder") && stderr.contains("does not exist"), "{stderr}");
+    assert!(!stderr.contains("wrote"), "the render ran first: {stderr}");
+    let (ok, stderr) = kage(&["render", "-o", dir.join("x.gif").to_str().unwrap()]);
+    assert!(!ok && stderr.contains("unknown image format '.gif'"), "{stderr}");
+    let readme = write(&dir, "README.md", "# notes\n");
+    let (ok, stderr) = kage(&["render", readme.to_str().unwrap(), "-o", dir.join("x.png").to_str().unwrap()]);
+    assert!(!ok && stderr.contains("not a file kage reads") && stderr.contains(".gltf"), "{stderr}");
+}

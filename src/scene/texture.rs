@@ -48,11 +48,13 @@ impl Wrap {
 
     /// Texel indices `i` and `i + 1` of a row of `n`, wrapped (the two a
     /// bilinear lookup blends; inside the row, as nearly all are, no division).
+    /// A coordinate far outside the texture saturates `i` to the ends of
+    /// i64, where `i + 1` would overflow: the comparisons are made without it.
     fn pair(self, i: i64, n: i64) -> [usize; 2] {
-        if i >= 0 && i + 1 < n {
+        if i >= 0 && i < n - 1 {
             [i as usize, i as usize + 1]
         } else {
-            [self.index(i, n) as usize, self.index(i + 1, n) as usize]
+            [self.index(i, n) as usize, self.index(i.saturating_add(1), n) as usize]
         }
     }
 }

@@ -118,6 +118,12 @@ pub fn default_view((lo, hi): (Vec3, Vec3)) -> Camera {
 /// `$fn` at or below which spheres and cylinders stay faceted in exact mode.
 const ALWAYS_FACETED_FN: f64 = 8.0;
 
+/// Most fragments around one circle of a faceted sphere or cylinder: a sphere
+/// of this many has about n²/2 = 2 × 10⁶ triangles; OpenSCAD's own preview
+/// draws far fewer. More is refused (`$fn = 1e20` would ask for more memory
+/// than any machine has).
+pub const MAX_FRAGMENTS: usize = 2048;
+
 /// Reads the text of a `.csg` file (named `path` in messages) as a solid.
 ///
 /// # Errors
@@ -432,16 +438,39 @@ impl Builder {
         Ok(self.options.geometry == Geometry::Faceted || (fine > 0.0 && fine <= ALWAYS_FACETED_FN))
     }
 
-    /// OpenSCAD's number of fragments around a circle of radius `r`.
+    /// OpenSCAD's number of fragments around a circle of radius `r`, at
+    /// most [`MAX_FRAGMENTS`]; `$fn`, `$fa` and `$fs` must be finite (and
+    /// `$fa`, `$fs` positive when `$fn` does not decide).
     fn fragments(&self, node: &CsgNode, r: f32) -> Result<usize> {
         let (fine, fa, fs) = (self.number(node, "$fn")?, self.number(node, "$fa")?, self.number(node, "$fs")?);
-        Ok(if f64::from(r) < 1e-10 || !fine.is_finite() {
-            3
+        for (name, v) in [("$fn", fine), ("$fa", fa), ("$fs", fs)] {
+            if !v.is_finite() {
+                return Err(
+                    self.invalid(&self.span_of(node, name), format!("`{name}` must be a finite number, not {v}"))
+                );
+            }
+        }
+        let n = if f64::from(r) < 1e-10 {
+            3.0
         } else if fine > 0.0 {
-            (fine.floor() as usize).max(3)
+            fine.floor().max(3.0)
+        } else if fa <= 0.0 || fs <= 0.0 {
+            let name = if fa <= 0.0 { "$fa" } else { "$fs" };
+            return Err(self.invalid(&self.span_of(node, name), format!("`{name}` must be above 0 when `$fn` is 0")));
         } else {
-            (360.0 / fa).min(2.0 * std::f64::consts::PI * f64::from(r) / fs).max(5.0).ceil() as usize
-        })
+            (360.0 / fa).min(2.0 * std::f64::consts::PI * f64::from(r) / fs).max(5.0).ceil()
+        };
+        if n > MAX_FRAGMENTS as f64 {
+            let span = self.span_of(node, if fine > 0.0 { "$fn" } else { "$fs" });
+            return Err(self.invalid(
+                &span,
+                format!(
+                    "`{}()` asks for {n:.0} fragments around a circle; at most {MAX_FRAGMENTS} are made",
+                    node.name
+                ),
+            ));
+        }
+        Ok(n as usize)
     }
 
     fn arg<'n>(&self, node: &'n CsgNode, name: &str) -> Result<&'n CsgValue> {

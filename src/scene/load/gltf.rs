@@ -31,26 +31,70 @@ struct Context<'a> {
     dir: &'a Path,
     assets: &'a dyn AssetSource,
     path: &'a Path,
+    /// Nodes placed so far ([`MAX_INSTANCES`]).
+    placed: std::cell::Cell<usize>,
 }
+
+/// Deepest node tree read: real files nest tens of levels; a chain of
+/// 100,000 would overflow the stack.
+pub const MAX_NODE_DEPTH: usize = 1000;
+
+/// Most nodes placed in one scene, counting a node once per parent that lists
+/// it: 40 nodes each listing the next twice would place 2⁴⁰.
+pub const MAX_INSTANCES: usize = 100_000;
 
 /// Parses glTF or GLB bytes; `path` locates external buffers and images.
 pub fn load(bytes: &[u8], path: &Path, assets: &dyn AssetSource) -> Result<LoadedModel, String> {
-    let gltf = gltf::Gltf::from_slice(bytes).map_err(|e| e.to_string())?;
+    super::contained("the glTF reader (gltf)", || load_contained(bytes, path, assets))?
+}
+
+fn load_contained(bytes: &[u8], path: &Path, assets: &dyn AssetSource) -> Result<LoadedModel, String> {
+    let gltf = gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| e.to_string())?;
+    // The gltf crate's own validation indexes some arrays unchecked, and its
+    // image sources unwrap: what they assume is checked here first.
+    checked_references(gltf.document.as_json())?;
+    let document = gltf::Document::from_json(gltf.document.into_json()).map_err(|e| format!("invalid glTF: {e}"))?;
+    let gltf = gltf::Gltf { document, blob: gltf.blob };
     let dir = path.parent().unwrap_or(Path::new(""));
     let base = assets.base_dir().map(|b| b.join(dir));
     let buffers = gltf::import_buffers(&gltf.document, base.as_deref(), gltf.blob.clone())
         .map_err(|e| format!("buffers: {e}"))?;
-    let cx = Context { doc: gltf.document, buffers, dir, assets, path };
+    let cx = Context { doc: gltf.document, buffers, dir, assets, path, placed: std::cell::Cell::new(0) };
     let materials: Vec<Material> = cx.doc.materials().map(|m| cx.material(&m)).collect::<Result<_, _>>()?;
     let mut model = LoadedModel::default();
     let scene = cx.doc.default_scene().or_else(|| cx.doc.scenes().next()).ok_or("the file has no scene")?;
     for node in scene.nodes() {
-        cx.visit(&node, Mat4::IDENTITY, &materials, &mut model)?;
+        cx.visit(&node, Mat4::IDENTITY, &materials, &mut model, &mut Vec::new())?;
     }
     if model.parts.is_empty() {
         return Err("the default scene has no triangle meshes".into());
     }
     Ok(model)
+}
+
+/// The references the gltf crate follows without checking: each primitive's
+/// attribute and index accessors, and each image's data (a URI, or a buffer
+/// view with a MIME type).
+fn checked_references(root: &gltf::json::Root) -> Result<(), String> {
+    let accessors = root.accessors.len();
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, prim) in mesh.primitives.iter().enumerate() {
+            let used = prim.attributes.values().map(|a| a.value()).chain(prim.indices.map(|i| i.value()));
+            if let Some(bad) = used.into_iter().find(|&i| i >= accessors) {
+                return Err(format!(
+                    "mesh {m} primitive {p} uses accessor {bad}, but the file has {accessors} accessor(s)"
+                ));
+            }
+        }
+    }
+    for (i, image) in root.images.iter().enumerate() {
+        match (&image.uri, &image.buffer_view, &image.mime_type) {
+            (None, None, _) => return Err(format!("image {i} has neither a uri nor a bufferView")),
+            (None, Some(_), None) => return Err(format!("image {i} is in a bufferView but has no mimeType")),
+            _ => {}
+        }
+    }
+    Ok(())
 }
 
 impl Context<'_> {
@@ -60,6 +104,35 @@ impl Context<'_> {
         parent: Mat4,
         materials: &[Material],
         out: &mut LoadedModel,
+        above: &mut Vec<usize>,
+    ) -> Result<(), String> {
+        let index = node.index();
+        if above.contains(&index) {
+            return Err(format!("node {index} is its own ancestor (the node tree has a cycle)"));
+        }
+        if above.len() >= MAX_NODE_DEPTH {
+            return Err(format!("the node tree is deeper than {MAX_NODE_DEPTH} levels"));
+        }
+        self.placed.set(self.placed.get() + 1);
+        if self.placed.get() > MAX_INSTANCES {
+            return Err(format!(
+                "the scene places more than {MAX_INSTANCES} nodes (a node listed as the child of several parents is placed once for each)"
+            ));
+        }
+        above.push(index);
+        let placed = self.place(node, parent, materials, out, above);
+        above.pop();
+        placed
+    }
+
+    /// [`Context::visit`]'s work, once the node is known to be placeable.
+    fn place(
+        &self,
+        node: &gltf::Node,
+        parent: Mat4,
+        materials: &[Material],
+        out: &mut LoadedModel,
+        above: &mut Vec<usize>,
     ) -> Result<(), String> {
         let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
         let affine = Affine3A::from_mat4(world);
@@ -75,7 +148,7 @@ impl Context<'_> {
             out.lights.push(self::light(&light, affine));
         }
         for child in node.children() {
-            self.visit(&child, world, materials, out)?;
+            self.visit(&child, world, materials, out, above)?;
         }
         Ok(())
     }

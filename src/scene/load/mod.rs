@@ -292,3 +292,18 @@ fn checked(
     model.note_repairs(path, repairs);
     Ok(mesh)
 }
+
+/// Runs `read`, a dependency's reader, turning a panic inside it into an
+/// error naming `reader`: bad input must never take kage down, and where a
+/// reader is known to panic on some input the input is checked first; this
+/// catches the cases not yet known.
+fn contained<T>(reader: &str, read: impl FnOnce() -> T) -> Result<T, String> {
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(read)).map_err(|panic| {
+        let why = panic
+            .downcast_ref::<&str>()
+            .map(|s| (*s).to_string())
+            .or_else(|| panic.downcast_ref::<String>().cloned())
+            .unwrap_or_else(|| "no message".into());
+        format!("{reader} failed on this file ({why}); the file is malformed or the reader has a bug")
+    })
+}

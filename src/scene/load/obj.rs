@@ -20,12 +20,18 @@ use crate::scene::Material;
 pub fn load(bytes: &[u8], path: &Path, assets: &dyn AssetSource) -> Result<LoadedModel, String> {
     let dir = path.parent().unwrap_or(Path::new(""));
     let options = tobj::LoadOptions { triangulate: true, single_index: true, ..Default::default() };
-    let (models, materials) = tobj::load_obj_buf(&mut Cursor::new(bytes), &options, |mtl| {
-        let bytes = assets.read(&dir.join(mtl)).map_err(|_| tobj::LoadError::OpenFileFailed)?;
-        tobj::load_mtl_buf(&mut Cursor::new(bytes))
-    })
-    .map_err(|e| format!("OBJ parse error: {e}"))?;
+    let mtl_warnings = std::cell::RefCell::new(Vec::new());
+    let parsed = super::contained("the OBJ reader (tobj)", || {
+        tobj::load_obj_buf(&mut Cursor::new(bytes), &options, |mtl| {
+            let file = dir.join(mtl);
+            let bytes = assets.read(&file).map_err(|_| tobj::LoadError::OpenFileFailed)?;
+            let text = normalised_mtl(&String::from_utf8_lossy(&bytes), &file, &mut mtl_warnings.borrow_mut());
+            tobj::load_mtl_buf(&mut Cursor::new(text.as_bytes()))
+        })
+    });
+    let (models, materials) = parsed?.map_err(|e| format!("OBJ parse error: {e}"))?;
     let mut out = LoadedModel::default();
+    out.warnings.extend(mtl_warnings.into_inner());
     let materials = materials.unwrap_or_else(|e| {
         out.warnings.push(format!("{}: materials not loaded ({e}); using the default material", path.display()));
         Vec::new()
@@ -49,6 +55,38 @@ pub fn load(bytes: &[u8], path: &Path, assets: &dyn AssetSource) -> Result<Loade
         return Err(first_error.unwrap_or_else(|| "the file has no triangles".into()));
     }
     Ok(out)
+}
+
+/// Keys whose values tobj reads as exactly three numbers (and panics on fewer).
+const COLOUR_KEYS: [&str; 4] = ["Ka", "Kd", "Ks", "Ke"];
+
+/// `text` of MTL file `file` with every colour given by one number written
+/// out as three (the MTL format allows `Kd 0.5` for grey); a colour of two
+/// numbers, which the format does not allow, is taken as grey of the first
+/// with a warning naming the line.
+fn normalised_mtl(text: &str, file: &Path, warnings: &mut Vec<String>) -> String {
+    let mut out = String::with_capacity(text.len() + 64);
+    for (n, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        let key = words.next().unwrap_or("");
+        let values: Vec<&str> = words.collect();
+        if COLOUR_KEYS.contains(&key) && (1..3).contains(&values.len()) {
+            if values.len() == 2 {
+                warnings.push(format!(
+                    "{}:{}: `{key}` has two numbers (one or three expected); taken as grey {}",
+                    file.display(),
+                    n + 1,
+                    values[0]
+                ));
+            }
+            let v = values[0];
+            out.push_str(&format!("{key} {v} {v} {v}\n"));
+        } else {
+            out.push_str(line);
+            out.push('\n');
+        }
+    }
+    out
 }
 
 fn mesh(m: &tobj::Mesh) -> Result<(Mesh, crate::scene::mesh::MeshRepairs), String> {
