@@ -65,9 +65,9 @@ struct ImageRec {
     #[serde(default = "default_height")]
     height: Spanned<i64>,
     #[serde(default = "default_background")]
-    background: V3,
-    #[serde(default)]
-    exposure: ExposureRec,
+    background: Spanned<V3>,
+    #[serde(default = "default_exposure")]
+    exposure: Spanned<ExposureRec>,
     antialias: Option<Spanned<AntialiasRec>>,
     #[serde(default)]
     translucency: TranslucencyRec,
@@ -183,8 +183,12 @@ fn default_width() -> Spanned<i64> {
 fn default_height() -> Spanned<i64> {
     Spanned::new(0..0, 540)
 }
-fn default_background() -> V3 {
-    [0.1, 0.1, 0.15]
+fn default_background() -> Spanned<V3> {
+    Spanned::new(0..0, [0.1, 0.1, 0.15])
+}
+
+fn default_exposure() -> Spanned<ExposureRec> {
+    Spanned::new(0..0, ExposureRec::default())
 }
 
 impl Default for ImageRec {
@@ -193,7 +197,7 @@ impl Default for ImageRec {
             width: default_width(),
             height: default_height(),
             background: default_background(),
-            exposure: ExposureRec::default(),
+            exposure: default_exposure(),
             antialias: None,
             translucency: TranslucencyRec::default(),
             tonemap: ToneRec::default(),
@@ -591,6 +595,9 @@ impl SceneFile {
         let mut by_name = HashMap::new();
         for m in &self.materials {
             let mat = self.material(m.get_ref(), assets)?;
+            if !(mat.shininess.is_finite() && mat.shininess >= 0.0) {
+                return Err(self.invalid(m.span(), format!("shininess must be finite and ≥ 0, not {}", mat.shininess)));
+            }
             if by_name.insert(mat.name.clone(), materials.len()).is_some() {
                 return Err(self.invalid(m.get_ref().name.span(), format!("material '{}' is defined twice", mat.name)));
             }
@@ -599,13 +606,13 @@ impl SceneFile {
         let mut scene = Scene {
             width: *w.get_ref() as u32,
             height: *h.get_ref() as u32,
-            background: Vec3::from(self.image.background),
+            background: self.background()?,
             camera: framing((Vec3::ZERO, Vec3::ONE), 1.0).0,
             lights: self.lights.iter().map(|l| self.light(l)).collect::<Result<_>>()?,
             materials,
             objects: Vec::new(),
             warnings: Vec::new(),
-            exposure: self.image.exposure.into(),
+            exposure: self.exposure()?,
             tone: self.image.tonemap.into(),
             antialias: self.antialias()?,
             fog: self.fog()?,
@@ -668,6 +675,24 @@ impl SceneFile {
         Ok(cam)
     }
 
+    /// The background colour: finite and ≥ 0.
+    fn background(&self) -> Result<Vec3> {
+        let b = &self.image.background;
+        let ok = b.get_ref().iter().all(|c| c.is_finite() && *c >= 0.0);
+        ok.then(|| Vec3::from(*b.get_ref())).ok_or_else(|| self.invalid(b.span(), "background must be finite and ≥ 0"))
+    }
+
+    /// The exposure: a finite number of stops, or `auto`.
+    fn exposure(&self) -> Result<Exposure> {
+        let e = &self.image.exposure;
+        match e.get_ref() {
+            ExposureRec::Stops(ev) if !ev.is_finite() => {
+                Err(self.invalid(e.span(), "exposure must be a finite number of stops or \"auto\""))
+            }
+            rec => Ok((*rec).into()),
+        }
+    }
+
     fn light(&self, l: &Spanned<LightRec>) -> Result<Light> {
         let r = l.get_ref();
         let need = |v: Option<V3>, key: &str| {
@@ -692,6 +717,19 @@ impl SceneFile {
                 outer: r.outer_angle.to_radians(),
             },
         };
+        let places = match kind {
+            LightKind::Point { position } => [position, Vec3::ZERO],
+            LightKind::Spot { position, direction, .. } => [position, direction],
+            LightKind::Directional { direction } => [direction, Vec3::ZERO],
+        };
+        if !places.iter().all(|p| p.is_finite()) {
+            return Err(self.invalid(l.span(), "light position, direction and target must be finite"));
+        }
+        if r.kind == LightType::Spot
+            && !(0.0 <= r.inner_angle && r.inner_angle <= r.outer_angle && r.outer_angle <= 180.0)
+        {
+            return Err(self.invalid(l.span(), "spot angles must satisfy 0 ≤ inner_angle ≤ outer_angle ≤ 180"));
+        }
         let values = [r.intensity, r.ambient, r.size, r.color[0], r.color[1], r.color[2]];
         if values.iter().any(|v| !v.is_finite() || *v < 0.0) {
             return Err(self.invalid(l.span(), "light colour, intensity, ambient and size must be finite and ≥ 0"));

@@ -86,7 +86,7 @@ impl CsgNode {
 /// [`Error::CsgSyntax`] where the text leaves OpenSCAD's grammar, located
 /// at the offending characters.
 pub fn parse_csg(path: &Path, text: Arc<str>) -> Result<Vec<CsgNode>> {
-    let mut p = Parser { text: &text, pos: 0 };
+    let mut p = Parser { text: &text, pos: 0, depth: 0 };
     let nodes = p.nodes(None);
     nodes.map_err(|(span, message)| Error::CsgSyntax {
         location: Box::new(SourceLocation::new(path, Arc::clone(&text), span)),
@@ -97,10 +97,17 @@ pub fn parse_csg(path: &Path, text: Arc<str>) -> Result<Vec<CsgNode>> {
 /// A syntax error: where, and what was expected.
 type Failure = (Range<usize>, String);
 
+/// Deepest nesting of `{` blocks and `[` vectors read: OpenSCAD exports nest
+/// a few tens of levels; 100,000 would overflow the stack of the reader and
+/// of everything that walks the tree it builds.
+pub const MAX_NESTING: usize = 1000;
+
 /// A recursive-descent reader over the file's bytes.
 struct Parser<'t> {
     text: &'t str,
     pos: usize,
+    /// `{` blocks and `[` vectors open around the reader.
+    depth: usize,
 }
 
 impl<'t> Parser<'t> {
@@ -144,7 +151,7 @@ impl<'t> Parser<'t> {
             }
             Some(b'{') => {
                 self.pos += 1;
-                self.nodes(Some(self.pos - 1))?
+                self.nested(|p| p.nodes(Some(p.pos - 1)))?
             }
             _ => return Err(self.here(&format!("expected `;` or `{{` after `{name}(...)`"))),
         };
@@ -195,7 +202,7 @@ impl<'t> Parser<'t> {
     fn value(&mut self) -> std::result::Result<CsgValue, Failure> {
         self.skip_space();
         match self.peek() {
-            Some(b'[') => self.vector(),
+            Some(b'[') => self.nested(Self::vector),
             Some(b'"') => Ok(self.string()),
             Some(c) if c.is_ascii_alphabetic() => {
                 let start = self.pos;
@@ -212,6 +219,21 @@ impl<'t> Parser<'t> {
             Some(b'-' | b'+' | b'.' | b'0'..=b'9') => self.number(),
             _ => Err(self.here("expected a value (a number, `[`, `true`, `false`, `undef` or a string)")),
         }
+    }
+
+    /// Reads with `read` one level deeper, refusing past [`MAX_NESTING`].
+    fn nested<T>(
+        &mut self,
+        read: impl FnOnce(&mut Self) -> std::result::Result<T, Failure>,
+    ) -> std::result::Result<T, Failure> {
+        if self.depth >= MAX_NESTING {
+            let at = self.pos.saturating_sub(1);
+            return Err((at..at + 1, format!("nested deeper than {MAX_NESTING} levels")));
+        }
+        self.depth += 1;
+        let read = read(self);
+        self.depth -= 1;
+        read
     }
 
     fn vector(&mut self) -> std::result::Result<CsgValue, Failure> {
