@@ -893,6 +893,9 @@ impl SceneFile {
             None => None,
         };
         let transform = self.transform(r, &model)?;
+        if !transform.is_finite() {
+            return Err(self.invalid(o.span(), "the object's translate, rotate, scale and fit must be finite"));
+        }
         let label = r
             .name
             .clone()

@@ -38,6 +38,10 @@ fn add_ground(scene: &mut Scene, (lo, hi): (Vec3, Vec3)) {
     scene.objects.push(Object { casts_shadows: false, ..ground });
 }
 
+/// Largest extent of a model along an axis that a camera frames: beyond it
+/// the camera's depth range and the depth buffer's precision fail.
+pub const MAX_MODEL_SIZE: f32 = 1e15;
+
 /// How a lone model file becomes a scene ([`scene_for_model_with`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ModelOptions {
@@ -99,6 +103,14 @@ pub fn scene_for_model_with(path: &Path, width: u32, height: u32, options: &Mode
         Scene::new(width, height, framed_camera((Vec3::ZERO, Vec3::ONE), 1.0, View::DEFAULT, FRAMING_FOV_DEG));
     add_model(&mut scene, &model, &path.display().to_string(), turn, None);
     let bounds = scene.bounds().ok_or_else(|| Error::Scene(format!("{}: the model is empty", path.display())))?;
+    let size = bounds.1 - bounds.0;
+    if !(size.is_finite() && size.max_element() <= MAX_MODEL_SIZE) {
+        let message = format!(
+            "{}: the model spans {size:?}, too large to frame (at most {MAX_MODEL_SIZE:e} along an axis; its coordinates or transforms are out of range)",
+            path.display()
+        );
+        return Err(Error::Scene(message));
+    }
     let interior = Interior::of(&scene, bounds);
     let camera = match (model.camera.filter(|_| options.file_camera), &interior) {
         (Some(own), _) => own.transformed(&turn),

@@ -208,6 +208,10 @@ impl Builder {
             "color" => {
                 let rgba = self.floats(node, None, 4)?;
                 let own = (rgba[..3] != [-1.0; 3]).then(|| Vec4::from_slice(&rgba));
+                if own.is_some_and(|c| !c.cmpge(Vec4::ZERO).all() || !c.cmple(Vec4::ONE).all()) {
+                    let message = format!("colour components must be between 0 and 1, not {rgba:?}");
+                    return Err(self.invalid(&node.span, message));
+                }
                 self.union(kids, m, color.or(own))
             }
             "hull" => self.hull(node, m, color),
@@ -485,7 +489,10 @@ impl Builder {
 
     fn number(&self, node: &CsgNode, name: &str) -> Result<f64> {
         match self.arg(node, name)? {
-            CsgValue::Number(x) => Ok(*x),
+            CsgValue::Number(x) if x.is_finite() && (*x as f32).is_finite() => Ok(*x),
+            CsgValue::Number(x) => {
+                Err(self.invalid(&self.span_of(node, name), format!("`{name}` must be a finite number, not {x}")))
+            }
             other => {
                 Err(self.invalid(&self.span_of(node, name), format!("`{name}` should be a number, not {other:?}")))
             }
@@ -513,7 +520,12 @@ impl Builder {
         let CsgValue::Vector(xs) = v else { return Err(bad()) };
         match xs[..] {
             [CsgValue::Number(x), CsgValue::Number(y), CsgValue::Number(z)] => {
-                Ok(Vec3::new(x as f32, y as f32, z as f32))
+                let p = Vec3::new(x as f32, y as f32, z as f32);
+                if p.is_finite() {
+                    Ok(p)
+                } else {
+                    Err(self.invalid(&self.span_of(node, name), format!("`{name}` holds a point that is not finite")))
+                }
             }
             _ => Err(bad()),
         }
@@ -530,12 +542,13 @@ impl Builder {
                 .ok_or_else(|| self.invalid(&node.span, format!("`{}()` needs an argument", node.name)))?,
         };
         let numbers: Option<Vec<f32>> = match value {
-            CsgValue::Vector(xs) if xs.len() == count => {
-                xs.iter().map(|x| if let CsgValue::Number(v) = x { Some(*v as f32) } else { None }).collect()
-            }
+            CsgValue::Vector(xs) if xs.len() == count => xs
+                .iter()
+                .map(|x| if let CsgValue::Number(v) = x { Some(*v as f32).filter(|v| v.is_finite()) } else { None })
+                .collect(),
             _ => None,
         };
-        numbers.ok_or_else(|| self.invalid(&span, format!("expected {count} numbers")))
+        numbers.ok_or_else(|| self.invalid(&span, format!("expected {count} finite numbers")))
     }
 
     /// `multmatrix`'s row-major 4 × 4 matrix.
@@ -548,6 +561,10 @@ impl Builder {
             for (c, x) in xs.iter().enumerate().take(4) {
                 let CsgValue::Number(v) = x else { return Err(bad()) };
                 m[r][c] = *v as f32;
+                if !m[r][c].is_finite() {
+                    let message = format!("`multmatrix` entry ({}, {}) must be a finite number, not {v}", r + 1, c + 1);
+                    return Err(self.invalid(&node.span, message));
+                }
             }
         }
         if rows.len() != 4 {

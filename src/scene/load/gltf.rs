@@ -145,7 +145,7 @@ impl Context<'_> {
             out.camera = camera(&cam, affine);
         }
         if let Some(light) = node.light() {
-            out.lights.push(self::light(&light, affine));
+            out.lights.push(self::light(&light, affine)?);
         }
         for child in node.children() {
             self.visit(&child, world, materials, out, above)?;
@@ -403,8 +403,21 @@ fn camera(cam: &gltf::Camera, at: Affine3A) -> Option<Camera> {
     c.validate().ok().map(|_| c)
 }
 
-fn light(l: &gltf::khr_lights_punctual::Light, at: Affine3A) -> Light {
+/// A `KHR_lights_punctual` light placed by `at`: its intensity and colour
+/// finite and ≥ 0, a spot's cone angles 0 ≤ inner ≤ outer ≤ π/2 (as the
+/// extension requires).
+fn light(l: &gltf::khr_lights_punctual::Light, at: Affine3A) -> Result<Light, String> {
     use gltf::khr_lights_punctual::Kind;
+    let which = format!("light {}", l.index());
+    let values = [l.intensity(), l.color()[0], l.color()[1], l.color()[2]];
+    if !values.iter().all(|v| v.is_finite() && *v >= 0.0 && *v < f32::MAX) {
+        return Err(format!("{which}: intensity and colour must be finite and ≥ 0, not {values:?}"));
+    }
+    if let Kind::Spot { inner_cone_angle: inner, outer_cone_angle: outer } = l.kind() {
+        if !(0.0 <= inner && inner <= outer && outer <= std::f32::consts::FRAC_PI_2) {
+            return Err(format!("{which}: cone angles must satisfy 0 ≤ inner ≤ outer ≤ π/2, not {inner} and {outer}"));
+        }
+    }
     let position = at.transform_point3(Vec3::ZERO);
     let direction = at.transform_vector3(Vec3::NEG_Z).normalize_or(Vec3::NEG_Y);
     let (kind, falloff) = match l.kind() {
@@ -415,7 +428,7 @@ fn light(l: &gltf::khr_lights_punctual::Light, at: Affine3A) -> Light {
             Falloff::InverseSquare,
         ),
     };
-    Light {
+    Ok(Light {
         kind,
         color: l.color().into(),
         intensity: l.intensity(),
@@ -423,5 +436,5 @@ fn light(l: &gltf::khr_lights_punctual::Light, at: Affine3A) -> Light {
         size: 0.0,
         falloff,
         ..Light::default()
-    }
+    })
 }
