@@ -98,6 +98,10 @@ fn checked_references(root: &gltf::json::Root) -> Result<(), String> {
 }
 
 impl Context<'_> {
+    /// Places `node` (under the transform `parent`, below the nodes `above`)
+    /// and its children into `out`: refused when it is among its own
+    /// ancestors, too deep ([`MAX_NODE_DEPTH`]) or one placement too many
+    /// ([`MAX_INSTANCES`]).
     fn visit(
         &self,
         node: &gltf::Node,
@@ -119,21 +123,6 @@ impl Context<'_> {
                 "the scene places more than {MAX_INSTANCES} nodes (a node listed as the child of several parents is placed once for each)"
             ));
         }
-        above.push(index);
-        let placed = self.place(node, parent, materials, out, above);
-        above.pop();
-        placed
-    }
-
-    /// [`Context::visit`]'s work, once the node is known to be placeable.
-    fn place(
-        &self,
-        node: &gltf::Node,
-        parent: Mat4,
-        materials: &[Material],
-        out: &mut LoadedModel,
-        above: &mut Vec<usize>,
-    ) -> Result<(), String> {
         let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
         let affine = Affine3A::from_mat4(world);
         if let Some(mesh) = node.mesh() {
@@ -147,9 +136,12 @@ impl Context<'_> {
         if let Some(light) = node.light() {
             out.lights.push(self::light(&light, affine)?);
         }
+        // An error ends the walk, so `above` is only kept right on success.
+        above.push(index);
         for child in node.children() {
             self.visit(&child, world, materials, out, above)?;
         }
+        above.pop();
         Ok(())
     }
 
