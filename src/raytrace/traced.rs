@@ -81,24 +81,33 @@ pub fn add_traced(
         normal_map::apply(&scene.materials[s.material], &mut s);
         tracer.bounces(&ray, &s, depth)
     };
-    // NaN marks the pixels that trace nothing.
-    let mut traced = vec![Vec3::NAN; w * h];
-    traced.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
-        for (x, out) in row.iter_mut().enumerate() {
-            if traces(x, y) {
-                *out = sample(x, y, Vec2::ZERO);
+    // Each traced pixel's sample, combined into `out` (rows of `w`) by `put`.
+    let trace_into = |out: &mut [Vec3], put: fn(&mut Vec3, Vec3)| -> usize {
+        let rows = out.par_chunks_mut(w).enumerate();
+        rows.map(|(y, row)| {
+            let mut count = 0;
+            for (x, px) in row.iter_mut().enumerate().filter(|(x, _)| traces(*x, y)) {
+                put(px, sample(x, y, Vec2::ZERO));
+                count += 1;
             }
-        }
-    });
-    let count = traced.par_iter().filter(|t| !t.x.is_nan()).count();
-    let refined = match refine {
-        Refine::Never => 0,
-        Refine::Contrast => refine_edges(&mut traced, w, sample),
+            count
+        })
+        .sum()
     };
-    image.pixels_mut().par_iter_mut().zip(traced.par_iter()).filter(|(_, t)| !t.x.is_nan()).for_each(|(px, t)| {
-        *px += *t;
-    });
-    (count, refined)
+    match refine {
+        // One sample a pixel: straight into the image.
+        Refine::Never => (trace_into(image.pixels_mut(), |px, t| *px += t), 0),
+        Refine::Contrast => {
+            // The samples apart first, NaN where nothing is traced: refining
+            // compares neighbours' traced light alone.
+            let mut traced = vec![Vec3::NAN; w * h];
+            let count = trace_into(&mut traced, |px, t| *px = t);
+            let refined = refine_edges(&mut traced, w, sample);
+            let pixels = image.pixels_mut().par_iter_mut().zip(traced.par_iter());
+            pixels.filter(|(_, t)| !t.x.is_nan()).for_each(|(px, t)| *px += *t);
+            (count, refined)
+        }
+    }
 }
 
 /// Traces again, at [`REFINE_OFFSETS`], every traced pixel of `traced` (rows

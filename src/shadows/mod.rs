@@ -317,11 +317,14 @@ impl MapPool {
     /// rendered. Give it back with [`MapPool::keep`] or [`MapPool::recycle`].
     pub fn term(&mut self, scene: &Scene, light: &Light, bounds: (Vec3, Vec3)) -> ShadowTerm {
         let key = MapKey::of(scene, light, bounds, self.view(scene));
-        if let Some(k) = self.previous.iter().position(|(have, _)| *have == key) {
-            self.reused += 1;
-            return self.previous.swap_remove(k).1;
-        }
-        ShadowTerm::build_within(scene, light, bounds, self)
+        self.reuse(&key).unwrap_or_else(|| ShadowTerm::build_within(scene, light, bounds, self))
+    }
+
+    /// Last frame's term for `key`, if it is still held (counted as reused).
+    fn reuse(&mut self, key: &MapKey) -> Option<ShadowTerm> {
+        let k = self.previous.iter().position(|(have, _)| have == key)?;
+        self.reused += 1;
+        Some(self.previous.swap_remove(k).1)
     }
 
     /// The shadow terms of `lights` (an area light's jittered samples), as
@@ -334,14 +337,7 @@ impl MapPool {
     pub fn terms(&mut self, scene: &Scene, lights: &[Light], bounds: (Vec3, Vec3)) -> Vec<ShadowTerm> {
         let key = |l: &Light| MapKey::of(scene, l, bounds, self.view(scene));
         let keys: Vec<MapKey> = lights.iter().map(key).collect();
-        let mut terms: Vec<Option<ShadowTerm>> = keys
-            .iter()
-            .map(|key| {
-                let k = self.previous.iter().position(|(have, _)| have == key)?;
-                self.reused += 1;
-                Some(self.previous.swap_remove(k).1)
-            })
-            .collect();
+        let mut terms: Vec<Option<ShadowTerm>> = keys.iter().map(|key| self.reuse(key)).collect();
         let todo: Vec<usize> = (0..lights.len()).filter(|&i| terms[i].is_none()).collect();
         if todo.len() < 2 || rayon::current_num_threads() < 2 {
             for i in todo {
