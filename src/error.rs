@@ -140,6 +140,10 @@ pub enum Error {
     /// The scene has nothing that can be drawn, or a value makes the camera unusable.
     #[error("invalid scene: {0}")]
     Scene(String),
+    /// A file or scene asks for more than its [`crate::limits::Limits`] allow:
+    /// refused before the work, naming the limit and how to raise it.
+    #[error("{0}")]
+    Limit(#[from] crate::limits::LimitExceeded),
     /// An image to measure could not be read or decoded.
     #[error("cannot read image {}: {message}", path.display())]
     ImageRead {

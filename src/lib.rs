@@ -6,7 +6,8 @@
 //! to that):
 //!
 //! ```text
-//! error · sampling · image · camera · bvh        the ground floor: typed errors, sample
+//! limits · error · sampling · image · camera · bvh   the ground floor: what one input
+//!                                                may ask for, typed errors, sample
 //!                                                patterns, the linear float image and
 //!                                                sRGB, the view and its rays, the BVH
 //!   ▼
@@ -52,6 +53,7 @@ pub mod csg;
 pub mod error;
 pub mod frame;
 pub mod image;
+pub mod limits;
 pub mod output;
 pub mod raytrace;
 pub mod resolve;
@@ -63,4 +65,5 @@ pub mod visibility;
 
 pub use error::{Error, SourceLocation};
 pub use frame::{render, Frame, FrameStats, RenderOptions, Renderer};
+pub use limits::{Limit, Limits};
 pub use scene::Scene;

@@ -10,6 +10,7 @@ use std::path::Path;
 /// The library's top-level modules, the ground floor first: each may use the
 /// ones before it only.
 const FRAME_ORDER: &[&str] = &[
+    "limits",
     "error",
     "sampling",
     "image",

@@ -47,7 +47,7 @@ fn every_corpus_file_parses() {
     let Some((_, files)) = corpus() else { return };
     for path in &files {
         let text = read(path);
-        let nodes = parse_csg(path, Arc::clone(&text)).unwrap_or_else(|e| panic!("{e}"));
+        let nodes = parse_csg(path, Arc::clone(&text), &Default::default()).unwrap_or_else(|e| panic!("{e}"));
         // Every node of the file is read: as many nodes as lines that open one.
         let opening = text.lines().filter(|l| l.trim_end().ends_with(';') || l.trim_end().ends_with('{')).count();
         assert_eq!(count(&nodes), opening, "{}", path.display());
@@ -67,7 +67,7 @@ fn primitive_counts_match_the_corpus_table() {
         let Some(path) = files.iter().find(|p| p.file_stem().is_some_and(|s| s == name)) else { continue };
         let expected: Vec<usize> = kinds.split('/').map(|k| k.parse().unwrap()).collect();
         let mut got = [0; 4];
-        leaves(&parse_csg(path, read(path)).unwrap(), &mut got);
+        leaves(&parse_csg(path, read(path), &Default::default()).unwrap(), &mut got);
         assert_eq!(got.to_vec(), expected, "{name}");
         checked += 1;
     }
@@ -80,7 +80,7 @@ fn every_corpus_model_loads_in_both_geometry_modes() {
     for path in &files {
         for geometry in [Geometry::Exact, Geometry::Faceted] {
             let options = CsgOptions { geometry, skip_unsupported: false };
-            let loaded = load_csg(path, read(path), &options).unwrap_or_else(|e| panic!("{e}"));
+            let loaded = load_csg(path, read(path), &options, &Default::default()).unwrap_or_else(|e| panic!("{e}"));
             assert!(loaded.solid.tree.is_some(), "{}: empty", path.display());
         }
     }
@@ -130,7 +130,7 @@ fn faceted_solids_agree_with_openscads_own_mesh_point_by_point() {
     let options = CsgOptions { geometry: Geometry::Faceted, skip_unsupported: false };
     for (dir, name) in models {
         let csg = dir.join(format!("{name}.csg"));
-        let solid = load_csg(&csg, read(&csg), &options).unwrap().solid;
+        let solid = load_csg(&csg, read(&csg), &options, &Default::default()).unwrap().solid;
         let stl = model(Path::new(&format!("{name}.stl")), &FileSystem { base: dir.clone() }).unwrap();
         let tris: Vec<[Vec3; 3]> = stl
             .parts
@@ -190,7 +190,7 @@ fn scanned_coverage_matches_openscads_mesh_rasterized_by_kage() {
         let dir = path.parent().unwrap_or(Path::new("."));
         let name = path.file_stem().and_then(|s| s.to_str()).unwrap_or_default();
         let (camera, w, h) = sidecar_camera(dir, name).unwrap_or_else(|| panic!("{name}: no camera sidecar"));
-        let solid = load_csg(path, read(path), &options).unwrap().solid;
+        let solid = load_csg(path, read(path), &options, &Default::default()).unwrap().solid;
         let scanned = kage::visibility::solids::scan_solid(&solid, &camera, w, h);
         // The mesh as OpenSCAD wrote it (z up, no ground): the sidecar camera's frame.
         let as_written =

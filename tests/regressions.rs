@@ -62,9 +62,16 @@ fn every_input_that_once_crashed_gives_what_the_list_says() {
             (Ok(scene), true) => {
                 let warned = case.text.is_empty() || scene.warnings.iter().any(|w| w.contains(&case.text));
                 assert!(warned, "{name}: no warning containing `{}` in {:?}", case.text, scene.warnings);
-                render(&scene, &RenderOptions::default()).unwrap_or_else(|e| panic!("{name}: loads but fails: {e}"));
+                let frame = render(&scene, &RenderOptions::default())
+                    .unwrap_or_else(|e| panic!("{name}: loads but fails: {e}"));
+                let bad = frame.image.pixels().iter().position(|p| !(p.is_finite() && p.min_element() >= 0.0));
+                assert!(bad.is_none(), "{name}: pixel {bad:?} is not a colour");
             }
-            (Ok(_), false) => panic!("{name}: loaded, but an error containing `{}` was expected", case.text),
+            (Ok(scene), false) => match render(&scene, &RenderOptions::default()) {
+                // What a frame asks for is checked when it starts.
+                Err(e) => assert!(e.to_string().contains(&case.text), "{name}: `{e}` lacks `{}`", case.text),
+                Ok(_) => panic!("{name}: rendered, but an error containing `{}` was expected", case.text),
+            },
             (Err(e), true) => panic!("{name}: expected to render, got: {e}"),
             (Err(e), false) => {
                 let e = e.to_string();

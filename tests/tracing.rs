@@ -55,6 +55,7 @@ fn mirror_scene() -> Scene {
         environment: None,
         translucency: Default::default(),
         tone: Default::default(),
+        limits: Default::default(),
         camera: Camera {
             eye: Vec3::new(0.0, 0.0, 5.0),
             target: Vec3::ZERO,

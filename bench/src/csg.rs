@@ -74,7 +74,7 @@ pub fn run(csg: &CsgArgs) -> Result<()> {
         let name = path.file_stem().and_then(|s| s.to_str()).unwrap_or_default();
         let text: Arc<str> = Arc::from(std::fs::read_to_string(path).map_err(|e| miette!("{e}"))?);
         let options = CsgOptions { geometry: Geometry::Exact, skip_unsupported: true };
-        let solid = load_csg(path, text, &options).map_err(|e| miette!("{e}"))?.solid;
+        let solid = load_csg(path, text, &options, &Default::default()).map_err(|e| miette!("{e}"))?.solid;
         let Some(camera) = corpus_camera(&dir, name) else {
             eprintln!("skipped {name}: no camera sidecar");
             continue;

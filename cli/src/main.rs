@@ -11,6 +11,7 @@ use clap::{Parser, Subcommand};
 use glam::Vec3;
 use kage::csg::openscad::{CsgOptions, Geometry};
 use kage::image::ToneCurve;
+use kage::limits::{LimitSetting, Limits};
 use kage::scene::framing::{CameraOverride, View};
 use kage::scene::model::{self, ModelOptions};
 use kage::scene::{demo::demo_scene, file, Antialias, EdgeFilter, EdgeMode, EdgeSelection, Exposure, Scene, Up};
@@ -151,6 +152,11 @@ struct RenderArgs {
     /// Vertical field of view in degrees (0 to 180).
     #[arg(long, value_parser = parse_fov)]
     fov: Option<f32>,
+    /// Sets one limit on what the input may ask for, as NAME=VALUE (again for
+    /// more; over a scene's `[limits]`): e.g. `--limit triangles=50000000`.
+    /// The limits and their defaults are listed in docs/scene-format.md.
+    #[arg(long = "limit", value_name = "NAME=VALUE")]
+    limits: Vec<LimitSetting>,
 }
 
 /// `--view`.
@@ -345,6 +351,7 @@ fn load(args: &RenderArgs) -> kage::error::Result<Scene> {
         ground: !args.no_ground,
         file_camera: args.camera == CameraArg::File,
         camera: camera_override(args),
+        limits: Limits::default().with_settings(&args.limits),
     };
     let (width, height) = (args.width, args.height);
     let mut scene = match args.input.as_deref() {
@@ -352,9 +359,14 @@ fn load(args: &RenderArgs) -> kage::error::Result<Scene> {
             return model::scene_for_model_with(p, width.unwrap_or(960), height.unwrap_or(540), &options);
         }
         None => demo_scene()?,
-        Some(p) if p.extension().is_some_and(|e| e.eq_ignore_ascii_case("toml")) => file::load_scene(p)?,
+        Some(p) if p.extension().is_some_and(|e| e.eq_ignore_ascii_case("toml")) => {
+            file::load_scene_with(p, &args.limits)?
+        }
         Some(p) => return Err(kage::Error::UnknownInput { path: p.to_path_buf() }),
     };
+    if args.input.is_none() {
+        scene.limits = scene.limits.with_settings(&args.limits);
+    }
     scene.width = width.unwrap_or(scene.width);
     scene.height = height.unwrap_or(scene.height);
     // A scene keeps its lights; the camera moves about what casts shadows

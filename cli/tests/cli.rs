@@ -316,3 +316,30 @@ fn a_bad_output_or_an_unknown_input_is_refused_before_the_render() {
     let (ok, stderr) = kage(&["render", readme.to_str().unwrap(), "-o", dir.join("x.png").to_str().unwrap()]);
     assert!(!ok && stderr.contains("not a file kage reads") && stderr.contains(".gltf"), "{stderr}");
 }
+
+#[test]
+fn a_limit_set_on_the_command_line_wins_and_an_unknown_one_is_named() {
+    let dir = scratch("limits");
+    let scene = write(&dir, "s.toml", "[limits]\ntriangles = 1000\n[[object]]\nshape = \"cube\"\n");
+    let out = dir.join("x.png");
+    let (ok, stderr) =
+        kage(&["render", scene.to_str().unwrap(), "-o", out.to_str().unwrap(), "--limit", "triangles=11"]);
+    assert!(!ok && stderr.contains("over the `triangles` limit of 11"), "{stderr}");
+    assert!(!stderr.contains("wrote"), "{stderr}");
+    let (ok, stderr) =
+        kage(&["render", scene.to_str().unwrap(), "-o", out.to_str().unwrap(), "--limit", "triangle=11"]);
+    assert!(!ok && stderr.contains("unknown limit 'triangle'") && stderr.contains("memory_mb"), "{stderr}");
+    let (ok, stderr) = kage(&[
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--width",
+        "64",
+        "--height",
+        "48",
+        "--limit",
+        "triangles=12",
+    ]);
+    assert!(ok, "{stderr}");
+}

@@ -30,6 +30,7 @@ use crate::camera::Camera;
 use crate::csg::CsgSolid;
 use crate::error::{Error, Result};
 use crate::image::ToneCurve;
+use crate::limits::Limits;
 
 /// Largest image side kage accepts, in pixels.
 pub const MAX_IMAGE_SIDE: u32 = 16_384;
@@ -203,6 +204,9 @@ pub struct Scene {
     pub objects: Vec<Object>,
     /// Things the loaders repaired or ignored, for the user to see.
     pub warnings: Vec<String>,
+    /// What rendering the scene may ask for: its triangles, shadow maps and
+    /// memory are checked against these before a frame starts.
+    pub limits: Limits,
 }
 
 /// Checks an image size before anything is allocated for it.
@@ -245,6 +249,7 @@ impl Scene {
             materials: Vec::new(),
             objects: Vec::new(),
             warnings: Vec::new(),
+            limits: Limits::default(),
         }
     }
 

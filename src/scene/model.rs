@@ -15,6 +15,7 @@ use super::{Environment, Exposure, Light, Material, Object, Scene, ShadowSetting
 use crate::camera::{Camera, Projection};
 use crate::csg::openscad::CsgOptions;
 use crate::error::{Error, Result};
+use crate::limits::Limits;
 
 /// A matte ground under `bounds` (kage's y-up world), four times their size,
 /// unless the camera looks at it from below.
@@ -58,6 +59,8 @@ pub struct ModelOptions {
     /// Changes to the camera (a view to frame the model from, an eye, a
     /// target, a field of view); the light rig follows the camera.
     pub camera: CameraOverride,
+    /// What the model may ask for.
+    pub limits: Limits,
 }
 
 impl Default for ModelOptions {
@@ -68,6 +71,7 @@ impl Default for ModelOptions {
             ground: true,
             file_camera: false,
             camera: CameraOverride::default(),
+            limits: Limits::default(),
         }
     }
 }
@@ -96,12 +100,29 @@ pub fn scene_for_model_with(path: &Path, width: u32, height: u32, options: &Mode
     let base = path.parent().unwrap_or(Path::new(".")).to_path_buf();
     let fs = load::FileSystem { base };
     let name = Path::new(path.file_name().unwrap_or(path.as_os_str()));
-    let model = load::model_with(name, &fs, &options.csg)?;
+    let model = load::model_with(name, &fs, &options.csg, &options.limits)?;
+    scene_for_loaded_model(&model, path, width, height, options)
+}
+
+/// [`scene_for_model_with`] for a model already loaded (from `path`, which
+/// names it in messages and objects).
+///
+/// # Errors
+///
+/// [`Error::Scene`] when it holds nothing to draw or is too large to frame.
+pub fn scene_for_loaded_model(
+    model: &load::LoadedModel,
+    path: &Path,
+    width: u32,
+    height: u32,
+    options: &ModelOptions,
+) -> Result<Scene> {
     let turn = options.up.unwrap_or(model.up).turn();
     let aspect = width as f32 / height as f32;
     let mut scene =
         Scene::new(width, height, framed_camera((Vec3::ZERO, Vec3::ONE), 1.0, View::DEFAULT, FRAMING_FOV_DEG));
-    add_model(&mut scene, &model, &path.display().to_string(), turn, None);
+    scene.limits = options.limits;
+    add_model(&mut scene, model, &path.display().to_string(), turn, None);
     let bounds = scene.bounds().ok_or_else(|| Error::Scene(format!("{}: the model is empty", path.display())))?;
     let size = bounds.1 - bounds.0;
     if !(size.is_finite() && size.max_element() <= MAX_MODEL_SIZE) {

@@ -5,9 +5,10 @@
 use glam::{Vec2, Vec3};
 
 use crate::image::srgb_to_linear;
+use crate::limits::{Limit, Limits};
 
 /// What happens outside [0, 1] texture coordinates.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub enum Wrap {
     /// The image tiles.
     #[default]
@@ -107,6 +108,22 @@ impl Level {
     }
 }
 
+/// What the `png` decoder assumes of a PNG's palette and does not check (it
+/// slices past the end of a `PLTE` chunk whose length is not a multiple of
+/// 3): the chunk holds 1 to 256 whole RGB entries. Other bytes pass.
+fn checked_png_palette(bytes: &[u8]) -> Result<(), String> {
+    let Some(mut rest) = bytes.strip_prefix(b"\x89PNG\r\n\x1a\n") else { return Ok(()) };
+    while rest.len() >= 12 {
+        let len = u32::from_be_bytes([rest[0], rest[1], rest[2], rest[3]]) as usize;
+        if &rest[4..8] == b"PLTE" && !(len.is_multiple_of(3) && (3..=768).contains(&len)) {
+            return Err(format!("the PNG's palette (PLTE) holds {len} bytes, not 1 to 256 RGB entries"));
+        }
+        let Some(next) = rest.get(12usize.saturating_add(len)..) else { break };
+        rest = next;
+    }
+    Ok(())
+}
+
 /// A decoded texture in linear RGB with its mip chain.
 #[derive(Debug, Clone)]
 pub struct Texture {
@@ -118,17 +135,47 @@ pub struct Texture {
 impl Texture {
     /// Decodes an encoded image (PNG, JPEG or OpenEXR). `srgb` says whether its
     /// values are sRGB-encoded colours (true for colour maps) or already linear.
+    /// Its size is read from the header first and refused past
+    /// [`Limit::TexturePixels`] (a 140 KB PNG can hold 11000² grey pixels).
     ///
     /// # Errors
     ///
-    /// The decoder's message when the bytes are no image it reads.
-    pub fn decode(bytes: &[u8], srgb: bool) -> Result<Texture, String> {
-        let img = ::image::load_from_memory(bytes).map_err(|e| e.to_string())?.into_rgb32f();
+    /// The decoder's message when the bytes are no image it reads; the limit's
+    /// when it is too large.
+    pub fn decode(bytes: &[u8], srgb: bool, limits: &Limits) -> Result<Texture, String> {
+        checked_png_palette(bytes)?;
+        let reader =
+            ::image::ImageReader::new(std::io::Cursor::new(bytes)).with_guessed_format().map_err(|e| e.to_string())?;
+        let mut header = reader.into_decoder().map_err(|e| e.to_string())?;
+        let (width, height) = ::image::ImageDecoder::dimensions(&header);
+        let pixels = u64::from(width) * u64::from(height);
+        limits
+            .check(Limit::TexturePixels, pixels, || format!("the {width} × {height} image"))
+            .map_err(|e| e.to_string())?;
+        // The decoder's own allocations are bounded too: what it holds
+        // while decoding is at most its output, 16 bytes a pixel (RGBA f32).
+        let mut own = ::image::Limits::default();
+        own.max_alloc = Some(pixels.saturating_mul(16).max(1 << 20));
+        ::image::ImageDecoder::set_limits(&mut header, own).map_err(|e| e.to_string())?;
+        // A decoder's panic on a malformed image not yet known to it is its
+        // bug, not kage's end: it becomes this image's error.
+        let decoded =
+            std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| ::image::DynamicImage::from_decoder(header)))
+                .map_err(|_| "the image decoder failed on this file (it is malformed, or the decoder has a bug)")?;
+        let img = decoded.map_err(|e| e.to_string())?.into_rgb32f();
         let (width, height) = img.dimensions();
         if width == 0 || height == 0 {
             return Err("the image has no pixels".into());
         }
-        let decode = |c: f32| if srgb { srgb_to_linear(c) } else { c };
+        // An EXR may hold NaN, infinite or negative values: none is a colour.
+        let decode = |c: f32| {
+            let c = if c.is_finite() { c.max(0.0) } else { 0.0 };
+            if srgb {
+                srgb_to_linear(c)
+            } else {
+                c
+            }
+        };
         let texels = img.pixels().map(|p| Vec3::new(decode(p[0]), decode(p[1]), decode(p[2]))).collect();
         Ok(Texture::from_texels(width, height, texels))
     }

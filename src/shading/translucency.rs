@@ -40,10 +40,17 @@ struct Layer {
 
 /// Blends `fragments` (in front of the opaque surfaces) into every target, in
 /// the scene's [`TranslucencyOrder`], lit by the frame's lights (their shadow
-/// maps taken from `pool`). Returns how many fragments were blended.
-pub fn composite(scene: &Scene, mut fragments: Vec<Fragment>, targets: &mut [Target], pool: &mut MapPool) -> usize {
+/// maps taken from `pool`). Returns how many fragments were blended and, when
+/// there were some, each pixel's transmittance: the share of the opaque
+/// surface behind them that it still shows.
+pub fn composite(
+    scene: &Scene,
+    mut fragments: Vec<Fragment>,
+    targets: &mut [Target],
+    pool: &mut MapPool,
+) -> (usize, Option<Vec<f32>>) {
     if fragments.is_empty() {
-        return 0;
+        return (0, None);
     }
     // Nearest first within each pixel: by depth, or the last drawn first.
     match scene.translucency {
@@ -77,7 +84,7 @@ pub fn composite(scene: &Scene, mut fragments: Vec<Fragment>, targets: &mut [Tar
     for t in targets.iter_mut() {
         add_layers(scene, &layers, t);
     }
-    layers.len()
+    (layers.len(), Some(transmittance))
 }
 
 /// Each fragment's weight α · (transmittance of the fragments nearer than it);

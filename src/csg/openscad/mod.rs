@@ -37,6 +37,7 @@ use glam::{Affine3A, DVec3, Mat4, Vec3, Vec4};
 use super::model::{ConvexPolyhedron, CsgSolid, CsgTree, Primitive, Shape};
 use crate::camera::{Camera, Projection};
 use crate::error::{Error, Result, SourceLocation};
+use crate::limits::{Limit, Limits};
 use syntax::{parse_csg, CsgNode, CsgValue};
 
 /// How spheres and cylinders become primitives.
@@ -118,23 +119,25 @@ pub fn default_view((lo, hi): (Vec3, Vec3)) -> Camera {
 /// `$fn` at or below which spheres and cylinders stay faceted in exact mode.
 const ALWAYS_FACETED_FN: f64 = 8.0;
 
-/// Most fragments around one circle of a faceted sphere or cylinder: a sphere
-/// of this many has about n²/2 = 2 × 10⁶ triangles; OpenSCAD's own preview
-/// draws far fewer. More is refused (`$fn = 1e20` would ask for more memory
-/// than any machine has).
-pub const MAX_FRAGMENTS: usize = 2048;
-
-/// Reads the text of a `.csg` file (named `path` in messages) as a solid.
+/// Reads the text of a `.csg` file (named `path` in messages) as a solid,
+/// within `limits` ([`Limit::Nesting`], [`Limit::Segments`], [`Limit::Facets`]
+/// and [`Limit::Primitives`] are checked here).
 ///
 /// # Errors
 ///
 /// As [`parse_csg`]; [`Error::CsgInvalid`] for a node kage cannot render
-/// (unless [`CsgOptions::skip_unsupported`]), a malformed argument or a
-/// polyhedron that is not convex.
-pub fn load_csg(path: &Path, text: Arc<str>, options: &CsgOptions) -> Result<LoadedCsg> {
-    let nodes = parse_csg(path, Arc::clone(&text))?;
-    let mut b =
-        Builder { path: path.to_path_buf(), text, options: *options, solid: CsgSolid::default(), warnings: Vec::new() };
+/// (unless [`CsgOptions::skip_unsupported`]), a malformed argument, a
+/// polyhedron that is not convex, or a request over a limit.
+pub fn load_csg(path: &Path, text: Arc<str>, options: &CsgOptions, limits: &Limits) -> Result<LoadedCsg> {
+    let nodes = parse_csg(path, Arc::clone(&text), limits)?;
+    let mut b = Builder {
+        path: path.to_path_buf(),
+        text,
+        options: *options,
+        limits: *limits,
+        solid: CsgSolid::default(),
+        warnings: Vec::new(),
+    };
     let tree = b.union(&nodes, Affine3A::IDENTITY, None)?;
     b.solid.tree = tree.into_tree().map(CsgTree::flattened);
     Ok(LoadedCsg { solid: b.solid, warnings: b.warnings })
@@ -172,6 +175,7 @@ struct Builder {
     path: PathBuf,
     text: Arc<str>,
     options: CsgOptions,
+    limits: Limits,
     solid: CsgSolid,
     warnings: Vec<String>,
 }
@@ -216,10 +220,8 @@ impl Builder {
             }
             "hull" => self.hull(node, m, color),
             "cube" | "sphere" | "cylinder" | "polyhedron" => {
-                Ok(self.primitive(node, m, color)?.map_or(Built::Empty, |p| {
-                    self.solid.primitives.push(p);
-                    Built::Tree(CsgTree::Leaf(self.solid.primitives.len() - 1))
-                }))
+                let Some(p) = self.primitive(node, m, color)? else { return Ok(Built::Empty) };
+                self.push(p)
             }
             name => {
                 let message = format!("`{name}()` is not a node kage renders (only cube, sphere, cylinder, convex polyhedron and their booleans, transforms and colours)");
@@ -286,9 +288,22 @@ impl Builder {
     fn hull(&mut self, node: &CsgNode, m: Affine3A, color: Option<Vec4>) -> Result<Built> {
         let mut points = Vec::new();
         self.hull_points(&node.children, Affine3A::IDENTITY, &mut points)?;
+        let what = || "this hull's points (its children's corners)".into();
+        if let Err(e) = self.limits.check(Limit::Facets, points.len() as u64, what) {
+            return Err(self.invalid(&node.span, e.to_string()));
+        }
         let Some(poly) = convex_hull(&points) else { return Ok(Built::Empty) };
         let shape = Shape::Polyhedron(poly);
-        self.solid.primitives.push(Primitive { shape, transform: m, color, source: node.span.clone() });
+        self.push(Primitive { shape, transform: m, color, source: node.span.clone() })
+    }
+
+    /// Adds `p` to the solid as a leaf, refused past [`Limit::Primitives`].
+    fn push(&mut self, p: Primitive) -> Result<Built> {
+        let count = self.solid.primitives.len() as u64 + 1;
+        if let Err(e) = self.limits.check(Limit::Primitives, count, || "the solid's primitives".into()) {
+            return Err(self.invalid(&p.source, e.to_string()));
+        }
+        self.solid.primitives.push(p);
         Ok(Built::Tree(CsgTree::Leaf(self.solid.primitives.len() - 1)))
     }
 
@@ -348,6 +363,10 @@ impl Builder {
         }
         // OpenSCAD's sphere: (n + 1) / 2 rings of n vertices, flat caps, no poles.
         let rings = n.div_ceil(2);
+        let facets = (n * (rings - 1) + 2) as u64;
+        if let Err(e) = self.limits.check(Limit::Facets, facets, || "this faceted sphere".into()) {
+            return Err(self.invalid(&node.span, e.to_string()));
+        }
         let points: Vec<Vec3> = (0..rings)
             .flat_map(|k| {
                 let phi = PI * (k as f32 + 0.5) / rings as f32;
@@ -443,7 +462,7 @@ impl Builder {
     }
 
     /// OpenSCAD's number of fragments around a circle of radius `r`, at
-    /// most [`MAX_FRAGMENTS`]; `$fn`, `$fa` and `$fs` must be finite (and
+    /// most [`Limit::Segments`]; `$fn`, `$fa` and `$fs` must be finite (and
     /// `$fa`, `$fs` positive when `$fn` does not decide).
     fn fragments(&self, node: &CsgNode, r: f32) -> Result<usize> {
         let (fine, fa, fs) = (self.number(node, "$fn")?, self.number(node, "$fa")?, self.number(node, "$fs")?);
@@ -464,15 +483,10 @@ impl Builder {
         } else {
             (360.0 / fa).min(2.0 * std::f64::consts::PI * f64::from(r) / fs).max(5.0).ceil()
         };
-        if n > MAX_FRAGMENTS as f64 {
+        let what = || format!("`{}()`'s circle", node.name);
+        if let Err(e) = self.limits.check(Limit::Segments, n.min(1e18) as u64, what) {
             let span = self.span_of(node, if fine > 0.0 { "$fn" } else { "$fs" });
-            return Err(self.invalid(
-                &span,
-                format!(
-                    "`{}()` asks for {n:.0} fragments around a circle; at most {MAX_FRAGMENTS} are made",
-                    node.name
-                ),
-            ));
+            return Err(self.invalid(&span, e.to_string()));
         }
         Ok(n as usize)
     }
@@ -693,7 +707,12 @@ mod tests {
     use super::*;
 
     fn load(text: &str, geometry: Geometry) -> Result<LoadedCsg> {
-        load_csg(Path::new("t.csg"), Arc::from(text), &CsgOptions { geometry, skip_unsupported: false })
+        load_csg(
+            Path::new("t.csg"),
+            Arc::from(text),
+            &CsgOptions { geometry, skip_unsupported: false },
+            &Limits::default(),
+        )
     }
 
     fn solid(text: &str) -> CsgSolid {
@@ -774,7 +793,7 @@ mod tests {
             other => panic!("expected an error, got {other:?}"),
         }
         let options = CsgOptions { geometry: Geometry::Exact, skip_unsupported: true };
-        let loaded = load_csg(Path::new("t.csg"), Arc::from(text), &options).unwrap();
+        let loaded = load_csg(Path::new("t.csg"), Arc::from(text), &options, &Limits::default()).unwrap();
         assert_eq!(loaded.solid.primitives.len(), 1);
         assert!(loaded.warnings[0].starts_with("t.csg:2:2: skipped"), "{:?}", loaded.warnings);
     }

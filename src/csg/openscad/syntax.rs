@@ -26,6 +26,7 @@ use std::path::Path;
 use std::sync::Arc;
 
 use crate::error::{Error, Result, SourceLocation};
+use crate::limits::{Limit, LimitExceeded, Limits};
 
 /// One node of a `.csg` file: `name(args);` or `name(args) { children }`.
 #[derive(Debug, Clone, PartialEq)]
@@ -85,8 +86,9 @@ impl CsgNode {
 ///
 /// [`Error::CsgSyntax`] where the text leaves OpenSCAD's grammar, located
 /// at the offending characters.
-pub fn parse_csg(path: &Path, text: Arc<str>) -> Result<Vec<CsgNode>> {
-    let mut p = Parser { text: &text, pos: 0, depth: 0 };
+pub fn parse_csg(path: &Path, text: Arc<str>, limits: &Limits) -> Result<Vec<CsgNode>> {
+    let max_depth = usize::try_from(limits.get(Limit::Nesting)).unwrap_or(usize::MAX);
+    let mut p = Parser { text: &text, pos: 0, depth: 0, max_depth };
     let nodes = p.nodes(None);
     nodes.map_err(|(span, message)| Error::CsgSyntax {
         location: Box::new(SourceLocation::new(path, Arc::clone(&text), span)),
@@ -97,17 +99,16 @@ pub fn parse_csg(path: &Path, text: Arc<str>) -> Result<Vec<CsgNode>> {
 /// A syntax error: where, and what was expected.
 type Failure = (Range<usize>, String);
 
-/// Deepest nesting of `{` blocks and `[` vectors read: OpenSCAD exports nest
-/// a few tens of levels; 100,000 would overflow the stack of the reader and
-/// of everything that walks the tree it builds.
-pub const MAX_NESTING: usize = 1000;
-
 /// A recursive-descent reader over the file's bytes.
 struct Parser<'t> {
     text: &'t str,
     pos: usize,
     /// `{` blocks and `[` vectors open around the reader.
     depth: usize,
+    /// The [`Limit::Nesting`] of `depth`: OpenSCAD exports nest a few tens
+    /// of levels; 100,000 would overflow the stack of the reader and of
+    /// everything that walks the tree it builds.
+    max_depth: usize,
 }
 
 impl<'t> Parser<'t> {
@@ -221,14 +222,20 @@ impl<'t> Parser<'t> {
         }
     }
 
-    /// Reads with `read` one level deeper, refusing past [`MAX_NESTING`].
+    /// Reads with `read` one level deeper, refusing past `max_depth`.
     fn nested<T>(
         &mut self,
         read: impl FnOnce(&mut Self) -> std::result::Result<T, Failure>,
     ) -> std::result::Result<T, Failure> {
-        if self.depth >= MAX_NESTING {
+        if self.depth >= self.max_depth {
             let at = self.pos.saturating_sub(1);
-            return Err((at..at + 1, format!("nested deeper than {MAX_NESTING} levels")));
+            let refused = LimitExceeded {
+                limit: Limit::Nesting,
+                asked: self.depth as u64 + 1,
+                allowed: self.max_depth as u64,
+                what: "the nesting of blocks and vectors".into(),
+            };
+            return Err((at..at + 1, refused.to_string()));
         }
         self.depth += 1;
         let read = read(self);
@@ -351,7 +358,7 @@ mod tests {
     use super::*;
 
     fn parse(text: &str) -> Result<Vec<CsgNode>> {
-        parse_csg(Path::new("t.csg"), Arc::from(text))
+        parse_csg(Path::new("t.csg"), Arc::from(text), &Limits::default())
     }
 
     /// The (line, column) and message of the error `text` gives.

@@ -152,19 +152,20 @@ impl EdgePass {
     }
 
     /// Step 3: blends the crossed pixels of every target (each part's move
-    /// fogged as its pixel is, by `fog`), then the pixels on solids'
+    /// scaled by how much of its opaque surface its pixel still shows, `seen`:
+    /// through fog and translucent surfaces), then the pixels on solids'
     /// outlines, measured by rays through the scene's BVH (from `trace`).
     pub fn apply(
         &mut self,
         scene: &Scene,
         vb: &VisibilityBuffer,
         targets: &mut [Target],
-        fog: Option<&[f32]>,
+        seen: Option<&[f32]>,
         trace: &mut TraceCache,
     ) {
         let Some(plan) = &self.plan else { return };
         if !self.applied {
-            targets.iter_mut().for_each(|t| plan.apply(t.image, t.parts, fog));
+            targets.iter_mut().for_each(|t| plan.apply(t.image, t.parts, seen));
             self.applied = true;
         }
         if scene.objects.iter().any(|o| o.solid().is_some()) {

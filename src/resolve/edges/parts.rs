@@ -199,14 +199,15 @@ impl EdgePlan {
 
     /// Blends `image` (holding the components `parts`): each crossed pixel
     /// becomes its parts' colours weighted by their areas, each part's colour
-    /// its pixel's moved as [`EdgePlan::record`] found (the move fogged as the
-    /// pixel is, by `1 − fog[pixel]`). Every blend reads the image as it was
-    /// before any of them.
-    pub fn apply(&self, image: &mut LinearImage, parts: ComponentSet, fog: Option<&[f32]>) {
+    /// its pixel's moved as [`EdgePlan::record`] found, scaled by how much of
+    /// the opaque surface the pixel still shows (`seen[pixel]`: `1 − fog`
+    /// times the transmittance of translucent surfaces over it). Every blend
+    /// reads the image as it was before any of them.
+    pub fn apply(&self, image: &mut LinearImage, parts: ComponentSet, seen: Option<&[f32]>) {
         let Some((_, moved)) = self.moved.iter().find(|(p, _)| *p == parts) else {
             return self.blend(image, |_, _, _| Vec3::ZERO); // not re-shaded
         };
-        self.blend(image, |_, pixel, k| moved[k] * fog.map_or(1.0, |f| 1.0 - f[pixel as usize]));
+        self.blend(image, |_, pixel, k| moved[k] * seen.map_or(1.0, |s| s[pixel as usize]));
     }
 
     /// [`EdgePlan::record`] and [`EdgePlan::apply`] in one step, for a frame

@@ -15,51 +15,58 @@
 //! coordinates; a `TANGENT` attribute is not read). Buffers and images may be
 //! files, GLB chunks or `data:` URIs.
 
+use std::cell::{Cell, RefCell};
+use std::collections::HashMap;
 use std::path::Path;
 use std::sync::Arc;
 
 use glam::{Affine3A, Mat4, Vec2, Vec3};
 
-use super::{checked, AssetSource, LoadedModel, Part};
+use super::{checked, Files, LoadedModel, Part};
 use crate::camera::{Camera, Projection};
+use crate::limits::{Limit, LimitExceeded};
 use crate::scene::mesh::{Mesh, NormalMode};
 use crate::scene::{ComponentMaps, Falloff, Light, LightKind, Material, NormalMap, Texture};
 
 struct Context<'a> {
     doc: gltf::Document,
-    buffers: Vec<gltf::buffer::Data>,
+    buffers: Vec<Vec<u8>>,
     dir: &'a Path,
-    assets: &'a dyn AssetSource,
+    from: Files<'a>,
     path: &'a Path,
-    /// Nodes placed so far ([`MAX_INSTANCES`]).
-    placed: std::cell::Cell<usize>,
+    /// Nodes placed so far ([`Limit::Instances`]): 40 nodes each listing the
+    /// next twice would place 2⁴⁰.
+    placed: Cell<u64>,
+    /// Textures decoded so far, by image and colour space: materials share them.
+    textures: RefCell<HashMap<(usize, bool), Arc<Texture>>>,
 }
 
-/// Deepest node tree read: real files nest tens of levels; a chain of
-/// 100,000 would overflow the stack.
-pub const MAX_NODE_DEPTH: usize = 1000;
-
-/// Most nodes placed in one scene, counting a node once per parent that lists
-/// it: 40 nodes each listing the next twice would place 2⁴⁰.
-pub const MAX_INSTANCES: usize = 100_000;
-
-/// Parses glTF or GLB bytes; `path` locates external buffers and images.
-pub fn load(bytes: &[u8], path: &Path, assets: &dyn AssetSource) -> Result<LoadedModel, String> {
-    super::contained("the glTF reader (gltf)", || load_contained(bytes, path, assets))?
+/// Parses glTF or GLB bytes; `path` locates external buffers and images
+/// (read through `from`, within its limits).
+pub(super) fn load(bytes: &[u8], path: &Path, from: Files) -> Result<LoadedModel, String> {
+    super::contained("the glTF reader (gltf)", || load_contained(bytes, path, from))?
 }
 
-fn load_contained(bytes: &[u8], path: &Path, assets: &dyn AssetSource) -> Result<LoadedModel, String> {
+fn load_contained(bytes: &[u8], path: &Path, from: Files) -> Result<LoadedModel, String> {
     let gltf = gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| e.to_string())?;
+    let nodes = gltf.document.as_json().nodes.len() as u64;
+    from.limits.check(Limit::GltfNodes, nodes, || "the file's nodes".into()).map_err(|e| e.to_string())?;
     // The gltf crate's own validation indexes some arrays unchecked, and its
     // image sources unwrap: what they assume is checked here first.
     checked_references(gltf.document.as_json())?;
+    checked_accessors(gltf.document.as_json())?;
     let document = gltf::Document::from_json(gltf.document.into_json()).map_err(|e| format!("invalid glTF: {e}"))?;
-    let gltf = gltf::Gltf { document, blob: gltf.blob };
     let dir = path.parent().unwrap_or(Path::new(""));
-    let base = assets.base_dir().map(|b| b.join(dir));
-    let buffers = gltf::import_buffers(&gltf.document, base.as_deref(), gltf.blob.clone())
-        .map_err(|e| format!("buffers: {e}"))?;
-    let cx = Context { doc: gltf.document, buffers, dir, assets, path, placed: std::cell::Cell::new(0) };
+    let buffers = buffers(&document, gltf.blob, dir, from)?;
+    let cx = Context {
+        doc: document,
+        buffers,
+        dir,
+        from,
+        path,
+        placed: Cell::new(0),
+        textures: RefCell::new(HashMap::new()),
+    };
     let materials: Vec<Material> = cx.doc.materials().map(|m| cx.material(&m)).collect::<Result<_, _>>()?;
     let mut model = LoadedModel::default();
     let scene = cx.doc.default_scene().or_else(|| cx.doc.scenes().next()).ok_or("the file has no scene")?;
@@ -97,11 +104,68 @@ fn checked_references(root: &gltf::json::Root) -> Result<(), String> {
     Ok(())
 }
 
+/// What the gltf crate's reader assumes of the accessors kage reads (positions,
+/// normals, the first texture coordinates, indices) and does not check: their
+/// element type (indices of floats are `unreachable!` to it), at least one
+/// element, every element inside the buffer view, no sparse storage.
+fn checked_accessors(root: &gltf::json::Root) -> Result<(), String> {
+    use gltf::json::accessor::{ComponentType as C, Type as T};
+    use gltf::json::mesh::Semantic;
+    use gltf::json::validation::Checked;
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, prim) in mesh.primitives.iter().enumerate() {
+            let mut used: Vec<(&str, usize, &[T], &[C])> = Vec::new();
+            for (semantic, index) in &prim.attributes {
+                let (name, types, components): (&str, &[T], &[C]) = match semantic {
+                    Checked::Valid(Semantic::Positions) => ("POSITION", &[T::Vec3], &[C::F32]),
+                    Checked::Valid(Semantic::Normals) => ("NORMAL", &[T::Vec3], &[C::F32]),
+                    Checked::Valid(Semantic::TexCoords(0)) => ("TEXCOORD_0", &[T::Vec2], &[C::F32, C::U8, C::U16]),
+                    _ => continue,
+                };
+                used.push((name, index.value(), types, components));
+            }
+            if let Some(i) = prim.indices {
+                used.push(("indices", i.value(), &[T::Scalar], &[C::U8, C::U16, C::U32]));
+            }
+            for (what, i, types, components) in used {
+                let fail = |why: &str| Err(format!("mesh {m} primitive {p}: its {what} accessor {i} {why}"));
+                let a = &root.accessors[i];
+                let (Checked::Valid(t), Checked::Valid(c)) = (a.type_, a.component_type) else {
+                    return fail("has an unknown element type");
+                };
+                if !types.contains(&t) || !components.contains(&c.0) {
+                    return fail(&format!("holds {:?} {t:?} elements, which {what} cannot be", c.0));
+                }
+                if a.sparse.is_some() {
+                    return fail("is sparse, which kage does not read");
+                }
+                if a.count.0 == 0 {
+                    return fail("has no elements");
+                }
+                let Some(v) = a.buffer_view else { continue };
+                let view = root
+                    .buffer_views
+                    .get(v.value())
+                    .ok_or_else(|| format!("accessor {i}: no buffer view {}", v.value()))?;
+                let size = (t.multiplicity() * c.0.size()) as u64;
+                let stride = view.byte_stride.map_or(size, |s| s.0 as u64);
+                let end = (a.count.0 - 1)
+                    .checked_mul(stride)
+                    .and_then(|e| e.checked_add(size + a.byte_offset.map_or(0, |o| o.0)));
+                if end.is_none_or(|end| end > view.byte_length.0) {
+                    return fail("reaches past its buffer view");
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
 impl Context<'_> {
     /// Places `node` (under the transform `parent`, below the nodes `above`)
     /// and its children into `out`: refused when it is among its own
-    /// ancestors, too deep ([`MAX_NODE_DEPTH`]) or one placement too many
-    /// ([`MAX_INSTANCES`]).
+    /// ancestors, too deep ([`Limit::Nesting`]: a chain of 100,000 would
+    /// overflow the stack) or one placement too many ([`Limit::Instances`]).
     fn visit(
         &self,
         node: &gltf::Node,
@@ -114,15 +178,16 @@ impl Context<'_> {
         if above.contains(&index) {
             return Err(format!("node {index} is its own ancestor (the node tree has a cycle)"));
         }
-        if above.len() >= MAX_NODE_DEPTH {
-            return Err(format!("the node tree is deeper than {MAX_NODE_DEPTH} levels"));
+        let limits = self.from.limits;
+        let depth = above.len() as u64 + 1;
+        if depth > limits.get(Limit::Nesting) {
+            let allowed = limits.get(Limit::Nesting);
+            let what = format!("node {index}, nested this deep,");
+            return Err(LimitExceeded { limit: Limit::Nesting, asked: depth, allowed, what }.to_string());
         }
         self.placed.set(self.placed.get() + 1);
-        if self.placed.get() > MAX_INSTANCES {
-            return Err(format!(
-                "the scene places more than {MAX_INSTANCES} nodes (a node listed as the child of several parents is placed once for each)"
-            ));
-        }
+        let what = || "the nodes the scene places (a node listed by several parents is placed once for each)".into();
+        limits.check(Limit::Instances, self.placed.get(), what).map_err(|e| e.to_string())?;
         let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
         let affine = Affine3A::from_mat4(world);
         if let Some(mesh) = node.mesh() {
@@ -131,7 +196,7 @@ impl Context<'_> {
             }
         }
         if let (Some(cam), None) = (node.camera(), out.camera) {
-            out.camera = camera(&cam, affine);
+            out.camera = Some(camera(&cam, affine)?);
         }
         if let Some(light) = node.light() {
             out.lights.push(self::light(&light, affine)?);
@@ -161,7 +226,7 @@ impl Context<'_> {
             ));
             return Ok(());
         }
-        let reader = prim.reader(|b| self.buffers.get(b.index()).map(|d| &d.0[..]));
+        let reader = prim.reader(|b| self.buffers.get(b.index()).map(|d| &d[..]));
         let positions: Vec<Vec3> =
             reader.read_positions().ok_or_else(|| format!("mesh '{name}' has no positions"))?.map(Vec3::from).collect();
         let normals = reader.read_normals().map(|n| n.map(Vec3::from).collect()).unwrap_or_default();
@@ -222,19 +287,33 @@ impl Context<'_> {
         Ok(out)
     }
 
+    /// The texture of `t`'s image, decoded once however many materials use it.
     fn texture(&self, t: &gltf::Texture, srgb: bool) -> Result<Arc<Texture>, String> {
+        let key = (t.source().index(), srgb);
+        if let Some(done) = self.textures.borrow().get(&key) {
+            return Ok(Arc::clone(done));
+        }
+        let limits = self.from.limits;
         let bytes = match t.source().source() {
             gltf::image::Source::View { view, .. } => {
-                let data = &self.buffers[view.buffer().index()].0;
-                data.get(view.offset()..view.offset() + view.length()).ok_or("image view outside its buffer")?.to_vec()
+                let data = self.buffers.get(view.buffer().index()).ok_or("image view of a missing buffer")?;
+                let range = view.offset()..view.offset().saturating_add(view.length());
+                data.get(range).ok_or("image view outside its buffer")?.to_vec()
             }
             gltf::image::Source::Uri { uri, .. } if uri.starts_with("data:") => data_uri(uri)?,
             gltf::image::Source::Uri { uri, .. } => {
                 let path = self.dir.join(percent_decoded(uri));
-                return crate::scene::load::texture(&path, srgb, self.assets).map_err(|e| e.to_string());
+                let texture =
+                    crate::scene::load::texture(&path, srgb, self.from.assets, limits).map_err(|e| e.to_string())?;
+                self.textures.borrow_mut().insert(key, Arc::clone(&texture));
+                return Ok(texture);
             }
         };
-        Texture::decode(&bytes, srgb).map(Arc::new).map_err(|e| format!("embedded image {}: {e}", t.index()))
+        let texture = Texture::decode(&bytes, srgb, limits)
+            .map(Arc::new)
+            .map_err(|e| format!("embedded image {}: {e}", t.index()))?;
+        self.textures.borrow_mut().insert(key, Arc::clone(&texture));
+        Ok(texture)
     }
 }
 
@@ -356,6 +435,31 @@ fn data_uri(uri: &str) -> Result<Vec<u8>, String> {
     }
 }
 
+/// The bytes of every buffer of `doc`: the GLB chunk `blob`, a `data:` URI,
+/// or a file next to the glTF (read through `from`, within its limits).
+fn buffers(doc: &gltf::Document, mut blob: Option<Vec<u8>>, dir: &Path, from: Files) -> Result<Vec<Vec<u8>>, String> {
+    doc.buffers()
+        .map(|b| {
+            let data = match b.source() {
+                gltf::buffer::Source::Bin => blob.take().ok_or("a buffer refers to the GLB chunk, which is absent")?,
+                gltf::buffer::Source::Uri(uri) if uri.starts_with("data:") => data_uri(uri)?,
+                gltf::buffer::Source::Uri(uri) => {
+                    from.read(&dir.join(percent_decoded(uri))).map_err(|e| format!("buffer {}: {e}", b.index()))?
+                }
+            };
+            if data.len() < b.length() {
+                return Err(format!(
+                    "buffer {} holds {} bytes, not the {} it declares",
+                    b.index(),
+                    data.len(),
+                    b.length()
+                ));
+            }
+            Ok(data)
+        })
+        .collect()
+}
+
 /// `%20`-style escapes of a URI decoded (glTF URIs are URI references).
 fn percent_decoded(uri: &str) -> String {
     let bytes = uri.as_bytes();
@@ -377,22 +481,32 @@ fn percent_decoded(uri: &str) -> String {
     String::from_utf8_lossy(&out).into_owned()
 }
 
-fn camera(cam: &gltf::Camera, at: Affine3A) -> Option<Camera> {
+fn camera(cam: &gltf::Camera, at: Affine3A) -> Result<Camera, String> {
+    let which = format!("camera {}", cam.index());
     let eye = at.transform_point3(Vec3::ZERO);
     let fwd = at.transform_vector3(Vec3::NEG_Z).normalize_or_zero();
     let up = at.transform_vector3(Vec3::Y).normalize_or_zero();
     let (projection, near, far) = match cam.projection() {
-        gltf::camera::Projection::Perspective(p) => (
-            Projection::Perspective { fov_y_deg: p.yfov().to_degrees() },
-            p.znear(),
-            p.zfar().unwrap_or(p.znear() * 1e5),
-        ),
+        gltf::camera::Projection::Perspective(p) => {
+            let yfov = p.yfov();
+            if !(yfov > 0.0 && yfov < std::f32::consts::PI) {
+                return Err(format!("{which}: yfov must be between 0 and π radians (both excluded), not {yfov}"));
+            }
+            if !(p.znear() > 0.0 && p.zfar().is_none_or(|far| far > p.znear())) {
+                return Err(format!("{which}: znear must be > 0 and zfar (if given) > znear"));
+            }
+            (Projection::Perspective { fov_y_deg: yfov.to_degrees() }, p.znear(), p.zfar().unwrap_or(p.znear() * 1e5))
+        }
         gltf::camera::Projection::Orthographic(o) => {
+            if !(o.ymag() > 0.0 && o.zfar() > o.znear().max(1e-4)) {
+                return Err(format!("{which}: ymag must be > 0 and zfar > znear"));
+            }
             (Projection::Orthographic { height: 2.0 * o.ymag() }, o.znear().max(1e-4), o.zfar())
         }
     };
     let c = Camera { eye, target: eye + fwd, up, near, far, projection, shift: glam::Vec2::ZERO };
-    c.validate().ok().map(|_| c)
+    c.validate().map_err(|e| format!("{which} (as its node places it): {e}"))?;
+    Ok(c)
 }
 
 /// A `KHR_lights_punctual` light placed by `at`: its intensity and colour

@@ -13,6 +13,7 @@ mod obj;
 mod openscad;
 mod stl;
 
+use std::collections::HashMap;
 use std::io;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -25,11 +26,21 @@ use crate::camera::Camera;
 use crate::csg::openscad::CsgOptions;
 use crate::csg::CsgSolid;
 use crate::error::{Error, Result};
+use crate::limits::{Limit, Limits};
 
 /// Where scene files find the files they name.
 pub trait AssetSource: Sync {
     /// Reads a file named relative to the scene.
     fn read(&self, path: &Path) -> io::Result<Vec<u8>>;
+    /// Reads a file of at most `max` bytes; a longer one is an error of
+    /// kind [`io::ErrorKind::FileTooLarge`] holding a [`FileTooLarge`], found
+    /// without reading more than `max + 1` bytes where the source can (a
+    /// path may name `/dev/zero`). By default [`AssetSource::read`], measured.
+    fn read_at_most(&self, path: &Path, max: u64) -> io::Result<Vec<u8>> {
+        let bytes = self.read(path)?;
+        FileTooLarge::check(bytes.len() as u64, max)?;
+        Ok(bytes)
+    }
     /// The path a user should see for `path` in messages.
     fn display_path(&self, path: &Path) -> PathBuf;
     /// The folder on disk relative paths start from, if files live on disk.
@@ -43,6 +54,36 @@ pub trait AssetSource: Sync {
     }
 }
 
+/// The payload of an [`io::ErrorKind::FileTooLarge`] error from
+/// [`AssetSource::read_at_most`]: how long the file is (or at least is).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct FileTooLarge {
+    /// Its length in bytes, as far as it was read.
+    pub bytes: u64,
+}
+
+impl FileTooLarge {
+    /// `Ok` when `bytes` ≤ `max`, else the error.
+    ///
+    /// # Errors
+    ///
+    /// An [`io::ErrorKind::FileTooLarge`] error holding `bytes`.
+    pub fn check(bytes: u64, max: u64) -> io::Result<()> {
+        if bytes <= max {
+            return Ok(());
+        }
+        Err(io::Error::new(io::ErrorKind::FileTooLarge, FileTooLarge { bytes }))
+    }
+}
+
+impl std::fmt::Display for FileTooLarge {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "the file holds {} bytes or more", self.bytes)
+    }
+}
+
+impl std::error::Error for FileTooLarge {}
+
 /// Files on disk, relative to a base folder (the scene file's).
 #[derive(Debug, Clone)]
 pub struct FileSystem {
@@ -53,6 +94,22 @@ pub struct FileSystem {
 impl AssetSource for FileSystem {
     fn read(&self, path: &Path) -> io::Result<Vec<u8>> {
         std::fs::read(self.base.join(path))
+    }
+    /// Reads a regular file only: a device (`/dev/zero`), pipe or folder
+    /// named as a mesh or texture is refused before anything is read, and
+    /// so is a file the file system says is longer than `max`.
+    fn read_at_most(&self, path: &Path, max: u64) -> io::Result<Vec<u8>> {
+        use std::io::Read;
+        let path = self.base.join(path);
+        let meta = std::fs::metadata(&path)?;
+        if !meta.is_file() {
+            return Err(io::Error::new(io::ErrorKind::InvalidInput, "not a regular file (a device, pipe or folder)"));
+        }
+        FileTooLarge::check(meta.len(), max)?;
+        let mut bytes = Vec::new();
+        std::fs::File::open(&path)?.take(max.saturating_add(1)).read_to_end(&mut bytes)?;
+        FileTooLarge::check(bytes.len() as u64, max)?;
+        Ok(bytes)
     }
     fn display_path(&self, path: &Path) -> PathBuf {
         self.base.join(path)
@@ -99,6 +156,26 @@ impl AssetSource for Embedded {
     }
     fn display_path(&self, path: &Path) -> PathBuf {
         Path::new("<builtin>").join(path)
+    }
+}
+
+/// Files held in memory, by the path a scene names them with: a scene and
+/// its files handed over whole (dropped into a viewer, built by a test or a
+/// fuzzer), read without touching the disk.
+#[derive(Debug, Clone, Default)]
+pub struct InMemory {
+    /// Each file's bytes.
+    pub files: HashMap<PathBuf, Vec<u8>>,
+}
+
+impl AssetSource for InMemory {
+    fn read(&self, path: &Path) -> io::Result<Vec<u8>> {
+        self.files.get(path).cloned().ok_or_else(|| {
+            io::Error::new(io::ErrorKind::NotFound, format!("'{}' is not among the files given", path.display()))
+        })
+    }
+    fn display_path(&self, path: &Path) -> PathBuf {
+        path.to_path_buf()
     }
 }
 
@@ -179,64 +256,95 @@ impl LoadedModel {
 }
 
 /// Loads a model file, choosing the loader by extension (`.csg` files with
-/// the default [`CsgOptions`]).
+/// the default [`CsgOptions`]), within the default [`Limits`].
 ///
 /// # Errors
 ///
 /// As [`model_with`].
 pub fn model(path: &Path, assets: &dyn AssetSource) -> Result<LoadedModel> {
-    model_with(path, assets, &CsgOptions::default())
+    model_with(path, assets, &CsgOptions::default(), &Limits::default())
 }
 
 /// Loads a model file, choosing the loader by extension; `.csg` files are read
-/// with `csg`.
+/// with `csg`. Nothing it asks for may pass `limits`.
 ///
 /// # Errors
 ///
 /// [`Error::Read`] when the file cannot be read, [`Error::MeshLoad`] when it
-/// does not parse (or its format is unknown), [`Error::MeshInvalid`] when its
-/// data cannot be drawn, and an OpenSCAD file's located
-/// [`Error::CsgSyntax`] / [`Error::CsgInvalid`].
-pub fn model_with(path: &Path, assets: &dyn AssetSource, csg: &CsgOptions) -> Result<LoadedModel> {
+/// does not parse (or its format is unknown, or it asks for more than a
+/// limit allows), [`Error::MeshInvalid`] when its data cannot be drawn, an
+/// OpenSCAD file's located [`Error::CsgSyntax`] / [`Error::CsgInvalid`], and
+/// [`Error::Limit`] when the file is larger than [`Limit::FileMb`].
+pub fn model_with(path: &Path, assets: &dyn AssetSource, csg: &CsgOptions, limits: &Limits) -> Result<LoadedModel> {
     let shown = assets.display_path(path);
     let ext = path.extension().and_then(|e| e.to_str()).unwrap_or_default().to_ascii_lowercase();
-    let bytes = read(path, assets)?;
+    let from = Files { assets, limits };
     let fail = |message: String| Error::MeshLoad { path: shown.clone(), message };
+    if !matches!(ext.as_str(), "obj" | "stl" | "gltf" | "glb" | "csg") {
+        return Err(fail(format!("unknown model format '.{ext}' (kage reads .obj, .stl, .gltf, .glb and .csg)")));
+    }
+    let bytes = read(path, assets, limits)?;
     let model = match ext.as_str() {
-        "obj" => obj::load(&bytes, path, assets).map_err(fail)?,
-        "stl" => LoadedModel { up: Up::Z, ..stl::load(&bytes).map_err(fail)? },
-        "gltf" | "glb" => gltf::load(&bytes, path, assets).map_err(fail)?,
+        "obj" => obj::load(&bytes, path, from).map_err(fail)?,
+        "stl" => LoadedModel { up: Up::Z, ..stl::load(&bytes, limits).map_err(fail)? },
+        "gltf" | "glb" => gltf::load(&bytes, path, from).map_err(fail)?,
         "csg" => {
             let text = String::from_utf8(bytes).map_err(|_| fail("the file is not UTF-8 text".into()))?;
-            let sidecar = assets.read(&path.with_extension("camera.txt")).ok();
-            LoadedModel { up: Up::Z, ..openscad::model(&shown, text.into(), sidecar.as_deref(), csg)? }
+            let sidecar = read(&path.with_extension("camera.txt"), assets, limits).ok();
+            LoadedModel { up: Up::Z, ..openscad::model(&shown, text.into(), sidecar.as_deref(), csg, limits)? }
         }
-        _ => return Err(fail(format!("unknown model format '.{ext}' (kage reads .obj, .stl, .gltf, .glb and .csg)"))),
+        _ => unreachable!("the extension was checked"),
     };
     Ok(model)
 }
 
-/// Reads a file through `assets`, naming it in the error.
+/// Where a loader reads the files a model names, and what it may ask for.
+#[derive(Clone, Copy)]
+struct Files<'a> {
+    assets: &'a dyn AssetSource,
+    limits: &'a Limits,
+}
+
+impl Files<'_> {
+    /// [`read`] within these limits.
+    fn read(&self, path: &Path) -> Result<Vec<u8>> {
+        read(path, self.assets, self.limits)
+    }
+}
+
+/// Reads a file through `assets`, naming it in the error; refused past
+/// [`Limit::FileMb`] (after reading at most one byte more).
 ///
 /// # Errors
 ///
-/// [`Error::Read`], naming the file as `assets` shows it.
-pub fn read(path: &Path, assets: &dyn AssetSource) -> Result<Vec<u8>> {
-    assets.read(path).map_err(|source| Error::Read { path: assets.display_path(path), source })
+/// [`Error::Read`], naming the file as `assets` shows it; [`Error::Limit`]
+/// when it is too large.
+pub fn read(path: &Path, assets: &dyn AssetSource, limits: &Limits) -> Result<Vec<u8>> {
+    let shown = || assets.display_path(path);
+    assets.read_at_most(path, limits.bytes(Limit::FileMb)).map_err(|source| {
+        match source.get_ref().and_then(|e| e.downcast_ref::<FileTooLarge>()) {
+            Some(over) => match limits.check_bytes(Limit::FileMb, over.bytes, || format!("{}", shown().display())) {
+                Err(e) => Error::Limit(e),
+                Ok(()) => Error::Read { path: shown(), source },
+            },
+            None => Error::Read { path: shown(), source },
+        }
+    })
 }
 
-/// Loads a colour (`srgb`) or data texture.
+/// Loads a colour (`srgb`) or data texture, its size checked against
+/// [`Limit::TexturePixels`] from the image header before it is decoded.
 ///
 /// # Errors
 ///
 /// [`Error::Read`] when the file cannot be read, [`Error::TextureLoad`] when
-/// it does not decode.
-pub fn texture(path: &Path, srgb: bool, assets: &dyn AssetSource) -> Result<Arc<Texture>> {
+/// it does not decode or is too large.
+pub fn texture(path: &Path, srgb: bool, assets: &dyn AssetSource, limits: &Limits) -> Result<Arc<Texture>> {
     // OpenEXR and Radiance HDR hold linear values whatever they depict.
     let ext = path.extension().and_then(|e| e.to_str()).unwrap_or_default().to_ascii_lowercase();
     let srgb = srgb && !matches!(ext.as_str(), "exr" | "hdr");
-    let bytes = read(path, assets)?;
-    Texture::decode(&bytes, srgb)
+    let bytes = read(path, assets, limits)?;
+    Texture::decode(&bytes, srgb, limits)
         .map(Arc::new)
         .map_err(|message| Error::TextureLoad { path: assets.display_path(path), message })
 }
@@ -249,13 +357,14 @@ pub fn texture_or_placeholder(
     path: &Path,
     srgb: bool,
     assets: &dyn AssetSource,
+    limits: &Limits,
     warnings: &mut Vec<String>,
 ) -> Arc<Texture> {
-    match texture(path, srgb, assets) {
+    match texture(path, srgb, assets, limits) {
         Ok(t) => return t,
         Err(Error::Read { source, .. }) if source.kind() == io::ErrorKind::NotFound => {
             if let Some(other) = assets.find_ignoring_case(path) {
-                match texture(&other, srgb, assets) {
+                match texture(&other, srgb, assets, limits) {
                     Ok(t) => return t,
                     Err(e) => warnings.push(format!("{e}; drawn as a magenta checker")),
                 }

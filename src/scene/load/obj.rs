@@ -12,19 +12,25 @@ use std::sync::Arc;
 
 use glam::{Affine3A, Vec2, Vec3};
 
-use super::{checked, AssetSource, LoadedModel, Part};
+use super::{checked, Files, LoadedModel, Part};
+use crate::error::Error;
 use crate::scene::mesh::{Mesh, NormalMode};
 use crate::scene::Material;
 
 /// Parses OBJ bytes; `path` locates the MTL files and textures it names.
-pub fn load(bytes: &[u8], path: &Path, assets: &dyn AssetSource) -> Result<LoadedModel, String> {
+pub(super) fn load(bytes: &[u8], path: &Path, from: Files) -> Result<LoadedModel, String> {
     let dir = path.parent().unwrap_or(Path::new(""));
     let options = tobj::LoadOptions { triangulate: true, single_index: true, ..Default::default() };
     let mtl_warnings = std::cell::RefCell::new(Vec::new());
     let parsed = super::contained("the OBJ reader (tobj)", || {
         tobj::load_obj_buf(&mut Cursor::new(bytes), &options, |mtl| {
             let file = dir.join(mtl);
-            let bytes = assets.read(&file).map_err(|_| tobj::LoadError::OpenFileFailed)?;
+            let bytes = from.read(&file).map_err(|e| {
+                if let Error::Limit(over) = e {
+                    mtl_warnings.borrow_mut().push(over.to_string());
+                }
+                tobj::LoadError::OpenFileFailed
+            })?;
             let text = normalised_mtl(&String::from_utf8_lossy(&bytes), &file, &mut mtl_warnings.borrow_mut());
             tobj::load_mtl_buf(&mut Cursor::new(text.as_bytes()))
         })
@@ -36,7 +42,7 @@ pub fn load(bytes: &[u8], path: &Path, assets: &dyn AssetSource) -> Result<Loade
         out.warnings.push(format!("{}: materials not loaded ({e}); using the default material", path.display()));
         Vec::new()
     });
-    let materials: Vec<Material> = materials.iter().map(|m| material(m, dir, assets, &mut out.warnings)).collect();
+    let materials: Vec<Material> = materials.iter().map(|m| material(m, dir, from, &mut out.warnings)).collect();
     let mut first_error = None;
     for m in models {
         let built = mesh(&m.mesh);
@@ -70,7 +76,9 @@ fn normalised_mtl(text: &str, file: &Path, warnings: &mut Vec<String>) -> String
         let mut words = line.split_whitespace();
         let key = words.next().unwrap_or("");
         let values: Vec<&str> = words.collect();
-        if COLOUR_KEYS.contains(&key) && (1..3).contains(&values.len()) {
+        if COLOUR_KEYS.contains(&key) && values.is_empty() {
+            warnings.push(format!("{}:{}: `{key}` has no numbers; ignored", file.display(), n + 1));
+        } else if COLOUR_KEYS.contains(&key) && values.len() < 3 {
             if values.len() == 2 {
                 warnings.push(format!(
                     "{}:{}: `{key}` has two numbers (one or three expected); taken as grey {}",
@@ -113,11 +121,13 @@ fn mesh(m: &tobj::Mesh) -> Result<(Mesh, crate::scene::mesh::MeshRepairs), Strin
 /// term: models 5 and 7 reflect `Ks` at every angle. Every model takes its
 /// opacity from `d` (or 1 − `Tr` when `d` is absent; 0 is read as opaque outside
 /// the glass models 4 and 9); `Ke` is the emission.
-fn material(m: &tobj::Material, dir: &Path, assets: &dyn AssetSource, warnings: &mut Vec<String>) -> Material {
+fn material(m: &tobj::Material, dir: &Path, from: Files, warnings: &mut Vec<String>) -> Material {
     let d = Material::default();
     let v = |c: Option<[f32; 3]>, default: Vec3| c.map_or(default, Vec3::from);
     let mut map = |name: &Option<String>| -> Vec<_> {
-        name.iter().map(|n| super::texture_or_placeholder(&dir.join(n.trim()), true, assets, warnings)).collect()
+        name.iter()
+            .map(|n| super::texture_or_placeholder(&dir.join(n.trim()), true, from.assets, from.limits, warnings))
+            .collect()
     };
     let kd = v(m.diffuse, d.kd);
     let ks = v(m.specular, d.ks);

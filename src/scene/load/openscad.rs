@@ -11,6 +11,7 @@ use super::{LoadedModel, SolidPart};
 use crate::csg::openscad::{default_view, load_csg, sidecar_camera, CsgOptions};
 use crate::error::Result;
 use crate::image::srgb_to_linear;
+use crate::limits::Limits;
 use crate::scene::Material;
 
 /// OpenSCAD's colour of faces without a `color` (the default "Cornfield"
@@ -21,8 +22,14 @@ const CORNFIELD_FACE: [u8; 3] = [249, 215, 44];
 /// (uncoloured primitives get OpenSCAD's face colour), and the camera of its
 /// sidecar (the text of `NAME.camera.txt`, if there is one and it reads) or
 /// else OpenSCAD's default view.
-pub fn model(path: &Path, text: Arc<str>, sidecar: Option<&[u8]>, options: &CsgOptions) -> Result<LoadedModel> {
-    let loaded = load_csg(path, text, options)?;
+pub fn model(
+    path: &Path,
+    text: Arc<str>,
+    sidecar: Option<&[u8]>,
+    options: &CsgOptions,
+    limits: &Limits,
+) -> Result<LoadedModel> {
+    let loaded = load_csg(path, text, options, limits)?;
     let solid = loaded.solid;
     let camera = sidecar
         .and_then(|b| std::str::from_utf8(b).ok())

@@ -7,11 +7,12 @@
 use glam::Vec3;
 
 use super::{checked, LoadedModel};
+use crate::limits::{Limit, Limits};
 use crate::scene::mesh::{Mesh, NormalMode};
 
 /// Parses STL bytes (binary when the size matches the triangle count, else ASCII).
-pub fn load(bytes: &[u8]) -> Result<LoadedModel, String> {
-    let positions = if is_binary(bytes) { binary(bytes)? } else { ascii(bytes)? };
+pub fn load(bytes: &[u8], limits: &Limits) -> Result<LoadedModel, String> {
+    let positions = if is_binary(bytes) { binary(bytes, limits)? } else { ascii(bytes)? };
     let triangles = (0..positions.len() as u32 / 3).map(|t| [3 * t, 3 * t + 1, 3 * t + 2]).collect();
     let mut model = LoadedModel::default();
     let built = Mesh::new(positions, Vec::new(), Vec::new(), triangles, NormalMode::Flat);
@@ -27,11 +28,12 @@ fn is_binary(bytes: &[u8]) -> bool {
     84 + 50 * n == bytes.len() as u64 || !bytes.starts_with(b"solid")
 }
 
-fn binary(bytes: &[u8]) -> Result<Vec<Vec3>, String> {
+fn binary(bytes: &[u8], limits: &Limits) -> Result<Vec<Vec3>, String> {
     if bytes.len() < 84 {
         return Err("file too short for a binary STL header".into());
     }
     let n = u32::from_le_bytes([bytes[80], bytes[81], bytes[82], bytes[83]]) as usize;
+    limits.check(Limit::Triangles, n as u64, || "the STL header".into()).map_err(|e| e.to_string())?;
     let body = &bytes[84..];
     if body.len() < n.saturating_mul(50) {
         return Err(format!("header promises {n} triangles but the file holds {}", body.len() / 50));
@@ -72,7 +74,7 @@ mod tests {
 
     #[test]
     fn ascii_and_binary_agree() {
-        let a = load(ASCII.as_bytes()).unwrap();
+        let a = load(ASCII.as_bytes(), &Limits::default()).unwrap();
         let mut bin = vec![0u8; 80];
         bin.extend(1u32.to_le_bytes());
         bin.extend([0u8; 12]);
@@ -80,7 +82,7 @@ mod tests {
             v.iter().for_each(|c| bin.extend(c.to_le_bytes()));
         }
         bin.extend([0u8; 2]);
-        let b = load(&bin).unwrap();
+        let b = load(&bin, &Limits::default()).unwrap();
         assert_eq!(a.parts[0].mesh.positions, b.parts[0].mesh.positions);
         assert_eq!(a.parts[0].mesh.normals[0], Vec3::Z);
     }
@@ -90,6 +92,6 @@ mod tests {
         let mut bin = vec![0u8; 80];
         bin.extend(5u32.to_le_bytes());
         bin.extend([0u8; 60]);
-        assert!(load(&bin).unwrap_err().contains("promises 5 triangles"));
+        assert!(load(&bin, &Limits::default()).unwrap_err().contains("promises 5 triangles"));
     }
 }

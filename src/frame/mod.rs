@@ -12,6 +12,10 @@
 //! as an interactive preview re-renders the same size again and again; [`render`]
 //! is the one-shot form.
 
+mod budget;
+
+pub use budget::{MemoryNeeded, BYTES_PER_PIXEL, BYTES_PER_TRIANGLE};
+
 use std::time::{Duration, Instant};
 
 use glam::{Vec2, Vec3};
@@ -199,7 +203,9 @@ impl Renderer {
     ///
     /// # Errors
     ///
-    /// What [`Scene::validate`] finds wrong with the scene.
+    /// What [`Scene::validate`] finds wrong with the scene, and
+    /// [`Error::Limit`] when a frame of it would ask for more than its
+    /// [`Scene::limits`] allow.
     pub fn render(&mut self, scene: &Scene) -> Result<&Frame> {
         self.render_reporting(scene, &|_, _| {})
     }
@@ -210,9 +216,10 @@ impl Renderer {
     ///
     /// # Errors
     ///
-    /// What [`Scene::validate`] finds wrong with the scene.
+    /// As [`Renderer::render`].
     pub fn render_reporting(&mut self, scene: &Scene, progress: &(dyn Fn(u32, u32) + Sync)) -> Result<&Frame> {
         scene.validate()?;
+        budget::check(scene)?;
         let (frame, scratch) = (&mut self.frame, &mut self.scratch);
         let options = &self.options;
         match &self.pool {
@@ -368,11 +375,26 @@ fn render_pass(scene: &Scene, frame: &mut Frame, scratch: &mut Scratch, ray_dept
     let nothing_over = scene.fog.is_none() && layers.is_empty();
     stats.timed(Stage::Edges, || edge_pass.record(targets, subpixel, nothing_over));
     let fog = stats.timed(Stage::Shading, || fog::fog_targets(scene, vb, targets));
-    stats.translucent_fragments +=
+    let (blended, transmittance) =
         stats.timed(Stage::Shading, || translucency::composite(scene, layers, targets, maps));
-    stats.timed(Stage::Edges, || edge_pass.apply(scene, vb, targets, fog.as_deref(), trace));
+    stats.translucent_fragments += blended;
+    let seen = seen_through(fog.as_deref(), transmittance.as_deref());
+    stats.timed(Stage::Edges, || edge_pass.apply(scene, vb, targets, seen.as_deref(), trace));
     stats.edge_blends = edge_pass.blends();
     stats.passes += 1;
+}
+
+/// Per pixel, the share of its opaque surface's colour the image still shows
+/// through fog (`1 − fog`) and translucent surfaces (their transmittance):
+/// what an edge's move, found on the opaque surfaces, is scaled by. `None`
+/// when it is 1 everywhere.
+fn seen_through(fog: Option<&[f32]>, transmittance: Option<&[f32]>) -> Option<Vec<f32>> {
+    match (fog, transmittance) {
+        (None, None) => None,
+        (Some(f), None) => Some(f.iter().map(|f| 1.0 - f).collect()),
+        (None, Some(t)) => Some(t.to_vec()),
+        (Some(f), Some(t)) => Some(f.iter().zip(t).map(|(f, t)| (1.0 - f) * t).collect()),
+    }
 }
 
 /// The shading passes ([`shading::shade_lit_beside`]) with `beside` run beside

@@ -5,7 +5,8 @@
 //! loads meshes and textures and produces a [`Scene`]. Both steps report errors at
 //! the file, line and column of the value at fault.
 
-use std::collections::HashMap;
+use std::cell::RefCell;
+use std::collections::{BTreeMap, HashMap};
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -24,11 +25,14 @@ use crate::camera::{Camera, Projection};
 use crate::csg::openscad::{CsgOptions, Geometry};
 use crate::error::{Error, Result, SourceLocation};
 use crate::image::ToneCurve;
+use crate::limits::{Limit, LimitSetting, Limits};
 use crate::scene::material::Filter;
 use crate::scene::settings::{
     Antialias, EdgeFilter, EdgeMode, EdgeSelection, Exposure, Fog, FogMode, TranslucencyOrder, MAX_JITTER_SAMPLES,
 };
 use crate::scene::texture::Wrap;
+
+mod values;
 
 type V3 = [f32; 3];
 
@@ -47,6 +51,9 @@ pub struct SceneFile {
     objects: Vec<Spanned<ObjectRec>>,
     fog: Option<Spanned<FogRec>>,
     environment: Option<Spanned<EnvironmentRec>>,
+    /// `[limits]`: limit name → value.
+    #[serde(default)]
+    limits: BTreeMap<Spanned<String>, Spanned<i64>>,
     #[serde(skip)]
     origin: Option<Origin>,
 }
@@ -414,7 +421,7 @@ fn shininess() -> f32 {
     32.0
 }
 
-#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Hash)]
 #[serde(rename_all = "kebab-case")]
 enum ShapeRec {
     Plane,
@@ -495,96 +502,42 @@ impl SceneFile {
         }
     }
 
-    fn environment(&self, assets: &dyn AssetSource) -> Result<Option<Environment>> {
-        let Some(rec) = &self.environment else { return Ok(None) };
-        let r = rec.get_ref();
-        if !(r.intensity.is_finite() && r.intensity >= 0.0 && r.rotate.is_finite()) {
-            return Err(self.invalid(rec.span(), "environment intensity must be finite and ≥ 0, rotate finite"));
-        }
-        // PNG and JPEG hold sRGB-encoded colours; EXR linear radiance (the loader knows).
-        let map = load::texture(Path::new(r.map.get_ref()), true, assets)?;
-        Ok(Some(Environment::new(map, r.intensity, r.rotate.to_radians(), r.background)))
+    /// Loads every mesh and texture and builds the scene, within the file's
+    /// `[limits]`.
+    ///
+    /// # Errors
+    ///
+    /// As [`SceneFile::build_with`].
+    pub fn build(&self, assets: &dyn AssetSource) -> Result<Scene> {
+        self.build_with(assets, &[])
     }
 
-    fn fog(&self) -> Result<Option<Fog>> {
-        let Some(rec) = &self.fog else { return Ok(None) };
-        let r = rec.get_ref();
-        let bad = |msg: &str| Err(self.invalid(rec.span(), msg.to_string()));
-        let finite = |v: Option<f32>| v.is_none_or(|v| v.is_finite() && v >= 0.0);
-        if !(finite(r.start)
-            && finite(r.end)
-            && finite(r.density)
-            && r.color.iter().all(|c| c.is_finite() && *c >= 0.0))
-        {
-            return bad("fog distances, density and colour must be finite and ≥ 0");
+    /// The limits this file sets in `[limits]`, over the defaults.
+    ///
+    /// # Errors
+    ///
+    /// [`Error::SceneInvalid`] at an unknown limit or a value below 0.
+    pub fn limits(&self) -> Result<Limits> {
+        let mut limits = Limits::default();
+        for (name, value) in &self.limits {
+            let limit = Limit::named(name.get_ref()).map_err(|e| self.invalid(name.span(), e))?;
+            let v = u64::try_from(*value.get_ref())
+                .map_err(|_| self.invalid(value.span(), "a limit is a whole number ≥ 0"))?;
+            limits.set(limit, v);
         }
-        let mode = match (r.mode, r.start, r.end, r.density) {
-            (FogModeRec::Linear, start, Some(end), None) if end > start.unwrap_or(0.0) => {
-                FogMode::Linear { start: start.unwrap_or(0.0), end }
-            }
-            (FogModeRec::Linear, ..) => return bad("linear fog needs `end` (> `start`, default 0) and no `density`"),
-            (FogModeRec::Exp, None, None, Some(density)) => FogMode::Exp { density },
-            (FogModeRec::Exp2, None, None, Some(density)) => FogMode::Exp2 { density },
-            _ => return bad("exp and exp2 fog need `density` and no `start`/`end`"),
-        };
-        Ok(Some(Fog { mode, color: r.color.into() }))
+        Ok(limits)
     }
 
-    fn antialias(&self) -> Result<Antialias> {
-        let Some(rec) = &self.image.antialias else { return Ok(Antialias::default()) };
-        let rec = rec.get_ref();
-        let method = rec.method.get_ref().as_str();
-        if method != "edge" {
-            if let Some(key) = [&rec.edges, &rec.filter].into_iter().flatten().next() {
-                return Err(self.invalid(key.span(), "`edges` and `filter` belong to method \"edge\""));
-            }
-        }
-        let mut mode = EdgeMode::default();
-        if let Some(e) = &rec.edges {
-            mode.selection = match e.get_ref().as_str() {
-                "outline" => EdgeSelection::Outline,
-                "all" => EdgeSelection::All,
-                other => {
-                    return Err(
-                        self.invalid(e.span(), format!("unknown edges '{other}' (expected \"outline\" or \"all\")"))
-                    )
-                }
-            };
-        }
-        if let Some(f) = &rec.filter {
-            mode.filter = match f.get_ref().as_str() {
-                "coverage" => EdgeFilter::Coverage,
-                "paper" => EdgeFilter::Paper,
-                other => {
-                    return Err(self
-                        .invalid(f.span(), format!("unknown filter '{other}' (expected \"coverage\" or \"paper\")")))
-                }
-            };
-        }
-        match (method, &rec.samples) {
-            ("none", None) => Ok(Antialias::None),
-            ("none", Some(n)) => Err(self.invalid(n.span(), "method \"none\" takes no samples")),
-            ("edge", None) => Ok(Antialias::Edge(mode)),
-            ("edge", Some(n)) => Err(self.invalid(n.span(), "method \"edge\" takes no samples")),
-            ("jitter", None) => Err(self.invalid(rec.method.span(), "method \"jitter\" needs `samples = n`")),
-            ("jitter", Some(n)) => match u32::try_from(*n.get_ref()) {
-                Ok(k @ 1..=MAX_JITTER_SAMPLES) => Ok(Antialias::Jitter(k)),
-                _ => Err(self.invalid(n.span(), format!("samples must be between 1 and {MAX_JITTER_SAMPLES}"))),
-            },
-            (other, _) => Err(self.invalid(
-                rec.method.span(),
-                format!("unknown antialiasing method '{other}' (expected \"none\", \"edge\" or \"jitter\")"),
-            )),
-        }
-    }
-
-    /// Loads every mesh and texture and builds the scene.
+    /// Loads every mesh and texture and builds the scene, within the file's
+    /// `[limits]` with `overrides` (the command line's) applied over them.
     ///
     /// # Errors
     ///
     /// [`Error::SceneInvalid`] for impossible values (located in the file), and
-    /// whatever loading a named mesh, model or texture fails with.
-    pub fn build(&self, assets: &dyn AssetSource) -> Result<Scene> {
+    /// whatever loading a named mesh, model or texture fails with (a request
+    /// past a limit among them).
+    pub fn build_with(&self, assets: &dyn AssetSource, overrides: &[LimitSetting]) -> Result<Scene> {
+        let from = Sources::new(assets, self.limits()?.with_settings(overrides));
         let (w, h) = (&self.image.width, &self.image.height);
         for side in [w, h] {
             if *side.get_ref() < 1 || *side.get_ref() > super::MAX_IMAGE_SIDE as i64 {
@@ -594,7 +547,7 @@ impl SceneFile {
         let mut materials = Vec::new();
         let mut by_name = HashMap::new();
         for m in &self.materials {
-            let mat = self.material(m.get_ref(), assets)?;
+            let mat = self.material(m.get_ref(), &from)?;
             if !(mat.shininess.is_finite() && mat.shininess >= 0.0) {
                 return Err(self.invalid(m.span(), format!("shininess must be finite and ≥ 0, not {}", mat.shininess)));
             }
@@ -616,14 +569,19 @@ impl SceneFile {
             tone: self.image.tonemap.into(),
             antialias: self.antialias()?,
             fog: self.fog()?,
-            environment: self.environment(assets)?,
+            environment: self.environment(&from)?,
             translucency: self.image.translucency.into(),
+            limits: from.limits,
         };
         let mut models = Vec::new();
         let mut produced = Vec::new();
         for o in &self.objects {
             let first = scene.objects.len();
-            models.push(self.object(o, &by_name, assets, &mut scene)?);
+            models.push(self.object(o, &by_name, &from, &mut scene)?);
+            let triangles: u64 =
+                scene.objects.iter().filter_map(Object::triangles).map(|m| m.triangles.len() as u64).sum();
+            let what = || format!("the objects up to this one ({})", scene.objects.len());
+            from.limits.check(Limit::Triangles, triangles, what).map_err(|e| self.invalid(o.span(), e.to_string()))?;
             produced.push((o.get_ref().name.clone(), first..scene.objects.len()));
         }
         self.resolve_only(&mut scene, &produced)?;
@@ -651,216 +609,11 @@ impl SceneFile {
         Ok(())
     }
 
-    fn camera(&self, c: &Spanned<CameraRec>) -> Result<Camera> {
-        let r = c.get_ref();
-        let projection = match r.projection {
-            ProjectionRec::Perspective => Projection::Perspective { fov_y_deg: r.fov },
-            ProjectionRec::Orthographic => {
-                let height = r.height.ok_or_else(|| {
-                    self.invalid(c.span(), "an orthographic camera needs `height` (world units shown top to bottom)")
-                })?;
-                Projection::Orthographic { height }
-            }
-        };
-        let cam = Camera {
-            eye: r.eye.into(),
-            target: r.target.into(),
-            up: r.up.into(),
-            near: r.near,
-            far: r.far,
-            projection,
-            shift: glam::Vec2::ZERO,
-        };
-        cam.validate().map_err(|m| self.invalid(c.span(), m))?;
-        Ok(cam)
-    }
-
-    /// The background colour: finite and ≥ 0.
-    fn background(&self) -> Result<Vec3> {
-        let b = &self.image.background;
-        let ok = b.get_ref().iter().all(|c| c.is_finite() && *c >= 0.0);
-        ok.then(|| Vec3::from(*b.get_ref())).ok_or_else(|| self.invalid(b.span(), "background must be finite and ≥ 0"))
-    }
-
-    /// The exposure: a finite number of stops, or `auto`.
-    fn exposure(&self) -> Result<Exposure> {
-        let e = &self.image.exposure;
-        match e.get_ref() {
-            ExposureRec::Stops(ev) if !ev.is_finite() => {
-                Err(self.invalid(e.span(), "exposure must be a finite number of stops or \"auto\""))
-            }
-            rec => Ok((*rec).into()),
-        }
-    }
-
-    fn light(&self, l: &Spanned<LightRec>) -> Result<Light> {
-        let r = l.get_ref();
-        let need = |v: Option<V3>, key: &str| {
-            v.map(Vec3::from)
-                .ok_or_else(|| self.invalid(l.span(), format!("a {:?} light needs `{key}`", r.kind).to_lowercase()))
-        };
-        let aim = |from: Option<V3>| -> Result<Vec3> {
-            let d = match (r.direction, r.target, from) {
-                (Some(d), _, _) => Vec3::from(d),
-                (None, Some(t), Some(p)) => Vec3::from(t) - Vec3::from(p),
-                _ => return Err(self.invalid(l.span(), "this light needs `direction` (or `position` and `target`)")),
-            };
-            d.try_normalize().ok_or_else(|| self.invalid(l.span(), "the light direction has zero length"))
-        };
-        let kind = match r.kind {
-            LightType::Point => LightKind::Point { position: need(r.position, "position")? },
-            LightType::Directional => LightKind::Directional { direction: aim(r.position)? },
-            LightType::Spot => LightKind::Spot {
-                position: need(r.position, "position")?,
-                direction: aim(r.position)?,
-                inner: r.inner_angle.to_radians(),
-                outer: r.outer_angle.to_radians(),
-            },
-        };
-        let places = match kind {
-            LightKind::Point { position } => [position, Vec3::ZERO],
-            LightKind::Spot { position, direction, .. } => [position, direction],
-            LightKind::Directional { direction } => [direction, Vec3::ZERO],
-        };
-        if !places.iter().all(|p| p.is_finite()) {
-            return Err(self.invalid(l.span(), "light position, direction and target must be finite"));
-        }
-        if r.kind == LightType::Spot
-            && !(0.0 <= r.inner_angle && r.inner_angle <= r.outer_angle && r.outer_angle <= 180.0)
-        {
-            return Err(self.invalid(l.span(), "spot angles must satisfy 0 ≤ inner_angle ≤ outer_angle ≤ 180"));
-        }
-        let values = [r.intensity, r.ambient, r.size, r.color[0], r.color[1], r.color[2]];
-        if values.iter().any(|v| !v.is_finite() || *v < 0.0) {
-            return Err(self.invalid(l.span(), "light colour, intensity, ambient and size must be finite and ≥ 0"));
-        }
-        let falloff = match r.falloff {
-            FalloffRec::None => Falloff::None,
-            FalloffRec::InverseSquare => Falloff::InverseSquare,
-        };
-        Ok(Light {
-            kind,
-            color: r.color.into(),
-            intensity: r.intensity,
-            ambient: r.ambient,
-            size: r.size,
-            falloff,
-            shadow: self.shadow(r.shadow.as_ref())?,
-            only: None, // resolved once the objects exist
-        })
-    }
-
-    fn shadow(&self, rec: Option<&Spanned<ShadowRec>>) -> Result<ShadowSettings> {
-        let mut s = ShadowSettings::default();
-        let Some(rec) = rec else { return Ok(s) };
-        let r = rec.get_ref();
-        s.method = match r.method {
-            ShadowMethodRec::None => ShadowMethod::None,
-            ShadowMethodRec::Map => ShadowMethod::Map,
-        };
-        let count = |v: &Option<Spanned<i64>>, lo: i64, hi: i64, what: &str| -> Result<Option<u32>> {
-            match v {
-                Some(n) if !(lo..=hi).contains(n.get_ref()) => {
-                    Err(self.invalid(n.span(), format!("{what} must be between {lo} and {hi}")))
-                }
-                Some(n) => Ok(Some(*n.get_ref() as u32)),
-                None => Ok(None),
-            }
-        };
-        if let Some(n) = count(&r.resolution, 16, 16384, "shadow resolution")? {
-            (s.resolution, s.by_need) = (n, false);
-        }
-        s.pcf = count(&r.pcf, 1, 15, "pcf")?.unwrap_or(s.pcf);
-        s.samples = count(&r.samples, 1, 256, "shadow samples")?.unwrap_or(s.samples);
-        for (v, slot) in [(r.bias, &mut s.bias), (r.slope, &mut s.slope)] {
-            if let Some(v) = v {
-                if !(v.is_finite() && v >= 0.0) {
-                    return Err(self.invalid(rec.span(), "shadow bias and slope must be finite and ≥ 0"));
-                }
-                *slot = v;
-            }
-        }
-        Ok(s)
-    }
-
-    /// Turns each light's `only = [names]` into object indices: a name means every
-    /// object its [[object]] record produced.
-    fn resolve_only(&self, scene: &mut Scene, produced: &[(Option<String>, Range<usize>)]) -> Result<()> {
-        for (light, rec) in scene.lights.iter_mut().zip(&self.lights) {
-            let Some(names) = &rec.get_ref().only else { continue };
-            let mut objects = Vec::new();
-            for name in names {
-                let hits: Vec<_> =
-                    produced.iter().filter(|(n, _)| n.as_deref() == Some(name.get_ref().as_str())).collect();
-                if hits.is_empty() {
-                    let msg = format!("no [[object]] named '{}' for this light to light", name.get_ref());
-                    return Err(self.invalid(name.span(), msg));
-                }
-                objects.extend(hits.into_iter().flat_map(|(_, r)| r.clone()));
-            }
-            light.only = Some(objects);
-        }
-        Ok(())
-    }
-
-    fn material(&self, r: &MaterialRec, assets: &dyn AssetSource) -> Result<Material> {
-        let wrap = match r.wrap {
-            WrapRec::Repeat => Wrap::Repeat,
-            WrapRec::Clamp => Wrap::Clamp,
-            WrapRec::Mirror => Wrap::Mirror,
-        };
-        let texture = |maps: &Option<MapsRec>, srgb: bool| -> Result<Vec<Arc<Texture>>> {
-            let load = |p: &String| {
-                let mut t = load::texture(Path::new(p), srgb, assets)?;
-                Arc::make_mut(&mut t).wrap = wrap;
-                Ok(t)
-            };
-            maps.as_ref().map_or(&[][..], MapsRec::paths).iter().map(load).collect()
-        };
-        Ok(Material {
-            name: r.name.get_ref().clone(),
-            ka: r.ka.unwrap_or(r.kd).into(),
-            kd: r.kd.into(),
-            ks: r.ks.into(),
-            shininess: r.shininess,
-            ke: r.ke.into(),
-            maps: super::ComponentMaps {
-                ambient: texture(&r.ka_map, true)?,
-                diffuse: texture(&r.kd_map, true)?,
-                specular: texture(&r.ks_map, true)?,
-                emission: texture(&r.ke_map, true)?,
-                normal: None,
-                filter: match r.filter {
-                    FilterRec::Trilinear => Filter::Trilinear,
-                    FilterRec::Bilinear => Filter::Bilinear,
-                },
-            },
-            two_sided: r.two_sided,
-            kr: r.kr.into(),
-            kt: r.kt.into(),
-            km: r.km.into(),
-            opacity: match &r.opacity {
-                Some(a) if !(0.0..=1.0).contains(a.get_ref()) => {
-                    return Err(self.invalid(a.span(), "opacity must be between 0 and 1"))
-                }
-                Some(a) => *a.get_ref(),
-                None => 1.0,
-            },
-            ior: match &r.ior {
-                Some(ior) if !(ior.get_ref().is_finite() && *ior.get_ref() >= 1.0) => {
-                    return Err(self.invalid(ior.span(), "the index of refraction must be a finite number ≥ 1"))
-                }
-                Some(ior) => *ior.get_ref(),
-                None => 1.5,
-            },
-        })
-    }
-
     fn object(
         &self,
         o: &Spanned<ObjectRec>,
         by_name: &HashMap<String, usize>,
-        assets: &dyn AssetSource,
+        from: &Sources,
         scene: &mut Scene,
     ) -> Result<LoadedModel> {
         let r = o.get_ref();
@@ -871,13 +624,9 @@ impl SceneFile {
                     GeometryRec::Faceted => Geometry::Faceted,
                 };
                 let csg = CsgOptions { geometry, skip_unsupported: r.skip_unsupported };
-                load::model_with(Path::new(path.get_ref()), assets, &csg)?
+                load::model_with(Path::new(path.get_ref()), from.assets, &csg, &from.limits)?
             }
-            (None, Some(shape)) => LoadedModel::single(match shape {
-                ShapeRec::Plane => shapes::plane(),
-                ShapeRec::Cube => shapes::cube(),
-                ShapeRec::Sphere => shapes::sphere(48),
-            }),
+            (None, Some(shape)) => from.shape(shape),
             _ => return Err(self.invalid(o.span(), "an object needs exactly one of `mesh` (a file) or `shape`")),
         };
         let material = match &r.material {
@@ -937,6 +686,45 @@ impl SceneFile {
     }
 }
 
+/// Where a scene's files come from and what they may ask for; the textures
+/// and shapes made so far, which every material or object naming them shares.
+struct Sources<'a> {
+    assets: &'a dyn AssetSource,
+    limits: Limits,
+    textures: RefCell<HashMap<(String, bool, Wrap), Arc<Texture>>>,
+    shapes: RefCell<HashMap<ShapeRec, LoadedModel>>,
+}
+
+impl<'a> Sources<'a> {
+    fn new(assets: &'a dyn AssetSource, limits: Limits) -> Sources<'a> {
+        Sources { assets, limits, textures: RefCell::default(), shapes: RefCell::default() }
+    }
+
+    /// The texture at `path` (a colour map if `srgb`), wrapping as `wrap` says.
+    fn texture(&self, path: &str, srgb: bool, wrap: Wrap) -> Result<Arc<Texture>> {
+        let key = (path.to_string(), srgb, wrap);
+        if let Some(done) = self.textures.borrow().get(&key) {
+            return Ok(Arc::clone(done));
+        }
+        let mut t = load::texture(Path::new(path), srgb, self.assets, &self.limits)?;
+        Arc::make_mut(&mut t).wrap = wrap;
+        self.textures.borrow_mut().insert(key, Arc::clone(&t));
+        Ok(t)
+    }
+
+    /// The built-in shape's model (one mesh, shared by every object of it).
+    fn shape(&self, shape: ShapeRec) -> LoadedModel {
+        let make = || {
+            LoadedModel::single(match shape {
+                ShapeRec::Plane => shapes::plane(),
+                ShapeRec::Cube => shapes::cube(),
+                ShapeRec::Sphere => shapes::sphere(48),
+            })
+        };
+        self.shapes.borrow_mut().entry(shape).or_insert_with(make).clone()
+    }
+}
+
 /// The bounds of `model` turned by `turn` (the box around its turned box).
 fn turned_bounds(model: &LoadedModel, turn: &Affine3A) -> (Vec3, Vec3) {
     let corners = box_corners(model.bounds()).map(|c| turn.transform_point3(c));
@@ -983,10 +771,27 @@ pub fn add_model(scene: &mut Scene, model: &LoadedModel, label: &str, transform:
 ///
 /// # Errors
 ///
-/// [`Error::Read`] when the file cannot be read; then as [`SceneFile::parse`]
-/// and [`SceneFile::build`].
+/// As [`load_scene_with`].
 pub fn load_scene(path: &Path) -> Result<Scene> {
-    let text = std::fs::read_to_string(path).map_err(|source| Error::Read { path: path.to_path_buf(), source })?;
+    load_scene_with(path, &[])
+}
+
+/// Reads and builds a scene file from disk, with `overrides` applied over
+/// its `[limits]`.
+///
+/// # Errors
+///
+/// [`Error::Read`] when the file cannot be read, [`Error::Limit`] when it is
+/// larger than [`Limit::FileMb`], [`Error::SceneSyntax`] when it is not UTF-8
+/// text; then as [`SceneFile::parse`] and [`SceneFile::build_with`].
+pub fn load_scene_with(path: &Path, overrides: &[LimitSetting]) -> Result<Scene> {
     let base = path.parent().unwrap_or(Path::new(".")).to_path_buf();
-    SceneFile::parse(&text, path)?.build(&load::FileSystem { base })
+    let files = load::FileSystem { base };
+    let name = Path::new(path.file_name().unwrap_or(path.as_os_str()));
+    let bytes = load::read(name, &files, &Limits::default().with_settings(overrides))?;
+    let text = String::from_utf8(bytes).map_err(|e| Error::SceneSyntax {
+        location: Box::new(SourceLocation::new(path, Arc::from(""), 0..0)),
+        message: format!("the file is not UTF-8 text (at byte {})", e.utf8_error().valid_up_to()),
+    })?;
+    SceneFile::parse(&text, path)?.build_with(&files, overrides)
 }
