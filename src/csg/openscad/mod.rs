@@ -288,10 +288,6 @@ impl Builder {
     fn hull(&mut self, node: &CsgNode, m: Affine3A, color: Option<Vec4>) -> Result<Built> {
         let mut points = Vec::new();
         self.hull_points(&node.children, Affine3A::IDENTITY, &mut points)?;
-        let what = || "this hull's points (its children's corners)".into();
-        if let Err(e) = self.limits.check(Limit::Facets, points.len() as u64, what) {
-            return Err(self.invalid(&node.span, e.to_string()));
-        }
         let Some(poly) = convex_hull(&points) else { return Ok(Built::Empty) };
         let shape = Shape::Polyhedron(poly);
         self.push(Primitive { shape, transform: m, color, source: node.span.clone() })
@@ -319,6 +315,12 @@ impl Builder {
                     self.options.geometry = faceted;
                     if let Some(Primitive { shape: Shape::Polyhedron(p), transform, .. }) = made? {
                         out.extend(p.vertices.iter().map(|v| transform.transform_point3(*v)));
+                    }
+                    // Refused as soon as the points pass the limit, not after
+                    // a file of 100,000 cubes has been read into the hull.
+                    let what = || "this hull's points (its children's corners)".into();
+                    if let Err(e) = self.limits.check(Limit::Facets, out.len() as u64, what) {
+                        return Err(self.invalid(&node.span, e.to_string()));
                     }
                 }
                 name => {
