@@ -97,9 +97,11 @@ impl PrimitiveSpec {
         let (shape, place) = match *self {
             PrimitiveSpec::Sphere(p) => (Shape::Sphere, p),
             PrimitiveSpec::Frustum(a, b, p) => {
+                // The larger radius is 1, as the OpenSCAD reader makes it (a
+                // frustum of two zero radii, a line, has no volume to draw).
                 let (a, b) = (unit(a, 0.0, 1.0), unit(b, 0.0, 1.0));
-                let big = a.max(b).max(0.05);
-                (Shape::Frustum { bottom: a / big, top: b / big }, p)
+                let (bottom, top) = if a.max(b) > 0.0 { (a / a.max(b), b / a.max(b)) } else { (1.0, 0.0) };
+                (Shape::Frustum { bottom, top }, p)
             }
             PrimitiveSpec::Cube(p) => (Shape::Polyhedron(ConvexPolyhedron::unit_cube()), p),
             PrimitiveSpec::Tetrahedron(p) => {
