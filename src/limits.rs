@@ -156,6 +156,13 @@ impl Limits {
         self.values[limit as usize] = value;
     }
 
+    /// These limits with `settings` applied in order.
+    #[must_use]
+    pub fn with_settings(mut self, settings: &[LimitSetting]) -> Limits {
+        settings.iter().for_each(|s| self.set(s.limit, s.value));
+        self
+    }
+
     /// `Ok` when `asked` is within `limit`; else the message refusing `what`.
     ///
     /// # Errors
@@ -231,15 +238,6 @@ impl FromStr for LimitSetting {
             .parse()
             .map_err(|_| format!("the value of limit '{}' must be a whole number ≥ 0", limit.name()))?;
         Ok(LimitSetting { limit, value })
-    }
-}
-
-impl Limits {
-    /// These limits with `settings` applied in order.
-    #[must_use]
-    pub fn with_settings(mut self, settings: &[LimitSetting]) -> Limits {
-        settings.iter().for_each(|s| self.set(s.limit, s.value));
-        self
     }
 }
 

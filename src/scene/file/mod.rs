@@ -575,11 +575,12 @@ impl SceneFile {
         };
         let mut models = Vec::new();
         let mut produced = Vec::new();
+        let mut triangles = 0;
         for o in &self.objects {
             let first = scene.objects.len();
             models.push(self.object(o, &by_name, &from, &mut scene)?);
-            let triangles: u64 =
-                scene.objects.iter().filter_map(Object::triangles).map(|m| m.triangles.len() as u64).sum();
+            let added = scene.objects[first..].iter().filter_map(Object::triangles);
+            triangles += added.map(|m| m.triangles.len() as u64).sum::<u64>();
             let what = || format!("the objects up to this one ({})", scene.objects.len());
             from.limits.check(Limit::Triangles, triangles, what).map_err(|e| self.invalid(o.span(), e.to_string()))?;
             produced.push((o.get_ref().name.clone(), first..scene.objects.len()));
