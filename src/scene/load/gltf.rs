@@ -149,6 +149,9 @@ fn checked_accessors(root: &gltf::json::Root) -> Result<(), String> {
                     .ok_or_else(|| format!("accessor {i}: no buffer view {}", v.value()))?;
                 let size = (t.multiplicity() * c.0.size()) as u64;
                 let stride = view.byte_stride.map_or(size, |s| s.0 as u64);
+                if stride < size {
+                    return fail("steps through its buffer view by less than one element (byteStride)");
+                }
                 let end = (a.count.0 - 1)
                     .checked_mul(stride)
                     .and_then(|e| e.checked_add(size + a.byte_offset.map_or(0, |o| o.0)));
