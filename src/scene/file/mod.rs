@@ -417,6 +417,11 @@ fn grey() -> V3 {
 fn ks() -> V3 {
     [0.2; 3]
 }
+/// Every component of `c` is a finite number ≥ 0.
+fn finite_non_negative(c: glam::Vec3) -> bool {
+    c.is_finite() && c.min_element() >= 0.0
+}
+
 fn shininess() -> f32 {
     32.0
 }
@@ -550,6 +555,13 @@ impl SceneFile {
             let mat = self.material(m.get_ref(), &from)?;
             if !(mat.shininess.is_finite() && mat.shininess >= 0.0) {
                 return Err(self.invalid(m.span(), format!("shininess must be finite and ≥ 0, not {}", mat.shininess)));
+            }
+            let colours =
+                [("kd", mat.kd), ("ka", mat.ka), ("ks", mat.ks), ("ke", mat.ke), ("kr", mat.kr), ("kt", mat.kt)];
+            if let Some((name, c)) = colours.into_iter().chain([("km", mat.km)]).find(|(_, c)| !finite_non_negative(*c))
+            {
+                let msg = format!("material '{}': `{name}` must be finite and ≥ 0, not {c}", mat.name);
+                return Err(self.invalid(m.span(), msg));
             }
             if by_name.insert(mat.name.clone(), materials.len()).is_some() {
                 return Err(self.invalid(m.get_ref().name.span(), format!("material '{}' is defined twice", mat.name)));
