@@ -9,6 +9,7 @@
 //! the two-map soft shadows (seed 001) plug into the same [`ShadowTerm`].
 
 mod map;
+pub mod slb;
 
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;

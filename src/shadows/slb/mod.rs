@@ -1,0 +1,5 @@
+//! The silhouette-line buffer of seed 000 (Yamaguchi & Ikedo, "Shadow
+//! Antialiasing with Virtual Projection Space", IPSJ 2008): exact shadow edges
+//! inside each shadow-map texel.
+
+pub mod walk;
