@@ -2,4 +2,7 @@
 //! Antialiasing with Virtual Projection Space", IPSJ 2008): exact shadow edges
 //! inside each shadow-map texel.
 
+pub mod buffer;
+pub mod line;
+pub mod region;
 pub mod walk;

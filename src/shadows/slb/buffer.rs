@@ -1,0 +1,542 @@
+//! The light pass's buffers of seed 000 (§3.2, Table 1): the edge buffer (one
+//! bit per texel: a silhouette crosses it) and the silhouette-line buffer, built
+//! from the casters' triangles as the light sees them.
+//!
+//! Every edge of every triangle is walked ([`super::walk`]) and recorded in the
+//! texels it crosses; then, per texel (§3.3.2), a record of one object that
+//! matches another in every field but the Polygon ID and an opposite L/R flag is
+//! an edge shared by two of its polygons and both go; and (§3.3.3) lines behind
+//! a polygon that covers the whole texel nearer the light go, the texel's edge
+//! bit with them when none is left.
+//!
+//! Store: a sorted compact form rather than the paper's hashed linked lists.
+//! The records are sorted by texel (in parallel), so one texel's lines are
+//! adjacent, grouped by object; a texel finds them through the edge bits and
+//! a running count of set bits per 64 texels (a rank: one popcount), with no
+//! hashing, no collisions and no pointers — 1.5 bits per texel plus 4 bytes
+//! per edge texel on top of the lines.
+//!
+//! Beyond the paper, the eye pass counts crossings from the texel's centre
+//! ([`super::region`]), so each edge texel also keeps the surfaces that cover
+//! its centre (their depth planes): the *layers*, every caster triangle over
+//! the centre by exact integer tests on the walk's grid, plus a correction
+//! wherever a line's k-bit form puts the centre on the other side of it than
+//! the exact edge does.
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+use super::line::{SilhouetteLine, TexelDepth};
+use super::walk::{Edge, WalkPoint, WALK_BITS};
+
+/// One caster triangle as the light sees it: texel coordinates (x right, y
+/// down) and reversed depth (larger nearer the light) per vertex.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LightTriangle {
+    /// The corners: x, y in texels, z reversed depth.
+    pub points: [DVec3; 3],
+    /// The object it belongs to.
+    pub object: u32,
+    /// Its index among its object's triangles (the Polygon ID).
+    pub polygon: u32,
+}
+
+/// A surface over an edge texel's centre, counted `count` times (a correction
+/// counts −1).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Layer {
+    /// Its depth plane over the texel.
+    pub depth: TexelDepth,
+    /// How many surfaces it stands for.
+    pub count: i32,
+}
+
+/// What one edge texel holds.
+#[derive(Debug, Clone, Copy)]
+pub struct Entry<'a> {
+    /// Its silhouette lines, grouped by object.
+    pub lines: &'a [SilhouetteLine],
+    /// The surfaces over its centre.
+    pub layers: &'a [Layer],
+}
+
+/// Counts from one build, for the paper's Table 8 and the benchmarks.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct BuildStats {
+    /// Records the walk made.
+    pub walked: usize,
+    /// Records removed as shared edges.
+    pub shared: usize,
+    /// Records removed as hidden.
+    pub hidden: usize,
+}
+
+/// The edge buffer and the silhouette-line buffer of one light view.
+#[derive(Debug, Clone, Default)]
+pub struct SilhouetteLineBuffer {
+    width: u32,
+    height: u32,
+    bits: u32,
+    edge: Vec<u64>,
+    rank: Vec<u32>,
+    line_start: Vec<u32>,
+    lines: Vec<SilhouetteLine>,
+    layer_start: Vec<u32>,
+    layers: Vec<Layer>,
+    stats: BuildStats,
+}
+
+/// A line being built, with where it lies and what the exact edge says of
+/// the texel's centre.
+#[derive(Debug, Clone, Copy)]
+struct Record {
+    texel: u32,
+    line: SilhouetteLine,
+    /// The exact edge has the centre on the polygon's side.
+    exact_centre_inside: bool,
+    /// The vertices at the line's start and end, where they lie in the texel.
+    ends: [Option<WalkPoint>; 2],
+}
+
+impl Record {
+    /// Everything the paper compares for shared edges (all but the Polygon
+    /// ID and the L/R flag), texel first.
+    fn key(&self) -> (u32, u32, u8, u32, u32, u32, u32) {
+        let l = &self.line;
+        let kind = (l.line.major as u8) << 2 | u8::from(l.line.x_positive) << 1 | u8::from(l.cross);
+        let end = |e: Option<f32>| e.map_or(u32::MAX, f32::to_bits);
+        (self.texel, l.object, kind, l.fraction, l.slope, end(l.start), end(l.end))
+    }
+}
+
+/// `sign(a × b)` for walk-grid vectors, exactly.
+fn cross(a: (i64, i64), b: (i64, i64)) -> i128 {
+    i128::from(a.0) * i128::from(b.1) - i128::from(a.1) * i128::from(b.0)
+}
+
+/// Which side of the directed line `p → q` the point `c + (ε, ε²)` lies on
+/// (simulation of simplicity: never on it), as ±1.
+fn side(p: WalkPoint, q: WalkPoint, c: (i64, i64)) -> i32 {
+    let d = (q.x - p.x, q.y - p.y);
+    let s = cross(d, (c.0 - p.x, c.1 - p.y));
+    let s = if s != 0 {
+        s
+    } else if d.1 != 0 {
+        -i128::from(d.1)
+    } else {
+        i128::from(d.0)
+    };
+    if s > 0 {
+        1
+    } else {
+        -1
+    }
+}
+
+/// The centre of texel `(x, y)` in walk units.
+fn centre(x: i64, y: i64) -> (i64, i64) {
+    let half = 1i64 << (WALK_BITS - 1);
+    ((x << WALK_BITS) + half, (y << WALK_BITS) + half)
+}
+
+/// A triangle snapped to the walk grid, with its depth plane.
+struct Snapped {
+    p: [WalkPoint; 3],
+    /// +1 or −1: the orientation of `p`.
+    turn: i32,
+    /// z = c + dx·x + dy·y in texel coordinates.
+    plane: (f64, f64, f64),
+    object: u32,
+    polygon: u32,
+}
+
+impl Snapped {
+    fn new(t: &LightTriangle) -> Option<Snapped> {
+        let p = t.points.map(|v| WalkPoint::snap(v.x, v.y));
+        let area = cross((p[1].x - p[0].x, p[1].y - p[0].y), (p[2].x - p[0].x, p[2].y - p[0].y));
+        if area == 0 || !t.points.iter().all(|v| v.is_finite()) {
+            return None;
+        }
+        let [a, b, c] = t.points;
+        let det = (b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y);
+        let dx = ((b.z - a.z) * (c.y - a.y) - (c.z - a.z) * (b.y - a.y)) / det;
+        let dy = ((c.z - a.z) * (b.x - a.x) - (b.z - a.z) * (c.x - a.x)) / det;
+        let plane = (a.z - dx * a.x - dy * a.y, dx, dy);
+        Some(Snapped { p, turn: if area > 0 { 1 } else { -1 }, plane, object: t.object, polygon: t.polygon })
+    }
+
+    fn depth(&self, x: i64, y: i64) -> TexelDepth {
+        let (c, dx, dy) = self.plane;
+        TexelDepth { c: (c + dx * x as f64 + dy * y as f64) as f32, dx: dx as f32, dy: dy as f32 }
+    }
+
+    /// Whether the centre of texel `(x, y)` (perturbed) lies inside.
+    fn covers_centre(&self, x: i64, y: i64) -> bool {
+        let c = centre(x, y);
+        (0..3).all(|i| side(self.p[i], self.p[(i + 1) % 3], c) == self.turn)
+    }
+
+    /// The bounding box in texels, inside a `width` × `height` map.
+    fn bounds(&self, width: u32, height: u32) -> Option<(i64, i64, i64, i64)> {
+        let lo = |f: fn(&WalkPoint) -> i64| self.p.iter().map(f).min().unwrap_or(0) >> WALK_BITS;
+        let hi = |f: fn(&WalkPoint) -> i64| self.p.iter().map(f).max().unwrap_or(0) >> WALK_BITS;
+        let (x0, y0) = (lo(|p| p.x).max(0), lo(|p| p.y).max(0));
+        let (x1, y1) = (hi(|p| p.x).min(i64::from(width) - 1), hi(|p| p.y).min(i64::from(height) - 1));
+        (x0 <= x1 && y0 <= y1).then_some((x0, y0, x1, y1))
+    }
+}
+
+/// `p → q` clipped to the rectangle `[lo, hi]²`-ish (`x ∈ [x0, x1]`,
+/// `y ∈ [y0, y1]`), parametrically; `None` when it misses.
+fn clip(p: (f64, f64), q: (f64, f64), x: (f64, f64), y: (f64, f64)) -> Option<((f64, f64), (f64, f64))> {
+    let (mut t0, mut t1) = (0.0f64, 1.0f64);
+    let d = (q.0 - p.0, q.1 - p.1);
+    for (o, dd, (lo, hi)) in [(p.0, d.0, x), (p.1, d.1, y)] {
+        if dd == 0.0 {
+            if o < lo || o > hi {
+                return None;
+            }
+            continue;
+        }
+        let (a, b) = ((lo - o) / dd, (hi - o) / dd);
+        let (a, b) = if a < b { (a, b) } else { (b, a) };
+        (t0, t1) = (t0.max(a), t1.min(b));
+    }
+    if t0 > t1 {
+        return None;
+    }
+    let at = |t: f64| {
+        if t == 0.0 {
+            p
+        } else if t == 1.0 {
+            q
+        } else {
+            (p.0 + d.0 * t, p.1 + d.1 * t)
+        }
+    };
+    Some((at(t0), at(t1)))
+}
+
+impl SilhouetteLineBuffer {
+    /// Builds the buffers of a `width` × `height` light view of `triangles`,
+    /// Fraction and Slope in `bits` bits (4 ..= 16).
+    #[must_use]
+    pub fn build(width: u32, height: u32, bits: u32, triangles: &[LightTriangle]) -> SilhouetteLineBuffer {
+        let snapped: Vec<Snapped> = triangles.par_iter().filter_map(Snapped::new).collect();
+        let mut records: Vec<Record> = snapped
+            .par_iter()
+            .fold(Vec::new, |mut out, t| {
+                walk_triangle(t, width, height, bits, &mut out);
+                out
+            })
+            .flatten()
+            .collect();
+        let walked = records.len();
+        records.par_sort_unstable_by_key(Record::key);
+        // Which (texel, polygon) pairs had a record before any went: a layer
+        // of a triangle with none covers its whole texel.
+        let mut crossed: Vec<(u32, u32, u32)> =
+            records.iter().map(|r| (r.texel, r.line.object, r.line.polygon)).collect();
+        crossed.par_sort_unstable();
+        crossed.dedup();
+        let records = remove_shared(records);
+        let shared = walked - records.len();
+        let mut buffer = SilhouetteLineBuffer {
+            width,
+            height,
+            bits,
+            stats: BuildStats { walked, shared, hidden: 0 },
+            ..SilhouetteLineBuffer::default()
+        };
+        buffer.set_edges(records.iter().map(|r| r.texel));
+        let layers = buffer.centre_layers(&snapped, &crossed);
+        buffer.finish(records, layers);
+        buffer
+    }
+
+    /// Sets the edge bits of `texels` (sorted) and the rank over them.
+    fn set_edges(&mut self, texels: impl Iterator<Item = u32>) {
+        let n = self.width as usize * self.height as usize;
+        self.edge = vec![0; n.div_ceil(64)];
+        for t in texels {
+            self.edge[t as usize / 64] |= 1 << (t % 64);
+        }
+        let mut total = 0u32;
+        self.rank = self
+            .edge
+            .iter()
+            .map(|w| {
+                let r = total;
+                total += w.count_ones();
+                r
+            })
+            .collect();
+    }
+
+    /// Every triangle over the centre of every edge texel: (texel, layer,
+    /// whether the triangle covers the texel whole).
+    fn centre_layers(&self, snapped: &[Snapped], crossed: &[(u32, u32, u32)]) -> Vec<(u32, Layer, bool)> {
+        let w = self.width as i64;
+        let mut layers: Vec<(u32, Layer, bool)> = snapped
+            .par_iter()
+            .fold(Vec::new, |mut out, t| {
+                let Some((x0, y0, x1, y1)) = t.bounds(self.width, self.height) else { return out };
+                for y in y0..=y1 {
+                    let (first, last) = (y * w + x0, y * w + x1);
+                    let mut k = first;
+                    while k <= last {
+                        let word = self.edge[k as usize / 64] >> (k % 64);
+                        if word == 0 {
+                            k += 64 - k % 64;
+                            continue;
+                        }
+                        k += i64::from(word.trailing_zeros());
+                        if k > last {
+                            break;
+                        }
+                        let x = k - y * w;
+                        if t.covers_centre(x, y) {
+                            let texel = k as u32;
+                            let whole = crossed.binary_search(&(texel, t.object, t.polygon)).is_err();
+                            out.push((texel, Layer { depth: t.depth(x, y), count: 1 }, whole));
+                        }
+                        k += 1;
+                    }
+                }
+                out
+            })
+            .flatten()
+            .collect();
+        layers.par_sort_unstable_by_key(|l| l.0);
+        layers
+    }
+
+    /// Per edge texel: the corrections, hidden-line removal, and the final
+    /// compact arrays.
+    fn finish(&mut self, records: Vec<Record>, layers: Vec<(u32, Layer, bool)>) {
+        let (mut lines, mut kept_layers) = (Vec::with_capacity(records.len()), Vec::new());
+        let (mut line_start, mut layer_start, mut texels) = (vec![0u32], vec![0u32], Vec::new());
+        let mut hidden = 0;
+        let (mut r, mut l) = (0, 0);
+        let mut here: Vec<Layer> = Vec::new();
+        while r < records.len() {
+            let texel = records[r].texel;
+            let r_end = r + records[r..].iter().take_while(|x| x.texel == texel).count();
+            while l < layers.len() && layers[l].0 < texel {
+                l += 1;
+            }
+            let l_end = l + layers[l..].iter().take_while(|x| x.0 == texel).count();
+            here.clear();
+            here.extend(layers[l..l_end].iter().map(|x| x.1));
+            for rec in &records[r..r_end] {
+                if rec.exact_centre_inside != rec.line.centre_inside {
+                    let count = if rec.line.centre_inside { 1 } else { -1 };
+                    here.push(Layer { depth: rec.line.depth, count });
+                }
+            }
+            // §3.3.3: a triangle over the whole texel hides what lies behind it
+            // at all four corners.
+            let front = layers[l..l_end].iter().filter(|x| x.2).map(|x| x.1.depth).max_by(|a, b| a.c.total_cmp(&b.c));
+            let behind = |d: &TexelDepth| {
+                front.is_some_and(|f| {
+                    [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)].iter().all(|&(x, y)| d.at(x, y) < f.at(x, y))
+                })
+            };
+            let before = lines.len();
+            let mut mine: Vec<Record> = records[r..r_end].to_vec();
+            close_vertices(&mut mine, self.bits);
+            lines.extend(mine.iter().map(|x| x.line).filter(|line| !behind(&line.depth)));
+            hidden += (r_end - r) - (lines.len() - before);
+            if lines.len() > before {
+                kept_layers.extend(here.iter().filter(|x| !behind(&x.depth)));
+                texels.push(texel);
+                line_start.push(lines.len() as u32);
+                layer_start.push(kept_layers.len() as u32);
+            }
+            (r, l) = (r_end, l_end);
+        }
+        self.stats.hidden = hidden;
+        self.set_edges(texels.into_iter());
+        (self.lines, self.layers, self.line_start, self.layer_start) = (lines, kept_layers, line_start, layer_start);
+    }
+
+    /// Whether a silhouette crosses texel `(x, y)` (the edge buffer).
+    #[inline]
+    #[must_use]
+    pub fn is_edge(&self, x: u32, y: u32) -> bool {
+        let t = (y * self.width + x) as usize;
+        self.edge.get(t / 64).is_some_and(|w| w >> (t % 64) & 1 == 1)
+    }
+
+    /// The lines and layers of texel `(x, y)`, if a silhouette crosses it.
+    #[inline]
+    #[must_use]
+    pub fn entry(&self, x: u32, y: u32) -> Option<Entry<'_>> {
+        if x >= self.width || y >= self.height {
+            return None;
+        }
+        let t = (y * self.width + x) as usize;
+        let word = self.edge[t / 64];
+        if word >> (t % 64) & 1 == 0 {
+            return None;
+        }
+        let below = word & ((1u64 << (t % 64)) - 1);
+        let i = (self.rank[t / 64] + below.count_ones()) as usize;
+        let (l0, l1) = (self.line_start[i] as usize, self.line_start[i + 1] as usize);
+        let (m0, m1) = (self.layer_start[i] as usize, self.layer_start[i + 1] as usize);
+        Some(Entry { lines: &self.lines[l0..l1], layers: &self.layers[m0..m1] })
+    }
+
+    /// Fraction and Slope bits.
+    #[must_use]
+    pub fn bits(&self) -> u32 {
+        self.bits
+    }
+
+    /// Texels a silhouette crosses (the paper's "SL交差グリッド数").
+    #[must_use]
+    pub fn edge_texels(&self) -> usize {
+        self.line_start.len() - 1
+    }
+
+    /// Lines stored (the paper's "SL数").
+    #[must_use]
+    pub fn line_count(&self) -> usize {
+        self.lines.len()
+    }
+
+    /// What the build walked and removed.
+    #[must_use]
+    pub fn stats(&self) -> BuildStats {
+        self.stats
+    }
+
+    /// Bytes held: edge bits, ranks, the lines and the layers.
+    #[must_use]
+    pub fn memory_bytes(&self) -> usize {
+        self.edge.len() * 8
+            + self.rank.len() * 4
+            + (self.line_start.len() + self.layer_start.len()) * 4
+            + self.lines.len() * std::mem::size_of::<SilhouetteLine>()
+            + self.layers.len() * std::mem::size_of::<Layer>()
+    }
+}
+
+/// Records of the three edges of `t` in the texels of a `width` × `height`
+/// map they cross.
+fn walk_triangle(t: &Snapped, width: u32, height: u32, bits: u32, out: &mut Vec<Record>) {
+    let unit = (1i64 << WALK_BITS) as f64;
+    let (w, h) = (i64::from(width), i64::from(height));
+    for i in 0..3 {
+        let (p, q, r) = (t.p[i], t.p[(i + 1) % 3], t.p[(i + 2) % 3]);
+        // Walk order, so both triangles of a shared edge clip it alike.
+        let (p, q) = if Edge::reversed(p, q) { (q, p) } else { (p, q) };
+        let inside = side(p, q, (r.x, r.y));
+        let f = |v: WalkPoint| (v.x as f64 / unit, v.y as f64 / unit);
+        let Some((a, b)) = clip(f(p), f(q), (-1.0, w as f64 + 1.0), (-1.0, h as f64 + 1.0)) else { continue };
+        let (a, b) = (
+            if a == f(p) { p } else { WalkPoint::snap(a.0, a.1) },
+            if b == f(q) { q } else { WalkPoint::snap(b.0, b.1) },
+        );
+        let Some(edge) = Edge::new(a, b) else { continue };
+        // L/R: the polygon on the +x side of the walk is a left edge; the
+        // walk runs towards +y, so +x is the side where p→q × (x step) < 0.
+        let left = inside < 0;
+        edge.walk(|v| {
+            if v.x < 0 || v.y < 0 || i64::from(v.x) >= w || i64::from(v.y) >= h {
+                return;
+            }
+            let mut line = SilhouetteLine::new(&v, edge.line, edge.slope, left, bits);
+            (line.polygon, line.object) = (t.polygon, t.object);
+            line.depth = t.depth(i64::from(v.x), i64::from(v.y));
+            let c = centre(i64::from(v.x), i64::from(v.y));
+            // The exact edge's side of the centre, counted only where the
+            // centre lies along the line's part in this texel.
+            let (a0, a1) = line.extent();
+            let (ca, _) = line.canonical(0.5, 0.5);
+            let exact = side(p, q, c) == inside;
+            let exact_centre_inside = if (a0..=a1).contains(&ca) { exact } else { line.centre_inside };
+            let ends = [v.start.map(|_| a), v.end.map(|_| b)];
+            out.push(Record { texel: (v.y as u32) * width + v.x as u32, line, exact_centre_inside, ends });
+        });
+    }
+}
+
+/// Moves the stored ends of lines meeting at one vertex to where their
+/// stored (quantised) lines meet, so that no way from the centre slips
+/// between them: the records of one texel.
+fn close_vertices(records: &mut [Record], bits: u32) {
+    let mut vertices: Vec<WalkPoint> = records.iter().flat_map(|r| r.ends).flatten().collect();
+    vertices.sort_unstable();
+    vertices.dedup();
+    for v in vertices {
+        let at: Vec<(usize, usize)> = (0..records.len())
+            .flat_map(|i| (0..2).map(move |e| (i, e)))
+            .filter(|&(i, e)| records[i].ends[e] == Some(v))
+            .collect();
+        let lines: Vec<&SilhouetteLine> = at.iter().map(|&(i, _)| &records[i].line).collect();
+        let Some(meet) = meeting_point(&lines, bits) else { continue };
+        for (i, e) in at {
+            let line = &mut records[i].line;
+            let a = line.canonical(meet.0, meet.1).0.clamp(0.0, 1.0);
+            if e == 0 {
+                line.start = Some(a);
+            } else {
+                line.end = Some(a);
+            }
+        }
+    }
+}
+
+/// Where the first two distinct lines among `lines` cross (texel
+/// coordinates), if they are not nearly parallel.
+fn meeting_point(lines: &[&SilhouetteLine], bits: u32) -> Option<(f32, f32)> {
+    let points = |l: &SilhouetteLine| {
+        let p = |a: f32| {
+            let (x, y) = l.texel_point(a, l.b_at(a, bits));
+            (f64::from(x), f64::from(y))
+        };
+        (p(0.0), p(1.0))
+    };
+    let first = lines.first()?;
+    let same = |a: &SilhouetteLine, b: &SilhouetteLine| {
+        (a.line, a.cross, a.fraction, a.slope) == (b.line, b.cross, b.fraction, b.slope)
+    };
+    let second = lines.iter().find(|l| !same(first, l))?;
+    let ((p0, p1), (q0, q1)) = (points(first), points(second));
+    let (d, e) = ((p1.0 - p0.0, p1.1 - p0.1), (q1.0 - q0.0, q1.1 - q0.1));
+    let det = d.0 * e.1 - d.1 * e.0;
+    if det.abs() < 1e-6 * (d.0.hypot(d.1) * e.0.hypot(e.1)) {
+        return None;
+    }
+    let t = ((q0.0 - p0.0) * e.1 - (q0.1 - p0.1) * e.0) / det;
+    let m = (p0.0 + t * d.0, p0.1 + t * d.1);
+    // A meeting point far outside the texel means the lines barely differ.
+    (m.0.abs() < 2.0 && m.1.abs() < 2.0).then_some((m.0 as f32, m.1 as f32))
+}
+
+/// §3.3.2: in each texel, records of one object equal in all but the
+/// Polygon ID and with opposite L/R flags are an edge two of its polygons
+/// share: they go in pairs. `records` are sorted by [`Record::key`].
+fn remove_shared(records: Vec<Record>) -> Vec<Record> {
+    let mut out = Vec::with_capacity(records.len());
+    let mut i = 0;
+    while i < records.len() {
+        let key = records[i].key();
+        let n = records[i..].iter().take_while(|r| r.key() == key).count();
+        let run = &records[i..i + n];
+        let lefts = run.iter().filter(|r| r.line.left).count();
+        let rights = n - lefts;
+        // Keep the surplus of the more numerous flag.
+        let keep_left = lefts > rights;
+        let mut surplus = lefts.abs_diff(rights);
+        for r in run {
+            if surplus > 0 && r.line.left == keep_left {
+                out.push(*r);
+                surplus -= 1;
+            }
+        }
+        i += n;
+    }
+    out
+}
