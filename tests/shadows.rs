@@ -8,54 +8,14 @@ use std::path::Path;
 use std::sync::Arc;
 
 use glam::{Affine3A, Vec2, Vec3};
-use kage::camera::Ray;
-use kage::raytrace::TraceScene;
 use kage::scene::mesh::shapes;
 use kage::scene::{Light, LightKind, Material, Object, Scene, ShadowSettings};
-use kage::shading::ObjectFrames;
 use kage::shadows::ShadowTerm;
 use kage::{render, RenderOptions};
 
-/// For every pixel of `scene`'s view whose surface faces a light, whether the
-/// shadow map calls it lit (term ≥ 0.5) and whether a shadow ray reaches the
-/// light: returns (misclassified, compared) over all lights.
+/// Shadow maps against shadow rays: (misclassified, compared).
 fn map_vs_rays(scene: &Scene) -> (usize, usize) {
-    let frame = render(scene, &RenderOptions::default()).expect("render");
-    let trace = TraceScene::new(scene);
-    let frames = ObjectFrames::new(scene);
-    let terms = ShadowTerm::build_all(scene);
-    let rays = scene.camera.pixel_rays(Vec2::new(scene.width as f32, scene.height as f32));
-    let eps = scene.bounds().map_or(1e-4, |(lo, hi)| (hi - lo).length() * 1e-5);
-    let (mut wrong, mut total) = (0, 0);
-    for y in 0..scene.height {
-        for x in 0..scene.width {
-            let item = frame.visibility.item(x, y);
-            if item.is_none() {
-                continue;
-            }
-            let s = frames.surface(scene, item, &rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5)));
-            for (light, term) in scene.lights.iter().zip(&terms) {
-                let to = light.incident(s.position).to_light;
-                let cos = s.normal.dot(to);
-                if cos <= 0.05 || !term.casts() {
-                    continue;
-                }
-                let origin = s.position + s.normal * eps;
-                let (dir, dist) = match light.kind {
-                    LightKind::Directional { direction } => (-direction, f32::INFINITY),
-                    LightKind::Point { position } | LightKind::Spot { position, .. } => {
-                        let d = position - origin;
-                        (d.normalize(), d.length() * (1.0 - 1e-4))
-                    }
-                };
-                let ray_lit = !trace.occluded(&Ray { origin, dir }, dist);
-                let map_lit = term.lit(s.position, cos) >= 0.5;
-                wrong += usize::from(ray_lit != map_lit);
-                total += 1;
-            }
-        }
-    }
-    (wrong, total)
+    common::terms_vs_rays(scene, &ShadowTerm::build_all(scene))
 }
 
 #[test]

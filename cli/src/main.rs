@@ -14,7 +14,9 @@ use kage::image::ToneCurve;
 use kage::limits::{LimitSetting, Limits};
 use kage::scene::framing::{CameraOverride, View};
 use kage::scene::model::{self, ModelOptions};
-use kage::scene::{demo::demo_scene, file, Antialias, EdgeFilter, EdgeMode, EdgeSelection, Exposure, Scene, Up};
+use kage::scene::{
+    demo::demo_scene, file, Antialias, EdgeFilter, EdgeMode, EdgeSelection, Exposure, Scene, ShadowMethod, Up,
+};
 use kage::shading::{Component, ComponentSet};
 use kage::{RenderOptions, Renderer};
 
@@ -113,6 +115,12 @@ struct RenderArgs {
     /// (clipped).
     #[arg(long, value_parser = parse_tone)]
     tonemap: Option<ToneCurve>,
+    /// Every light's shadows by this method instead of its own: `none`,
+    /// `map` (shadow maps) or `slb` (silhouette-line buffer: shadow maps
+    /// with exact edges inside each texel). Each light keeps its other
+    /// shadow settings.
+    #[arg(long, value_parser = parse_shadow_method)]
+    shadows: Option<ShadowMethod>,
     /// An OpenSCAD .csg model's spheres and cylinders: `exact` (true curved
     /// surfaces) or `faceted` as OpenSCAD's own mesh ($fn, $fa, $fs), to compare
     /// with OpenSCAD pixel for pixel.
@@ -265,6 +273,14 @@ fn parse_antialias(s: &str) -> Result<Antialias, String> {
     }
 }
 
+fn parse_shadow_method(s: &str) -> Result<ShadowMethod, String> {
+    let found = ShadowMethod::NAMES.iter().find(|(n, _)| n.eq_ignore_ascii_case(s.trim()));
+    found.map(|(_, m)| *m).ok_or_else(|| {
+        let names: Vec<&str> = ShadowMethod::NAMES.iter().map(|(n, _)| *n).collect();
+        format!("'{s}' is not a shadow method (expected one of {})", names.join(", "))
+    })
+}
+
 fn parse_tone(s: &str) -> Result<ToneCurve, String> {
     ToneCurve::from_name(s).ok_or_else(|| {
         let names: Vec<&str> = ToneCurve::NAMES.iter().map(|(n, _)| *n).collect();
@@ -384,6 +400,9 @@ fn render_command(args: &RenderArgs) -> kage::error::Result<()> {
     let mut scene = load(args)?;
     scene.antialias = args.antialias.unwrap_or(scene.antialias);
     scene.tone = args.tonemap.unwrap_or(scene.tone);
+    if let Some(method) = args.shadows {
+        scene.lights.iter_mut().for_each(|l| l.shadow = l.shadow.with_method(method));
+    }
     for w in &scene.warnings {
         eprintln!("warning: {w}");
     }

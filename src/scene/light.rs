@@ -102,6 +102,16 @@ pub enum ShadowMethod {
     /// orthographic, fitted to the view; point: a cube of six maps).
     #[default]
     Map,
+    /// The silhouette-line buffer of seed 000: the same maps, plus the exact
+    /// silhouette lines in the texels they cross, so shadow edges are exact
+    /// inside a texel ([`ShadowSettings::bits`], [`ShadowSettings::scale`]).
+    Slb,
+}
+
+impl ShadowMethod {
+    /// Every method, by its name in scene files and on the command line.
+    pub const NAMES: [(&'static str, ShadowMethod); 3] =
+        [("none", ShadowMethod::None), ("map", ShadowMethod::Map), ("slb", ShadowMethod::Slb)];
 }
 
 /// A light's shadow technique and its parameters.
@@ -129,6 +139,13 @@ pub struct ShadowSettings {
     /// `size` is rendered as this many passes, each with the light moved to
     /// another point of its disc and its own shadow map, averaged.
     pub samples: u32,
+    /// Silhouette-line buffer: bits of each line's Fraction and Slope (4–16;
+    /// 8 places a line within 1/256 texel).
+    pub bits: u32,
+    /// Silhouette-line buffer: the virtual projection space's scale — the
+    /// light's view drawn this many times wider into the same map (seed 000
+    /// §4.4), so one map holds a scene that many times larger.
+    pub scale: f32,
 }
 
 impl Default for ShadowSettings {
@@ -190,10 +207,28 @@ impl ShadowSettings {
         slope: 1.5,
         pcf: 1,
         samples: 8,
+        bits: 8,
+        scale: 1.0,
     };
+
+    /// The silhouette-line buffer's defaults: a 1024² map, 8-bit lines, scale 1.
+    pub const SLB: ShadowSettings =
+        ShadowSettings { method: ShadowMethod::Slb, resolution: 1024, by_need: false, ..ShadowSettings::MAP };
 
     /// No shadows.
     pub const NONE: ShadowSettings = ShadowSettings { method: ShadowMethod::None, ..ShadowSettings::MAP };
+
+    /// These settings with `method` instead, and that method's default
+    /// resolution when it differs from this one's.
+    #[must_use]
+    pub fn with_method(self, method: ShadowMethod) -> ShadowSettings {
+        let base = |m: ShadowMethod| if m == ShadowMethod::Slb { ShadowSettings::SLB } else { ShadowSettings::MAP };
+        let mut s = ShadowSettings { method, ..self };
+        if (s.resolution, s.by_need) == (base(self.method).resolution, base(self.method).by_need) {
+            (s.resolution, s.by_need) = (base(method).resolution, base(method).by_need);
+        }
+        s
+    }
 }
 
 /// Light arriving at a point: unit direction towards the light and the radiance

@@ -176,9 +176,16 @@ pub mod shapes {
         let mut m = Mesh::default();
         for i in 0..=stacks {
             let theta = std::f32::consts::PI * i as f32 / stacks as f32;
+            // The poles exactly on the axis and the seam's two columns at one
+            // place, so the triangles meeting there share their corners exactly.
+            let (sin_t, cos_t) = match i {
+                0 => (0.0, 1.0),
+                _ if i == stacks => (0.0, -1.0),
+                _ => theta.sin_cos(),
+            };
             for j in 0..=slices {
-                let phi = std::f32::consts::TAU * j as f32 / slices as f32;
-                let p = Vec3::new(theta.sin() * phi.cos(), theta.cos(), -theta.sin() * phi.sin());
+                let phi = std::f32::consts::TAU * (j % slices) as f32 / slices as f32;
+                let p = Vec3::new(sin_t * phi.cos(), cos_t, -sin_t * phi.sin());
                 m.positions.push(p);
                 m.normals.push(p);
                 m.uvs.push(Vec2::new(j as f32 / slices as f32, i as f32 / stacks as f32));

@@ -20,6 +20,30 @@ use crate::visibility::{rasterize_casters, VisibilityBuffer, Workers};
 /// shadows off their casters.
 const MAX_SLOPE: f32 = 8.0;
 
+/// A point located in a map: texel coordinates and the depth limit.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Located {
+    /// Texel column coordinate (fractional).
+    pub u: f32,
+    /// Texel row coordinate (fractional).
+    pub v: f32,
+    /// Reversed depth a surface must exceed to hide the point.
+    pub z_limit: f32,
+}
+
+/// Eight points located in a map ([`DepthMap::locate_lanes`]).
+#[derive(Debug, Clone, Copy)]
+pub struct LocatedLanes {
+    /// All bits set in lanes whose point lies in the map.
+    pub inside: f32x8,
+    /// Texel column coordinates.
+    pub u: f32x8,
+    /// Texel row coordinates.
+    pub v: f32x8,
+    /// Depth limits.
+    pub z_limit: f32x8,
+}
+
 /// Depths seen from a light through one camera.
 #[derive(Debug, Clone)]
 pub struct DepthMap {
@@ -101,30 +125,54 @@ impl DepthMap {
         (u >= 0.0 && v >= 0.0 && u < n && v < n).then_some((u, v, d))
     }
 
-    /// Fraction of the k × k texels around `p`'s projection whose surface does not
-    /// hide `p`, with `cos_theta` = N·L at `p` (for the slope bias). Points outside
-    /// the map are lit.
+    /// Where `p` falls in the map and the depth a surface there must be
+    /// nearer than (reversed depth, larger is nearer) to hide it, with
+    /// `cos_theta` = N·L at `p` for the slope bias and the bias reaching
+    /// `reach` texels from `p`'s own; `None` when `p` is outside the map or
+    /// at the light (lit).
+    #[inline]
     #[must_use]
-    pub fn lit(&self, p: Vec3, cos_theta: f32, settings: &ShadowSettings) -> f32 {
-        let Some((u, v, d)) = self.project(p) else { return 1.0 };
+    pub fn locate(&self, p: Vec3, cos_theta: f32, settings: &ShadowSettings, reach: f32) -> Option<Located> {
+        let (u, v, d) = self.project(p)?;
         let texel = if self.ortho { self.texel } else { self.texel * d };
         let c = cos_theta.clamp(1e-3, 1.0);
         let tan = ((1.0 - c * c).sqrt() / c).min(MAX_SLOPE);
-        let k = settings.pcf.max(1) as i32;
-        // A wider filter reaches texels further from the receiver's own, where a
-        // sloped receiver is deeper: scale the slope term with the filter radius.
-        let reach = 1.0 + (k - 1) as f32 * 0.5;
         let limit = d - texel * (settings.bias + settings.slope * tan * reach);
-        // Lit where the stored surface is at least `limit` away: compared in the
-        // stored reversed depth, which falls with distance, so one division per
-        // lookup instead of one per texel.
+        // Compared in the stored reversed depth, which falls with distance, so
+        // one division per lookup instead of one per texel.
         let z_limit = if self.ortho {
             ((self.far - limit) / (self.far - self.near)).max(0.0)
         } else if limit > self.near {
             self.near / limit
         } else {
-            return 1.0; // the receiver is at the light
+            return None; // the receiver is at the light
         };
+        Some(Located { u, v, z_limit })
+    }
+
+    /// The reversed depth the map holds at texel `(x, y)` (0: nothing).
+    #[inline]
+    #[must_use]
+    pub fn texel_depth(&self, x: u32, y: u32) -> f32 {
+        self.depth.depths()[(y * self.resolution + x) as usize]
+    }
+
+    /// Texels along a side.
+    #[must_use]
+    pub fn resolution(&self) -> u32 {
+        self.resolution
+    }
+
+    /// Fraction of the k × k texels around `p`'s projection whose surface does not
+    /// hide `p`, with `cos_theta` = N·L at `p` (for the slope bias). Points outside
+    /// the map are lit.
+    #[must_use]
+    pub fn lit(&self, p: Vec3, cos_theta: f32, settings: &ShadowSettings) -> f32 {
+        let k = settings.pcf.max(1) as i32;
+        // A wider filter reaches texels further from the receiver's own, where a
+        // sloped receiver is deeper: scale the slope term with the filter radius.
+        let reach = 1.0 + (k - 1) as f32 * 0.5;
+        let Some(Located { u, v, z_limit }) = self.locate(p, cos_theta, settings, reach) else { return 1.0 };
         let (cu, cv) = (u as i32, v as i32);
         let last = self.resolution as i32 - 1;
         let depth = self.depth.depths();
@@ -139,11 +187,10 @@ impl DepthMap {
         lit as f32 / (k * k) as f32
     }
 
-    /// [`DepthMap::lit`] for eight points at once (`p` as x, y and z lanes): the
-    /// projection, bias and depth limit as vector arithmetic, the texel reads one
-    /// lane at a time.
+    /// [`DepthMap::locate`] for eight points: which lie in the map, their
+    /// texel coordinates and depth limits (infinite for a point at the light).
     #[must_use]
-    pub fn lit_lanes(&self, p: [f32x8; 3], cos_theta: f32x8, settings: &ShadowSettings) -> f32x8 {
+    pub fn locate_lanes(&self, p: [f32x8; 3], cos_theta: f32x8, settings: &ShadowSettings, reach: f32) -> LocatedLanes {
         let m = self.view_proj;
         let row = |r: usize| {
             let (a, b, c, d) = (m.x_axis[r], m.y_axis[r], m.z_axis[r], m.w_axis[r]);
@@ -169,8 +216,6 @@ impl DepthMap {
         let texel = if self.ortho { f32x8::splat(self.texel) } else { d * f32x8::splat(self.texel) };
         let c = cos_theta.max(f32x8::splat(1e-3)).min(f32x8::ONE);
         let tan = ((f32x8::ONE - c * c).sqrt() / c).min(f32x8::splat(MAX_SLOPE));
-        let k = settings.pcf.max(1) as i32;
-        let reach = 1.0 + (k - 1) as f32 * 0.5;
         let bias = f32x8::splat(settings.bias) + tan * f32x8::splat(settings.slope * reach);
         let limit = d - texel * bias;
         let z_limit = if self.ortho {
@@ -179,6 +224,18 @@ impl DepthMap {
             let near = f32x8::splat(self.near);
             limit.simd_gt(near).select(near / limit, f32x8::splat(f32::INFINITY))
         };
+        LocatedLanes { inside, u, v, z_limit }
+    }
+
+    /// [`DepthMap::lit`] for eight points at once (`p` as x, y and z lanes): the
+    /// projection, bias and depth limit as vector arithmetic, the texel reads one
+    /// lane at a time.
+    #[must_use]
+    pub fn lit_lanes(&self, p: [f32x8; 3], cos_theta: f32x8, settings: &ShadowSettings) -> f32x8 {
+        let k = settings.pcf.max(1) as i32;
+        let reach = 1.0 + (k - 1) as f32 * 0.5;
+        let LocatedLanes { inside, u, v, z_limit } = self.locate_lanes(p, cos_theta, settings, reach);
+        let zero = f32x8::ZERO;
         let depth = self.depth.depths();
         let res = self.resolution as usize;
         // k × k taps; each tap's eight texel reads are issued before any compare, so

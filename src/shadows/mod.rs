@@ -15,7 +15,8 @@ use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 use wide::f32x8;
 
-pub use map::DepthMap;
+pub use map::{DepthMap, Located, LocatedLanes};
+pub use slb::SlbMap;
 
 use crate::scene::{GeometryKey, Light, LightKind, Scene, ShadowMethod, ShadowSettings};
 
@@ -36,6 +37,10 @@ pub enum ShadowTerm {
     /// Six maps around a point (point lights, wide spots): +x, −x, +y, −y, +z, −z,
     /// each at half the configured resolution.
     Cube(Box<[DepthMap; 6]>, Vec3, ShadowSettings),
+    /// One map with its silhouette-line buffer (seed 000).
+    Slb(Box<SlbMap>, ShadowSettings),
+    /// Six of them around a point.
+    SlbCube(Box<[SlbMap; 6]>, Vec3, ShadowSettings),
 }
 
 impl ShadowTerm {
@@ -56,25 +61,48 @@ impl ShadowTerm {
         let view = *pool.view(scene);
         let casters = pool.casters(scene);
         let (w, h) = (scene.width, scene.height);
+        let slb = settings.method == ShadowMethod::Slb;
         let map = |cam: Camera, most: u32, pool: &mut MapPool| {
             let res = map_resolution(&settings, most, &view, (w, h), &cam, bounds);
             DepthMap::render(scene, &cam, res, &casters, pool.workers, pool.take())
         };
+        let lines = |cam: Camera, most: u32, pool: &mut MapPool| {
+            let res = map_resolution(&settings, most, &view, (w, h), &cam, bounds);
+            SlbMap::render(scene, &cam, res, &casters, pool.workers, pool.take(), settings.bits)
+        };
         // A cube's six faces take half the resolution: 1.5 single maps of memory.
         let (single, face) = (settings.resolution.max(1), (settings.resolution / 2).max(16));
+        // The virtual projection space (seed 000 §4.4): the view `scale` times wider.
+        let scale = if slb { settings.scale.max(f32::MIN_POSITIVE) } else { 1.0 };
+        let one = |cam: Camera, pool: &mut MapPool| {
+            if slb {
+                ShadowTerm::Slb(Box::new(lines(cam, single, pool)), settings)
+            } else {
+                ShadowTerm::Map(map(cam, single, pool), settings)
+            }
+        };
         match placement(light, bounds) {
             Placement::None => ShadowTerm::Unshadowed,
             Placement::Cone { eye, axis, fov_y_deg } => {
-                let cam = light_camera(eye, axis, Projection::Perspective { fov_y_deg }, bounds);
-                ShadowTerm::Map(map(cam, single, pool), settings)
+                let wider = 2.0 * ((fov_y_deg.to_radians() * 0.5).tan() * scale).atan().to_degrees().min(85.0);
+                let fov_y_deg = if slb { wider } else { fov_y_deg };
+                one(light_camera(eye, axis, Projection::Perspective { fov_y_deg }, bounds), pool)
             }
             Placement::Cube { eye } => {
-                let faces = [Vec3::X, Vec3::NEG_X, Vec3::Y, Vec3::NEG_Y, Vec3::Z, Vec3::NEG_Z].map(|axis| {
-                    let cam = light_camera(eye, axis, Projection::Perspective { fov_y_deg: 90.0 }, bounds);
+                let cams = [Vec3::X, Vec3::NEG_X, Vec3::Y, Vec3::NEG_Y, Vec3::Z, Vec3::NEG_Z]
+                    .map(|axis| (axis, light_camera(eye, axis, Projection::Perspective { fov_y_deg: 90.0 }, bounds)));
+                if slb {
+                    let faces = cams.map(|(axis, cam)| {
+                        // No caster in this face's pyramid: nothing to draw.
+                        let most = if face_sees(eye, axis, bounds) { face } else { 1 };
+                        lines(cam, most, pool)
+                    });
+                    return ShadowTerm::SlbCube(Box::new(faces), eye, settings);
+                }
+                let faces = cams.map(|(axis, cam)| {
                     if face_sees(eye, axis, bounds) {
                         map(cam, face, pool)
                     } else {
-                        // No caster in this face's pyramid: nothing to draw.
                         DepthMap::empty(&cam, pool.take())
                     }
                 });
@@ -82,7 +110,11 @@ impl ShadowTerm {
             }
             Placement::Parallel { direction } => {
                 let aspect = w as f32 / h as f32;
-                ShadowTerm::Map(map(fitted_orthographic(&view, aspect, direction, bounds), single, pool), settings)
+                let mut cam = fitted_orthographic(&view, aspect, direction, bounds);
+                if let Projection::Orthographic { height } = &mut cam.projection {
+                    *height *= scale;
+                }
+                one(cam, pool)
             }
         }
     }
@@ -119,6 +151,8 @@ impl ShadowTerm {
             ShadowTerm::Unshadowed => 1.0,
             ShadowTerm::Map(map, s) => map.lit(p, cos_theta, s),
             ShadowTerm::Cube(faces, centre, s) => faces[cube_face(p - *centre)].lit(p, cos_theta, s),
+            ShadowTerm::Slb(map, s) => map.lit(p, cos_theta, s),
+            ShadowTerm::SlbCube(faces, centre, s) => faces[cube_face(p - *centre)].lit(p, cos_theta, s),
         }
     }
 
@@ -137,6 +171,11 @@ impl ShadowTerm {
                 }
                 let c = cos_theta.to_array();
                 f32x8::new(std::array::from_fn(|i| faces[face[i]].lit(Vec3::new(x[i], y[i], z[i]), c[i], s)))
+            }
+            ShadowTerm::Slb(map, s) => map.lit_lanes(p, cos_theta, s),
+            ShadowTerm::SlbCube(..) => {
+                let (x, y, z, c) = (p[0].to_array(), p[1].to_array(), p[2].to_array(), cos_theta.to_array());
+                f32x8::new(std::array::from_fn(|i| self.lit(Vec3::new(x[i], y[i], z[i]), c[i])))
             }
         }
     }
@@ -172,6 +211,8 @@ impl ShadowTerm {
             ShadowTerm::Unshadowed => 0,
             ShadowTerm::Map(m, _) => m.memory_bytes(),
             ShadowTerm::Cube(f, ..) => f.iter().map(DepthMap::memory_bytes).sum(),
+            ShadowTerm::Slb(m, _) => m.memory_bytes(),
+            ShadowTerm::SlbCube(f, ..) => f.iter().map(SlbMap::memory_bytes).sum(),
         }
     }
 }
@@ -400,6 +441,8 @@ impl MapPool {
             ShadowTerm::Unshadowed => {}
             ShadowTerm::Map(map, _) => self.free.push(map.into_buffer()),
             ShadowTerm::Cube(faces, ..) => self.free.extend(faces.into_iter().map(DepthMap::into_buffer)),
+            ShadowTerm::Slb(map, _) => self.free.push(map.into_buffer()),
+            ShadowTerm::SlbCube(faces, ..) => self.free.extend(faces.into_iter().map(SlbMap::into_buffer)),
         }
     }
 

@@ -18,6 +18,7 @@ use glam::Vec3;
 
 use crate::scene::{Body, Scene};
 
+pub use clip::{ClipPlanes, MAX_CLIPPED};
 pub use raster::{fragments, rasterize, rasterize_casters, Faces, Fragment, RasterStats, Workers};
 
 /// What a pixel sees: an object and one of its triangles, or one primitive of a

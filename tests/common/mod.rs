@@ -10,6 +10,7 @@ use glam::{Affine3A, Vec3};
 use kage::camera::{Camera, Projection};
 use kage::scene::mesh::NormalMode;
 use kage::scene::{Antialias, Falloff, Light, LightKind, Material, Mesh, Object, Scene};
+use kage::shadows::ShadowTerm;
 use rand::rngs::StdRng;
 use rand::Rng;
 
@@ -162,4 +163,45 @@ pub fn view_distance(cam: &Camera, d: f32) -> f32 {
         Projection::Perspective { .. } => cam.near / d,
         Projection::Orthographic { .. } => cam.far - d * (cam.far - cam.near),
     }
+}
+
+/// For every pixel of `scene`'s view whose surface faces a light, whether its
+/// shadow term in `terms` calls it lit (≥ 0.5) and whether a shadow ray through
+/// the BVH reaches the light: returns (misclassified, compared) over all lights.
+pub fn terms_vs_rays(scene: &Scene, terms: &[ShadowTerm]) -> (usize, usize) {
+    let frame = kage::render(scene, &kage::RenderOptions::default()).expect("render");
+    let trace = kage::raytrace::TraceScene::new(scene);
+    let frames = kage::shading::ObjectFrames::new(scene);
+    let rays = scene.camera.pixel_rays(glam::Vec2::new(scene.width as f32, scene.height as f32));
+    let eps = scene.bounds().map_or(1e-4, |(lo, hi)| (hi - lo).length() * 1e-5);
+    let (mut wrong, mut total) = (0, 0);
+    for y in 0..scene.height {
+        for x in 0..scene.width {
+            let item = frame.visibility.item(x, y);
+            if item.is_none() {
+                continue;
+            }
+            let s = frames.surface(scene, item, &rays.ray(glam::Vec2::new(x as f32 + 0.5, y as f32 + 0.5)));
+            for (light, term) in scene.lights.iter().zip(terms) {
+                let to = light.incident(s.position).to_light;
+                let cos = s.normal.dot(to);
+                if cos <= 0.05 || !term.casts() {
+                    continue;
+                }
+                let origin = s.position + s.normal * eps;
+                let (dir, dist) = match light.kind {
+                    LightKind::Directional { direction } => (-direction, f32::INFINITY),
+                    LightKind::Point { position } | LightKind::Spot { position, .. } => {
+                        let d = position - origin;
+                        (d.normalize(), d.length() * (1.0 - 1e-4))
+                    }
+                };
+                let ray_lit = !trace.occluded(&kage::camera::Ray { origin, dir }, dist);
+                let map_lit = term.lit(s.position, cos) >= 0.5;
+                wrong += usize::from(ray_lit != map_lit);
+                total += 1;
+            }
+        }
+    }
+    (wrong, total)
 }

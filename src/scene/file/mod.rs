@@ -310,6 +310,8 @@ struct ShadowRec {
     slope: Option<f32>,
     pcf: Option<Spanned<i64>>,
     samples: Option<Spanned<i64>>,
+    bits: Option<Spanned<i64>>,
+    scale: Option<Spanned<f32>>,
 }
 
 #[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default)]
@@ -318,6 +320,7 @@ enum ShadowMethodRec {
     None,
     #[default]
     Map,
+    Slb,
 }
 
 fn inner() -> f32 {
@@ -666,6 +669,15 @@ impl SceneFile {
         let first = scene.objects.len();
         add_model(scene, &model, &label, transform, material);
         scene.objects[first..].iter_mut().for_each(|o| o.casts_shadows = r.casts_shadows);
+        let limit = super::model::MAX_MODEL_SIZE;
+        let out_of_range = scene.objects[first..]
+            .iter()
+            .filter_map(Object::world_bounds)
+            .find(|(lo, hi)| !(lo.abs().max_element() <= limit && hi.abs().max_element() <= limit));
+        if let Some((lo, hi)) = out_of_range {
+            let msg = format!("the object reaches from {lo} to {hi}: every coordinate must lie within ±{limit:e}");
+            return Err(self.invalid(o.span(), msg));
+        }
         Ok(model)
     }
 

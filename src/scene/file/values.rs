@@ -197,10 +197,11 @@ impl SceneFile {
         let mut s = ShadowSettings::default();
         let Some(rec) = rec else { return Ok(s) };
         let r = rec.get_ref();
-        s.method = match r.method {
+        s = s.with_method(match r.method {
             ShadowMethodRec::None => ShadowMethod::None,
             ShadowMethodRec::Map => ShadowMethod::Map,
-        };
+            ShadowMethodRec::Slb => ShadowMethod::Slb,
+        });
         let count = |v: &Option<Spanned<i64>>, lo: i64, hi: i64, what: &str| -> Result<Option<u32>> {
             match v {
                 Some(n) if !(lo..=hi).contains(n.get_ref()) => {
@@ -215,6 +216,14 @@ impl SceneFile {
         }
         s.pcf = count(&r.pcf, 1, 15, "pcf")?.unwrap_or(s.pcf);
         s.samples = count(&r.samples, 1, 256, "shadow samples")?.unwrap_or(s.samples);
+        s.bits = count(&r.bits, 4, 16, "shadow bits")?.unwrap_or(s.bits);
+        if let Some(scale) = &r.scale {
+            let v = *scale.get_ref();
+            if !(v.is_finite() && v > 0.0) {
+                return Err(self.invalid(scale.span(), "shadow scale must be a finite number above 0"));
+            }
+            s.scale = v;
+        }
         for (v, slot) in [(r.bias, &mut s.bias), (r.slope, &mut s.slope)] {
             if let Some(v) = v {
                 if !(v.is_finite() && v >= 0.0) {

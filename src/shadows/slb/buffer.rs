@@ -63,9 +63,9 @@ pub struct Entry<'a> {
 /// Counts from one build, for the paper's Table 8 and the benchmarks.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct BuildStats {
-    /// Records the walk made.
+    /// Records the walk made (of the edges not found shared beforehand).
     pub walked: usize,
-    /// Records removed as shared edges.
+    /// Edges (unwalked) and records removed as shared.
     pub shared: usize,
     /// Records removed as hidden.
     pub hidden: usize,
@@ -176,6 +176,15 @@ impl Snapped {
         (0..3).all(|i| side(self.p[i], self.p[(i + 1) % 3], c) == self.turn)
     }
 
+    /// Whether the whole of texel `(x, y)` lies inside: its four corners do
+    /// (perturbed as the centre is).
+    fn covers_texel(&self, x: i64, y: i64) -> bool {
+        let unit = 1i64 << WALK_BITS;
+        let corners =
+            [(0, 0), (unit, 0), (0, unit), (unit, unit)].map(|(dx, dy)| ((x << WALK_BITS) + dx, (y << WALK_BITS) + dy));
+        corners.iter().all(|&c| (0..3).all(|i| side(self.p[i], self.p[(i + 1) % 3], c) == self.turn))
+    }
+
     /// The bounding box in texels, inside a `width` × `height` map.
     fn bounds(&self, width: u32, height: u32) -> Option<(i64, i64, i64, i64)> {
         let lo = |f: fn(&WalkPoint) -> i64| self.p.iter().map(f).min().unwrap_or(0) >> WALK_BITS;
@@ -223,24 +232,19 @@ impl SilhouetteLineBuffer {
     #[must_use]
     pub fn build(width: u32, height: u32, bits: u32, triangles: &[LightTriangle]) -> SilhouetteLineBuffer {
         let snapped: Vec<Snapped> = triangles.par_iter().filter_map(Snapped::new).collect();
-        let mut records: Vec<Record> = snapped
+        let edges = silhouette_edges(&snapped);
+        let mut records: Vec<Record> = edges
             .par_iter()
-            .fold(Vec::new, |mut out, t| {
-                walk_triangle(t, width, height, bits, &mut out);
+            .fold(Vec::new, |mut out, &(t, i)| {
+                walk_edge(&snapped[t], i, width, height, bits, &mut out);
                 out
             })
             .flatten()
             .collect();
         let walked = records.len();
         records.par_sort_unstable_by_key(Record::key);
-        // Which (texel, polygon) pairs had a record before any went: a layer
-        // of a triangle with none covers its whole texel.
-        let mut crossed: Vec<(u32, u32, u32)> =
-            records.iter().map(|r| (r.texel, r.line.object, r.line.polygon)).collect();
-        crossed.par_sort_unstable();
-        crossed.dedup();
         let records = remove_shared(records);
-        let shared = walked - records.len();
+        let shared = 3 * snapped.len() - edges.len() + walked - records.len();
         let mut buffer = SilhouetteLineBuffer {
             width,
             height,
@@ -249,7 +253,7 @@ impl SilhouetteLineBuffer {
             ..SilhouetteLineBuffer::default()
         };
         buffer.set_edges(records.iter().map(|r| r.texel));
-        let layers = buffer.centre_layers(&snapped, &crossed);
+        let layers = buffer.centre_layers(&snapped);
         buffer.finish(records, layers);
         buffer
     }
@@ -275,7 +279,7 @@ impl SilhouetteLineBuffer {
 
     /// Every triangle over the centre of every edge texel: (texel, layer,
     /// whether the triangle covers the texel whole).
-    fn centre_layers(&self, snapped: &[Snapped], crossed: &[(u32, u32, u32)]) -> Vec<(u32, Layer, bool)> {
+    fn centre_layers(&self, snapped: &[Snapped]) -> Vec<(u32, Layer, bool)> {
         let w = self.width as i64;
         let mut layers: Vec<(u32, Layer, bool)> = snapped
             .par_iter()
@@ -297,7 +301,7 @@ impl SilhouetteLineBuffer {
                         let x = k - y * w;
                         if t.covers_centre(x, y) {
                             let texel = k as u32;
-                            let whole = crossed.binary_search(&(texel, t.object, t.polygon)).is_err();
+                            let whole = t.covers_texel(x, y);
                             out.push((texel, Layer { depth: t.depth(x, y), count: 1 }, whole));
                         }
                         k += 1;
@@ -422,23 +426,60 @@ impl SilhouetteLineBuffer {
     }
 }
 
-/// Records of the three edges of `t` in the texels of a `width` × `height`
-/// map they cross.
-fn walk_triangle(t: &Snapped, width: u32, height: u32, bits: u32, out: &mut Vec<Record>) {
+/// §3.3.2 once per edge rather than once per texel: the edges of one
+/// object's triangles that are not shared by two triangles lying on its
+/// opposite sides, as (triangle, edge) pairs. Both triangles of a shared edge
+/// walk it between the same two points, so their records would match in
+/// every texel but for the Polygon ID and the L/R flag: this finds the same
+/// pairs the paper's per-texel comparison finds, without walking them.
+fn silhouette_edges(snapped: &[Snapped]) -> Vec<(usize, usize)> {
+    let mut all: Vec<(u32, WalkPoint, WalkPoint, bool, usize, usize)> = snapped
+        .par_iter()
+        .enumerate()
+        .flat_map_iter(|(t, tri)| {
+            (0..3).map(move |i| {
+                let (p, q, r) = (tri.p[i], tri.p[(i + 1) % 3], tri.p[(i + 2) % 3]);
+                let (p, q) = if Edge::reversed(p, q) { (q, p) } else { (p, q) };
+                (tri.object, p, q, side(p, q, (r.x, r.y)) < 0, t, i)
+            })
+        })
+        .collect();
+    all.par_sort_unstable_by_key(|e| (e.0, e.1, e.2));
+    let mut out = Vec::new();
+    let mut k = 0;
+    while k < all.len() {
+        let n = all[k..].iter().take_while(|e| (e.0, e.1, e.2) == (all[k].0, all[k].1, all[k].2)).count();
+        let run = &all[k..k + n];
+        let lefts = run.iter().filter(|e| e.3).count();
+        let (keep_left, mut surplus) = (lefts > n - lefts, lefts.abs_diff(n - lefts));
+        for e in run {
+            if surplus > 0 && e.3 == keep_left {
+                out.push((e.4, e.5));
+                surplus -= 1;
+            }
+        }
+        k += n;
+    }
+    out
+}
+
+/// Records of edge `i` of `t` in the texels of a `width` × `height` map it
+/// crosses.
+fn walk_edge(t: &Snapped, i: usize, width: u32, height: u32, bits: u32, out: &mut Vec<Record>) {
     let unit = (1i64 << WALK_BITS) as f64;
     let (w, h) = (i64::from(width), i64::from(height));
-    for i in 0..3 {
+    {
         let (p, q, r) = (t.p[i], t.p[(i + 1) % 3], t.p[(i + 2) % 3]);
         // Walk order, so both triangles of a shared edge clip it alike.
         let (p, q) = if Edge::reversed(p, q) { (q, p) } else { (p, q) };
         let inside = side(p, q, (r.x, r.y));
         let f = |v: WalkPoint| (v.x as f64 / unit, v.y as f64 / unit);
-        let Some((a, b)) = clip(f(p), f(q), (-1.0, w as f64 + 1.0), (-1.0, h as f64 + 1.0)) else { continue };
+        let Some((a, b)) = clip(f(p), f(q), (-1.0, w as f64 + 1.0), (-1.0, h as f64 + 1.0)) else { return };
         let (a, b) = (
             if a == f(p) { p } else { WalkPoint::snap(a.0, a.1) },
             if b == f(q) { q } else { WalkPoint::snap(b.0, b.1) },
         );
-        let Some(edge) = Edge::new(a, b) else { continue };
+        let Some(edge) = Edge::new(a, b) else { return };
         // L/R: the polygon on the +x side of the walk is a left edge; the
         // walk runs towards +y, so +x is the side where p→q × (x step) < 0.
         let left = inside < 0;

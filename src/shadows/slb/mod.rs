@@ -3,6 +3,11 @@
 //! inside each shadow-map texel.
 
 pub mod buffer;
+pub mod light;
 pub mod line;
 pub mod region;
+pub mod term;
 pub mod walk;
+
+pub use buffer::SilhouetteLineBuffer;
+pub use term::SlbMap;

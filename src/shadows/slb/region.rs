@@ -23,8 +23,10 @@
 //! surfaces over it — holes, concave outlines, an object over itself and
 //! several objects in one texel alike, with no product-or-union case to
 //! choose. Only surfaces nearer the light than the receiver are counted (each
-//! line and layer carries its polygon's depth plane), which is the per-line
-//! depth test that lets an object shadow itself.
+//! line and layer carries its polygon's depth plane, read for a layer at the
+//! centre it covers and for a line where the way crosses it, never carried
+//! past its polygon), which is the per-line depth test that lets an object
+//! shadow itself.
 
 use super::buffer::{Entry, Layer};
 use super::line::SilhouetteLine;
@@ -43,30 +45,36 @@ pub fn covered(entry: &Entry<'_>, mx: f32, my: f32, z_limit: f32, bits: u32) -> 
 /// polygon on the way from the centre, minus one per line crossed out.
 #[must_use]
 pub fn surfaces_over(entry: &Entry<'_>, mx: f32, my: f32, z_limit: f32, bits: u32) -> i32 {
-    let nearer = |layer: &Layer| layer.depth.at(mx, my) > z_limit;
+    // A layer's depth at the centre it covers (as a shadow map samples it); a
+    // line's where the way crosses it (its edge's own depth): never a plane
+    // carried past the polygon it belongs to.
+    let nearer = |layer: &Layer| layer.depth.at(0.5, 0.5) > z_limit;
     let mut count: i32 = entry.layers.iter().filter(|l| nearer(l)).map(|l| l.count).sum();
     for line in entry.lines {
-        if line.depth.at(mx, my) <= z_limit {
+        let inside = line.strictly_inside(mx, my, bits);
+        if inside == line.centre_inside {
             continue;
         }
-        let inside = line.strictly_inside(mx, my, bits);
-        if inside != line.centre_inside && crosses_from_centre(line, mx, my, bits) {
-            count += if inside { 1 } else { -1 };
+        if let Some((x, y)) = crossing_from_centre(line, mx, my, bits) {
+            if line.depth.at(x, y) > z_limit {
+                count += if inside { 1 } else { -1 };
+            }
         }
     }
     count
 }
 
-/// Whether the way from the texel's centre to `(mx, my)`, which ends on the
-/// other side of `line`'s line, meets it within the line's part in the texel.
-fn crosses_from_centre(line: &SilhouetteLine, mx: f32, my: f32, bits: u32) -> bool {
+/// Where the way from the texel's centre to `(mx, my)`, which ends on the
+/// other side of `line`'s line, meets it, if within the line's part in the
+/// texel.
+fn crossing_from_centre(line: &SilhouetteLine, mx: f32, my: f32, bits: u32) -> Option<(f32, f32)> {
     let (ca, cb) = line.canonical(0.5, 0.5);
     let (qa, qb) = line.canonical(mx, my);
     let (fc, fq) = (cb - line.b_at(ca, bits), qb - line.b_at(qa, bits));
     let t = if fc == fq { 0.0 } else { fc / (fc - fq) };
     let a = ca + t * (qa - ca);
     let (lo, hi) = line.extent();
-    (lo..=hi).contains(&a)
+    (lo..=hi).contains(&a).then_some((0.5 + t * (mx - 0.5), 0.5 + t * (my - 0.5)))
 }
 
 /// How Table 7's flags are read as bits.

@@ -1,0 +1,193 @@
+//! The silhouette-line buffer (seed 000) against shadow rays through the BVH:
+//! the example scenes, random scenes of meshes at scales 1, 16 and 64, a
+//! closed mesh's lines, and an object shadowing itself.
+
+mod common;
+
+use std::path::Path;
+use std::sync::Arc;
+
+use glam::{Affine3A, Quat, Vec2, Vec3};
+use kage::camera::{Camera, Projection};
+use kage::scene::mesh::shapes;
+use kage::scene::{Light, LightKind, Material, Mesh, Object, Scene, ShadowMethod};
+use kage::shadows::ShadowTerm;
+use rand::rngs::StdRng;
+use rand::{Rng, SeedableRng};
+
+/// `scene` with every light's shadows by `method`.
+fn with_method(mut scene: Scene, method: ShadowMethod) -> Scene {
+    scene.lights.iter_mut().for_each(|l| l.shadow = l.shadow.with_method(method));
+    scene
+}
+
+/// Share of lit tests where the term and shadow rays disagree, and the count.
+fn disagreement(scene: &Scene) -> (f64, usize, usize) {
+    let (wrong, total) = common::terms_vs_rays(scene, &ShadowTerm::build_all(scene));
+    (wrong as f64 / total.max(1) as f64, wrong, total)
+}
+
+#[test]
+fn slb_agrees_with_shadow_rays_on_the_example_scenes_better_than_maps() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenes");
+    let mut scenes = vec![("demo", kage::scene::demo::demo_scene().unwrap())];
+    for name in ["spotlights", "cad-ortho", "reflections", "showroom"] {
+        scenes.push((name, kage::scene::file::load_scene(&dir.join(format!("{name}.toml"))).unwrap()));
+    }
+    for (name, mut scene) in scenes {
+        (scene.width, scene.height) = (320, 200);
+        let (map, map_wrong, _) = disagreement(&with_method(scene.clone(), ShadowMethod::Map));
+        let (slb, slb_wrong, total) = disagreement(&with_method(scene, ShadowMethod::Slb));
+        eprintln!("{name}: map {:.3}%, slb {:.3}% of {total}", 100.0 * map, 100.0 * slb);
+        assert!(total > 10_000, "{name}: only {total} tests");
+        assert!(slb < 0.0005, "{name}: the SLB disagrees with shadow rays on {slb_wrong} of {total}");
+        assert!(slb_wrong <= map_wrong, "{name}: SLB {slb_wrong} > map {map_wrong}");
+    }
+}
+
+/// A floor, and 3–8 cubes and spheres above it at random, under a spot or a
+/// directional light from a random direction, seen from above at an angle.
+fn random_scene(rng: &mut StdRng) -> Scene {
+    let camera = Camera {
+        eye: Vec3::new(rng.gen_range(-3.0..3.0), 6.0, 6.0),
+        target: Vec3::ZERO,
+        up: Vec3::Y,
+        near: 0.1,
+        far: 50.0,
+        projection: Projection::Perspective { fov_y_deg: 45.0 },
+        shift: Vec2::ZERO,
+    };
+    let mut scene = common::scene_with(shapes::plane(), camera, 160, 120, false);
+    scene.objects[0].transform = Affine3A::from_scale(Vec3::splat(12.0));
+    scene.materials.push(Material::default());
+    for k in 0..rng.gen_range(3..9) {
+        let mesh: Mesh = if rng.gen_bool(0.5) { shapes::cube() } else { shapes::sphere(rng.gen_range(6..24)) };
+        let s = Vec3::new(rng.gen_range(0.2..1.0), rng.gen_range(0.2..1.0), rng.gen_range(0.2..1.0));
+        let r = Quat::from_euler(glam::EulerRot::XYZ, rng.gen_range(0.0..3.0), rng.gen_range(0.0..3.0), 0.0);
+        let t = Vec3::new(rng.gen_range(-2.5..2.5), rng.gen_range(0.3..2.0), rng.gen_range(-2.5..2.5));
+        let transform = Affine3A::from_scale_rotation_translation(s, r, t);
+        scene.objects.push(Object::mesh(format!("o{k}"), Arc::new(mesh), transform, 1));
+    }
+    let from = Vec3::new(rng.gen_range(-1.0..1.0), rng.gen_range(0.6..1.5), rng.gen_range(-1.0..1.0)).normalize();
+    let kind = if rng.gen_bool(0.5) {
+        LightKind::Directional { direction: -from }
+    } else {
+        let position = from * 8.0;
+        LightKind::Spot { position, direction: -from, inner: 0.5, outer: 0.6 }
+    };
+    scene.lights = vec![Light { kind, ..Light::default() }];
+    scene
+}
+
+/// On random scenes of meshes the SLB's decisions equal shadow rays on at
+/// least 99.9% of the visible points the light faces at scale 1. With the
+/// virtual projection space 16 and 64 times wider the texels the lines do not
+/// cross are plain map lookups whose depth bias grows with the texel (the
+/// paper's §4.5 defect in another place): 0.2% and 4.3% today, held to those
+/// here until the map's own texels carry depth planes too.
+#[test]
+fn slb_decisions_equal_shadow_rays_on_random_scenes_at_scales_1_16_and_64() {
+    let mut rng = StdRng::seed_from_u64(36);
+    for scale in [1.0, 16.0, 64.0] {
+        let (mut wrong, mut total) = (0, 0);
+        for _ in 0..6 {
+            let mut scene = with_method(random_scene(&mut rng), ShadowMethod::Slb);
+            scene.lights[0].shadow.scale = scale;
+            let (_, w, t) = disagreement(&scene);
+            (wrong, total) = (wrong + w, total + t);
+        }
+        eprintln!("scale {scale}: {wrong} of {total} disagree");
+        assert!(total > 30_000, "scale {scale}: only {total} tests");
+        let allowed = match scale as u32 {
+            1 => 0.001,
+            16 => 0.003,
+            _ => 0.05,
+        };
+        assert!(
+            (wrong as f64) <= allowed * total as f64,
+            "scale {scale}: {wrong} of {total} disagree with shadow rays"
+        );
+    }
+}
+
+/// A closed mesh leaves no shared lines: every texel the buffer keeps for a
+/// lone sphere lies on its outline as the light sees it, none inside.
+#[test]
+fn a_closed_mesh_keeps_only_its_outline() {
+    let (res, radius_texels) = (256u32, 80.0f32);
+    let camera = Camera {
+        eye: Vec3::new(0.0, 10.0, 0.0),
+        target: Vec3::ZERO,
+        up: Vec3::Z,
+        near: 0.1,
+        far: 20.0,
+        projection: Projection::Orthographic { height: 2.0 * res as f32 / (2.0 * radius_texels) },
+        shift: Vec2::ZERO,
+    };
+    let mut scene = common::scene_with(shapes::sphere(32), camera, 64, 64, false);
+    scene.objects[0].transform = Affine3A::IDENTITY;
+    let map = kage::shadows::SlbMap::render(
+        &scene,
+        &camera,
+        res,
+        &[true],
+        kage::visibility::Workers::All,
+        kage::visibility::VisibilityBuffer::depth_only(0, 0),
+        8,
+    );
+    let slb = map.buffer();
+    let stats = slb.stats();
+    assert!(slb.edge_texels() > 400, "{} edge texels", slb.edge_texels());
+    assert!(stats.shared > 5 * slb.line_count(), "{stats:?}: most edges are shared");
+    let centre = res as f32 / 2.0;
+    for y in 0..res {
+        for x in 0..res {
+            if slb.is_edge(x, y) {
+                let r = Vec2::new(x as f32 + 0.5 - centre, y as f32 + 0.5 - centre).length();
+                // The polygon's outline lies between the inscribed and the
+                // circumscribed circles of its 64-gon.
+                assert!((r - radius_texels).abs() < 2.0, "edge texel ({x}, {y}) at radius {r}");
+            }
+        }
+    }
+}
+
+/// An object shadows itself: a bent plate (one mesh, an L whose upright
+/// shades its foot) under a low light, as shadow rays say.
+#[test]
+fn a_bent_plate_shadows_itself_as_rays_say() {
+    let mut mesh = shapes::plane();
+    let mut upright = shapes::plane();
+    let stand = Affine3A::from_rotation_translation(
+        Quat::from_rotation_x(std::f32::consts::FRAC_PI_2),
+        Vec3::new(0.0, 0.5, -0.5),
+    );
+    upright.positions.iter_mut().for_each(|p| *p = stand.transform_point3(*p));
+    upright.normals.iter_mut().for_each(|n| *n = stand.transform_vector3(*n));
+    let base = mesh.positions.len() as u32;
+    mesh.positions.extend(upright.positions);
+    mesh.normals.extend(upright.normals);
+    mesh.uvs.extend(upright.uvs);
+    mesh.triangles.extend(upright.triangles.iter().map(|t| t.map(|i| i + base)));
+    let camera = Camera {
+        eye: Vec3::new(0.0, 2.0, 2.5),
+        target: Vec3::new(0.0, 0.2, 0.0),
+        up: Vec3::Y,
+        near: 0.1,
+        far: 20.0,
+        projection: Projection::Perspective { fov_y_deg: 40.0 },
+        shift: Vec2::ZERO,
+    };
+    let mut scene = common::scene_with(mesh, camera, 320, 240, true);
+    scene.lights = vec![Light {
+        kind: LightKind::Directional { direction: Vec3::new(0.3, -0.6, 1.0).normalize() },
+        ..Light::default()
+    }];
+    let scene = with_method(scene, ShadowMethod::Slb);
+    let terms = ShadowTerm::build_all(&scene);
+    // Points on the foot behind the upright are in its shadow.
+    let shade = terms[0].lit(Vec3::new(0.0, 0.0, -0.35), 1.0);
+    assert_eq!(shade, 0.0, "the foot behind the upright is lit");
+    let (share, wrong, total) = disagreement(&scene);
+    assert!(total > 5000 && share < 0.002, "{wrong} of {total} disagree with shadow rays");
+}
