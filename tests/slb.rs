@@ -81,10 +81,10 @@ fn random_scene(rng: &mut StdRng) -> Scene {
 
 /// On random scenes of meshes the SLB's decisions equal shadow rays on at
 /// least 99.9% of the visible points the light faces at scale 1. With the
-/// virtual projection space 16 and 64 times wider the texels the lines do not
-/// cross are plain map lookups whose depth bias grows with the texel (the
-/// paper's §4.5 defect in another place): 0.2% and 4.3% today, held to those
-/// here until the map's own texels carry depth planes too.
+/// virtual projection space 16 and 64 times wider the depth bias, counted in
+/// texels, grows with the texel and shadows go missing in the texels the
+/// lines cross, where a caster nears its receiver: 0.2% and 4.3% today, held
+/// to those here until the bias no longer scales with the texel.
 #[test]
 fn slb_decisions_equal_shadow_rays_on_random_scenes_at_scales_1_16_and_64() {
     let mut rng = StdRng::seed_from_u64(36);
