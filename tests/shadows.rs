@@ -20,13 +20,7 @@ fn map_vs_rays(scene: &Scene) -> (usize, usize) {
 
 #[test]
 fn shadow_maps_agree_with_shadow_rays_on_the_example_scenes() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenes");
-    let mut scenes = vec![("demo", kage::scene::demo::demo_scene().unwrap())];
-    for name in ["spotlights", "cad-ortho", "reflections", "showroom"] {
-        scenes.push((name, kage::scene::file::load_scene(&dir.join(format!("{name}.toml"))).unwrap()));
-    }
-    for (name, mut scene) in scenes {
-        (scene.width, scene.height) = (320, 200);
+    for (name, scene) in common::shadow_example_scenes() {
         let (wrong, total) = map_vs_rays(&scene);
         let share = wrong as f64 / total as f64;
         eprintln!("{name}: {wrong} of {total} lit tests disagree ({:.3}%)", 100.0 * share);

@@ -4,7 +4,6 @@
 
 mod common;
 
-use std::path::Path;
 use std::sync::Arc;
 
 use glam::{Affine3A, Quat, Vec2, Vec3};
@@ -29,13 +28,7 @@ fn disagreement(scene: &Scene) -> (f64, usize, usize) {
 
 #[test]
 fn slb_agrees_with_shadow_rays_on_the_example_scenes_better_than_maps() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenes");
-    let mut scenes = vec![("demo", kage::scene::demo::demo_scene().unwrap())];
-    for name in ["spotlights", "cad-ortho", "reflections", "showroom"] {
-        scenes.push((name, kage::scene::file::load_scene(&dir.join(format!("{name}.toml"))).unwrap()));
-    }
-    for (name, mut scene) in scenes {
-        (scene.width, scene.height) = (320, 200);
+    for (name, scene) in common::shadow_example_scenes() {
         let (map, map_wrong, _) = disagreement(&with_method(scene.clone(), ShadowMethod::Map));
         let (slb, slb_wrong, total) = disagreement(&with_method(scene, ShadowMethod::Slb));
         eprintln!("{name}: map {:.3}%, slb {:.3}% of {total}", 100.0 * map, 100.0 * slb);

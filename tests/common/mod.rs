@@ -205,3 +205,17 @@ pub fn terms_vs_rays(scene: &Scene, terms: &[ShadowTerm]) -> (usize, usize) {
     }
     (wrong, total)
 }
+
+/// The demo and four example scenes whose shadows the shadow tests judge, at
+/// 320 × 200.
+pub fn shadow_example_scenes() -> Vec<(&'static str, Scene)> {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenes");
+    let mut scenes = vec![("demo", kage::scene::demo::demo_scene().unwrap())];
+    for name in ["spotlights", "cad-ortho", "reflections", "showroom"] {
+        scenes.push((name, kage::scene::file::load_scene(&dir.join(format!("{name}.toml"))).unwrap()));
+    }
+    for (_, scene) in &mut scenes {
+        (scene.width, scene.height) = (320, 200);
+    }
+    scenes
+}
