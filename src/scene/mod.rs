@@ -32,6 +32,10 @@ use crate::error::{Error, Result};
 use crate::image::ToneCurve;
 use crate::limits::Limits;
 
+/// Largest world coordinate (in magnitude) an object may reach: squared
+/// distances of points this far still fit in an f32.
+pub const MAX_COORDINATE: f32 = 1e15;
+
 /// Largest image side kage accepts, in pixels.
 pub const MAX_IMAGE_SIDE: u32 = 16_384;
 /// Largest image kage accepts, in pixels (a 16k × 8k frame).

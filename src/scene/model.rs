@@ -41,7 +41,7 @@ fn add_ground(scene: &mut Scene, (lo, hi): (Vec3, Vec3)) {
 
 /// Largest extent of a model along an axis that a camera frames: beyond it
 /// the camera's depth range and the depth buffer's precision fail.
-pub const MAX_MODEL_SIZE: f32 = 1e15;
+pub const MAX_MODEL_SIZE: f32 = super::MAX_COORDINATE;
 
 /// How a lone model file becomes a scene ([`scene_for_model_with`]).
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -669,7 +669,7 @@ impl SceneFile {
         let first = scene.objects.len();
         add_model(scene, &model, &label, transform, material);
         scene.objects[first..].iter_mut().for_each(|o| o.casts_shadows = r.casts_shadows);
-        let limit = super::model::MAX_MODEL_SIZE;
+        let limit = super::MAX_COORDINATE;
         let out_of_range = scene.objects[first..]
             .iter()
             .filter_map(Object::world_bounds)
