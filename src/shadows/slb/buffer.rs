@@ -445,22 +445,23 @@ fn silhouette_edges(snapped: &[Snapped]) -> Vec<(usize, usize)> {
         })
         .collect();
     all.par_sort_unstable_by_key(|e| (e.0, e.1, e.2));
-    let mut out = Vec::new();
-    let mut k = 0;
-    while k < all.len() {
-        let n = all[k..].iter().take_while(|e| (e.0, e.1, e.2) == (all[k].0, all[k].1, all[k].2)).count();
-        let run = &all[k..k + n];
-        let lefts = run.iter().filter(|e| e.3).count();
-        let (keep_left, mut surplus) = (lefts > n - lefts, lefts.abs_diff(n - lefts));
-        for e in run {
-            if surplus > 0 && e.3 == keep_left {
-                out.push((e.4, e.5));
-                surplus -= 1;
-            }
-        }
-        k += n;
-    }
-    out
+    unpaired(&all, |a, b| (a.0, a.1, a.2) == (b.0, b.1, b.2), |e| e.3).into_iter().map(|e| (e.4, e.5)).collect()
+}
+
+/// §3.3.2's pairing over `sorted`, whose runs of `same` items are adjacent:
+/// in each run, items of opposite L/R flags (`left`) cancel in pairs and the
+/// surplus of the more numerous flag is kept.
+fn unpaired<T>(sorted: &[T], same: impl Fn(&T, &T) -> bool, left: impl Fn(&T) -> bool) -> Vec<&T> {
+    let left = &left;
+    sorted
+        .chunk_by(same)
+        .flat_map(|run| {
+            let lefts = run.iter().filter(|r| left(r)).count();
+            let keep_left = 2 * lefts > run.len();
+            let surplus = lefts.abs_diff(run.len() - lefts);
+            run.iter().filter(move |r| left(r) == keep_left).take(surplus)
+        })
+        .collect()
 }
 
 /// Records of edge `i` of `t` in the texels of a `width` × `height` map it
@@ -468,39 +469,35 @@ fn silhouette_edges(snapped: &[Snapped]) -> Vec<(usize, usize)> {
 fn walk_edge(t: &Snapped, i: usize, width: u32, height: u32, bits: u32, out: &mut Vec<Record>) {
     let unit = (1i64 << WALK_BITS) as f64;
     let (w, h) = (i64::from(width), i64::from(height));
-    {
-        let (p, q, r) = (t.p[i], t.p[(i + 1) % 3], t.p[(i + 2) % 3]);
-        // Walk order, so both triangles of a shared edge clip it alike.
-        let (p, q) = if Edge::reversed(p, q) { (q, p) } else { (p, q) };
-        let inside = side(p, q, (r.x, r.y));
-        let f = |v: WalkPoint| (v.x as f64 / unit, v.y as f64 / unit);
-        let Some((a, b)) = clip(f(p), f(q), (-1.0, w as f64 + 1.0), (-1.0, h as f64 + 1.0)) else { return };
-        let (a, b) = (
-            if a == f(p) { p } else { WalkPoint::snap(a.0, a.1) },
-            if b == f(q) { q } else { WalkPoint::snap(b.0, b.1) },
-        );
-        let Some(edge) = Edge::new(a, b) else { return };
-        // L/R: the polygon on the +x side of the walk is a left edge; the
-        // walk runs towards +y, so +x is the side where p→q × (x step) < 0.
-        let left = inside < 0;
-        edge.walk(|v| {
-            if v.x < 0 || v.y < 0 || i64::from(v.x) >= w || i64::from(v.y) >= h {
-                return;
-            }
-            let mut line = SilhouetteLine::new(&v, edge.line, edge.slope, left, bits);
-            (line.polygon, line.object) = (t.polygon, t.object);
-            line.depth = t.depth(i64::from(v.x), i64::from(v.y));
-            let c = centre(i64::from(v.x), i64::from(v.y));
-            // The exact edge's side of the centre, counted only where the
-            // centre lies along the line's part in this texel.
-            let (a0, a1) = line.extent();
-            let (ca, _) = line.canonical(0.5, 0.5);
-            let exact = side(p, q, c) == inside;
-            let exact_centre_inside = if (a0..=a1).contains(&ca) { exact } else { line.centre_inside };
-            let ends = [v.start.map(|_| a), v.end.map(|_| b)];
-            out.push(Record { texel: (v.y as u32) * width + v.x as u32, line, exact_centre_inside, ends });
-        });
-    }
+    let (p, q, r) = (t.p[i], t.p[(i + 1) % 3], t.p[(i + 2) % 3]);
+    // Walk order, so both triangles of a shared edge clip it alike.
+    let (p, q) = if Edge::reversed(p, q) { (q, p) } else { (p, q) };
+    let inside = side(p, q, (r.x, r.y));
+    let f = |v: WalkPoint| (v.x as f64 / unit, v.y as f64 / unit);
+    let Some((a, b)) = clip(f(p), f(q), (-1.0, w as f64 + 1.0), (-1.0, h as f64 + 1.0)) else { return };
+    let (a, b) =
+        (if a == f(p) { p } else { WalkPoint::snap(a.0, a.1) }, if b == f(q) { q } else { WalkPoint::snap(b.0, b.1) });
+    let Some(edge) = Edge::new(a, b) else { return };
+    // L/R: the polygon on the +x side of the walk is a left edge; the
+    // walk runs towards +y, so +x is the side where p→q × (x step) < 0.
+    let left = inside < 0;
+    edge.walk(|v| {
+        if v.x < 0 || v.y < 0 || i64::from(v.x) >= w || i64::from(v.y) >= h {
+            return;
+        }
+        let mut line = SilhouetteLine::new(&v, edge.line, edge.slope, left, bits);
+        (line.polygon, line.object) = (t.polygon, t.object);
+        line.depth = t.depth(i64::from(v.x), i64::from(v.y));
+        let c = centre(i64::from(v.x), i64::from(v.y));
+        // The exact edge's side of the centre, counted only where the
+        // centre lies along the line's part in this texel.
+        let (a0, a1) = line.extent();
+        let (ca, _) = line.canonical(0.5, 0.5);
+        let exact = side(p, q, c) == inside;
+        let exact_centre_inside = if (a0..=a1).contains(&ca) { exact } else { line.centre_inside };
+        let ends = [v.start.map(|_| a), v.end.map(|_| b)];
+        out.push(Record { texel: (v.y as u32) * width + v.x as u32, line, exact_centre_inside, ends });
+    });
 }
 
 /// Moves the stored ends of lines meeting at one vertex to where their
@@ -560,24 +557,5 @@ fn meeting_point(lines: &[&SilhouetteLine], bits: u32) -> Option<(f32, f32)> {
 /// Polygon ID and with opposite L/R flags are an edge two of its polygons
 /// share: they go in pairs. `records` are sorted by [`Record::key`].
 fn remove_shared(records: Vec<Record>) -> Vec<Record> {
-    let mut out = Vec::with_capacity(records.len());
-    let mut i = 0;
-    while i < records.len() {
-        let key = records[i].key();
-        let n = records[i..].iter().take_while(|r| r.key() == key).count();
-        let run = &records[i..i + n];
-        let lefts = run.iter().filter(|r| r.line.left).count();
-        let rights = n - lefts;
-        // Keep the surplus of the more numerous flag.
-        let keep_left = lefts > rights;
-        let mut surplus = lefts.abs_diff(rights);
-        for r in run {
-            if surplus > 0 && r.line.left == keep_left {
-                out.push(*r);
-                surplus -= 1;
-            }
-        }
-        i += n;
-    }
-    out
+    unpaired(&records, |a, b| a.key() == b.key(), |r| r.line.left).into_iter().copied().collect()
 }

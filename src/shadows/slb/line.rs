@@ -161,10 +161,20 @@ impl SilhouetteLine {
     #[inline]
     #[must_use]
     pub fn canonical(&self, mx: f32, my: f32) -> (f32, f32) {
-        let mirror = |v: f32| if self.line.x_positive { v } else { 1.0 - v };
         match self.line.major {
-            Major::X => (mirror(mx), my),
-            Major::Y => (my, mirror(mx)),
+            Major::X => (self.mirror(mx), my),
+            Major::Y => (my, self.mirror(mx)),
+        }
+    }
+
+    /// A texel-local x in the line's frame, mirrored for x-negative lines
+    /// (its own inverse).
+    #[inline]
+    fn mirror(&self, x: f32) -> f32 {
+        if self.line.x_positive {
+            x
+        } else {
+            1.0 - x
         }
     }
 
@@ -172,10 +182,9 @@ impl SilhouetteLine {
     #[inline]
     #[must_use]
     pub fn texel_point(&self, a: f32, b: f32) -> (f32, f32) {
-        let mirror = |v: f32| if self.line.x_positive { v } else { 1.0 - v };
         match self.line.major {
-            Major::X => (mirror(a), b),
-            Major::Y => (mirror(b), a),
+            Major::X => (self.mirror(a), b),
+            Major::Y => (self.mirror(b), a),
         }
     }
 
