@@ -322,3 +322,43 @@ fn scene_files_and_the_model_rig_say_which_objects_cast_shadows() {
     assert_eq!(ground, [false]);
     assert!(rig.objects.iter().filter(|o| o.name != "ground").all(|o| o.casts_shadows));
 }
+
+/// The images `--aov shadow` writes: each light's shadow term at the surface
+/// each pixel shows decides lit or not as shadow rays do (by maps and by the
+/// silhouette-line buffer), is 0 where the surface faces away from the light
+/// and 1 where no object is seen.
+#[test]
+fn shadow_images_show_each_lights_term_as_shadow_rays_say() {
+    use kage::scene::ShadowMethod;
+    let (_, scene) = common::shadow_example_scenes().into_iter().find(|(n, _)| *n == "spotlights").expect("spotlights");
+    for (method, most) in [(ShadowMethod::Map, 0.005), (ShadowMethod::Slb, 0.001)] {
+        let mut scene = scene.clone();
+        scene.lights.iter_mut().for_each(|l| l.shadow = l.shadow.with_method(method));
+        let frame = render(&scene, &RenderOptions { shadow_images: true, ..RenderOptions::default() }).unwrap();
+        assert_eq!(frame.shadows.len(), scene.lights.len());
+        let w = scene.width;
+        let at = |light: usize, (x, y): (u32, u32)| frame.shadows[light].pixels()[(y * w + x) as usize].x;
+        let (wrong, total) = common::decisions_vs_rays(&scene, |light, pixel, _, _| Some(at(light, pixel)));
+        eprintln!("{method:?}: {wrong} of {total} shadow-image pixels disagree with shadow rays");
+        assert!(total > 10_000 && (wrong as f64) < most * total as f64, "{method:?}: {wrong} of {total}");
+        let frames = kage::shading::ObjectFrames::new(&scene);
+        let rays = scene.camera.pixel_rays(Vec2::new(w as f32, scene.height as f32));
+        let (mut away, mut background) = (0, 0);
+        for (y, x) in (0..scene.height).flat_map(|y| (0..w).map(move |x| (y, x))) {
+            let item = frame.visibility.item(x, y);
+            if item.is_none() {
+                background += 1;
+                assert!((0..scene.lights.len()).all(|l| at(l, (x, y)) == 1.0), "background at ({x}, {y})");
+                continue;
+            }
+            let s = frames.surface(&scene, item, &rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5)));
+            for (l, light) in scene.lights.iter().enumerate() {
+                if s.normal.dot(light.incident(s.position).to_light) < -0.05 {
+                    away += 1;
+                    assert_eq!(at(l, (x, y)), 0.0, "({x}, {y}) faces away from light {l}");
+                }
+            }
+        }
+        assert!(away > 100 && background > 100, "{away} pixels facing away, {background} background");
+    }
+}

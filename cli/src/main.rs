@@ -103,9 +103,11 @@ struct RenderArgs {
     /// Also write these parts of the image, each on its own, next to the
     /// output as NAME.PART.EXT: a comma list of ambient, diffuse, specular,
     /// emission (with the background), traced (reflections and refraction); or
-    /// `all`. They add up to the image.
-    #[arg(long, value_parser = parse_components)]
-    aov: Option<ComponentSet>,
+    /// `all` (these five, which add up to the image). `shadow` writes each
+    /// light's shadow term as NAME.shadow.N.exr (N: the light's number from
+    /// 0, in the scene's order; 1 lit, 0 in shadow).
+    #[arg(long, value_parser = parse_aovs)]
+    aov: Option<Aovs>,
     /// Brightness of 8-bit output: stops (e.g. 1.5, -1) or `auto`.
     #[arg(long, value_parser = parse_exposure, allow_hyphen_values = true)]
     exposure: Option<Exposure>,
@@ -225,20 +227,31 @@ fn aov_path(output: &Path, name: &str) -> PathBuf {
     output.with_file_name(format!("{stem}.{name}.{ext}"))
 }
 
-fn parse_components(s: &str) -> Result<ComponentSet, String> {
-    if s == "all" {
-        return Ok(ComponentSet::ALL);
-    }
-    let list: Result<Vec<Component>, String> = s
-        .split(',')
-        .map(|name| {
-            Component::from_name(name.trim()).ok_or_else(|| {
+/// What `--aov` asks for: components of the image, and whether the lights'
+/// shadow terms.
+#[derive(Debug, Clone, Copy)]
+struct Aovs {
+    components: ComponentSet,
+    shadow: bool,
+}
+
+fn parse_aovs(s: &str) -> Result<Aovs, String> {
+    let mut aovs = Aovs { components: ComponentSet::EMPTY, shadow: false };
+    let mut list = Vec::new();
+    for name in s.split(',').map(str::trim) {
+        match name {
+            "all" => aovs.components = ComponentSet::ALL,
+            "shadow" => aovs.shadow = true,
+            _ => list.push(Component::from_name(name).ok_or_else(|| {
                 let known: Vec<&str> = Component::ALL.iter().map(|c| c.name()).collect();
-                format!("'{name}' is not a component (expected 'all' or some of {})", known.join(", "))
-            })
-        })
-        .collect();
-    Ok(ComponentSet::of(&list?))
+                format!("'{name}' is not a component (expected 'all', 'shadow' or some of {})", known.join(", "))
+            })?),
+        }
+    }
+    if aovs.components != ComponentSet::ALL {
+        aovs.components = ComponentSet::of(&list);
+    }
+    Ok(aovs)
 }
 
 fn parse_antialias(s: &str) -> Result<Antialias, String> {
@@ -409,8 +422,14 @@ fn render_command(args: &RenderArgs) -> kage::error::Result<()> {
     if args.reference {
         return reference_command(args, &scene);
     }
-    let aovs = args.aov.unwrap_or(ComponentSet::EMPTY);
-    let options = RenderOptions { threads: args.threads, ray_depth: args.ray_depth, aovs, ..RenderOptions::default() };
+    let wanted = args.aov.unwrap_or(Aovs { components: ComponentSet::EMPTY, shadow: false });
+    let options = RenderOptions {
+        threads: args.threads,
+        ray_depth: args.ray_depth,
+        aovs: wanted.components,
+        shadow_images: wanted.shadow,
+        ..RenderOptions::default()
+    };
     let mut renderer = Renderer::new(&options)?;
     let bar = Progress::new("passes");
     renderer.render_reporting(&scene, &|done, total| bar.update(done as u64, total as u64))?;
@@ -425,6 +444,12 @@ fn render_command(args: &RenderArgs) -> kage::error::Result<()> {
         let path = aov_path(&args.output, c.name());
         kage::output::write_image(image, &path, exposure, scene.tone)?;
         eprintln!("wrote {} ({} component)", path.display(), c.name());
+    }
+    for (i, image) in frame.shadows.iter().enumerate() {
+        // Linear floats, unexposed: 1 is lit, 0 in shadow.
+        let path = aov_path(&args.output.with_extension("exr"), &format!("shadow.{i}"));
+        kage::output::write_image(image, &path, 1.0, ToneCurve::Clip)?;
+        eprintln!("wrote {} (light {i}'s shadow term)", path.display());
     }
     if frame.visibility.items().iter().all(|i| i.is_none()) {
         eprintln!("warning: no object is in view: the image shows only the background (check the camera)");

@@ -124,6 +124,29 @@ fn jpeg_output() {
     assert!(mean < 4.0, "mean difference {mean} of 255");
 }
 
+/// `--aov shadow` writes one linear image per light (1 lit, 0 in shadow) and
+/// the components asked for beside it; an unknown name lists `shadow`.
+#[test]
+fn aov_shadow_writes_each_lights_term() {
+    let dir = scratch("aov-shadow");
+    let out = dir.join("a.png");
+    let (ok, err) =
+        kage(&["render", "--width", "96", "--height", "54", "--aov", "shadow,diffuse", "-o", out.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    assert!(dir.join("a.diffuse.png").exists(), "{err}");
+    for light in 0..2 {
+        let term = image::open(dir.join(format!("a.shadow.{light}.exr"))).unwrap().to_rgb32f();
+        assert_eq!(term.dimensions(), (96, 54));
+        let values = term.as_raw();
+        assert!(values.iter().all(|v| (0.0..=1.0).contains(v)), "light {light}: a term outside 0..1");
+        let shadowed = values.iter().filter(|&&v| v < 0.5).count();
+        assert!(shadowed > 30 && shadowed < values.len() / 2, "light {light}: {shadowed} shadowed values");
+    }
+    assert!(!dir.join("a.shadow.2.exr").exists(), "the demo has two lights");
+    let (ok, err) = kage(&["render", "--aov", "shade", "-o", out.to_str().unwrap()]);
+    assert!(!ok && err.contains("'shade' is not a component") && err.contains("'shadow'"), "{err}");
+}
+
 #[test]
 fn a_csg_node_kage_cannot_render_is_reported_at_its_line() {
     let dir = scratch("csg-node");

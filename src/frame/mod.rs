@@ -49,11 +49,19 @@ pub struct RenderOptions {
     /// no spot or point light's map again). Off, every frame renders every map,
     /// as a renderer that keeps nothing between frames does.
     pub keep_shadow_maps: bool,
+    /// Also write each light's shadow term on its own ([`Frame::shadows`]).
+    pub shadow_images: bool,
 }
 
 impl Default for RenderOptions {
     fn default() -> Self {
-        RenderOptions { threads: None, ray_depth: 4, aovs: ComponentSet::EMPTY, keep_shadow_maps: true }
+        RenderOptions {
+            threads: None,
+            ray_depth: 4,
+            aovs: ComponentSet::EMPTY,
+            keep_shadow_maps: true,
+            shadow_images: false,
+        }
     }
 }
 
@@ -151,6 +159,11 @@ pub struct Frame {
     pub visibility: VisibilityBuffer,
     /// The requested components, each on its own (seed 002 Fig. 4).
     pub aovs: Vec<(Component, LinearImage)>,
+    /// When [`RenderOptions::shadow_images`] asks for them, each light's
+    /// shadow term at the surface each pixel shows, in the scene's order of
+    /// lights (grey: 1 lit, 0 in shadow or facing away from the light; 1
+    /// where no object is seen). The mean of the passes, when jittered.
+    pub shadows: Vec<LinearImage>,
     /// Timings and counts.
     pub stats: FrameStats,
 }
@@ -171,6 +184,8 @@ struct Scratch {
     accum: LinearImage,
     /// One pass's components (when AOVs are requested), in `Frame::aovs`' order.
     aovs: Vec<LinearImage>,
+    /// One pass's shadow terms (when requested), in `Frame::shadows`' order.
+    shadows: Vec<LinearImage>,
     /// Shadow-map buffers, reused from light to light and frame to frame.
     maps: MapPool,
     /// The BVH of the traced term, rebuilt only when the geometry changes.
@@ -195,6 +210,7 @@ impl Renderer {
             visibility: VisibilityBuffer::new(0, 0),
             stats: FrameStats::default(),
             aovs: Vec::new(),
+            shadows: Vec::new(),
         };
         Ok(Renderer { pool, frame, options: *options, scratch: Scratch::default() })
     }
@@ -277,30 +293,33 @@ fn render_into(
     if !options.keep_shadow_maps {
         scratch.maps.forget();
     }
-    fit_component_images(scene, options.aovs, frame, scratch);
+    fit_component_images(scene, options, frame, scratch);
     let offsets = scene.antialias.offsets();
     if offsets.len() == 1 && offsets[0] == Vec2::ZERO {
         let edges = match scene.antialias {
             Antialias::Edge(mode) => Some(EdgeOptions { mode, ..EdgeOptions::default() }),
             _ => None,
         };
-        render_pass(scene, frame, scratch, options.ray_depth, edges.as_ref());
+        render_pass(scene, frame, scratch, options, edges.as_ref());
         frame.aovs.iter_mut().zip(&mut scratch.aovs).for_each(|((_, a), s)| std::mem::swap(a, s));
+        std::mem::swap(&mut frame.shadows, &mut scratch.shadows);
         progress(1, 1);
     } else {
-        render_jittered(scene, &offsets, frame, scratch, options.ray_depth, progress);
+        render_jittered(scene, &offsets, frame, scratch, options, progress);
     }
     frame.stats.buffer_bytes = frame.visibility.memory_bytes()
         + std::mem::size_of_val(frame.image.pixels())
         + std::mem::size_of_val(scratch.accum.pixels())
-        + (frame.aovs.len() + scratch.aovs.len()) * std::mem::size_of_val(frame.image.pixels())
+        + (frame.aovs.len() + scratch.aovs.len() + frame.shadows.len() + scratch.shadows.len())
+            * std::mem::size_of_val(frame.image.pixels())
         + scratch.maps.memory_bytes();
 }
 
 /// Makes the frame's component images (and one pass's, in `scratch`) the
 /// components `wanted` names, at the scene's size; the images are kept from
 /// frame to frame, like every other buffer.
-fn fit_component_images(scene: &Scene, wanted: ComponentSet, frame: &mut Frame, scratch: &mut Scratch) {
+fn fit_component_images(scene: &Scene, options: &RenderOptions, frame: &mut Frame, scratch: &mut Scratch) {
+    let (wanted, options_shadows) = (options.aovs, options.shadow_images);
     let (w, h) = (scene.width, scene.height);
     let components: Vec<Component> = wanted.iter().collect();
     frame.aovs.resize_with(components.len(), || (Component::Ambient, LinearImage::default()));
@@ -310,6 +329,9 @@ fn fit_component_images(scene: &Scene, wanted: ComponentSet, frame: &mut Frame, 
     }
     scratch.aovs.resize_with(frame.aovs.len(), LinearImage::default);
     scratch.aovs.iter_mut().for_each(|a| a.resize(w, h));
+    let lights = if options_shadows { scene.lights.len() } else { 0 };
+    frame.shadows.resize_with(lights, LinearImage::default);
+    frame.shadows.iter_mut().for_each(|a| a.resize(w, h));
 }
 
 /// Seed 002 §4's accumulation buffer: one pass per sub-pixel `offsets`, each
@@ -320,12 +342,13 @@ fn render_jittered(
     offsets: &[Vec2],
     frame: &mut Frame,
     scratch: &mut Scratch,
-    ray_depth: u32,
+    options: &RenderOptions,
     progress: &(dyn Fn(u32, u32) + Sync),
 ) {
     scratch.accum.resize(scene.width, scene.height);
     scratch.accum.pixels_mut().fill(Vec3::ZERO);
     frame.aovs.iter_mut().for_each(|(_, a)| a.pixels_mut().fill(Vec3::ZERO));
+    frame.shadows.iter_mut().for_each(|a| a.pixels_mut().fill(Vec3::ZERO));
     // Directional lights' maps are fitted to the unshifted view: the passes
     // share them (and the next frame may reuse them).
     scratch.maps.fit_to(Some(scene.camera));
@@ -333,9 +356,10 @@ fn render_jittered(
     let mut pass = scene.clone();
     for (done, &offset) in (1..).zip(offsets) {
         pass.camera = jitter::shifted(&scene.camera, offset, (scene.width, scene.height));
-        render_pass(&pass, frame, scratch, ray_depth, None);
+        render_pass(&pass, frame, scratch, options, None);
         jitter::accumulate(&mut scratch.accum, &frame.image, weight);
         frame.aovs.iter_mut().zip(&scratch.aovs).for_each(|((_, a), s)| jitter::accumulate(a, s, weight));
+        frame.shadows.iter_mut().zip(&scratch.shadows).for_each(|(a, s)| jitter::accumulate(a, s, weight));
         progress(done, offsets.len() as u32);
     }
     scratch.maps.fit_to(None);
@@ -343,12 +367,20 @@ fn render_jittered(
 }
 
 /// One visibility pass and everything shaded from it into `frame.image`, and
-/// the components `frame.aovs` names into `scratch.aovs` (same order), with
-/// the edge pass if `edges` asks for one; adds its timings to the frame's
+/// the components `frame.aovs` names into `scratch.aovs` (same order) and the
+/// shadow terms into `scratch.shadows` when `options` asks for them, with the
+/// edge pass if `edges` asks for one; adds its timings to the frame's
 /// statistics.
-fn render_pass(scene: &Scene, frame: &mut Frame, scratch: &mut Scratch, ray_depth: u32, edges: Option<&EdgeOptions>) {
-    let Frame { image, visibility, aovs, stats } = frame;
-    let Scratch { aovs: component_images, maps, trace, edges: edge_pass, subpixel, .. } = scratch;
+fn render_pass(
+    scene: &Scene,
+    frame: &mut Frame,
+    scratch: &mut Scratch,
+    options: &RenderOptions,
+    edges: Option<&EdgeOptions>,
+) {
+    let ray_depth = options.ray_depth;
+    let Frame { image, visibility, aovs, stats, .. } = frame;
+    let Scratch { aovs: component_images, maps, trace, edges: edge_pass, subpixel, shadows, .. } = scratch;
     visibility.resize(scene.width, scene.height);
     stats.raster = stats.timed(Stage::Visibility, || visibility::rasterize(scene, visibility));
     let vb = &*visibility;
@@ -363,6 +395,9 @@ fn render_pass(scene: &Scene, frame: &mut Frame, scratch: &mut Scratch, ray_dept
     let (lit, planned) = stats.timed(Stage::Shading, || shade(scene, vb, targets, maps, subpixel, beside));
     stats.add_lit(&lit);
     stats.add(Stage::Edges, planned);
+    if options.shadow_images {
+        shading::shadow_images::shadow_term_images(scene, vb, maps, shadows);
+    }
     let builds = trace.builds();
     let refine = if edges.is_some() { Refine::Contrast } else { Refine::Never };
     let (traced, refined) =

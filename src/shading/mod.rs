@@ -7,7 +7,7 @@
 //! scalar statement of eq. 1 the lanes are tested against (with
 //! `normal_map.rs`, the maps that tilt its normal); `reflection_map.rs`,
 //! `fog.rs` and `translucency.rs` are the once-per-frame passes of §3.4, §3.5 and
-//! eq. 4's Ie.
+//! eq. 4's Ie; `shadow_images.rs` writes each light's shadow term on its own.
 
 pub(crate) mod fog;
 // Public rather than crate-private: crate-private, its entry points were
@@ -18,6 +18,7 @@ pub(crate) mod normal_map;
 pub(crate) mod passes;
 pub(crate) mod phong;
 pub(crate) mod reflection_map;
+pub(crate) mod shadow_images;
 pub(crate) mod subpixel;
 pub(crate) mod surface;
 pub(crate) mod translucency;

@@ -407,6 +407,26 @@ impl MapPool {
         terms.into_iter().map(|t| t.expect("every term reused or built")).collect()
     }
 
+    /// Calls `f` with `light`'s term of this frame: the one kept for the next
+    /// frame ([`MapPool::keep`]) when there is one, else a term rendered for
+    /// the call and recycled after it.
+    pub fn with_term<T>(
+        &mut self,
+        scene: &Scene,
+        light: &Light,
+        bounds: (Vec3, Vec3),
+        f: impl FnOnce(&ShadowTerm) -> T,
+    ) -> T {
+        let key = MapKey::of(scene, light, bounds, self.view(scene));
+        if let Some((_, term)) = self.kept.iter().find(|(have, _)| *have == key) {
+            return f(term);
+        }
+        let term = ShadowTerm::build_within(scene, light, bounds, self);
+        let out = f(&term);
+        self.recycle(term);
+        out
+    }
+
     /// Keeps `light`'s term for the next frame.
     pub fn keep(&mut self, scene: &Scene, light: &Light, bounds: (Vec3, Vec3), term: ShadowTerm) {
         self.kept.push((MapKey::of(scene, light, bounds, self.view(scene)), term));

@@ -165,10 +165,22 @@ pub fn view_distance(cam: &Camera, d: f32) -> f32 {
     }
 }
 
-/// For every pixel of `scene`'s view whose surface faces a light, whether its
-/// shadow term in `terms` calls it lit (≥ 0.5) and whether a shadow ray through
-/// the BVH reaches the light: returns (misclassified, compared) over all lights.
+/// Shadow terms `terms` (one per light) against shadow rays: (misclassified,
+/// compared) over the visible pixels' surfaces (at pixel centres) facing a
+/// light that casts shadows.
 pub fn terms_vs_rays(scene: &Scene, terms: &[ShadowTerm]) -> (usize, usize) {
+    decisions_vs_rays(scene, |light, _, s, cos| terms[light].casts().then(|| terms[light].lit(s.position, cos)))
+}
+
+/// A shadow decision against shadow rays: per visible pixel (its centre's
+/// surface, as the renderer reconstructs it) and light whose N·L there is
+/// above 0.05, `decide(light, (x, y), surface, N·L)` (`None`: not compared)
+/// read as lit when ≥ 0.5, against whether a ray from the surface to the
+/// light reaches it. Returns (misclassified, compared).
+pub fn decisions_vs_rays(
+    scene: &Scene,
+    decide: impl Fn(usize, (u32, u32), &kage::shading::SurfacePoint, f32) -> Option<f32>,
+) -> (usize, usize) {
     let frame = kage::render(scene, &kage::RenderOptions::default()).expect("render");
     let trace = kage::raytrace::TraceScene::new(scene);
     let frames = kage::shading::ObjectFrames::new(scene);
@@ -182,12 +194,13 @@ pub fn terms_vs_rays(scene: &Scene, terms: &[ShadowTerm]) -> (usize, usize) {
                 continue;
             }
             let s = frames.surface(scene, item, &rays.ray(glam::Vec2::new(x as f32 + 0.5, y as f32 + 0.5)));
-            for (light, term) in scene.lights.iter().zip(terms) {
+            for (i, light) in scene.lights.iter().enumerate() {
                 let to = light.incident(s.position).to_light;
                 let cos = s.normal.dot(to);
-                if cos <= 0.05 || !term.casts() {
+                if cos <= 0.05 {
                     continue;
                 }
+                let Some(decided) = decide(i, (x, y), &s, cos) else { continue };
                 let origin = s.position + s.normal * eps;
                 let (dir, dist) = match light.kind {
                     LightKind::Directional { direction } => (-direction, f32::INFINITY),
@@ -197,8 +210,7 @@ pub fn terms_vs_rays(scene: &Scene, terms: &[ShadowTerm]) -> (usize, usize) {
                     }
                 };
                 let ray_lit = !trace.occluded(&kage::camera::Ray { origin, dir }, dist);
-                let map_lit = term.lit(s.position, cos) >= 0.5;
-                wrong += usize::from(ray_lit != map_lit);
+                wrong += usize::from(ray_lit != (decided >= 0.5));
                 total += 1;
             }
         }
