@@ -294,7 +294,7 @@ fn a_floor_that_casts_no_shadow_leaves_the_map_to_the_casters_and_still_receives
     assert!((wrong as f64) < 0.005 * total as f64, "{wrong} of {total} shadow-map tests disagree with shadow rays");
     let under_box = Vec3::new(0.0, 0.0, 0.0);
     assert!(
-        ShadowTerm::build(&scene, &scene.lights[0]).lit(under_box, 1.0) < 0.5,
+        ShadowTerm::build(&scene, &scene.lights[0]).lit(under_box, 1.0, kage::shadows::UNKNOWN_RECEIVER) < 0.5,
         "the floor under the box is shadowed"
     );
     // A floor that casts, under everything and lit from above, casts onto
@@ -338,7 +338,7 @@ fn shadow_images_show_each_lights_term_as_shadow_rays_say() {
         assert_eq!(frame.shadows.len(), scene.lights.len());
         let w = scene.width;
         let at = |light: usize, (x, y): (u32, u32)| frame.shadows[light].pixels()[(y * w + x) as usize].x;
-        let (wrong, total) = common::decisions_vs_rays(&scene, |light, pixel, _, _| Some(at(light, pixel)));
+        let (wrong, total) = common::decisions_vs_rays(&scene, |light, q| Some(at(light, q.pixel)));
         eprintln!("{method:?}: {wrong} of {total} shadow-image pixels disagree with shadow rays");
         assert!(total > 10_000 && (wrong as f64) < most * total as f64, "{method:?}: {wrong} of {total}");
         let frames = kage::shading::ObjectFrames::new(&scene);

@@ -72,12 +72,11 @@ fn random_scene(rng: &mut StdRng) -> Scene {
     scene
 }
 
-/// On random scenes of meshes the SLB's decisions equal shadow rays on at
-/// least 99.9% of the visible points the light faces at scale 1. With the
-/// virtual projection space 16 and 64 times wider the depth bias, counted in
-/// texels, grows with the texel and shadows go missing in the texels the
-/// lines cross, where a caster nears its receiver: 0.2% and 4.3% today, held
-/// to those here until the bias no longer scales with the texel.
+/// On random scenes of meshes (cubes and spheres that may pierce the floor
+/// and each other) the SLB's decisions equal shadow rays on at least 99.9% of
+/// the visible points the light faces, at scale 1 and with the virtual
+/// projection space 16 and 64 times wider, where a texel holds a whole
+/// caster and its contact with the floor.
 #[test]
 fn slb_decisions_equal_shadow_rays_on_random_scenes_at_scales_1_16_and_64() {
     let mut rng = StdRng::seed_from_u64(36);
@@ -91,15 +90,7 @@ fn slb_decisions_equal_shadow_rays_on_random_scenes_at_scales_1_16_and_64() {
         }
         eprintln!("scale {scale}: {wrong} of {total} disagree");
         assert!(total > 30_000, "scale {scale}: only {total} tests");
-        let allowed = match scale as u32 {
-            1 => 0.001,
-            16 => 0.003,
-            _ => 0.05,
-        };
-        assert!(
-            (wrong as f64) <= allowed * total as f64,
-            "scale {scale}: {wrong} of {total} disagree with shadow rays"
-        );
+        assert!((wrong as f64) <= 0.001 * total as f64, "scale {scale}: {wrong} of {total} disagree with shadow rays");
     }
 }
 
@@ -179,7 +170,7 @@ fn a_bent_plate_shadows_itself_as_rays_say() {
     let scene = with_method(scene, ShadowMethod::Slb);
     let terms = ShadowTerm::build_all(&scene);
     // Points on the foot behind the upright are in its shadow.
-    let shade = terms[0].lit(Vec3::new(0.0, 0.0, -0.35), 1.0);
+    let shade = terms[0].lit(Vec3::new(0.0, 0.0, -0.35), 1.0, 0);
     assert_eq!(shade, 0.0, "the foot behind the upright is lit");
     let (share, wrong, total) = disagreement(&scene);
     assert!(total > 5000 && share < 0.002, "{wrong} of {total} disagree with shadow rays");

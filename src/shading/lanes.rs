@@ -135,6 +135,8 @@ pub struct Block {
     tangents: [[Vec3; 2]; LANES],
     /// Which lanes hold a pixel that sees something.
     pub live: [bool; LANES],
+    /// The object each lane's triangle belongs to.
+    object: [u32; LANES],
 }
 
 impl Block {
@@ -159,6 +161,7 @@ impl Block {
         self.u.set(i, Vec3::new(uv[0].x, uv[1].x, uv[2].x));
         self.v.set(i, Vec3::new(uv[0].y, uv[1].y, uv[2].y));
         self.material[i] = tri.material;
+        self.object[i] = tri.item.object;
         self.live[i] = true;
         self.textured[i] = k.is_none();
         self.tangents[i] = g.tangents;
@@ -196,6 +199,7 @@ impl Block {
             ke: self.ke.load(),
             shininess: F::new(self.shininess),
             whole,
+            object: self.object,
         }
     }
 
@@ -304,6 +308,7 @@ pub fn shade_run(
         ke: V3::splat(ke),
         shininess: F::splat(n),
         whole: whole_exponent(n),
+        object: [tri.item.object; LANES],
     };
     let row = TriangleRow::new(&g, &rays.line(x0));
     for (b, out) in out.chunks_exact_mut(LANES).enumerate() {
@@ -330,6 +335,8 @@ struct LaneInputs {
     shininess: F,
     /// The exponent shared by all lanes when it is a whole number.
     whole: Option<u32>,
+    /// The object each lane's surface belongs to (the shadow's receiver).
+    object: [u32; LANES],
 }
 
 fn whole_exponent(n: f32) -> Option<u32> {
@@ -494,13 +501,14 @@ impl<'a> Lighting<'a> {
     /// material's coefficients there: the passes' arithmetic, lane for lane,
     /// for points that are not a row of pixels (sub-pixel samples).
     #[must_use]
-    pub fn shade_points(&self, points: &[Option<(&Coefficients, &SurfacePoint)>; LANES]) -> [Components; LANES] {
+    pub fn shade_points(&self, points: &[Option<(&Coefficients, &SurfacePoint, u32)>; LANES]) -> [Components; LANES] {
         let Some(first) = points.iter().flatten().next() else { return [Components::default(); LANES] };
         let (mut k, mut p, mut n, mut v) = (Block::default(), Gather::default(), Gather::default(), Gather::default());
         // Empty lanes repeat the first point (shaded, then dropped).
-        for (i, (k_i, s)) in points.iter().map(|q| q.unwrap_or(*first)).enumerate() {
+        for (i, (k_i, s, object)) in points.iter().map(|q| q.unwrap_or(*first)).enumerate() {
             k.set_coefficients(i, k_i);
             k.live[i] = true;
+            k.object[i] = object;
             p.set(i, s.position);
             n.set(i, s.normal);
             v.set(i, s.to_eye);
@@ -538,7 +546,7 @@ impl<'a> Lighting<'a> {
             let cos_theta = s.n.dot(l);
             let lit = cos_theta.simd_gt(F::ZERO);
             let casts = terms.iter().any(ShadowTerm::casts);
-            let radiance = if casts { radiance.scale(shadow(terms, s, cos_theta)) } else { radiance };
+            let radiance = if casts { radiance.scale(shadow(terms, s, cos_theta, &inp.object)) } else { radiance };
             let r = s.n.scale(cos_theta + cos_theta).sub(l);
             let cos_alpha = r.dot(s.v).max(F::ZERO);
             let spec = power(cos_alpha, inp.shininess, inp.whole);
@@ -555,11 +563,11 @@ impl<'a> Lighting<'a> {
 /// from the light it is irrelevant: the diffuse and specular terms are zero
 /// there anyway).
 #[inline(always)]
-fn shadow(terms: &[ShadowTerm], s: &LaneSurface, cos_theta: F) -> F {
+fn shadow(terms: &[ShadowTerm], s: &LaneSurface, cos_theta: F, receivers: &[u32; LANES]) -> F {
     if !cos_theta.simd_gt(F::ZERO).any() {
         return F::ZERO;
     }
-    ShadowTerm::mean_lit_lanes(terms, [s.p.x, s.p.y, s.p.z], cos_theta)
+    ShadowTerm::mean_lit_lanes(terms, [s.p.x, s.p.y, s.p.z], cos_theta, receivers)
 }
 
 /// `x^n` per lane for x ≥ 0: by repeated squaring when every lane has the same

@@ -33,10 +33,10 @@ pub fn shadow_term_images(scene: &Scene, vb: &VisibilityBuffer, pool: &mut MapPo
                 image.pixels_mut().par_iter_mut().zip(&surfaces).for_each(|(px, surface)| {
                     let lit = match surface {
                         None => 1.0,
-                        Some((p, n)) => {
+                        Some((p, n, object)) => {
                             let cos_theta = n.dot(light.light.incident(*p).to_light);
                             if cos_theta > 0.0 {
-                                term.lit(*p, cos_theta)
+                                term.lit(*p, cos_theta, *object)
                             } else {
                                 0.0
                             }
@@ -52,9 +52,9 @@ pub fn shadow_term_images(scene: &Scene, vb: &VisibilityBuffer, pool: &mut MapPo
     }
 }
 
-/// The position and shading normal of the surface each pixel of `vb` shows
-/// (at the pixel's centre), row by row; `None` where no object is seen.
-fn visible_surfaces(scene: &Scene, vb: &VisibilityBuffer) -> Vec<Option<(Vec3, Vec3)>> {
+/// The position, shading normal and object of the surface each pixel of `vb`
+/// shows (at the pixel's centre), row by row; `None` where no object is seen.
+fn visible_surfaces(scene: &Scene, vb: &VisibilityBuffer) -> Vec<Option<(Vec3, Vec3, u32)>> {
     let w = vb.width() as usize;
     let frames = ObjectFrames::new(scene);
     let rays = scene.camera.pixel_rays(Vec2::new(vb.width() as f32, vb.height() as f32));
@@ -62,12 +62,13 @@ fn visible_surfaces(scene: &Scene, vb: &VisibilityBuffer) -> Vec<Option<(Vec3, V
     out.par_chunks_mut(w.max(1)).enumerate().for_each(|(y, row)| {
         for (x, slot) in row.iter_mut().enumerate() {
             let (x, y) = (x as u32, y as u32);
-            if vb.item(x, y).is_none() {
+            let item = vb.item(x, y);
+            if item.is_none() {
                 continue;
             }
             let ray = rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
             let s = frames.surface_at(scene, vb, x, y, &ray);
-            *slot = Some((s.position, s.normal));
+            *slot = Some((s.position, s.normal, item.object));
         }
     });
     out

@@ -162,7 +162,7 @@ impl SubpixelShading {
         lanes.for_each(|(acc, surfaces)| {
             let lit = |i: usize| {
                 let s = surfaces.get(i)?.as_ref()?;
-                receivers.is_none_or(|r| r[s.object as usize]).then_some((&s.coefficients, &s.point))
+                receivers.is_none_or(|r| r[s.object as usize]).then_some((&s.coefficients, &s.point, s.object))
             };
             let points = std::array::from_fn(lit);
             for ((sum, added), point) in acc.iter_mut().zip(lighting.shade_points(&points)).zip(points) {

@@ -76,7 +76,7 @@ pub fn composite(
         layers.par_iter_mut().filter(|l| light.only.as_ref().is_none_or(|o| o.contains(&l.object))).for_each(|l| {
             let s = &l.surface;
             let cos = s.normal.dot(light.incident(s.position).to_light);
-            let shadow = if cos > 0.0 { ShadowTerm::mean_lit(&terms, s.position, cos) } else { 1.0 };
+            let shadow = if cos > 0.0 { ShadowTerm::mean_lit(&terms, s.position, cos, l.object as u32) } else { 1.0 };
             phong::add_light(&mut l.lit, light, &l.k, s, shadow);
         });
         terms.into_iter().for_each(|t| pool.recycle(t));

@@ -20,6 +20,13 @@ use crate::visibility::{rasterize_casters, VisibilityBuffer, Workers};
 /// shadows off their casters.
 const MAX_SLOPE: f32 = 8.0;
 
+/// The constant bias, in texels, against surfaces of other objects than the
+/// receiver ([`Located::z_other`]).
+#[inline]
+fn other_bias(settings: &ShadowSettings) -> f32 {
+    settings.bias / settings.scale.max(1.0)
+}
+
 /// A point located in a map: texel coordinates and the depth limit.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Located {
@@ -29,6 +36,12 @@ pub struct Located {
     pub v: f32,
     /// Reversed depth a surface must exceed to hide the point.
     pub z_limit: f32,
+    /// Reversed depth a surface of another object than the point's must
+    /// exceed to hide it, where that surface's depth is known at the point
+    /// (a silhouette line's): the constant bias of the map drawn without the
+    /// virtual projection space's scale, and no slope bias, which only the
+    /// receiver's own surface, sampled away from the point, needs.
+    pub z_other: f32,
 }
 
 /// Eight points located in a map ([`DepthMap::locate_lanes`]).
@@ -42,6 +55,8 @@ pub struct LocatedLanes {
     pub v: f32x8,
     /// Depth limits.
     pub z_limit: f32x8,
+    /// Depth limits against other objects' surfaces ([`Located::z_other`]).
+    pub z_other: f32x8,
 }
 
 /// Depths seen from a light through one camera.
@@ -138,16 +153,23 @@ impl DepthMap {
         let c = cos_theta.clamp(1e-3, 1.0);
         let tan = ((1.0 - c * c).sqrt() / c).min(MAX_SLOPE);
         let limit = d - texel * (settings.bias + settings.slope * tan * reach);
-        // Compared in the stored reversed depth, which falls with distance, so
-        // one division per lookup instead of one per texel.
-        let z_limit = if self.ortho {
-            ((self.far - limit) / (self.far - self.near)).max(0.0)
+        let z_limit = self.reversed(limit)?;
+        let z_other = self.reversed(d - texel * other_bias(settings)).unwrap_or(z_limit);
+        Some(Located { u, v, z_limit, z_other })
+    }
+
+    /// Distance `limit` along the light's axis as the stored reversed depth
+    /// (which falls with distance: one division per lookup instead of one
+    /// per texel); `None` for a perspective map's point at the light.
+    #[inline]
+    fn reversed(&self, limit: f32) -> Option<f32> {
+        if self.ortho {
+            Some(((self.far - limit) / (self.far - self.near)).max(0.0))
         } else if limit > self.near {
-            self.near / limit
+            Some(self.near / limit)
         } else {
-            return None; // the receiver is at the light
-        };
-        Some(Located { u, v, z_limit })
+            None
+        }
     }
 
     /// The reversed depth the map holds at texel `(x, y)` (0: nothing).
@@ -172,7 +194,7 @@ impl DepthMap {
         // A wider filter reaches texels further from the receiver's own, where a
         // sloped receiver is deeper: scale the slope term with the filter radius.
         let reach = 1.0 + (k - 1) as f32 * 0.5;
-        let Some(Located { u, v, z_limit }) = self.locate(p, cos_theta, settings, reach) else { return 1.0 };
+        let Some(Located { u, v, z_limit, .. }) = self.locate(p, cos_theta, settings, reach) else { return 1.0 };
         let (cu, cv) = (u as i32, v as i32);
         let last = self.resolution as i32 - 1;
         let depth = self.depth.depths();
@@ -217,14 +239,17 @@ impl DepthMap {
         let c = cos_theta.max(f32x8::splat(1e-3)).min(f32x8::ONE);
         let tan = ((f32x8::ONE - c * c).sqrt() / c).min(f32x8::splat(MAX_SLOPE));
         let bias = f32x8::splat(settings.bias) + tan * f32x8::splat(settings.slope * reach);
-        let limit = d - texel * bias;
-        let z_limit = if self.ortho {
-            ((f32x8::splat(self.far) - limit) / f32x8::splat(self.far - self.near)).max(zero)
-        } else {
-            let near = f32x8::splat(self.near);
-            limit.simd_gt(near).select(near / limit, f32x8::splat(f32::INFINITY))
+        let reversed = |limit: f32x8| {
+            if self.ortho {
+                ((f32x8::splat(self.far) - limit) / f32x8::splat(self.far - self.near)).max(zero)
+            } else {
+                let near = f32x8::splat(self.near);
+                limit.simd_gt(near).select(near / limit, f32x8::splat(f32::INFINITY))
+            }
         };
-        LocatedLanes { inside, u, v, z_limit }
+        let z_limit = reversed(d - texel * bias);
+        let z_other = reversed(d - texel * f32x8::splat(other_bias(settings)));
+        LocatedLanes { inside, u, v, z_limit, z_other }
     }
 
     /// [`DepthMap::lit`] for eight points at once (`p` as x, y and z lanes): the
@@ -234,7 +259,7 @@ impl DepthMap {
     pub fn lit_lanes(&self, p: [f32x8; 3], cos_theta: f32x8, settings: &ShadowSettings) -> f32x8 {
         let k = settings.pcf.max(1) as i32;
         let reach = 1.0 + (k - 1) as f32 * 0.5;
-        let LocatedLanes { inside, u, v, z_limit } = self.locate_lanes(p, cos_theta, settings, reach);
+        let LocatedLanes { inside, u, v, z_limit, .. } = self.locate_lanes(p, cos_theta, settings, reach);
         let zero = f32x8::ZERO;
         let depth = self.depth.depths();
         let res = self.resolution as usize;

@@ -16,6 +16,7 @@ use rayon::prelude::*;
 use wide::f32x8;
 
 pub use map::{DepthMap, Located, LocatedLanes};
+pub use slb::region::UNKNOWN_RECEIVER;
 pub use slb::SlbMap;
 
 use crate::scene::{GeometryKey, Light, LightKind, Scene, ShadowMethod, ShadowSettings};
@@ -144,21 +145,25 @@ impl ShadowTerm {
         !matches!(self, ShadowTerm::Unshadowed)
     }
 
-    /// `shadow_i` at world point `p` with N·L = `cos_theta`: 1 lit, 0 in shadow.
+    /// `shadow_i` at world point `p` of object `receiver` (its index in the
+    /// scene, or [`UNKNOWN_RECEIVER`]: the silhouette-line buffer then holds
+    /// every caster to the bias of the receiver's own surface) with N·L =
+    /// `cos_theta`: 1 lit, 0 in shadow.
     #[must_use]
-    pub fn lit(&self, p: Vec3, cos_theta: f32) -> f32 {
+    pub fn lit(&self, p: Vec3, cos_theta: f32, receiver: u32) -> f32 {
         match self {
             ShadowTerm::Unshadowed => 1.0,
             ShadowTerm::Map(map, s) => map.lit(p, cos_theta, s),
             ShadowTerm::Cube(faces, centre, s) => faces[cube_face(p - *centre)].lit(p, cos_theta, s),
-            ShadowTerm::Slb(map, s) => map.lit(p, cos_theta, s),
-            ShadowTerm::SlbCube(faces, centre, s) => faces[cube_face(p - *centre)].lit(p, cos_theta, s),
+            ShadowTerm::Slb(map, s) => map.lit(p, cos_theta, s, receiver),
+            ShadowTerm::SlbCube(faces, centre, s) => faces[cube_face(p - *centre)].lit(p, cos_theta, s, receiver),
         }
     }
 
-    /// [`ShadowTerm::lit`] for eight points (x, y, z lanes) with N·L `cos_theta`.
+    /// [`ShadowTerm::lit`] for eight points (x, y, z lanes) of objects
+    /// `receivers` with N·L `cos_theta`.
     #[must_use]
-    pub fn lit_lanes(&self, p: [f32x8; 3], cos_theta: f32x8) -> f32x8 {
+    pub fn lit_lanes(&self, p: [f32x8; 3], cos_theta: f32x8, receivers: &[u32; 8]) -> f32x8 {
         match self {
             ShadowTerm::Unshadowed => f32x8::ONE,
             ShadowTerm::Map(map, s) => map.lit_lanes(p, cos_theta, s),
@@ -172,10 +177,10 @@ impl ShadowTerm {
                 let c = cos_theta.to_array();
                 f32x8::new(std::array::from_fn(|i| faces[face[i]].lit(Vec3::new(x[i], y[i], z[i]), c[i], s)))
             }
-            ShadowTerm::Slb(map, s) => map.lit_lanes(p, cos_theta, s),
+            ShadowTerm::Slb(map, s) => map.lit_lanes(p, cos_theta, s, receivers),
             ShadowTerm::SlbCube(..) => {
                 let (x, y, z, c) = (p[0].to_array(), p[1].to_array(), p[2].to_array(), cos_theta.to_array());
-                f32x8::new(std::array::from_fn(|i| self.lit(Vec3::new(x[i], y[i], z[i]), c[i])))
+                f32x8::new(std::array::from_fn(|i| self.lit(Vec3::new(x[i], y[i], z[i]), c[i], receivers[i])))
             }
         }
     }
@@ -183,22 +188,22 @@ impl ShadowTerm {
     /// The mean of `terms`' [`ShadowTerm::lit`] (1 when there are none): the
     /// shadow term of an area light from its jittered samples' maps.
     #[must_use]
-    pub fn mean_lit(terms: &[ShadowTerm], p: Vec3, cos_theta: f32) -> f32 {
+    pub fn mean_lit(terms: &[ShadowTerm], p: Vec3, cos_theta: f32, receiver: u32) -> f32 {
         match terms {
             [] => 1.0,
-            [one] => one.lit(p, cos_theta),
-            _ => terms.iter().map(|t| t.lit(p, cos_theta)).sum::<f32>() / terms.len() as f32,
+            [one] => one.lit(p, cos_theta, receiver),
+            _ => terms.iter().map(|t| t.lit(p, cos_theta, receiver)).sum::<f32>() / terms.len() as f32,
         }
     }
 
     /// [`ShadowTerm::mean_lit`] for eight points.
     #[must_use]
-    pub fn mean_lit_lanes(terms: &[ShadowTerm], p: [f32x8; 3], cos_theta: f32x8) -> f32x8 {
+    pub fn mean_lit_lanes(terms: &[ShadowTerm], p: [f32x8; 3], cos_theta: f32x8, receivers: &[u32; 8]) -> f32x8 {
         match terms {
             [] => f32x8::ONE,
-            [one] => one.lit_lanes(p, cos_theta),
+            [one] => one.lit_lanes(p, cos_theta, receivers),
             _ => {
-                let sum = terms.iter().fold(f32x8::ZERO, |acc, t| acc + t.lit_lanes(p, cos_theta));
+                let sum = terms.iter().fold(f32x8::ZERO, |acc, t| acc + t.lit_lanes(p, cos_theta, receivers));
                 sum * f32x8::splat(1.0 / terms.len() as f32)
             }
         }
@@ -664,9 +669,9 @@ mod tests {
                     };
                     let lanes: [(Vec3, f32); 8] = std::array::from_fn(|i| point(i as u32));
                     let p = [0, 1, 2].map(|a| f32x8::new(lanes.map(|(p, _)| p[a])));
-                    let got = term.lit_lanes(p, f32x8::new(lanes.map(|(_, c)| c))).to_array();
+                    let got = term.lit_lanes(p, f32x8::new(lanes.map(|(_, c)| c)), &[UNKNOWN_RECEIVER; 8]).to_array();
                     for (&(p, c), g) in lanes.iter().zip(got) {
-                        let want = term.lit(p, c);
+                        let want = term.lit(p, c, UNKNOWN_RECEIVER);
                         differ += usize::from((want - g).abs() > 1e-6);
                         shadowed += usize::from(want < 1.0);
                         total += 1;

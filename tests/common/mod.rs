@@ -169,18 +169,28 @@ pub fn view_distance(cam: &Camera, d: f32) -> f32 {
 /// compared) over the visible pixels' surfaces (at pixel centres) facing a
 /// light that casts shadows.
 pub fn terms_vs_rays(scene: &Scene, terms: &[ShadowTerm]) -> (usize, usize) {
-    decisions_vs_rays(scene, |light, _, s, cos| terms[light].casts().then(|| terms[light].lit(s.position, cos)))
+    decisions_vs_rays(scene, |light, at| {
+        terms[light].casts().then(|| terms[light].lit(at.surface.position, at.cos, at.object))
+    })
 }
 
-/// A shadow decision against shadow rays: per visible pixel (its centre's
-/// surface, as the renderer reconstructs it) and light whose N·L there is
-/// above 0.05, `decide(light, (x, y), surface, N·L)` (`None`: not compared)
+/// A visible point a shadow decision is asked for.
+pub struct ShadowQuery<'a> {
+    /// Its pixel.
+    pub pixel: (u32, u32),
+    /// The surface at the pixel's centre, as the renderer reconstructs it.
+    pub surface: &'a kage::shading::SurfacePoint,
+    /// Its object.
+    pub object: u32,
+    /// N·L there.
+    pub cos: f32,
+}
+
+/// A shadow decision against shadow rays: per visible pixel and light whose
+/// N·L there is above 0.05, `decide(light, query)` (`None`: not compared)
 /// read as lit when ≥ 0.5, against whether a ray from the surface to the
 /// light reaches it. Returns (misclassified, compared).
-pub fn decisions_vs_rays(
-    scene: &Scene,
-    decide: impl Fn(usize, (u32, u32), &kage::shading::SurfacePoint, f32) -> Option<f32>,
-) -> (usize, usize) {
+pub fn decisions_vs_rays(scene: &Scene, mut decide: impl FnMut(usize, &ShadowQuery) -> Option<f32>) -> (usize, usize) {
     let frame = kage::render(scene, &kage::RenderOptions::default()).expect("render");
     let trace = kage::raytrace::TraceScene::new(scene);
     let frames = kage::shading::ObjectFrames::new(scene);
@@ -200,7 +210,8 @@ pub fn decisions_vs_rays(
                 if cos <= 0.05 {
                     continue;
                 }
-                let Some(decided) = decide(i, (x, y), &s, cos) else { continue };
+                let query = ShadowQuery { pixel: (x, y), surface: &s, object: item.object, cos };
+                let Some(decided) = decide(i, &query) else { continue };
                 let origin = s.position + s.normal * eps;
                 let (dir, dist) = match light.kind {
                     LightKind::Directional { direction } => (-direction, f32::INFINITY),

@@ -49,6 +49,8 @@ pub struct Layer {
     pub depth: TexelDepth,
     /// How many surfaces it stands for.
     pub count: i32,
+    /// The object it belongs to.
+    pub object: u32,
 }
 
 /// What one edge texel holds.
@@ -302,7 +304,7 @@ impl SilhouetteLineBuffer {
                         if t.covers_centre(x, y) {
                             let texel = k as u32;
                             let whole = t.covers_texel(x, y);
-                            out.push((texel, Layer { depth: t.depth(x, y), count: 1 }, whole));
+                            out.push((texel, Layer { depth: t.depth(x, y), count: 1, object: t.object }, whole));
                         }
                         k += 1;
                     }
@@ -335,7 +337,7 @@ impl SilhouetteLineBuffer {
             for rec in &records[r..r_end] {
                 if rec.exact_centre_inside != rec.line.centre_inside {
                     let count = if rec.line.centre_inside { 1 } else { -1 };
-                    here.push(Layer { depth: rec.line.depth, count });
+                    here.push(Layer { depth: rec.line.depth, count, object: rec.line.object });
                 }
             }
             // §3.3.3: a triangle over the whole texel hides what lies behind it

@@ -32,36 +32,115 @@ use super::buffer::{Entry, Layer};
 use super::line::SilhouetteLine;
 use super::walk::Major;
 
-/// Whether a caster surface nearer the light than reversed depth `z_limit`
-/// lies over `(mx, my)` in the texel of `entry` (the receiver at `(mx, my)`
-/// is then in shadow).
-#[must_use]
-pub fn covered(entry: &Entry<'_>, mx: f32, my: f32, z_limit: f32, bits: u32) -> bool {
-    surfaces_over(entry, mx, my, z_limit, bits) > 0
+/// The receiver of a lookup whose object is not known: every surface is held
+/// to the full bias ([`DepthLimits::own`]).
+pub const UNKNOWN_RECEIVER: u32 = u32::MAX;
+
+/// The reversed depths a caster surface must exceed to hide a receiver: one
+/// for surfaces of the receiver's own object (with the slope bias its own
+/// surface needs, sampled away from the point), one for every other object's.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DepthLimits {
+    /// The receiver's object ([`UNKNOWN_RECEIVER`]: not known).
+    pub receiver: u32,
+    /// The limit for the receiver's own surfaces.
+    pub own: f32,
+    /// The limit for other objects' surfaces.
+    pub other: f32,
 }
 
-/// How many caster surfaces nearer the light than `z_limit` lie over
-/// `(mx, my)`: the layers over the centre, plus one per line crossed into its
-/// polygon on the way from the centre, minus one per line crossed out.
+impl DepthLimits {
+    /// One limit for every surface (the receiver unknown).
+    #[must_use]
+    pub const fn uniform(z_limit: f32) -> DepthLimits {
+        DepthLimits { receiver: UNKNOWN_RECEIVER, own: z_limit, other: z_limit }
+    }
+
+    /// The limit for a surface of `object`.
+    #[inline]
+    #[must_use]
+    pub fn of(&self, object: u32) -> f32 {
+        if object == self.receiver || self.receiver == UNKNOWN_RECEIVER {
+            self.own
+        } else {
+            self.other
+        }
+    }
+}
+
+/// Whether a caster surface nearer the light than `limits` allow lies over
+/// `(mx, my)` in the texel of `entry` (the receiver at `(mx, my)` is then in
+/// shadow).
 #[must_use]
-pub fn surfaces_over(entry: &Entry<'_>, mx: f32, my: f32, z_limit: f32, bits: u32) -> i32 {
+pub fn covered(entry: &Entry<'_>, mx: f32, my: f32, limits: &DepthLimits, bits: u32) -> bool {
+    surfaces_over(entry, mx, my, limits, bits) > 0
+}
+
+/// How many caster surfaces nearer the light than `limits` allow lie over
+/// `(mx, my)`: per object, the layers over the centre, plus one per line
+/// crossed into its polygon on the way from the centre, minus one per line
+/// crossed out — once with every surface counted (how many of the object's
+/// surfaces lie over the point at all) and once with only those nearer than
+/// the limit; an object adds the smaller of the two, and nothing where it
+/// does not reach the point. (An object that pierces the receiver's depth
+/// inside the texel can be nearer at the centre and farther where the way
+/// leaves it; counted by depth alone, that one surface would stay over a
+/// point it does not reach.)
+#[must_use]
+pub fn surfaces_over(entry: &Entry<'_>, mx: f32, my: f32, limits: &DepthLimits, bits: u32) -> i32 {
+    let mut tally = ObjectTally::default();
     // A layer's depth at the centre it covers (as a shadow map samples it); a
     // line's where the way crosses it (its edge's own depth): never a plane
     // carried past the polygon it belongs to.
-    let nearer = |layer: &Layer| layer.depth.at(0.5, 0.5) > z_limit;
-    let mut count: i32 = entry.layers.iter().filter(|l| nearer(l)).map(|l| l.count).sum();
+    for layer in entry.layers {
+        let nearer = layer.depth.at(0.5, 0.5) > limits.of(layer.object);
+        tally.add(layer.object, layer.count, nearer);
+    }
     for line in entry.lines {
         let inside = line.strictly_inside(mx, my, bits);
         if inside == line.centre_inside {
             continue;
         }
         if let Some((x, y)) = crossing_from_centre(line, mx, my, bits) {
-            if line.depth.at(x, y) > z_limit {
-                count += if inside { 1 } else { -1 };
-            }
+            let nearer = line.depth.at(x, y) > limits.of(line.object);
+            tally.add(line.object, if inside { 1 } else { -1 }, nearer);
         }
     }
-    count
+    tally.surfaces()
+}
+
+/// Objects an edge texel holds at most that [`ObjectTally`] keeps apart;
+/// beyond them, the rest share one tally.
+const TALLIED_OBJECTS: usize = 8;
+
+/// Per object: surfaces over the point, all of them and the nearer ones.
+#[derive(Default)]
+struct ObjectTally {
+    objects: [u32; TALLIED_OBJECTS],
+    all: [i32; TALLIED_OBJECTS],
+    nearer: [i32; TALLIED_OBJECTS],
+    len: usize,
+}
+
+impl ObjectTally {
+    fn add(&mut self, object: u32, count: i32, nearer: bool) {
+        let k = match self.objects[..self.len].iter().position(|&o| o == object) {
+            Some(k) => k,
+            None if self.len < TALLIED_OBJECTS => {
+                self.objects[self.len] = object;
+                self.len += 1;
+                self.len - 1
+            }
+            None => TALLIED_OBJECTS - 1,
+        };
+        self.all[k] += count;
+        self.nearer[k] += if nearer { count } else { 0 };
+    }
+
+    /// The nearer surfaces over the point, of the objects that reach it.
+    fn surfaces(&self) -> i32 {
+        (0..self.len).filter(|&k| self.all[k] > 0).map(|k| self.nearer[k].clamp(0, self.all[k])).sum()
+    }
 }
 
 /// Where the way from the texel's centre to `(mx, my)`, which ends on the
@@ -304,7 +383,8 @@ mod tests {
         for bits in [8, 16] {
             for vertex in [false, true] {
                 for n in if vertex { 2..=3 } else { 1..=3 } {
-                    let t = tally(bits, n..=n, vertex, |e, mx, my| covered(e, mx, my, 0.5, bits));
+                    let t =
+                        tally(bits, n..=n, vertex, |e, mx, my| covered(e, mx, my, &DepthLimits::uniform(0.5), bits));
                     assert_eq!(t.wrong, 0, "k = {bits}, {n} lines, vertex {vertex}: {} of {}", t.wrong, t.points);
                 }
             }

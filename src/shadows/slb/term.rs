@@ -9,7 +9,7 @@ use wide::f32x8;
 
 use super::buffer::SilhouetteLineBuffer;
 use super::light::light_triangles;
-use super::region::covered;
+use super::region::{covered, DepthLimits};
 use crate::camera::Camera;
 use crate::scene::{Scene, ShadowSettings};
 use crate::shadows::map::{DepthMap, Located, LocatedLanes};
@@ -47,37 +47,51 @@ impl SlbMap {
         SlbMap { map, slb, solids }
     }
 
-    /// `shadow_i` at `p` with N·L = `cos_theta`: 1 lit, 0 in shadow.
+    /// `shadow_i` at `p`, a point of object `receiver` (an index into the
+    /// scene's objects; [`UNKNOWN_RECEIVER`] when not known), with N·L =
+    /// `cos_theta`: 1 lit, 0 in shadow. Another object's silhouette is held
+    /// to a depth bias that does not grow with the texel; the receiver's own,
+    /// and the map, to the full bias.
+    ///
+    /// [`UNKNOWN_RECEIVER`]: super::region::UNKNOWN_RECEIVER
     #[must_use]
-    pub fn lit(&self, p: Vec3, cos_theta: f32, settings: &ShadowSettings) -> f32 {
+    pub fn lit(&self, p: Vec3, cos_theta: f32, settings: &ShadowSettings, receiver: u32) -> f32 {
         match self.map.locate(p, cos_theta, settings, 1.0) {
-            Some(Located { u, v, z_limit }) => self.lit_at(u, v, z_limit),
+            Some(Located { u, v, z_limit, z_other }) => {
+                self.lit_at(u, v, &DepthLimits { receiver, own: z_limit, other: z_other })
+            }
             None => 1.0,
         }
     }
 
-    /// [`SlbMap::lit`] for eight points: located as vectors, decided lane by
-    /// lane.
+    /// [`SlbMap::lit`] for eight points, of objects `receivers`: located as
+    /// vectors, decided lane by lane.
     #[must_use]
-    pub fn lit_lanes(&self, p: [f32x8; 3], cos_theta: f32x8, settings: &ShadowSettings) -> f32x8 {
-        let LocatedLanes { inside, u, v, z_limit } = self.map.locate_lanes(p, cos_theta, settings, 1.0);
+    pub fn lit_lanes(&self, p: [f32x8; 3], cos_theta: f32x8, settings: &ShadowSettings, receivers: &[u32; 8]) -> f32x8 {
+        let LocatedLanes { inside, u, v, z_limit, z_other } = self.map.locate_lanes(p, cos_theta, settings, 1.0);
         let mask = inside.to_bitmask();
-        let (u, v, z) = (u.to_array(), v.to_array(), z_limit.to_array());
-        f32x8::new(std::array::from_fn(|i| if mask >> i & 1 == 1 { self.lit_at(u[i], v[i], z[i]) } else { 1.0 }))
+        let (u, v, own, other) = (u.to_array(), v.to_array(), z_limit.to_array(), z_other.to_array());
+        f32x8::new(std::array::from_fn(|i| {
+            if mask >> i & 1 == 1 {
+                self.lit_at(u[i], v[i], &DepthLimits { receiver: receivers[i], own: own[i], other: other[i] })
+            } else {
+                1.0
+            }
+        }))
     }
 
     /// The term at texel coordinates `(u, v)` (inside the map) for a receiver
-    /// whose depth limit is `z_limit`: the map where no silhouette crosses the
-    /// texel, the lines where one does.
+    /// held to `limits`: the map where no silhouette crosses the texel, the
+    /// lines where one does.
     #[inline]
-    fn lit_at(&self, u: f32, v: f32, z_limit: f32) -> f32 {
+    fn lit_at(&self, u: f32, v: f32, limits: &DepthLimits) -> f32 {
         let (x, y) = (u as u32, v as u32);
         let hidden = match self.slb.entry(x, y) {
             Some(entry) => {
-                covered(&entry, u - x as f32, v - y as f32, z_limit, self.slb.bits())
-                    || (self.solids && self.map.texel_depth(x, y) > z_limit)
+                covered(&entry, u - x as f32, v - y as f32, limits, self.slb.bits())
+                    || (self.solids && self.map.texel_depth(x, y) > limits.own)
             }
-            None => self.map.texel_depth(x, y) > z_limit,
+            None => self.map.texel_depth(x, y) > limits.own,
         };
         if hidden {
             0.0
