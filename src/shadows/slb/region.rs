@@ -28,7 +28,7 @@
 //! past its polygon), which is the per-line depth test that lets an object
 //! shadow itself.
 
-use super::buffer::{Entry, Layer};
+use super::buffer::Entry;
 use super::line::SilhouetteLine;
 use super::walk::Major;
 
