@@ -294,7 +294,7 @@ fn a_floor_that_casts_no_shadow_leaves_the_map_to_the_casters_and_still_receives
     assert!((wrong as f64) < 0.005 * total as f64, "{wrong} of {total} shadow-map tests disagree with shadow rays");
     let under_box = Vec3::new(0.0, 0.0, 0.0);
     assert!(
-        ShadowTerm::build(&scene, &scene.lights[0]).lit(under_box, 1.0, kage::shadows::UNKNOWN_RECEIVER) < 0.5,
+        ShadowTerm::build(&scene, &scene.lights[0]).lit(under_box, 1.0, &kage::shadows::Receiver::UNKNOWN) < 0.5,
         "the floor under the box is shadowed"
     );
     // A floor that casts, under everything and lit from above, casts onto

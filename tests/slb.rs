@@ -1,6 +1,7 @@
 //! The silhouette-line buffer (seed 000) against shadow rays through the BVH:
 //! the example scenes, random scenes of meshes at scales 1, 16 and 64, a
-//! closed mesh's lines, and an object shadowing itself.
+//! closed mesh's lines, an object shadowing itself, and the antialiased term
+//! against 16 × 16 shadow rays per pixel; the scene file's keys.
 
 mod common;
 
@@ -170,8 +171,89 @@ fn a_bent_plate_shadows_itself_as_rays_say() {
     let scene = with_method(scene, ShadowMethod::Slb);
     let terms = ShadowTerm::build_all(&scene);
     // Points on the foot behind the upright are in its shadow.
-    let shade = terms[0].lit(Vec3::new(0.0, 0.0, -0.35), 1.0, 0);
+    let shade = terms[0].lit(Vec3::new(0.0, 0.0, -0.35), 1.0, &kage::shadows::Receiver::of_object(0));
     assert_eq!(shade, 0.0, "the foot behind the upright is lit");
     let (share, wrong, total) = disagreement(&scene);
     assert!(total > 5000 && share < 0.002, "{wrong} of {total} disagree with shadow rays");
+}
+
+/// RMSE against `truth` over the pixels it has a value for, and how many.
+fn rmse(image: &kage::image::LinearImage, pixels: &[(u32, u32, u32)], truth: &[Option<f32>]) -> (f64, usize) {
+    let w = image.width();
+    let (sum, n) = pixels.iter().zip(truth).fold((0.0, 0), |(sum, n), (&(x, y, _), t)| match t {
+        Some(t) => {
+            let d = f64::from(image.pixels()[(y * w + x) as usize].x - t);
+            (sum + d * d, n + 1)
+        }
+        None => (sum, n),
+    });
+    ((sum / n.max(1) as f64).sqrt(), n)
+}
+
+/// The antialiased SLB term against 16 × 16 shadow rays per pixel, on the
+/// pixels along shadow boundaries (where the 0/1 term changes within a
+/// pixel's 3 × 3 neighbourhood, on one object): its RMSE is at most a third
+/// of the 0/1 term's.
+#[test]
+fn the_antialiased_boundary_is_a_third_as_far_from_the_ray_traced_coverage() {
+    let mut scenes: Vec<Scene> = common::shadow_example_scenes()
+        .into_iter()
+        .filter(|(name, _)| ["spotlights", "cad-ortho"].contains(name))
+        .map(|(_, s)| s)
+        .collect();
+    let mut rng = StdRng::seed_from_u64(7);
+    scenes.extend((0..2).map(|_| random_scene(&mut rng)));
+    let (mut sharp_total, mut smooth_total, mut count) = (0.0, 0.0, 0);
+    for scene in scenes {
+        let scene = with_method(scene, ShadowMethod::Slb);
+        let options = kage::RenderOptions { shadow_images: true, ..kage::RenderOptions::default() };
+        let images = |antialias: bool| {
+            let mut s = scene.clone();
+            s.lights.iter_mut().for_each(|l| l.shadow.antialias = antialias);
+            kage::render(&s, &options).unwrap()
+        };
+        let (sharp, smooth) = (images(false), images(true));
+        let (w, h) = (scene.width, scene.height);
+        for light in 0..scene.lights.len() {
+            let hard = &sharp.shadows[light];
+            let value = |x: u32, y: u32| hard.pixels()[(y * w + x) as usize].x;
+            let mut pixels = Vec::new();
+            for y in 1..h - 1 {
+                for x in 1..w - 1 {
+                    let item = sharp.visibility.item(x, y);
+                    let around = (y - 1..=y + 1).flat_map(|v| (x - 1..=x + 1).map(move |u| (u, v)));
+                    let (lo, hi) =
+                        around.fold((1.0f32, 0.0f32), |(lo, hi), (u, v)| (lo.min(value(u, v)), hi.max(value(u, v))));
+                    if !item.is_none() && lo < hi {
+                        pixels.push((x, y, item.object));
+                    }
+                }
+            }
+            let truth = common::ray_traced_shadow(&scene, light, &pixels, 16);
+            let (a, n) = rmse(hard, &pixels, &truth);
+            let (b, _) = rmse(&smooth.shadows[light], &pixels, &truth);
+            eprintln!("light {light}: {n} boundary pixels, RMSE 0/1 {a:.4}, antialiased {b:.4}");
+            (sharp_total, smooth_total, count) =
+                (sharp_total + a * a * n as f64, smooth_total + b * b * n as f64, count + n);
+        }
+    }
+    let (sharp, smooth) = ((sharp_total / count as f64).sqrt(), (smooth_total / count as f64).sqrt());
+    eprintln!("all: {count} pixels, RMSE 0/1 {sharp:.4}, antialiased {smooth:.4} ({:.2}x)", smooth / sharp);
+    assert!(count > 2000, "only {count} boundary pixels");
+    assert!(smooth <= sharp / 3.0, "antialiased RMSE {smooth:.4} vs 0/1 {sharp:.4}");
+}
+
+/// A scene file's `shadow` table sets the SLB's keys, each to what it says.
+#[test]
+fn a_scene_file_sets_the_slb_keys() {
+    let text = "[[light]]\ntype = \"directional\"\ndirection = [0, -1, 0]\n\
+                shadow = { method = \"slb\", bits = 12, scale = 4, antialias = false }\n\
+                [[light]]\ntype = \"directional\"\ndirection = [0, -1, 0]\nshadow = { method = \"slb\" }\n\
+                [[object]]\nshape = \"cube\"\n";
+    let fs = kage::scene::load::FileSystem { base: std::env::temp_dir() };
+    let scene =
+        kage::scene::file::SceneFile::parse(text, std::path::Path::new("slb.toml")).unwrap().build(&fs).unwrap();
+    let (set, default) = (scene.lights[0].shadow, scene.lights[1].shadow);
+    assert_eq!((set.method, set.bits, set.scale, set.antialias), (ShadowMethod::Slb, 12, 4.0, false));
+    assert_eq!((default.bits, default.scale, default.antialias, default.resolution), (8, 1.0, true, 1024));
 }

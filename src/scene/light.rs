@@ -146,6 +146,10 @@ pub struct ShadowSettings {
     /// light's view drawn this many times wider into the same map (seed 000
     /// §4.4), so one map holds a scene that many times larger.
     pub scale: f32,
+    /// Silhouette-line buffer: average the term over each pixel's footprint
+    /// on the receiver where a shadow's edge passes near, so the edge is
+    /// antialiased (off: lit or not at the pixel's centre).
+    pub antialias: bool,
 }
 
 impl Default for ShadowSettings {
@@ -209,9 +213,11 @@ impl ShadowSettings {
         samples: 8,
         bits: 8,
         scale: 1.0,
+        antialias: true,
     };
 
-    /// The silhouette-line buffer's defaults: a 1024² map, 8-bit lines, scale 1.
+    /// The silhouette-line buffer's defaults: a 1024² map, 8-bit lines, scale
+    /// 1, antialiased edges.
     pub const SLB: ShadowSettings =
         ShadowSettings { method: ShadowMethod::Slb, resolution: 1024, by_need: false, ..ShadowSettings::MAP };
 

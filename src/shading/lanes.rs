@@ -15,7 +15,7 @@ use super::phong::{Coefficients, Component, ComponentSet, Components};
 use super::surface::{PreparedTriangle, SurfacePoint, TriangleGeometry};
 use crate::camera::PixelRays;
 use crate::scene::{Falloff, Light, LightKind};
-use crate::shadows::ShadowTerm;
+use crate::shadows::{ReceiverLanes, ShadowTerm};
 
 /// Pixels shaded together.
 pub const LANES: usize = 8;
@@ -339,6 +339,14 @@ struct LaneInputs {
     object: [u32; LANES],
 }
 
+impl LaneInputs {
+    /// The lanes' receivers of shadows: their objects and triangles' planes.
+    #[inline(always)]
+    fn receivers(&self) -> ReceiverLanes {
+        ReceiverLanes { objects: self.object, planes: [self.geometric.x, self.geometric.y, self.geometric.z] }
+    }
+}
+
 fn whole_exponent(n: f32) -> Option<u32> {
     (n.fract() == 0.0 && (1.0..=4096.0).contains(&n)).then_some(n as u32)
 }
@@ -546,7 +554,7 @@ impl<'a> Lighting<'a> {
             let cos_theta = s.n.dot(l);
             let lit = cos_theta.simd_gt(F::ZERO);
             let casts = terms.iter().any(ShadowTerm::casts);
-            let radiance = if casts { radiance.scale(shadow(terms, s, cos_theta, &inp.object)) } else { radiance };
+            let radiance = if casts { radiance.scale(shadow(terms, s, cos_theta, &inp.receivers())) } else { radiance };
             let r = s.n.scale(cos_theta + cos_theta).sub(l);
             let cos_alpha = r.dot(s.v).max(F::ZERO);
             let spec = power(cos_alpha, inp.shininess, inp.whole);
@@ -563,7 +571,7 @@ impl<'a> Lighting<'a> {
 /// from the light it is irrelevant: the diffuse and specular terms are zero
 /// there anyway).
 #[inline(always)]
-fn shadow(terms: &[ShadowTerm], s: &LaneSurface, cos_theta: F, receivers: &[u32; LANES]) -> F {
+fn shadow(terms: &[ShadowTerm], s: &LaneSurface, cos_theta: F, receivers: &ReceiverLanes) -> F {
     if !cos_theta.simd_gt(F::ZERO).any() {
         return F::ZERO;
     }

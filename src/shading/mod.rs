@@ -28,7 +28,7 @@ use rayon::prelude::*;
 
 use crate::image::LinearImage;
 use crate::scene::Scene;
-use crate::shadows::ShadowTerm;
+use crate::shadows::{Receiver, ShadowTerm};
 use crate::visibility::{ItemId, VisibilityBuffer};
 
 pub use lanes::{Blend, Lighting};
@@ -219,8 +219,11 @@ pub fn shade_into_scalar(scene: &Scene, vb: &VisibilityBuffer, image: &mut Linea
                     continue;
                 }
                 let cos_theta = s.normal.dot(light.incident(s.position).to_light);
-                let shadow =
-                    if cos_theta > 0.0 { ShadowTerm::mean_lit(terms, s.position, cos_theta, item.object) } else { 1.0 };
+                let shadow = if cos_theta > 0.0 {
+                    ShadowTerm::mean_lit(terms, s.position, cos_theta, &Receiver::of_object(item.object))
+                } else {
+                    1.0
+                };
                 phong::add_light(&mut acc, light, &k, &s, shadow);
             }
             *px = acc.total();

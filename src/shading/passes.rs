@@ -26,13 +26,13 @@
 
 use std::time::Instant;
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
 use super::reflection_map::{add_reflection_map, flat_background};
 use super::{shade_pass, Blend, Component, ComponentSet, Lighting, ShadingPass, SubpixelShading};
 use crate::image::LinearImage;
 use crate::scene::{Light, Scene};
-use crate::shadows::{MapPool, ShadowTerm};
+use crate::shadows::{MapPool, PixelView, ShadowTerm};
 use crate::visibility::VisibilityBuffer;
 
 /// What the passes of one frame cost.
@@ -88,7 +88,9 @@ fn frame_lights_within(scene: &Scene, (lo, hi): (Vec3, Vec3)) -> Vec<FrameLight>
 }
 
 /// The shadow terms of `light`'s samples (taken from `pool`: last frame's where
-/// they still hold), timed into `stats`.
+/// they still hold), timed into `stats`, set to look up `scene`'s view when
+/// the light has one sample (an area light's samples average their edges
+/// already: antialiasing each would cost as much again for little).
 fn terms(
     scene: &Scene,
     light: &FrameLight,
@@ -97,8 +99,11 @@ fn terms(
     stats: &mut PassStats,
 ) -> Vec<ShadowTerm> {
     let t = Instant::now();
-    let terms = pool.terms(scene, &light.samples, bounds);
+    let mut terms = pool.terms(scene, &light.samples, bounds);
     stats.shadow_ms += t.elapsed().as_secs_f64() * 1e3;
+    let view = PixelView::new(&scene.camera.pixel_rays(Vec2::new(scene.width as f32, scene.height as f32)));
+    let view = (terms.len() == 1).then_some(view);
+    terms.iter_mut().for_each(|t| t.set_view(view));
     terms
 }
 

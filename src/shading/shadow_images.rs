@@ -12,7 +12,7 @@ use super::passes::frame_lights;
 use super::surface::ObjectFrames;
 use crate::image::LinearImage;
 use crate::scene::Scene;
-use crate::shadows::MapPool;
+use crate::shadows::{MapPool, PixelView, Receiver};
 use crate::visibility::VisibilityBuffer;
 
 /// Writes every light's shadow term at the pixels of `vb` into `images` (one
@@ -23,6 +23,7 @@ pub fn shadow_term_images(scene: &Scene, vb: &VisibilityBuffer, pool: &mut MapPo
     let (w, h) = (vb.width(), vb.height());
     images.resize_with(scene.lights.len(), LinearImage::default);
     let surfaces = visible_surfaces(scene, vb);
+    let view = PixelView::new(&scene.camera.pixel_rays(Vec2::new(w as f32, h as f32)));
     let bounds = scene.caster_bounds().unwrap_or_default();
     for (image, light) in images.iter_mut().zip(frame_lights(scene)) {
         image.resize(w, h);
@@ -30,13 +31,14 @@ pub fn shadow_term_images(scene: &Scene, vb: &VisibilityBuffer, pool: &mut MapPo
         let weight = 1.0 / light.samples.len().max(1) as f32;
         for sample in &light.samples {
             pool.with_term(scene, sample, bounds, |term| {
+                term.set_view((light.samples.len() == 1).then_some(view));
                 image.pixels_mut().par_iter_mut().zip(&surfaces).for_each(|(px, surface)| {
                     let lit = match surface {
                         None => 1.0,
-                        Some((p, n, object)) => {
+                        Some((p, n, receiver)) => {
                             let cos_theta = n.dot(light.light.incident(*p).to_light);
                             if cos_theta > 0.0 {
-                                term.lit(*p, cos_theta, *object)
+                                term.lit(*p, cos_theta, receiver)
                             } else {
                                 0.0
                             }
@@ -52,9 +54,10 @@ pub fn shadow_term_images(scene: &Scene, vb: &VisibilityBuffer, pool: &mut MapPo
     }
 }
 
-/// The position, shading normal and object of the surface each pixel of `vb`
-/// shows (at the pixel's centre), row by row; `None` where no object is seen.
-fn visible_surfaces(scene: &Scene, vb: &VisibilityBuffer) -> Vec<Option<(Vec3, Vec3, u32)>> {
+/// The position and shading normal of the surface each pixel of `vb` shows
+/// (at the pixel's centre), and that surface as a shadow's receiver (its
+/// object and plane), row by row; `None` where no object is seen.
+fn visible_surfaces(scene: &Scene, vb: &VisibilityBuffer) -> Vec<Option<(Vec3, Vec3, Receiver)>> {
     let w = vb.width() as usize;
     let frames = ObjectFrames::new(scene);
     let rays = scene.camera.pixel_rays(Vec2::new(vb.width() as f32, vb.height() as f32));
@@ -67,8 +70,10 @@ fn visible_surfaces(scene: &Scene, vb: &VisibilityBuffer) -> Vec<Option<(Vec3, V
                 continue;
             }
             let ray = rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
-            let s = frames.surface_at(scene, vb, x, y, &ray);
-            *slot = Some((s.position, s.normal, item.object));
+            let triangle = frames.prepare_at(scene, vb, x, y, &ray);
+            let s = triangle.surface(&ray);
+            let receiver = Receiver { object: item.object, plane: triangle.geometry().geometric };
+            *slot = Some((s.position, s.normal, receiver));
         }
     });
     out

@@ -24,7 +24,7 @@ use super::phong::{self, Coefficients, Components};
 use super::reflection_map::reflection_map;
 use super::{frame_lights, Component, FrameLight, ObjectFrames, SurfacePoint, Target};
 use crate::scene::{Scene, TranslucencyOrder};
-use crate::shadows::{MapPool, ShadowTerm};
+use crate::shadows::{MapPool, Receiver, ShadowTerm};
 use crate::visibility::Fragment;
 
 /// One translucent fragment, ready to be added.
@@ -76,7 +76,11 @@ pub fn composite(
         layers.par_iter_mut().filter(|l| light.only.as_ref().is_none_or(|o| o.contains(&l.object))).for_each(|l| {
             let s = &l.surface;
             let cos = s.normal.dot(light.incident(s.position).to_light);
-            let shadow = if cos > 0.0 { ShadowTerm::mean_lit(&terms, s.position, cos, l.object as u32) } else { 1.0 };
+            let shadow = if cos > 0.0 {
+                ShadowTerm::mean_lit(&terms, s.position, cos, &Receiver::of_object(l.object as u32))
+            } else {
+                1.0
+            };
             phong::add_light(&mut l.lit, light, &l.k, s, shadow);
         });
         terms.into_iter().for_each(|t| pool.recycle(t));

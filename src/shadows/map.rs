@@ -36,6 +36,8 @@ pub struct Located {
     pub v: f32,
     /// Reversed depth a surface must exceed to hide the point.
     pub z_limit: f32,
+    /// World size of one texel at the point's distance from the light.
+    pub texel: f32,
     /// Reversed depth a surface of another object than the point's must
     /// exceed to hide it, where that surface's depth is known at the point
     /// (a silhouette line's): the constant bias of the map drawn without the
@@ -155,7 +157,7 @@ impl DepthMap {
         let limit = d - texel * (settings.bias + settings.slope * tan * reach);
         let z_limit = self.reversed(limit)?;
         let z_other = self.reversed(d - texel * other_bias(settings)).unwrap_or(z_limit);
-        Some(Located { u, v, z_limit, z_other })
+        Some(Located { u, v, z_limit, texel, z_other })
     }
 
     /// Distance `limit` along the light's axis as the stored reversed depth

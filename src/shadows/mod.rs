@@ -8,6 +8,7 @@
 //! the part of the scene the camera sees. The silhouette-line buffer (seed 000) and
 //! the two-map soft shadows (seed 001) plug into the same [`ShadowTerm`].
 
+mod footprint;
 mod map;
 pub mod slb;
 
@@ -15,8 +16,8 @@ use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 use wide::f32x8;
 
+pub use footprint::{PixelView, Receiver, ReceiverLanes, UNKNOWN_RECEIVER};
 pub use map::{DepthMap, Located, LocatedLanes};
-pub use slb::region::UNKNOWN_RECEIVER;
 pub use slb::SlbMap;
 
 use crate::scene::{GeometryKey, Light, LightKind, Scene, ShadowMethod, ShadowSettings};
@@ -139,18 +140,27 @@ impl ShadowTerm {
         scene.lights.iter().map(|l| ShadowTerm::build(scene, l)).collect()
     }
 
+    /// Sets the pixel rays of the frame its lookups are for (antialiased
+    /// silhouette-line lookups average over each pixel's footprint; other
+    /// methods ignore it).
+    pub fn set_view(&mut self, view: Option<PixelView>) {
+        match self {
+            ShadowTerm::Slb(map, _) => map.set_view(view),
+            ShadowTerm::SlbCube(faces, ..) => faces.iter_mut().for_each(|f| f.set_view(view)),
+            _ => {}
+        }
+    }
+
     /// Whether this term can shadow anything.
     #[must_use]
     pub fn casts(&self) -> bool {
         !matches!(self, ShadowTerm::Unshadowed)
     }
 
-    /// `shadow_i` at world point `p` of object `receiver` (its index in the
-    /// scene, or [`UNKNOWN_RECEIVER`]: the silhouette-line buffer then holds
-    /// every caster to the bias of the receiver's own surface) with N·L =
-    /// `cos_theta`: 1 lit, 0 in shadow.
+    /// `shadow_i` at world point `p` on `receiver` with N·L = `cos_theta`: 1
+    /// lit, 0 in shadow (between on an antialiased edge).
     #[must_use]
-    pub fn lit(&self, p: Vec3, cos_theta: f32, receiver: u32) -> f32 {
+    pub fn lit(&self, p: Vec3, cos_theta: f32, receiver: &Receiver) -> f32 {
         match self {
             ShadowTerm::Unshadowed => 1.0,
             ShadowTerm::Map(map, s) => map.lit(p, cos_theta, s),
@@ -160,10 +170,10 @@ impl ShadowTerm {
         }
     }
 
-    /// [`ShadowTerm::lit`] for eight points (x, y, z lanes) of objects
-    /// `receivers` with N·L `cos_theta`.
+    /// [`ShadowTerm::lit`] for eight points (x, y, z lanes) on `receivers`
+    /// with N·L `cos_theta`.
     #[must_use]
-    pub fn lit_lanes(&self, p: [f32x8; 3], cos_theta: f32x8, receivers: &[u32; 8]) -> f32x8 {
+    pub fn lit_lanes(&self, p: [f32x8; 3], cos_theta: f32x8, receivers: &ReceiverLanes) -> f32x8 {
         match self {
             ShadowTerm::Unshadowed => f32x8::ONE,
             ShadowTerm::Map(map, s) => map.lit_lanes(p, cos_theta, s),
@@ -180,7 +190,7 @@ impl ShadowTerm {
             ShadowTerm::Slb(map, s) => map.lit_lanes(p, cos_theta, s, receivers),
             ShadowTerm::SlbCube(..) => {
                 let (x, y, z, c) = (p[0].to_array(), p[1].to_array(), p[2].to_array(), cos_theta.to_array());
-                f32x8::new(std::array::from_fn(|i| self.lit(Vec3::new(x[i], y[i], z[i]), c[i], receivers[i])))
+                f32x8::new(std::array::from_fn(|i| self.lit(Vec3::new(x[i], y[i], z[i]), c[i], &receivers.lane(i))))
             }
         }
     }
@@ -188,7 +198,7 @@ impl ShadowTerm {
     /// The mean of `terms`' [`ShadowTerm::lit`] (1 when there are none): the
     /// shadow term of an area light from its jittered samples' maps.
     #[must_use]
-    pub fn mean_lit(terms: &[ShadowTerm], p: Vec3, cos_theta: f32, receiver: u32) -> f32 {
+    pub fn mean_lit(terms: &[ShadowTerm], p: Vec3, cos_theta: f32, receiver: &Receiver) -> f32 {
         match terms {
             [] => 1.0,
             [one] => one.lit(p, cos_theta, receiver),
@@ -198,7 +208,7 @@ impl ShadowTerm {
 
     /// [`ShadowTerm::mean_lit`] for eight points.
     #[must_use]
-    pub fn mean_lit_lanes(terms: &[ShadowTerm], p: [f32x8; 3], cos_theta: f32x8, receivers: &[u32; 8]) -> f32x8 {
+    pub fn mean_lit_lanes(terms: &[ShadowTerm], p: [f32x8; 3], cos_theta: f32x8, receivers: &ReceiverLanes) -> f32x8 {
         match terms {
             [] => f32x8::ONE,
             [one] => one.lit_lanes(p, cos_theta, receivers),
@@ -420,14 +430,14 @@ impl MapPool {
         scene: &Scene,
         light: &Light,
         bounds: (Vec3, Vec3),
-        f: impl FnOnce(&ShadowTerm) -> T,
+        f: impl FnOnce(&mut ShadowTerm) -> T,
     ) -> T {
         let key = MapKey::of(scene, light, bounds, self.view(scene));
-        if let Some((_, term)) = self.kept.iter().find(|(have, _)| *have == key) {
+        if let Some((_, term)) = self.kept.iter_mut().find(|(have, _)| *have == key) {
             return f(term);
         }
-        let term = ShadowTerm::build_within(scene, light, bounds, self);
-        let out = f(&term);
+        let mut term = ShadowTerm::build_within(scene, light, bounds, self);
+        let out = f(&mut term);
         self.recycle(term);
         out
     }
@@ -669,9 +679,9 @@ mod tests {
                     };
                     let lanes: [(Vec3, f32); 8] = std::array::from_fn(|i| point(i as u32));
                     let p = [0, 1, 2].map(|a| f32x8::new(lanes.map(|(p, _)| p[a])));
-                    let got = term.lit_lanes(p, f32x8::new(lanes.map(|(_, c)| c)), &[UNKNOWN_RECEIVER; 8]).to_array();
+                    let got = term.lit_lanes(p, f32x8::new(lanes.map(|(_, c)| c)), &ReceiverLanes::UNKNOWN).to_array();
                     for (&(p, c), g) in lanes.iter().zip(got) {
-                        let want = term.lit(p, c, UNKNOWN_RECEIVER);
+                        let want = term.lit(p, c, &Receiver::UNKNOWN);
                         differ += usize::from((want - g).abs() > 1e-6);
                         shadowed += usize::from(want < 1.0);
                         total += 1;

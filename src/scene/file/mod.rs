@@ -312,6 +312,7 @@ struct ShadowRec {
     samples: Option<Spanned<i64>>,
     bits: Option<Spanned<i64>>,
     scale: Option<Spanned<f32>>,
+    antialias: Option<bool>,
 }
 
 #[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default)]

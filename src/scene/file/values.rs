@@ -217,6 +217,7 @@ impl SceneFile {
         s.pcf = count(&r.pcf, 1, 15, "pcf")?.unwrap_or(s.pcf);
         s.samples = count(&r.samples, 1, 256, "shadow samples")?.unwrap_or(s.samples);
         s.bits = count(&r.bits, 4, 16, "shadow bits")?.unwrap_or(s.bits);
+        s.antialias = r.antialias.unwrap_or(s.antialias);
         if let Some(scale) = &r.scale {
             let v = *scale.get_ref();
             if !(v.is_finite() && v > 0.0) {

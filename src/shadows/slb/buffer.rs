@@ -374,6 +374,30 @@ impl SilhouetteLineBuffer {
         self.edge.get(t / 64).is_some_and(|w| w >> (t % 64) & 1 == 1)
     }
 
+    /// Whether a silhouette crosses any texel of columns `x0..=x1` and rows
+    /// `y0..=y1` (clipped to the buffer), reading the edge buffer a word at
+    /// a time.
+    #[must_use]
+    pub fn any_edge(&self, (x0, x1): (i64, i64), (y0, y1): (i64, i64)) -> bool {
+        let (w, h) = (i64::from(self.width), i64::from(self.height));
+        let (x0, x1, y0, y1) = (x0.max(0), x1.min(w - 1), y0.max(0), y1.min(h - 1));
+        if x0 > x1 || y0 > y1 {
+            return false;
+        }
+        (y0..=y1).any(|y| {
+            let (mut k, last) = ((y * w + x0) as usize, (y * w + x1) as usize);
+            while k <= last {
+                let take = (64 - k % 64).min(last - k + 1);
+                let mask = if take == 64 { u64::MAX } else { (1u64 << take) - 1 };
+                if self.edge[k / 64] >> (k % 64) & mask != 0 {
+                    return true;
+                }
+                k += take;
+            }
+            false
+        })
+    }
+
     /// The lines and layers of texel `(x, y)`, if a silhouette crosses it.
     #[inline]
     #[must_use]

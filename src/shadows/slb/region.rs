@@ -26,15 +26,15 @@
 //! line and layer carries its polygon's depth plane, read for a layer at the
 //! centre it covers and for a line where the way crosses it, never carried
 //! past its polygon), which is the per-line depth test that lets an object
-//! shadow itself.
+//! shadow itself; each object is counted on its own, and adds nothing where
+//! it does not reach the point. The receiver's own surfaces are held to the
+//! full depth bias, every other object's to a bias that does not grow with
+//! the texel ([`DepthLimits`]).
 
 use super::buffer::Entry;
 use super::line::SilhouetteLine;
 use super::walk::Major;
-
-/// The receiver of a lookup whose object is not known: every surface is held
-/// to the full bias ([`DepthLimits::own`]).
-pub const UNKNOWN_RECEIVER: u32 = u32::MAX;
+use crate::shadows::footprint::UNKNOWN_RECEIVER;
 
 /// The reversed depths a caster surface must exceed to hide a receiver: one
 /// for surfaces of the receiver's own object (with the slope bias its own

@@ -3,6 +3,13 @@
 //! plain map lookup), the buffer's lines the rest, at the point's position
 //! inside the texel — so only texels with the edge bit cost more than a plain
 //! map lookup.
+//!
+//! Antialiased, a point whose texel or a neighbour holds lines is decided at
+//! 4 × 4 points of its pixel's footprint on the receiver's plane
+//! ([`PixelView::footprint`]) and the share found lit is its term: the edge
+//! is known exactly, so the share is the edge's true coverage of the pixel
+//! up to the 16 samples' steps, where a shadow map could only blur its
+//! staircase.
 
 use glam::Vec3;
 use wide::f32x8;
@@ -12,6 +19,7 @@ use super::light::light_triangles;
 use super::region::{covered, DepthLimits};
 use crate::camera::Camera;
 use crate::scene::{Scene, ShadowSettings};
+use crate::shadows::footprint::{PixelView, Receiver, ReceiverLanes};
 use crate::shadows::map::{DepthMap, Located, LocatedLanes};
 use crate::visibility::{VisibilityBuffer, Workers};
 
@@ -24,7 +32,16 @@ pub struct SlbMap {
     /// cross also asks the map (their shadows stay; such a texel's edge is the
     /// map's again where a solid or a mesh covers its centre).
     solids: bool,
+    /// The frame's pixel rays, for antialiased lookups ([`SlbMap::set_view`]).
+    view: Option<PixelView>,
 }
+
+/// Samples per side of the footprint grid an antialiased lookup averages.
+const FOOTPRINT_GRID: usize = 4;
+
+/// Widest reach, in texels, of a footprint whose texels are scanned for
+/// lines; a wider one is sampled without looking.
+const MAX_SCANNED_REACH: f32 = 8.0;
 
 impl SlbMap {
     /// Renders the depth map of the casters `casters` marks through `camera`
@@ -44,40 +61,105 @@ impl SlbMap {
         let triangles = light_triangles(scene, camera, resolution, casters);
         let slb = SilhouetteLineBuffer::build(resolution, resolution, bits.clamp(4, 16), &triangles);
         let solids = scene.objects.iter().zip(casters).any(|(o, &c)| c && o.triangles().is_none());
-        SlbMap { map, slb, solids }
+        SlbMap { map, slb, solids, view: None }
     }
 
-    /// `shadow_i` at `p`, a point of object `receiver` (an index into the
-    /// scene's objects; [`UNKNOWN_RECEIVER`] when not known), with N·L =
-    /// `cos_theta`: 1 lit, 0 in shadow. Another object's silhouette is held
-    /// to a depth bias that does not grow with the texel; the receiver's own,
-    /// and the map, to the full bias.
-    ///
-    /// [`UNKNOWN_RECEIVER`]: super::region::UNKNOWN_RECEIVER
+    /// Sets the pixel rays of the frame the lookups are for: antialiased
+    /// lookups need them for the pixels' footprints (`None`: every lookup is
+    /// decided at its point).
+    pub fn set_view(&mut self, view: Option<PixelView>) {
+        self.view = view;
+    }
+
+    /// `shadow_i` at `p` on `receiver` with N·L = `cos_theta`: 1 lit, 0 in
+    /// shadow, and between where `settings` asks for antialiasing, the
+    /// receiver's plane and the view are known and a shadow's edge passes
+    /// near. Another object's silhouette is held to a depth bias that does
+    /// not grow with the texel; the receiver's own, and the map, to the full
+    /// bias.
     #[must_use]
-    pub fn lit(&self, p: Vec3, cos_theta: f32, settings: &ShadowSettings, receiver: u32) -> f32 {
-        match self.map.locate(p, cos_theta, settings, 1.0) {
-            Some(Located { u, v, z_limit, z_other }) => {
-                self.lit_at(u, v, &DepthLimits { receiver, own: z_limit, other: z_other })
-            }
-            None => 1.0,
+    pub fn lit(&self, p: Vec3, cos_theta: f32, settings: &ShadowSettings, receiver: &Receiver) -> f32 {
+        let Some(at) = self.map.locate(p, cos_theta, settings, 1.0) else { return 1.0 };
+        match self.footprint(p, &at, settings, receiver) {
+            Some(footprint) => self.footprint_share(p, footprint, cos_theta, settings, receiver.object),
+            None => self.lit_at(at.u, at.v, &limits(&at, receiver.object)),
         }
     }
 
-    /// [`SlbMap::lit`] for eight points, of objects `receivers`: located as
-    /// vectors, decided lane by lane.
+    /// [`SlbMap::lit`] for eight points, on `receivers`: located as vectors,
+    /// decided lane by lane.
     #[must_use]
-    pub fn lit_lanes(&self, p: [f32x8; 3], cos_theta: f32x8, settings: &ShadowSettings, receivers: &[u32; 8]) -> f32x8 {
+    pub fn lit_lanes(
+        &self,
+        p: [f32x8; 3],
+        cos_theta: f32x8,
+        settings: &ShadowSettings,
+        receivers: &ReceiverLanes,
+    ) -> f32x8 {
         let LocatedLanes { inside, u, v, z_limit, z_other } = self.map.locate_lanes(p, cos_theta, settings, 1.0);
         let mask = inside.to_bitmask();
         let (u, v, own, other) = (u.to_array(), v.to_array(), z_limit.to_array(), z_other.to_array());
+        if self.view.is_none() || !settings.antialias {
+            return f32x8::new(std::array::from_fn(|i| {
+                let limits = DepthLimits { receiver: receivers.objects[i], own: own[i], other: other[i] };
+                if mask >> i & 1 == 0 {
+                    1.0
+                } else {
+                    self.lit_at(u[i], v[i], &limits)
+                }
+            }));
+        }
+        let (x, y, z, c) = (p[0].to_array(), p[1].to_array(), p[2].to_array(), cos_theta.to_array());
         f32x8::new(std::array::from_fn(|i| {
-            if mask >> i & 1 == 1 {
-                self.lit_at(u[i], v[i], &DepthLimits { receiver: receivers[i], own: own[i], other: other[i] })
-            } else {
-                1.0
+            if mask >> i & 1 == 0 {
+                return 1.0;
             }
+            let point = Vec3::new(x[i], y[i], z[i]);
+            self.lit(point, c[i], settings, &receivers.lane(i))
         }))
+    }
+
+    /// The footprint of `p`'s pixel on its receiver's plane, when the lookup
+    /// located at `at` is to be antialiased: asked for, the plane and view
+    /// known, and a line in a texel the footprint reaches or next to one.
+    #[inline]
+    fn footprint(&self, p: Vec3, at: &Located, settings: &ShadowSettings, receiver: &Receiver) -> Option<[Vec3; 2]> {
+        let view = self.view.as_ref().filter(|_| settings.antialias && receiver.plane != Vec3::ZERO)?;
+        let footprint = view.footprint(p, receiver.plane);
+        // The footprint's reach in texels, at most its world size over a
+        // texel's (seen from the light it can only shrink).
+        let reach = 0.5 * (footprint[0].length() + footprint[1].length()) / at.texel.max(f32::MIN_POSITIVE);
+        if reach > MAX_SCANNED_REACH {
+            return Some(footprint);
+        }
+        let r = reach.ceil().max(1.0) as i64;
+        let (x, y) = (at.u as i64, at.v as i64);
+        self.slb.any_edge((x - r, x + r), (y - r, y + r)).then_some(footprint)
+    }
+
+    /// The share of [`FOOTPRINT_GRID`]² points of the footprint
+    /// `[right, down]` around `p` (a point of object `receiver`) that are lit.
+    fn footprint_share(
+        &self,
+        p: Vec3,
+        [right, down]: [Vec3; 2],
+        cos_theta: f32,
+        settings: &ShadowSettings,
+        receiver: u32,
+    ) -> f32 {
+        let step = 1.0 / FOOTPRINT_GRID as f32;
+        let offset = |k: usize| (k as f32 + 0.5) * step - 0.5;
+        let mut lit = 0.0;
+        for j in 0..FOOTPRINT_GRID {
+            for i in 0..FOOTPRINT_GRID {
+                let q = p + right * offset(i) + down * offset(j);
+                lit += match self.map.locate(q, cos_theta, settings, 1.0) {
+                    Some(at) => self.lit_at(at.u, at.v, &limits(&at, receiver)),
+                    None => 1.0,
+                };
+            }
+        }
+        lit * step * step
     }
 
     /// The term at texel coordinates `(u, v)` (inside the map) for a receiver
@@ -123,4 +205,10 @@ impl SlbMap {
     pub fn memory_bytes(&self) -> usize {
         self.map.memory_bytes() + self.slb.memory_bytes()
     }
+}
+
+/// The depth limits of a point located at `at` on object `receiver`.
+#[inline]
+fn limits(at: &Located, receiver: u32) -> DepthLimits {
+    DepthLimits { receiver, own: at.z_limit, other: at.z_other }
 }
