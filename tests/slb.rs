@@ -257,3 +257,21 @@ fn a_scene_file_sets_the_slb_keys() {
     assert_eq!((set.method, set.bits, set.scale, set.antialias), (ShadowMethod::Slb, 12, 4.0, false));
     assert_eq!((default.bits, default.scale, default.antialias, default.resolution), (8, 1.0, true, 1024));
 }
+
+/// The examples that show the method — a heat sink whose fins shadow each
+/// other (one mesh), an atrium under a pergola of slats — agree with shadow
+/// rays more closely with the SLB their files ask for than with maps.
+#[test]
+fn the_slb_examples_agree_with_shadow_rays_better_than_maps() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenes");
+    for name in ["heatsink", "atrium"] {
+        let mut scene = kage::scene::file::load_scene(&dir.join(format!("{name}.toml"))).unwrap();
+        (scene.width, scene.height) = (320, 200);
+        assert!(scene.lights.iter().all(|l| l.shadow.method == ShadowMethod::Slb), "{name} asks for the SLB");
+        let (slb, slb_wrong, total) = disagreement(&scene);
+        let (map, map_wrong, _) = disagreement(&with_method(scene, ShadowMethod::Map));
+        eprintln!("{name}: map {:.3}%, slb {:.3}% of {total}", 100.0 * map, 100.0 * slb);
+        assert!(total > 10_000 && slb < 0.0005, "{name}: the SLB disagrees with shadow rays on {slb_wrong} of {total}");
+        assert!(slb_wrong < map_wrong, "{name}: SLB {slb_wrong} ≥ map {map_wrong}");
+    }
+}
