@@ -9,6 +9,7 @@ use std::sync::Arc;
 
 use glam::{Affine3A, Quat, Vec2, Vec3};
 use kage::camera::{Camera, Projection};
+use kage::raytrace::shadow_truth;
 use kage::scene::mesh::shapes;
 use kage::scene::{Light, LightKind, Material, Mesh, Object, Scene, ShadowMethod};
 use kage::shadows::ShadowTerm;
@@ -177,19 +178,6 @@ fn a_bent_plate_shadows_itself_as_rays_say() {
     assert!(total > 5000 && share < 0.002, "{wrong} of {total} disagree with shadow rays");
 }
 
-/// RMSE against `truth` over the pixels it has a value for, and how many.
-fn rmse(image: &kage::image::LinearImage, pixels: &[(u32, u32, u32)], truth: &[Option<f32>]) -> (f64, usize) {
-    let w = image.width();
-    let (sum, n) = pixels.iter().zip(truth).fold((0.0, 0), |(sum, n), (&(x, y, _), t)| match t {
-        Some(t) => {
-            let d = f64::from(image.pixels()[(y * w + x) as usize].x - t);
-            (sum + d * d, n + 1)
-        }
-        None => (sum, n),
-    });
-    ((sum / n.max(1) as f64).sqrt(), n)
-}
-
 /// The antialiased SLB term against 16 × 16 shadow rays per pixel, on the
 /// pixels along shadow boundaries (where the 0/1 term changes within a
 /// pixel's 3 × 3 neighbourhood, on one object): its RMSE is at most a third
@@ -213,25 +201,13 @@ fn the_antialiased_boundary_is_a_third_as_far_from_the_ray_traced_coverage() {
             kage::render(&s, &options).unwrap()
         };
         let (sharp, smooth) = (images(false), images(true));
-        let (w, h) = (scene.width, scene.height);
+        let rays = shadow_truth::ShadowRays::new(&scene);
         for light in 0..scene.lights.len() {
-            let hard = &sharp.shadows[light];
-            let value = |x: u32, y: u32| hard.pixels()[(y * w + x) as usize].x;
-            let mut pixels = Vec::new();
-            for y in 1..h - 1 {
-                for x in 1..w - 1 {
-                    let item = sharp.visibility.item(x, y);
-                    let around = (y - 1..=y + 1).flat_map(|v| (x - 1..=x + 1).map(move |u| (u, v)));
-                    let (lo, hi) =
-                        around.fold((1.0f32, 0.0f32), |(lo, hi), (u, v)| (lo.min(value(u, v)), hi.max(value(u, v))));
-                    if !item.is_none() && lo < hi {
-                        pixels.push((x, y, item.object));
-                    }
-                }
-            }
-            let truth = common::ray_traced_shadow(&scene, light, &pixels, 16);
-            let (a, n) = rmse(hard, &pixels, &truth);
-            let (b, _) = rmse(&smooth.shadows[light], &pixels, &truth);
+            let (hard, soft) = (sharp.shadows[light].pixels(), smooth.shadows[light].pixels());
+            let pixels = shadow_truth::boundary_pixels(&sharp.visibility, hard);
+            let truth = rays.covered_share(light, &pixels, 16);
+            let (a, n) = shadow_truth::rmse_at(hard, scene.width, &pixels, &truth);
+            let (b, _) = shadow_truth::rmse_at(soft, scene.width, &pixels, &truth);
             eprintln!("light {light}: {n} boundary pixels, RMSE 0/1 {a:.4}, antialiased {b:.4}");
             (sharp_total, smooth_total, count) =
                 (sharp_total + a * a * n as f64, smooth_total + b * b * n as f64, count + n);

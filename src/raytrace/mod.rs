@@ -8,10 +8,12 @@
 //! (nearest hit) and `occluded` (anything before a distance?); [`TraceCache`]
 //! keeps it while the geometry stays. [`tracer`] shades what a ray sees, bounces
 //! included; [`traced`] is the raster frame's traced term, [`mod@reference`] the
-//! ray-traced oracle, both on top of it.
+//! ray-traced oracle, both on top of it; [`shadow_truth`] holds a shadow
+//! method's decisions and antialiased terms to shadow rays.
 
 mod cache;
 pub mod reference;
+pub mod shadow_truth;
 pub mod traced;
 pub mod tracer;
 pub mod triangle;

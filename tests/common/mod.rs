@@ -170,65 +170,19 @@ pub fn view_distance(cam: &Camera, d: f32) -> f32 {
 /// light that casts shadows.
 pub fn terms_vs_rays(scene: &Scene, terms: &[ShadowTerm]) -> (usize, usize) {
     decisions_vs_rays(scene, |light, at| {
-        terms[light]
-            .casts()
-            .then(|| terms[light].lit(at.surface.position, at.cos, &kage::shadows::Receiver::of_object(at.object)))
+        let receiver = kage::shadows::Receiver::of_object(at.object);
+        terms[light].casts().then(|| terms[light].lit(at.surface.position, at.cos_theta, &receiver))
     })
 }
 
-/// A visible point a shadow decision is asked for.
-pub struct ShadowQuery<'a> {
-    /// Its pixel.
-    pub pixel: (u32, u32),
-    /// The surface at the pixel's centre, as the renderer reconstructs it.
-    pub surface: &'a kage::shading::SurfacePoint,
-    /// Its object.
-    pub object: u32,
-    /// N·L there.
-    pub cos: f32,
-}
-
-/// A shadow decision against shadow rays: per visible pixel and light whose
-/// N·L there is above 0.05, `decide(light, query)` (`None`: not compared)
-/// read as lit when ≥ 0.5, against whether a ray from the surface to the
-/// light reaches it. Returns (misclassified, compared).
-pub fn decisions_vs_rays(scene: &Scene, mut decide: impl FnMut(usize, &ShadowQuery) -> Option<f32>) -> (usize, usize) {
+/// [`kage::raytrace::shadow_truth::ShadowRays::misclassified`] over `scene`'s
+/// frame.
+pub fn decisions_vs_rays(
+    scene: &Scene,
+    decide: impl Fn(usize, &kage::raytrace::shadow_truth::ShadowQuery) -> Option<f32> + Sync,
+) -> (usize, usize) {
     let frame = kage::render(scene, &kage::RenderOptions::default()).expect("render");
-    let trace = kage::raytrace::TraceScene::new(scene);
-    let frames = kage::shading::ObjectFrames::new(scene);
-    let rays = scene.camera.pixel_rays(glam::Vec2::new(scene.width as f32, scene.height as f32));
-    let eps = scene.bounds().map_or(1e-4, |(lo, hi)| (hi - lo).length() * 1e-5);
-    let (mut wrong, mut total) = (0, 0);
-    for y in 0..scene.height {
-        for x in 0..scene.width {
-            let item = frame.visibility.item(x, y);
-            if item.is_none() {
-                continue;
-            }
-            let s = frames.surface(scene, item, &rays.ray(glam::Vec2::new(x as f32 + 0.5, y as f32 + 0.5)));
-            for (i, light) in scene.lights.iter().enumerate() {
-                let to = light.incident(s.position).to_light;
-                let cos = s.normal.dot(to);
-                if cos <= 0.05 {
-                    continue;
-                }
-                let query = ShadowQuery { pixel: (x, y), surface: &s, object: item.object, cos };
-                let Some(decided) = decide(i, &query) else { continue };
-                let origin = s.position + s.normal * eps;
-                let (dir, dist) = match light.kind {
-                    LightKind::Directional { direction } => (-direction, f32::INFINITY),
-                    LightKind::Point { position } | LightKind::Spot { position, .. } => {
-                        let d = position - origin;
-                        (d.normalize(), d.length() * (1.0 - 1e-4))
-                    }
-                };
-                let ray_lit = !trace.occluded(&kage::camera::Ray { origin, dir }, dist);
-                wrong += usize::from(ray_lit != (decided >= 0.5));
-                total += 1;
-            }
-        }
-    }
-    (wrong, total)
+    kage::raytrace::shadow_truth::ShadowRays::new(scene).misclassified(&frame.visibility, decide)
 }
 
 /// The demo and four example scenes whose shadows the shadow tests judge, at
@@ -243,58 +197,4 @@ pub fn shadow_example_scenes() -> Vec<(&'static str, Scene)> {
         (scene.width, scene.height) = (320, 200);
     }
     scenes
-}
-
-/// Each light's exact shadow term averaged over `n` × `n` rays through each
-/// of `pixels` (stratified, at sub-pixel cell centres): the share of the
-/// rays' hit points a shadow ray from which reaches the light, with `None`
-/// for a pixel whose rays do not all meet `object` (an outline pixel) and
-/// surfaces that face the light (a crease to a face turned away), or whose
-/// centre's surface the light meets at a grazing angle (N·L ≤ 0.1, where the
-/// shadow term hardly shows).
-pub fn ray_traced_shadow(scene: &Scene, light: usize, pixels: &[(u32, u32, u32)], n: u32) -> Vec<Option<f32>> {
-    use rayon::prelude::*;
-    let trace = kage::raytrace::TraceScene::new(scene);
-    let frames = kage::shading::ObjectFrames::new(scene);
-    let rays = scene.camera.pixel_rays(glam::Vec2::new(scene.width as f32, scene.height as f32));
-    let eps = scene.bounds().map_or(1e-4, |(lo, hi)| (hi - lo).length() * 1e-5);
-    let light = &scene.lights[light];
-    pixels
-        .par_iter()
-        .map(|&(x, y, object)| {
-            let centre = rays.ray(glam::Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
-            let hit = trace.intersect(&centre, f32::INFINITY)?;
-            let s = frames.surface(scene, hit.item, &centre);
-            if s.normal.dot(light.incident(s.position).to_light) <= 0.1 {
-                return None; // where the light grazes the surface its shadow hardly shows
-            }
-            let mut lit = 0u32;
-            for j in 0..n {
-                for i in 0..n {
-                    let at =
-                        glam::Vec2::new(x as f32 + (i as f32 + 0.5) / n as f32, y as f32 + (j as f32 + 0.5) / n as f32);
-                    let ray = rays.ray(at);
-                    let hit = trace.intersect(&ray, f32::INFINITY)?;
-                    if hit.item.object != object {
-                        return None;
-                    }
-                    let s = frames.surface(scene, hit.item, &ray);
-                    let to = light.incident(s.position).to_light;
-                    if s.normal.dot(to) <= 0.0 {
-                        return None; // a crease to a face the light does not reach
-                    }
-                    let origin = s.position + s.normal * eps;
-                    let (dir, dist) = match light.kind {
-                        LightKind::Directional { direction } => (-direction, f32::INFINITY),
-                        LightKind::Point { position } | LightKind::Spot { position, .. } => {
-                            let d = position - origin;
-                            (d.normalize(), d.length() * (1.0 - 1e-4))
-                        }
-                    };
-                    lit += u32::from(!trace.occluded(&kage::camera::Ray { origin, dir }, dist));
-                }
-            }
-            Some(lit as f32 / (n * n) as f32)
-        })
-        .collect()
 }
