@@ -131,7 +131,13 @@ fn with(scene: &Scene, settings: &ShadowSettings, (w, h): (u32, u32)) -> Scene {
 /// coverage.
 struct Truth<'a> {
     rays: ShadowRays<'a>,
-    boundaries: Vec<(Vec<(u32, u32, u32)>, Vec<Option<f32>>)>,
+    boundaries: Vec<Boundary>,
+}
+
+/// One light's boundary pixels (x, y, object) and their rays' coverage.
+struct Boundary {
+    pixels: Vec<(u32, u32, u32)>,
+    covered: Vec<Option<f32>>,
 }
 
 /// The truth of `scene`: boundary pixels where shadow rays through the pixel
@@ -154,7 +160,7 @@ fn truth(scene: &Scene) -> Result<Truth<'_>> {
         });
         let pixels = shadow_truth::boundary_pixels(vb, &image);
         let covered = rays.covered_share(light, &pixels, 16);
-        boundaries.push((pixels, covered));
+        boundaries.push(Boundary { pixels, covered });
     }
     Ok(Truth { rays, boundaries })
 }
@@ -172,8 +178,8 @@ fn errors(scene: &Scene, truth: &Truth) -> Result<(f64, f64)> {
     let (mut sum, mut n) = (0.0, 0);
     let shadowed = scene.lights.iter().map(|l| l.shadow.method != ShadowMethod::None);
     let measured = frame.shadows.iter().zip(&truth.boundaries).zip(shadowed).filter(|(_, s)| *s);
-    for ((image, (pixels, covered)), _) in measured {
-        let (rmse, k) = shadow_truth::rmse_at(image.pixels(), scene.width, pixels, covered);
+    for ((image, boundary), _) in measured {
+        let (rmse, k) = shadow_truth::rmse_at(image.pixels(), scene.width, &boundary.pixels, &boundary.covered);
         (sum, n) = (sum + rmse * rmse * k as f64, n + k);
     }
     Ok((wrong as f64 / total.max(1) as f64, (sum / n.max(1) as f64).sqrt()))
