@@ -1,8 +1,9 @@
 //! Exact hard shadows by shadow rays through the BVH, the truth a shadow
-//! method is measured against on the same scene: [`misclassified`] counts
-//! the visible points where a method's lit/shadowed decision differs from a
-//! shadow ray's, [`covered_share`] is the exact share of a pixel's n × n
-//! rays that reach the light (what an antialiased shadow term estimates).
+//! method is measured against on the same scene:
+//! [`ShadowRays::misclassified`] counts the visible points where a method's
+//! lit/shadowed decision differs from a shadow ray's,
+//! [`ShadowRays::covered_share`] is the exact share of a pixel's n × n rays
+//! that reach the light (what an antialiased shadow term estimates).
 
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;

@@ -17,9 +17,9 @@
 //!
 //! [`covered`] is kage's, and is exact for any number of lines, objects and
 //! layers: it counts surfaces. The texel keeps how many caster surfaces lie
-//! over its centre ([`Layer`]); walking from the centre to the point, each
-//! stored line crossed into its polygon's side adds one surface and each
-//! crossed out of it removes one, so the count at the point is the number of
+//! over its centre ([`Layer`](super::buffer::Layer)); walking from the
+//! centre to the point, each stored line crossed into its polygon's side
+//! adds one surface and each crossed out of it removes one, so the count at the point is the number of
 //! surfaces over it — holes, concave outlines, an object over itself and
 //! several objects in one texel alike, with no product-or-union case to
 //! choose. Only surfaces nearer the light than the receiver are counted (each
