@@ -251,3 +251,36 @@ fn the_slb_examples_agree_with_shadow_rays_better_than_maps() {
         assert!(slb_wrong < map_wrong, "{name}: SLB {slb_wrong} ≥ map {map_wrong}");
     }
 }
+
+/// Boxes under a sun 12° above the floor, the view 16 times wider: a box's
+/// whole shadow lies within the floor's own slope bias (about 8 texels at
+/// that angle), so the texels no outline crosses must hold the box to the
+/// box's bias, not the floor's (the map keeps each texel's object).
+#[test]
+fn long_grazing_shadows_stay_with_the_view_16_times_wider() {
+    let camera = Camera {
+        eye: Vec3::new(0.0, 7.0, 9.0),
+        target: Vec3::ZERO,
+        up: Vec3::Y,
+        near: 0.1,
+        far: 60.0,
+        projection: Projection::Perspective { fov_y_deg: 45.0 },
+        shift: Vec2::ZERO,
+    };
+    let mut scene = common::scene_with(shapes::plane(), camera, 320, 200, false);
+    scene.objects[0].transform = Affine3A::from_scale(Vec3::splat(30.0));
+    let cube = Arc::new(shapes::cube());
+    for k in 0..9 {
+        let at = Vec3::new(-3.0 + 3.0 * (k % 3) as f32, 0.4, -3.0 + 3.0 * (k / 3) as f32);
+        let transform =
+            Affine3A::from_scale_rotation_translation(Vec3::splat(0.8), Quat::from_rotation_y(0.4 * k as f32), at);
+        scene.objects.push(Object::mesh(format!("box {k}"), cube.clone(), transform, 0));
+    }
+    let sun = 12f32.to_radians();
+    let direction = -Vec3::new(0.8 * sun.cos(), sun.sin(), 0.6 * sun.cos()).normalize();
+    scene.lights = vec![Light { kind: LightKind::Directional { direction }, ..Light::default() }];
+    let mut scene = with_method(scene, ShadowMethod::Slb);
+    scene.lights[0].shadow.scale = 16.0;
+    let (share, wrong, total) = disagreement(&scene);
+    assert!(total > 20_000 && share < 0.001, "{wrong} of {total} disagree with shadow rays");
+}

@@ -181,6 +181,16 @@ impl DepthMap {
         self.depth.depths()[(y * self.resolution + x) as usize]
     }
 
+    /// The object whose surface the map holds at texel `(x, y)`, when the map
+    /// keeps item ids (an SLB's does); `None` otherwise or where it holds
+    /// nothing.
+    #[inline]
+    #[must_use]
+    pub fn texel_object(&self, x: u32, y: u32) -> Option<u32> {
+        let item = self.depth.items().get((y * self.resolution + x) as usize)?;
+        (!item.is_none()).then_some(item.object)
+    }
+
     /// Texels along a side.
     #[must_use]
     pub fn resolution(&self) -> u32 {

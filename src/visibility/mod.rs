@@ -193,6 +193,18 @@ impl VisibilityBuffer {
         }
     }
 
+    /// Whether the buffer keeps item ids from the next [`rasterize`] on (a
+    /// depth-only buffer that starts to, or one that stops and frees them).
+    pub fn keep_items(&mut self, keep: bool) {
+        self.with_items = keep;
+        if keep {
+            self.items.resize(self.depth.len(), ItemId::NONE);
+        } else {
+            self.items = Vec::new();
+            self.normals = Vec::new();
+        }
+    }
+
     /// Forgets everything drawn.
     pub fn clear(&mut self) {
         self.depth.fill(0.0);
