@@ -57,6 +57,8 @@ pub struct LocatedLanes {
     pub v: f32x8,
     /// Depth limits.
     pub z_limit: f32x8,
+    /// World sizes of one texel at the points' distances.
+    pub texel: f32x8,
     /// Depth limits against other objects' surfaces ([`Located::z_other`]).
     pub z_other: f32x8,
 }
@@ -261,7 +263,7 @@ impl DepthMap {
         };
         let z_limit = reversed(d - texel * bias);
         let z_other = reversed(d - texel * f32x8::splat(other_bias(settings)));
-        LocatedLanes { inside, u, v, z_limit, z_other }
+        LocatedLanes { inside, u, v, z_limit, texel, z_other }
     }
 
     /// [`DepthMap::lit`] for eight points at once (`p` as x, y and z lanes): the

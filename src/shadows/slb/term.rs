@@ -88,10 +88,25 @@ impl SlbMap {
     /// bias.
     #[must_use]
     pub fn lit(&self, p: Vec3, cos_theta: f32, settings: &ShadowSettings, receiver: &Receiver) -> f32 {
-        let Some(at) = self.map.locate(p, cos_theta, settings, 1.0) else { return 1.0 };
-        match self.footprint(p, &at, settings, receiver) {
+        match self.map.locate(p, cos_theta, settings, 1.0) {
+            Some(at) => self.lit_located(p, &at, cos_theta, settings, receiver),
+            None => 1.0,
+        }
+    }
+
+    /// [`SlbMap::lit`] of `p`, located at `at`.
+    #[inline]
+    fn lit_located(
+        &self,
+        p: Vec3,
+        at: &Located,
+        cos_theta: f32,
+        settings: &ShadowSettings,
+        receiver: &Receiver,
+    ) -> f32 {
+        match self.footprint(p, at, settings, receiver) {
             Some(footprint) => self.footprint_share(p, footprint, cos_theta, settings, receiver.object),
-            None => self.lit_at(at.u, at.v, &limits(&at, receiver.object)),
+            None => self.lit_at(at.u, at.v, &limits(at, receiver.object)),
         }
     }
 
@@ -105,7 +120,7 @@ impl SlbMap {
         settings: &ShadowSettings,
         receivers: &ReceiverLanes,
     ) -> f32x8 {
-        let LocatedLanes { inside, u, v, z_limit, z_other } = self.map.locate_lanes(p, cos_theta, settings, 1.0);
+        let LocatedLanes { inside, u, v, z_limit, texel, z_other } = self.map.locate_lanes(p, cos_theta, settings, 1.0);
         let mask = inside.to_bitmask();
         let (u, v, own, other) = (u.to_array(), v.to_array(), z_limit.to_array(), z_other.to_array());
         if self.view.is_none() || !settings.antialias {
@@ -119,12 +134,13 @@ impl SlbMap {
             }));
         }
         let (x, y, z, c) = (p[0].to_array(), p[1].to_array(), p[2].to_array(), cos_theta.to_array());
+        let texel = texel.to_array();
         f32x8::new(std::array::from_fn(|i| {
             if mask >> i & 1 == 0 {
                 return 1.0;
             }
-            let point = Vec3::new(x[i], y[i], z[i]);
-            self.lit(point, c[i], settings, &receivers.lane(i))
+            let at = Located { u: u[i], v: v[i], z_limit: own[i], texel: texel[i], z_other: other[i] };
+            self.lit_located(Vec3::new(x[i], y[i], z[i]), &at, c[i], settings, &receivers.lane(i))
         }))
     }
 
