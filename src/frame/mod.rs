@@ -319,9 +319,8 @@ fn render_into(
 /// components `wanted` names, at the scene's size; the images are kept from
 /// frame to frame, like every other buffer.
 fn fit_component_images(scene: &Scene, options: &RenderOptions, frame: &mut Frame, scratch: &mut Scratch) {
-    let (wanted, options_shadows) = (options.aovs, options.shadow_images);
     let (w, h) = (scene.width, scene.height);
-    let components: Vec<Component> = wanted.iter().collect();
+    let components: Vec<Component> = options.aovs.iter().collect();
     frame.aovs.resize_with(components.len(), || (Component::Ambient, LinearImage::default()));
     for ((slot, image), &c) in frame.aovs.iter_mut().zip(&components) {
         *slot = c;
@@ -329,7 +328,7 @@ fn fit_component_images(scene: &Scene, options: &RenderOptions, frame: &mut Fram
     }
     scratch.aovs.resize_with(frame.aovs.len(), LinearImage::default);
     scratch.aovs.iter_mut().for_each(|a| a.resize(w, h));
-    let lights = if options_shadows { scene.lights.len() } else { 0 };
+    let lights = if options.shadow_images { scene.lights.len() } else { 0 };
     frame.shadows.resize_with(lights, LinearImage::default);
     frame.shadows.iter_mut().for_each(|a| a.resize(w, h));
 }

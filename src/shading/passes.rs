@@ -88,9 +88,8 @@ fn frame_lights_within(scene: &Scene, (lo, hi): (Vec3, Vec3)) -> Vec<FrameLight>
 }
 
 /// The shadow terms of `light`'s samples (taken from `pool`: last frame's where
-/// they still hold), timed into `stats`, set to look up `scene`'s view when
-/// the light has one sample (an area light's samples average their edges
-/// already: antialiasing each would cost as much again for little).
+/// they still hold), timed into `stats`, set to look up `scene`'s view
+/// ([`light_view`]).
 fn terms(
     scene: &Scene,
     light: &FrameLight,
@@ -101,10 +100,18 @@ fn terms(
     let t = Instant::now();
     let mut terms = pool.terms(scene, &light.samples, bounds);
     stats.shadow_ms += t.elapsed().as_secs_f64() * 1e3;
-    let view = PixelView::new(&scene.camera.pixel_rays(Vec2::new(scene.width as f32, scene.height as f32)));
-    let view = (terms.len() == 1).then_some(view);
+    let view = light_view(scene, light);
     terms.iter_mut().for_each(|t| t.set_view(view));
     terms
+}
+
+/// The view `light`'s shadow terms look up `scene`'s pixels through: its
+/// pixel rays when the light has one sample, none for an area light's
+/// jittered samples (they average their edges already: antialiasing each
+/// would cost as much again for little).
+pub(crate) fn light_view(scene: &Scene, light: &FrameLight) -> Option<PixelView> {
+    let rays = scene.camera.pixel_rays(Vec2::new(scene.width as f32, scene.height as f32));
+    (light.samples.len() == 1).then(|| PixelView::new(&rays))
 }
 
 /// Shades `vb` with every light of `scene`, shadows included, into each target:

@@ -8,11 +8,11 @@
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
-use super::passes::frame_lights;
+use super::passes::{frame_lights, light_view};
 use super::surface::ObjectFrames;
 use crate::image::LinearImage;
 use crate::scene::Scene;
-use crate::shadows::{MapPool, PixelView, Receiver};
+use crate::shadows::{MapPool, Receiver};
 use crate::visibility::VisibilityBuffer;
 
 /// Writes every light's shadow term at the pixels of `vb` into `images` (one
@@ -23,15 +23,14 @@ pub fn shadow_term_images(scene: &Scene, vb: &VisibilityBuffer, pool: &mut MapPo
     let (w, h) = (vb.width(), vb.height());
     images.resize_with(scene.lights.len(), LinearImage::default);
     let surfaces = visible_surfaces(scene, vb);
-    let view = PixelView::new(&scene.camera.pixel_rays(Vec2::new(w as f32, h as f32)));
     let bounds = scene.caster_bounds().unwrap_or_default();
     for (image, light) in images.iter_mut().zip(frame_lights(scene)) {
         image.resize(w, h);
         image.pixels_mut().fill(Vec3::ZERO);
-        let weight = 1.0 / light.samples.len().max(1) as f32;
+        let (weight, view) = (1.0 / light.samples.len() as f32, light_view(scene, &light));
         for sample in &light.samples {
             pool.with_term(scene, sample, bounds, |term| {
-                term.set_view((light.samples.len() == 1).then_some(view));
+                term.set_view(view);
                 image.pixels_mut().par_iter_mut().zip(&surfaces).for_each(|(px, surface)| {
                     let lit = match surface {
                         None => 1.0,
@@ -47,9 +46,6 @@ pub fn shadow_term_images(scene: &Scene, vb: &VisibilityBuffer, pool: &mut MapPo
                     *px += Vec3::splat(lit * weight);
                 });
             });
-        }
-        if light.samples.is_empty() {
-            image.pixels_mut().fill(Vec3::ONE);
         }
     }
 }

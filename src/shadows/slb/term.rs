@@ -123,24 +123,16 @@ impl SlbMap {
         let LocatedLanes { inside, u, v, z_limit, texel, z_other } = self.map.locate_lanes(p, cos_theta, settings, 1.0);
         let mask = inside.to_bitmask();
         let (u, v, own, other) = (u.to_array(), v.to_array(), z_limit.to_array(), z_other.to_array());
-        if self.view.is_none() || !settings.antialias {
-            return f32x8::new(std::array::from_fn(|i| {
-                let limits = DepthLimits { receiver: receivers.objects[i], own: own[i], other: other[i] };
-                if mask >> i & 1 == 0 {
-                    1.0
-                } else {
-                    self.lit_at(u[i], v[i], &limits)
-                }
-            }));
-        }
         let (x, y, z, c) = (p[0].to_array(), p[1].to_array(), p[2].to_array(), cos_theta.to_array());
-        let texel = texel.to_array();
+        let (texel, planes) = (texel.to_array(), receivers.planes.map(|n| n.to_array()));
         f32x8::new(std::array::from_fn(|i| {
             if mask >> i & 1 == 0 {
                 return 1.0;
             }
             let at = Located { u: u[i], v: v[i], z_limit: own[i], texel: texel[i], z_other: other[i] };
-            self.lit_located(Vec3::new(x[i], y[i], z[i]), &at, c[i], settings, &receivers.lane(i))
+            let plane = Vec3::new(planes[0][i], planes[1][i], planes[2][i]);
+            let receiver = Receiver { object: receivers.objects[i], plane };
+            self.lit_located(Vec3::new(x[i], y[i], z[i]), &at, c[i], settings, &receiver)
         }))
     }
 
