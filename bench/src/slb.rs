@@ -94,24 +94,27 @@ fn grid_of_boxes() -> Scene {
     scene
 }
 
-/// The scenes: the demo, the heat sink and atrium examples, a grid of boxes under grazing light,
-/// and the Stanford bunny when the shared assets are there.
+/// The scenes: the demo, the heat sink, atrium and CSG examples, a grid of boxes under grazing
+/// light, and the Stanford bunny and a CAD part from OpenSCAD when the shared assets are there.
 fn scenes(c: &Common) -> Result<Vec<(String, Scene)>> {
     let mut out = Vec::new();
     let demo = kage::scene::demo::demo_scene().map_err(|e| miette!("{e}"))?;
     out.push(("demo".to_string(), demo));
     let dir = repository().join("examples/scenes");
-    for name in ["heatsink", "atrium"] {
+    for name in ["heatsink", "atrium", "csg"] {
         let scene = kage::scene::file::load_scene(&dir.join(format!("{name}.toml"))).map_err(|e| miette!("{e}"))?;
         out.push((format!("{name}.toml"), scene));
     }
     out.push(("grid of boxes, sun at 12°".to_string(), grid_of_boxes()));
-    let bunny = c.assets().join("meshes/stanford-bunny/stanford-bunny.obj");
-    if bunny.exists() {
-        let scene = kage::scene::model::scene_for_model(&bunny, 640, 360).map_err(|e| miette!("{e}"))?;
-        out.push(("stanford-bunny.obj".to_string(), scene));
-    } else {
-        eprintln!("skipped {} (not found)", bunny.display());
+    for model in ["meshes/stanford-bunny/stanford-bunny.obj", "csg/mk3_x_end.csg"] {
+        let path = c.assets().join(model);
+        if path.exists() {
+            let scene = kage::scene::model::scene_for_model(&path, 640, 360).map_err(|e| miette!("{e}"))?;
+            let name = path.file_name().map_or_else(String::new, |n| n.to_string_lossy().into_owned());
+            out.push((name, scene));
+        } else {
+            eprintln!("skipped {} (not found)", path.display());
+        }
     }
     Ok(out)
 }

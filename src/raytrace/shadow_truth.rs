@@ -89,7 +89,7 @@ impl<'a> ShadowRays<'a> {
                         continue;
                     }
                     let ray = self.rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
-                    let s = self.frames.surface(self.scene, item, &ray);
+                    let s = self.frames.surface_at(self.scene, vb, x, y, &ray);
                     for (i, light) in self.scene.lights.iter().enumerate() {
                         let cos_theta = s.normal.dot(light.incident(s.position).to_light);
                         if cos_theta <= GRAZING {
@@ -146,7 +146,16 @@ impl<'a> ShadowRays<'a> {
     fn hit(&self, at: Vec2, object: u32) -> Option<SurfacePoint> {
         let ray = self.rays.ray(at);
         let hit = self.trace.intersect(&ray, f32::INFINITY)?;
-        (hit.item.object == object).then(|| self.frames.surface(self.scene, hit.item, &ray))
+        if hit.item.object != object {
+            return None;
+        }
+        Some(match hit.item.primitive() {
+            // A solid's point: its tangent plane there.
+            Some(_) => {
+                ObjectFrames::tangent(self.scene, hit.item, ray.origin + ray.dir * hit.t, hit.normal).surface(&ray)
+            }
+            None => self.frames.surface(self.scene, hit.item, &ray),
+        })
     }
 }
 

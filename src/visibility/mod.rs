@@ -96,6 +96,9 @@ pub struct VisibilityBuffer {
     normals: Vec<Vec3>,
     /// False for a depth-only buffer (shadow maps), whose `items` stay empty.
     with_items: bool,
+    /// False for a buffer whose solids' normals are not wanted (every shadow
+    /// map, even one that keeps items).
+    with_normals: bool,
 }
 
 impl VisibilityBuffer {
@@ -111,6 +114,7 @@ impl VisibilityBuffer {
             items: vec![ItemId::NONE; n],
             normals: Vec::new(),
             with_items: true,
+            with_normals: true,
         }
     }
 
@@ -127,6 +131,7 @@ impl VisibilityBuffer {
             items: Vec::new(),
             normals: Vec::new(),
             with_items: false,
+            with_normals: false,
         }
     }
 
@@ -218,7 +223,7 @@ impl VisibilityBuffer {
     /// Depth, items (empty for a depth-only buffer) and normals (allocated here
     /// when the buffer keeps items), for drawing solids.
     fn solid_parts_mut(&mut self) -> (&mut [f32], &mut [ItemId], &mut [Vec3]) {
-        if self.with_items && self.normals.len() != self.depth.len() {
+        if self.with_normals && self.normals.len() != self.depth.len() {
             self.normals.resize(self.depth.len(), Vec3::ZERO);
         }
         (&mut self.depth, &mut self.items, &mut self.normals)

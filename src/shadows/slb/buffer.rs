@@ -1,6 +1,8 @@
 //! The light pass's buffers of seed 000 (§3.2, Table 1): the edge buffer (one
 //! bit per texel: a silhouette crosses it) and the silhouette-line buffer, built
-//! from the casters' triangles as the light sees them.
+//! from the casters' triangles as the light sees them (a CSG solid's are
+//! those of its outline band, [`super::solid`], with its [`SolidCoverage`]
+//! over the centres the band does not reach).
 //!
 //! Every edge of every triangle is walked ([`super::walk`]) and recorded in the
 //! texels it crosses; then, per texel (§3.3.2), a record of one object that
@@ -23,35 +25,12 @@
 //! wherever a line's k-bit form puts the centre on the other side of it than
 //! the exact edge does.
 
-use glam::DVec3;
 use rayon::prelude::*;
 
-use super::line::{SilhouetteLine, TexelDepth};
+use super::light::LightTriangle;
+use super::line::{Layer, SilhouetteLine, TexelDepth};
+use super::solid::SolidCoverage;
 use super::walk::{Edge, WalkPoint, WALK_BITS};
-
-/// One caster triangle as the light sees it: texel coordinates (x right, y
-/// down) and reversed depth (larger nearer the light) per vertex.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct LightTriangle {
-    /// The corners: x, y in texels, z reversed depth.
-    pub points: [DVec3; 3],
-    /// The object it belongs to.
-    pub object: u32,
-    /// Its index among its object's triangles (the Polygon ID).
-    pub polygon: u32,
-}
-
-/// A surface over an edge texel's centre, counted `count` times (a correction
-/// counts −1).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Layer {
-    /// Its depth plane over the texel.
-    pub depth: TexelDepth,
-    /// How many surfaces it stands for.
-    pub count: i32,
-    /// The object it belongs to.
-    pub object: u32,
-}
 
 /// What one edge texel holds.
 #[derive(Debug, Clone, Copy)]
@@ -150,6 +129,7 @@ struct Snapped {
     plane: (f64, f64, f64),
     object: u32,
     polygon: u32,
+    open: u8,
 }
 
 impl Snapped {
@@ -164,7 +144,8 @@ impl Snapped {
         let dx = ((b.z - a.z) * (c.y - a.y) - (c.z - a.z) * (b.y - a.y)) / det;
         let dy = ((c.z - a.z) * (b.x - a.x) - (b.z - a.z) * (c.x - a.x)) / det;
         let plane = (a.z - dx * a.x - dy * a.y, dx, dy);
-        Some(Snapped { p, turn: if area > 0 { 1 } else { -1 }, plane, object: t.object, polygon: t.polygon })
+        let turn = if area > 0 { 1 } else { -1 };
+        Some(Snapped { p, turn, plane, object: t.object, polygon: t.polygon, open: t.open })
     }
 
     fn depth(&self, x: i64, y: i64) -> TexelDepth {
@@ -230,9 +211,16 @@ fn clip(p: (f64, f64), q: (f64, f64), x: (f64, f64), y: (f64, f64)) -> Option<((
 
 impl SilhouetteLineBuffer {
     /// Builds the buffers of a `width` × `height` light view of `triangles`,
-    /// Fraction and Slope in `bits` bits (4 ..= 16).
+    /// Fraction and Slope in `bits` bits (4 ..= 16), with `solids` over the
+    /// centres their triangles do not hold.
     #[must_use]
-    pub fn build(width: u32, height: u32, bits: u32, triangles: &[LightTriangle]) -> SilhouetteLineBuffer {
+    pub fn build(
+        width: u32,
+        height: u32,
+        bits: u32,
+        triangles: &[LightTriangle],
+        solids: &[SolidCoverage],
+    ) -> SilhouetteLineBuffer {
         let snapped: Vec<Snapped> = triangles.par_iter().filter_map(Snapped::new).collect();
         let edges = silhouette_edges(&snapped);
         let mut records: Vec<Record> = edges
@@ -255,7 +243,7 @@ impl SilhouetteLineBuffer {
             ..SilhouetteLineBuffer::default()
         };
         buffer.set_edges(records.iter().map(|r| r.texel));
-        let layers = buffer.centre_layers(&snapped);
+        let layers = buffer.centre_layers(&snapped, solids);
         buffer.finish(records, layers);
         buffer
     }
@@ -279,9 +267,10 @@ impl SilhouetteLineBuffer {
             .collect();
     }
 
-    /// Every triangle over the centre of every edge texel: (texel, layer,
-    /// whether the triangle covers the texel whole).
-    fn centre_layers(&self, snapped: &[Snapped]) -> Vec<(u32, Layer, bool)> {
+    /// Every triangle over the centre of every edge texel, and every solid
+    /// there that no triangle stands for: (texel, layer, whether the
+    /// triangle covers the texel whole).
+    fn centre_layers(&self, snapped: &[Snapped], solids: &[SolidCoverage]) -> Vec<(u32, Layer, bool)> {
         let w = self.width as i64;
         let mut layers: Vec<(u32, Layer, bool)> = snapped
             .par_iter()
@@ -313,6 +302,18 @@ impl SilhouetteLineBuffer {
             })
             .flatten()
             .collect();
+        if !solids.is_empty() {
+            let width = self.width as usize;
+            let edge = &self.edge;
+            layers.par_extend(edge.par_iter().enumerate().flat_map_iter(|(w, &word)| {
+                let bits = (0..64).filter(move |b| word >> b & 1 == 1);
+                bits.flat_map(move |b| {
+                    let t = w * 64 + b;
+                    let (x, y) = (t % width, t / width);
+                    solids.iter().filter_map(move |s| s.layer(x, y)).map(move |l| (t as u32, l, false))
+                })
+            }));
+        }
         layers.par_sort_unstable_by_key(|l| l.0);
         layers
     }
@@ -350,7 +351,7 @@ impl SilhouetteLineBuffer {
             };
             let before = lines.len();
             let mut mine: Vec<Record> = records[r..r_end].to_vec();
-            close_vertices(&mut mine, self.bits);
+            close_vertices(&mut mine, self.bits, self.width);
             lines.extend(mine.iter().map(|x| x.line).filter(|line| !behind(&line.depth)));
             hidden += (r_end - r) - (lines.len() - before);
             if lines.len() > before {
@@ -471,7 +472,11 @@ fn silhouette_edges(snapped: &[Snapped]) -> Vec<(usize, usize)> {
         })
         .collect();
     all.par_sort_unstable_by_key(|e| (e.0, e.1, e.2));
-    unpaired(&all, |a, b| (a.0, a.1, a.2) == (b.0, b.1, b.2), |e| e.3).into_iter().map(|e| (e.4, e.5)).collect()
+    unpaired(&all, |a, b| (a.0, a.1, a.2) == (b.0, b.1, b.2), |e| e.3)
+        .into_iter()
+        .filter(|e| snapped[e.4].open >> e.5 & 1 == 0)
+        .map(|e| (e.4, e.5))
+        .collect()
 }
 
 /// §3.3.2's pairing over `sorted`, whose runs of `same` items are adjacent:
@@ -528,8 +533,14 @@ fn walk_edge(t: &Snapped, i: usize, width: u32, height: u32, bits: u32, out: &mu
 
 /// Moves the stored ends of lines meeting at one vertex to where their
 /// stored (quantised) lines meet, so that no way from the centre slips
-/// between them: the records of one texel.
-fn close_vertices(records: &mut [Record], bits: u32) {
+/// between them: the records of one texel of a map `width` texels wide. Two
+/// lines of nearly one direction (a curved outline's chords) meet far from
+/// their vertex once quantised; where the meeting point lies more than
+/// 2^(2−k) texel from the vertex, the ends stay where the vertex is.
+fn close_vertices(records: &mut [Record], bits: u32, width: u32) {
+    let Some(first) = records.first() else { return };
+    let (tx, ty) = (f64::from(first.texel % width), f64::from(first.texel / width));
+    let reach = 4.0 / f64::from(1u32 << bits);
     let mut vertices: Vec<WalkPoint> = records.iter().flat_map(|r| r.ends).flatten().collect();
     vertices.sort_unstable();
     vertices.dedup();
@@ -540,6 +551,10 @@ fn close_vertices(records: &mut [Record], bits: u32) {
             .collect();
         let lines: Vec<&SilhouetteLine> = at.iter().map(|&(i, _)| &records[i].line).collect();
         let Some(meet) = meeting_point(&lines, bits) else { continue };
+        let (vx, vy) = v.texels();
+        if (f64::from(meet.0) - (vx - tx)).hypot(f64::from(meet.1) - (vy - ty)) > reach {
+            continue;
+        }
         for (i, e) in at {
             let line = &mut records[i].line;
             let a = line.canonical(meet.0, meet.1).0.clamp(0.0, 1.0);

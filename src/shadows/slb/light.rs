@@ -6,10 +6,25 @@
 use glam::{DMat4, DVec3, DVec4, Mat4};
 use rayon::prelude::*;
 
-use super::buffer::LightTriangle;
 use crate::camera::Camera;
 use crate::scene::Scene;
 use crate::visibility::{ClipPlanes, MAX_CLIPPED};
+
+/// One caster triangle as the light sees it: texel coordinates (x right, y
+/// down) and reversed depth (larger nearer the light) per vertex.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LightTriangle {
+    /// The corners: x, y in texels, z reversed depth.
+    pub points: [DVec3; 3],
+    /// The object it belongs to.
+    pub object: u32,
+    /// Its index among its object's triangles (the Polygon ID).
+    pub polygon: u32,
+    /// Bit `i`: edge `i` (corner `i` to corner `i + 1`) is no silhouette
+    /// and is not walked (a side of a solid's outline band lying inside the
+    /// solid; 0 for a mesh's triangles).
+    pub open: u8,
+}
 
 /// Texels of band beyond the map's sides that clipping keeps.
 const BAND_TEXELS: f64 = 4.0;
@@ -50,14 +65,14 @@ pub fn light_triangles(scene: &Scene, camera: &Camera, resolution: u32, casters:
                 let object = i as u32;
                 let polygon = t as u32;
                 if ca | cb | cc == 0 {
-                    out.push(LightTriangle { points: corners.map(to_texels), object, polygon });
+                    out.push(LightTriangle { points: corners.map(to_texels), object, polygon, open: 0 });
                     continue;
                 }
                 let mut poly = [DVec4::ZERO; MAX_CLIPPED];
                 let k = planes.clip(corners, ca | cb | cc, &mut poly);
                 for j in 1..k.saturating_sub(1) {
                     let points = [poly[0], poly[j], poly[j + 1]].map(to_texels);
-                    out.push(LightTriangle { points, object, polygon });
+                    out.push(LightTriangle { points, object, polygon, open: 0 });
                 }
             }
             out.into_iter()

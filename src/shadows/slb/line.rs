@@ -34,6 +34,18 @@ impl TexelDepth {
     }
 }
 
+/// A surface over an edge texel's centre, counted `count` times (a correction
+/// counts −1).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Layer {
+    /// Its depth plane over the texel.
+    pub depth: TexelDepth,
+    /// How many surfaces it stands for.
+    pub count: i32,
+    /// The object it belongs to.
+    pub object: u32,
+}
+
 /// A silhouette line's record in one texel.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SilhouetteLine {

@@ -17,7 +17,7 @@
 //!
 //! [`covered`] is kage's, and is exact for any number of lines, objects and
 //! layers: it counts surfaces. The texel keeps how many caster surfaces lie
-//! over its centre ([`Layer`](super::buffer::Layer)); walking from the
+//! over its centre ([`Layer`](super::line::Layer)); walking from the
 //! centre to the point, each stored line crossed into its polygon's side
 //! adds one surface and each crossed out of it removes one, so the count at the point is the number of
 //! surfaces over it — holes, concave outlines, an object over itself and
@@ -272,7 +272,8 @@ pub fn paper_inside(lines: &[SilhouetteLine], mx: f32, my: f32, bits: u32, table
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::shadows::slb::buffer::{LightTriangle, SilhouetteLineBuffer};
+    use crate::shadows::slb::buffer::SilhouetteLineBuffer;
+    use crate::shadows::slb::light::LightTriangle;
     use glam::DVec3;
     use rand::{Rng, SeedableRng};
 
@@ -302,7 +303,7 @@ mod tests {
             .map(|i| {
                 let (p, q) = (outline[i], outline[(i + 1) % n]);
                 let v = |(x, y): (f64, f64)| DVec3::new(x, y, 0.9);
-                LightTriangle { points: [v(centre), v(p), v(q)], object: 0, polygon: i as u32 }
+                LightTriangle { points: [v(centre), v(p), v(q)], object: 0, polygon: i as u32, open: 0 }
             })
             .collect();
         (outline, tris)
@@ -355,7 +356,7 @@ mod tests {
                 break;
             }
             let (outline, tris) = polygon(&mut rng);
-            let slb = SilhouetteLineBuffer::build(3, 3, bits, &tris);
+            let slb = SilhouetteLineBuffer::build(3, 3, bits, &tris, &[]);
             let Some(entry) = slb.entry(1, 1) else { continue };
             let has_vertex = outline.iter().any(|&(x, y)| (1.0..2.0).contains(&x) && (1.0..2.0).contains(&y));
             if !lines.contains(&entry.lines.len()) || has_vertex != vertex {
@@ -415,7 +416,7 @@ mod tests {
         let (mut corners, mut printed_wrong, mut misread) = (0, 0, [0usize; 4]);
         while corners < 3000 {
             let (_, tris) = polygon(&mut rng);
-            let slb = SilhouetteLineBuffer::build(3, 3, bits, &tris);
+            let slb = SilhouetteLineBuffer::build(3, 3, bits, &tris, &[]);
             let Some(entry) = slb.entry(1, 1) else { continue };
             let [a, b] = entry.lines else { continue };
             let Some(v) = shared_vertex(a, b, bits, 4.0 / 65536.0) else { continue };

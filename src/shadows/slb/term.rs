@@ -22,10 +22,12 @@ use wide::f32x8;
 use super::buffer::SilhouetteLineBuffer;
 use super::light::light_triangles;
 use super::region::{covered, DepthLimits};
+use super::solid::solid_outline;
 use crate::camera::Camera;
 use crate::scene::{Scene, ShadowSettings};
 use crate::shadows::footprint::{PixelView, Receiver, ReceiverLanes};
 use crate::shadows::map::{DepthMap, Located, LocatedLanes};
+use crate::visibility::solids::draw_solids;
 use crate::visibility::{VisibilityBuffer, Workers};
 
 /// One light view's depth map and silhouette-line buffer.
@@ -33,10 +35,6 @@ use crate::visibility::{VisibilityBuffer, Workers};
 pub struct SlbMap {
     map: DepthMap,
     slb: SilhouetteLineBuffer,
-    /// CSG solids cast into the map: they have no lines, so a texel the lines
-    /// cross also asks the map (their shadows stay; such a texel's edge is the
-    /// map's again where a solid or a mesh covers its centre).
-    solids: bool,
     /// The frame's pixel rays, for antialiased lookups ([`SlbMap::set_view`]).
     view: Option<PixelView>,
 }
@@ -67,10 +65,24 @@ impl SlbMap {
         // that object's bias (the receiver's own, or the small one of others).
         depth.keep_items(true);
         let map = DepthMap::render(scene, camera, resolution, casters, workers, depth);
-        let triangles = light_triangles(scene, camera, resolution, casters);
-        let slb = SilhouetteLineBuffer::build(resolution, resolution, bits.clamp(4, 16), &triangles);
-        let solids = scene.objects.iter().zip(casters).any(|(o, &c)| c && o.triangles().is_none());
-        SlbMap { map, slb, solids, view: None }
+        let bits = bits.clamp(4, 16);
+        let mut triangles = light_triangles(scene, camera, resolution, casters);
+        let mut solids = Vec::new();
+        for (object, o) in scene.objects.iter().enumerate().filter(|&(i, _)| casters.get(i) == Some(&true)) {
+            let Some(solid) = o.solid() else { continue };
+            // The solid alone, as the map would hold it.
+            let map_depth = || {
+                let mut alone = VisibilityBuffer::depth_only(resolution, resolution);
+                draw_solids(scene, camera, |i| i == object, &mut alone);
+                alone.depths().to_vec()
+            };
+            let world = solid.transformed(&o.transform);
+            let (outline, coverage) = solid_outline(&world, object as u32, camera, resolution, bits, map_depth);
+            triangles.extend(outline);
+            solids.push(coverage);
+        }
+        let slb = SilhouetteLineBuffer::build(resolution, resolution, bits, &triangles, &solids);
+        SlbMap { map, slb, view: None }
     }
 
     /// Sets the pixel rays of the frame the lookups are for: antialiased
@@ -186,10 +198,7 @@ impl SlbMap {
     fn lit_at(&self, u: f32, v: f32, limits: &DepthLimits) -> f32 {
         let (x, y) = (u as u32, v as u32);
         let hidden = match self.slb.entry(x, y) {
-            Some(entry) => {
-                covered(&entry, u - x as f32, v - y as f32, limits, self.slb.bits())
-                    || (self.solids && self.map_hides(x, y, limits))
-            }
+            Some(entry) => covered(&entry, u - x as f32, v - y as f32, limits, self.slb.bits()),
             None => self.map_hides(x, y, limits),
         };
         if hidden {

@@ -297,7 +297,8 @@ pub fn draw_solids(
         let (depth, items, normals) = vb.solid_parts_mut();
         let n = w * BAND_ROWS;
         let (mut items, mut normals) = (items.chunks_mut(n), normals.chunks_mut(n));
-        // Depth-only buffers have no items or normals: their bands get empty slices.
+        // Depth-only buffers have no items or normals, a map that keeps items no
+        // normals: their bands get empty slices.
         let bands: Vec<(&mut [f32], &mut [ItemId], &mut [Vec3])> = depth
             .chunks_mut(n)
             .map(|d| (d, items.next().unwrap_or(&mut []), normals.next().unwrap_or(&mut [])))
@@ -314,6 +315,8 @@ pub fn draw_solids(
                     // A depth map needs no item or normal.
                     if !items.is_empty() {
                         items[i] = ItemId::primitive_of(object as u32, h.primitive);
+                    }
+                    if !normals.is_empty() {
                         normals[i] = row.crossing(x, h).normal;
                     }
                 }
