@@ -12,7 +12,7 @@ use glam::{Affine3A, Vec2, Vec3};
 use kage::camera::{Camera, Projection};
 use kage::raytrace::shadow_truth::{self, ShadowRays};
 use kage::scene::mesh::shapes;
-use kage::scene::{Light, LightKind, Material, Object, ShadowMethod, ShadowSettings};
+use kage::scene::{Light, LightKind, Material, Mesh, Object, ShadowMethod, ShadowSettings};
 use kage::shadows::{Receiver, ShadowTerm};
 use kage::{RenderOptions, Renderer, Scene};
 use miette::{miette, Result};
@@ -94,8 +94,63 @@ fn grid_of_boxes() -> Scene {
     scene
 }
 
-/// The scenes: the demo, the heat sink, atrium and CSG examples, a grid of boxes under grazing
-/// light, and the Stanford bunny and a CAD part from OpenSCAD when the shared assets are there.
+/// A torus (ring radius 1, tube 0.35) as `rings` × `sides` quads, about the y axis.
+fn torus(rings: u32, sides: u32) -> Mesh {
+    let mut m = Mesh::default();
+    for i in 0..rings {
+        let a = std::f32::consts::TAU * i as f32 / rings as f32;
+        for j in 0..sides {
+            let b = std::f32::consts::TAU * j as f32 / sides as f32;
+            let n = Vec3::new(b.cos() * a.cos(), b.sin(), b.cos() * a.sin());
+            m.positions.push(Vec3::new(a.cos(), 0.0, a.sin()) + n * 0.35);
+            m.normals.push(n);
+            m.uvs.push(Vec2::new(i as f32 / rings as f32, j as f32 / sides as f32));
+        }
+    }
+    let at = |i: u32, j: u32| (i % rings) * sides + j % sides;
+    for i in 0..rings {
+        for j in 0..sides {
+            let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+            m.triangles.push([a, c, b]);
+            m.triangles.push([a, d, c]);
+        }
+    }
+    m
+}
+
+/// A tilted torus over a floor under a spot light: its hole lets light through
+/// and its ring shadows itself.
+fn torus_scene() -> Scene {
+    let camera = Camera {
+        eye: Vec3::new(0.0, 3.5, 4.5),
+        target: Vec3::new(0.0, 0.5, 0.0),
+        up: Vec3::Y,
+        near: 0.1,
+        far: 50.0,
+        projection: Projection::Perspective { fov_y_deg: 45.0 },
+        shift: Vec2::ZERO,
+    };
+    let mut scene = Scene::new(640, 360, camera);
+    scene.materials.push(Material::default());
+    let plane = Arc::new(shapes::plane());
+    scene.objects.push(Object::mesh("floor", plane, Affine3A::from_scale(Vec3::splat(20.0)), 0));
+    let turn = glam::Quat::from_rotation_x(0.6) * glam::Quat::from_rotation_z(0.3);
+    let transform = Affine3A::from_rotation_translation(turn, Vec3::new(0.0, 1.1, 0.0));
+    scene.objects.push(Object::mesh("torus", Arc::new(torus(96, 48)), transform, 0));
+    let position = Vec3::new(-2.5, 5.0, 1.5);
+    let kind = LightKind::Spot {
+        position,
+        direction: (Vec3::new(0.0, 0.5, 0.0) - position).normalize(),
+        inner: 0.5,
+        outer: 0.6,
+    };
+    scene.lights.push(Light { kind, ambient: 0.2, ..Light::default() });
+    scene
+}
+
+/// The scenes: the demo, the heat sink, atrium and CSG examples, a torus, a grid of boxes under
+/// grazing light, and the Stanford bunny and dragon and a CAD part from OpenSCAD when the shared
+/// assets are there.
 fn scenes(c: &Common) -> Result<Vec<(String, Scene)>> {
     let mut out = Vec::new();
     let demo = kage::scene::demo::demo_scene().map_err(|e| miette!("{e}"))?;
@@ -105,8 +160,9 @@ fn scenes(c: &Common) -> Result<Vec<(String, Scene)>> {
         let scene = kage::scene::file::load_scene(&dir.join(format!("{name}.toml"))).map_err(|e| miette!("{e}"))?;
         out.push((format!("{name}.toml"), scene));
     }
+    out.push(("torus over a floor".to_string(), torus_scene()));
     out.push(("grid of boxes, sun at 12°".to_string(), grid_of_boxes()));
-    for model in ["meshes/stanford-bunny/stanford-bunny.obj", "csg/mk3_x_end.csg"] {
+    for model in ["meshes/stanford-bunny/stanford-bunny.obj", "meshes/dragon/dragon.obj", "csg/mk3_x_end.csg"] {
         let path = c.assets().join(model);
         if path.exists() {
             let scene = kage::scene::model::scene_for_model(&path, 640, 360).map_err(|e| miette!("{e}"))?;

@@ -118,13 +118,22 @@ impl SilhouetteLine {
     #[inline]
     #[must_use]
     pub fn strictly_inside(&self, mx: f32, my: f32, bits: u32) -> bool {
-        let (a, b) = self.canonical(mx, my);
-        let off = b - self.b_at(a, bits);
+        let off = self.offset(mx, my, bits);
         if self.inside_above() {
             off > 0.0
         } else {
             off < 0.0
         }
+    }
+
+    /// How far `(mx, my)` (texel-local, inside the texel or not) lies off
+    /// the line along its minor axis, signed (positive above it in the
+    /// canonical frame): an affine function of the point.
+    #[inline]
+    #[must_use]
+    pub fn offset(&self, mx: f32, my: f32, bits: u32) -> f32 {
+        let (a, b) = self.canonical(mx, my);
+        b - self.b_at(a, bits)
     }
 
     /// The major-axis extent of the line's part in the texel, from its End

@@ -139,7 +139,7 @@ struct LightView<'a> {
 /// The reversed depth of `caster`'s solid at texel coordinates `p` of the map
 /// `rays` make for `camera`, where the map would hold it (between its
 /// planes); `None` where it does not.
-fn depth_at(caster: &CsgCaster, rays: &PixelRays, camera: &Camera, p: DVec2) -> Option<f64> {
+pub(super) fn depth_at(caster: &CsgCaster, rays: &PixelRays, camera: &Camera, p: DVec2) -> Option<f64> {
     let ray = rays.ray(Vec2::new(p.x as f32, p.y as f32));
     let hit = caster.first_hit(&ray, 0.0, f32::INFINITY)?;
     let axis = (camera.target - camera.eye).normalize();
@@ -432,112 +432,5 @@ fn fan(v: &[(Corner, Option<usize>)], across: [bool; 4], object: u32, polygon: u
             open |= 4;
         }
         out.push(LightTriangle { points: [v[0].0, v[t].0, v[t + 1].0], object, polygon, open });
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use glam::{Affine3A, Quat, Vec3};
-    use rand::{Rng, SeedableRng};
-
-    use super::*;
-    use crate::camera::Projection;
-    use crate::csg::{ConvexPolyhedron, CsgTree, Primitive, Shape};
-    use crate::shadows::slb::buffer::SilhouetteLineBuffer;
-    use crate::shadows::slb::region::{covered, DepthLimits};
-
-    /// Two random primitives joined, intersected or one cut from the other,
-    /// within about a unit of the origin.
-    fn random_solid(rng: &mut rand::rngs::StdRng) -> CsgSolid {
-        let mut primitive = || {
-            let shape = match rng.gen_range(0..3) {
-                0 => Shape::Sphere,
-                1 => Shape::Frustum { bottom: 1.0, top: rng.gen_range(0.0..1.0) },
-                _ => Shape::Polyhedron(ConvexPolyhedron::unit_cube()),
-            };
-            let s = Vec3::new(rng.gen_range(0.3..0.9), rng.gen_range(0.3..0.9), rng.gen_range(0.3..0.9));
-            let r = Quat::from_euler(glam::EulerRot::XYZ, rng.gen_range(0.0..3.0), rng.gen_range(0.0..3.0), 0.0);
-            let t = Vec3::new(rng.gen_range(-0.4..0.4), rng.gen_range(-0.4..0.4), rng.gen_range(-0.4..0.4));
-            let transform = Affine3A::from_scale_rotation_translation(s, r, t);
-            Primitive { shape, transform, color: None, source: 0..0 }
-        };
-        let primitives = vec![primitive(), primitive()];
-        let (a, b) = (CsgTree::Leaf(0), CsgTree::Leaf(1));
-        let tree = match rng.gen_range(0..3) {
-            0 => CsgTree::Union(vec![a, b]),
-            1 => CsgTree::Intersection(vec![a, b]),
-            _ => CsgTree::Difference(Box::new(a), vec![b]),
-        };
-        CsgSolid { primitives, tree: Some(tree) }
-    }
-
-    /// A light looking at the origin from a random side, the solid taking
-    /// `share` of its view's height.
-    fn light(rng: &mut rand::rngs::StdRng, share: f32) -> Camera {
-        let from = Vec3::new(rng.gen_range(-1.0..1.0), rng.gen_range(0.5..1.0), rng.gen_range(-1.0..1.0)).normalize();
-        let ortho = rng.gen_bool(0.5);
-        let eye = from * 6.0;
-        let projection = if ortho {
-            Projection::Orthographic { height: 2.5 / share }
-        } else {
-            Projection::Perspective { fov_y_deg: (2.0 * (1.25 / share / 6.0f32).atan()).to_degrees() }
-        };
-        Camera { eye, target: Vec3::ZERO, up: Vec3::Y, near: 0.5, far: 20.0, projection, shift: Vec2::ZERO }
-    }
-
-    /// The outline band and layers decide coverage at random points of the
-    /// map as a ray through each point does, on random two-primitive
-    /// solids large (texel-centre lattice) and small (a finer one) in the
-    /// map: points within 2^-8 texel of a decision change along x are not
-    /// judged.
-    #[test]
-    fn the_outline_covers_what_rays_through_the_solid_meet() {
-        let mut rng = rand::rngs::StdRng::seed_from_u64(5);
-        let (n, bits) = (128u32, 12);
-        for share in [0.9, 0.05] {
-            let (mut wrong, mut judged) = (0, 0);
-            for _ in 0..12 {
-                let (solid, camera) = (random_solid(&mut rng), light(&mut rng, share));
-                let rays = camera.pixel_rays(Vec2::splat(n as f32));
-                let caster = CsgCaster::new(&solid);
-                let meets = |p: DVec2| depth_at(&caster, &rays, &camera, p).is_some();
-                let map = || {
-                    let centre = |k: usize| DVec2::new((k % n as usize) as f64 + 0.5, (k / n as usize) as f64 + 0.5);
-                    (0..(n * n) as usize)
-                        .map(|k| depth_at(&caster, &rays, &camera, centre(k)).map_or(0.0, |z| z as f32))
-                        .collect()
-                };
-                let (triangles, coverage) = solid_outline(&solid, 0, &camera, n, bits, map);
-                let slb = SilhouetteLineBuffer::build(n, n, bits, &triangles, std::slice::from_ref(&coverage));
-                let (x0, y0, w, h) = coverage.texels;
-                for _ in 0..4000 {
-                    let p = DVec2::new(
-                        rng.gen_range(x0 as f64..(x0 + w) as f64),
-                        rng.gen_range(y0 as f64..(y0 + h) as f64),
-                    );
-                    let near = 1.0 / 256.0;
-                    let truth = meets(p);
-                    if meets(p - DVec2::X * near) != truth || meets(p + DVec2::X * near) != truth {
-                        continue;
-                    }
-                    let (x, y) = (p.x as u32, p.y as u32);
-                    let decided = match slb.entry(x, y) {
-                        Some(e) => covered(
-                            &e,
-                            (p.x - f64::from(x)) as f32,
-                            (p.y - f64::from(y)) as f32,
-                            &DepthLimits::uniform(0.0),
-                            bits,
-                        ),
-                        None => coverage.depth[(y as usize - y0) * w + x as usize - x0] > 0.0,
-                    };
-                    judged += 1;
-                    wrong += usize::from(decided != truth);
-                }
-            }
-            assert!(judged > 20_000, "share {share}: only {judged} points");
-            eprintln!("share {share}: {wrong} of {judged}");
-            assert!(wrong * 1000 <= judged, "share {share}: {wrong} of {judged} points decided unlike the rays");
-        }
     }
 }

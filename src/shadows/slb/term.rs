@@ -9,18 +9,25 @@
 //! no line crosses once the view was 16 times wider: 3.2% of its lit tests
 //! wrong, 0.026% with the ids; `kage-bench slb`.)
 //!
-//! Antialiased, a point whose texel or a neighbour holds lines is decided at
-//! 4 × 4 points of its pixel's footprint on the receiver's plane
-//! ([`PixelView::footprint`]) and the share found lit is its term: the edge
-//! is known exactly, so the share is the edge's true coverage of the pixel
-//! up to the 16 samples' steps, where a shadow map could only blur its
-//! staircase.
+//! Antialiased, a point whose pixel's footprint on the receiver's plane
+//! ([`PixelView::footprint`]) has a stored line passing through it (its
+//! bounding box in texels) is decided at 4 × 4 points of the footprint and
+//! the share found lit is its term: the edge is known exactly, so the share
+//! is the edge's true coverage of the pixel up to the 16 samples' steps,
+//! where a shadow map could only blur its staircase. With one line under the
+//! footprint, each point takes the decision of its side of that line, found
+//! at one point per side: two lookups instead of sixteen, the same term
+//! (the demo's boundary RMSE is unchanged to four places) and, with the
+//! lines tested against the footprint rather than the texels near it, the
+//! 1920×1080 demo's shading 1.8× faster at scale 16 and 64 (`kage-bench
+//! slb`).
 
 use glam::Vec3;
 use wide::f32x8;
 
 use super::buffer::SilhouetteLineBuffer;
 use super::light::light_triangles;
+use super::line::SilhouetteLine;
 use super::region::{covered, DepthLimits};
 use super::solid::solid_outline;
 use crate::camera::Camera;
@@ -37,6 +44,30 @@ pub struct SlbMap {
     slb: SilhouetteLineBuffer,
     /// The frame's pixel rays, for antialiased lookups ([`SlbMap::set_view`]).
     view: Option<PixelView>,
+}
+
+/// A pixel's footprint on its receiver's plane, to be averaged over.
+struct Footprint {
+    /// Its sides, a pixel right and a pixel down.
+    axes: [Vec3; 2],
+    /// The one line under it, when only one is.
+    one_line: Option<OneLine>,
+}
+
+/// A line under a footprint, with the texel it is stored in and the
+/// footprint's corners (texel coordinates: −½ right −½ down, +½ −½, −½ +½,
+/// +½ +½).
+struct OneLine {
+    line: SilhouetteLine,
+    texel: (f32, f32),
+    corners: [(f32, f32); 4],
+}
+
+/// The lines under a footprint.
+enum Under {
+    Nothing,
+    One(OneLine),
+    Many,
 }
 
 /// Samples per side of the footprint grid an antialiased lookup averages.
@@ -150,43 +181,100 @@ impl SlbMap {
 
     /// The footprint of `p`'s pixel on its receiver's plane, when the lookup
     /// located at `at` is to be antialiased: asked for, the plane and view
-    /// known, and a line in a texel the footprint reaches or next to one.
+    /// known, and a line under the footprint.
     #[inline]
-    fn footprint(&self, p: Vec3, at: &Located, settings: &ShadowSettings, receiver: &Receiver) -> Option<[Vec3; 2]> {
+    fn footprint(&self, p: Vec3, at: &Located, settings: &ShadowSettings, receiver: &Receiver) -> Option<Footprint> {
         let view = self.view.as_ref().filter(|_| settings.antialias && receiver.plane != Vec3::ZERO)?;
-        let footprint = view.footprint(p, receiver.plane);
+        let axes = view.footprint(p, receiver.plane);
         // The footprint's reach in texels, at most its world size over a
         // texel's (seen from the light it can only shrink).
-        let reach = 0.5 * (footprint[0].length() + footprint[1].length()) / at.texel.max(f32::MIN_POSITIVE);
+        let reach = 0.5 * (axes[0].length() + axes[1].length()) / at.texel.max(f32::MIN_POSITIVE);
         if reach > MAX_SCANNED_REACH {
-            return Some(footprint);
+            return Some(Footprint { axes, one_line: None });
         }
         let r = reach.ceil().max(1.0) as i64;
         let (x, y) = (at.u as i64, at.v as i64);
-        self.slb.any_edge((x - r, x + r), (y - r, y + r)).then_some(footprint)
+        if !self.slb.any_edge((x - r, x + r), (y - r, y + r)) {
+            return None;
+        }
+        match self.lines_under(p, axes) {
+            Under::Nothing => None,
+            Under::One(line) => Some(Footprint { axes, one_line: Some(line) }),
+            Under::Many => Some(Footprint { axes, one_line: None }),
+        }
     }
 
-    /// The share of [`FOOTPRINT_GRID`]² points of the footprint
-    /// `[right, down]` around `p` (a point of object `receiver`) that are lit.
+    /// The stored lines that pass through the bounding box, in texels, of the
+    /// footprint `[right, down]` around `p` (many, too, where the footprint
+    /// leaves the map): where none does, every footprint point is decided
+    /// as `p` is, up to the receiver's depth crossing a caster's inside the
+    /// footprint.
+    fn lines_under(&self, p: Vec3, [right, down]: [Vec3; 2]) -> Under {
+        let mut corners = [(0.0, 0.0); 4];
+        for (k, (i, j)) in [(-0.5, -0.5), (0.5, -0.5), (-0.5, 0.5), (0.5, 0.5)].into_iter().enumerate() {
+            let Some((u, v, _)) = self.map.project(p + right * i + down * j) else { return Under::Many };
+            corners[k] = (u, v);
+        }
+        let lo = corners.iter().fold((f32::INFINITY, f32::INFINITY), |m, c| (m.0.min(c.0), m.1.min(c.1)));
+        let hi = corners.iter().fold((f32::NEG_INFINITY, f32::NEG_INFINITY), |m, c| (m.0.max(c.0), m.1.max(c.1)));
+        let bits = self.slb.bits();
+        let mut found = None;
+        for ty in lo.1 as u32..=hi.1 as u32 {
+            for tx in lo.0 as u32..=hi.0 as u32 {
+                let Some(entry) = self.slb.entry(tx, ty) else { continue };
+                let (x0, y0, x1, y1) = (lo.0 - tx as f32, lo.1 - ty as f32, hi.0 - tx as f32, hi.1 - ty as f32);
+                for line in entry.lines {
+                    let f = [(x0, y0), (x1, y0), (x0, y1), (x1, y1)].map(|(mx, my)| line.offset(mx, my, bits));
+                    if f.iter().any(|&v| v > 0.0) && f.iter().any(|&v| v <= 0.0) {
+                        if found.is_some() {
+                            return Under::Many;
+                        }
+                        found = Some(OneLine { line: *line, texel: (tx as f32, ty as f32), corners });
+                    }
+                }
+            }
+        }
+        found.map_or(Under::Nothing, Under::One)
+    }
+
+    /// The lit share of the footprint around `p` (a point of object
+    /// `receiver`): [`FOOTPRINT_GRID`]² points of it, each decided — or, with
+    /// one line under it, each given the decision of its side of the line,
+    /// found at one point of each side.
     fn footprint_share(
         &self,
         p: Vec3,
-        [right, down]: [Vec3; 2],
+        footprint: Footprint,
         cos_theta: f32,
         settings: &ShadowSettings,
         receiver: u32,
     ) -> f32 {
+        let [right, down] = footprint.axes;
         let step = 1.0 / FOOTPRINT_GRID as f32;
         let offset = |k: usize| (k as f32 + 0.5) * step - 0.5;
-        let mut lit = 0.0;
-        for j in 0..FOOTPRINT_GRID {
-            for i in 0..FOOTPRINT_GRID {
-                let q = p + right * offset(i) + down * offset(j);
-                lit += match self.map.locate(q, cos_theta, settings, 1.0) {
-                    Some(at) => self.lit_at(at.u, at.v, &limits(&at, receiver)),
-                    None => 1.0,
-                };
+        let decide = |i: usize, j: usize| {
+            let q = p + right * offset(i) + down * offset(j);
+            match self.map.locate(q, cos_theta, settings, 1.0) {
+                Some(at) => self.lit_at(at.u, at.v, &limits(&at, receiver)),
+                None => 1.0,
             }
+        };
+        let points = (0..FOOTPRINT_GRID).flat_map(|j| (0..FOOTPRINT_GRID).map(move |i| (i, j)));
+        let Some(one) = footprint.one_line else {
+            return points.map(|(i, j)| decide(i, j)).sum::<f32>() * step * step;
+        };
+        // Each point's side, where the footprint's corners put it.
+        let [c00, c10, c01, c11] = one.corners;
+        let bits = self.slb.bits();
+        let mut sides = [None::<f32>; 2];
+        let mut lit = 0.0;
+        for (i, j) in points {
+            let (s, t) = (offset(i) + 0.5, offset(j) + 0.5);
+            let mix =
+                |a: f32, b: f32, c: f32, d: f32| (a * (1.0 - s) + b * s) * (1.0 - t) + (c * (1.0 - s) + d * s) * t;
+            let (u, v) = (mix(c00.0, c10.0, c01.0, c11.0), mix(c00.1, c10.1, c01.1, c11.1));
+            let side = usize::from(one.line.offset(u - one.texel.0, v - one.texel.1, bits) > 0.0);
+            lit += *sides[side].get_or_insert_with(|| decide(i, j));
         }
         lit * step * step
     }
@@ -209,11 +297,22 @@ impl SlbMap {
     }
 
     /// Whether the map's surface at texel `(x, y)` hides a receiver held to
-    /// `limits` (by the bias of the object it belongs to).
+    /// `limits` (by the bias of the object it belongs to). The texel's object
+    /// is read only where its depth lies between the two limits: the item
+    /// buffer is twice the depth map's size, and reading it at every lookup
+    /// was a quarter of the SLB's shading time (its cache misses; `perf` on
+    /// the 1920×1080 demo).
     #[inline]
     fn map_hides(&self, x: u32, y: u32, limits: &DepthLimits) -> bool {
+        let z = self.map.texel_depth(x, y);
+        if z <= limits.own.min(limits.other) {
+            return false;
+        }
+        if z > limits.own.max(limits.other) {
+            return true;
+        }
         let limit = self.map.texel_object(x, y).map_or(limits.own, |o| limits.of(o));
-        self.map.texel_depth(x, y) > limit
+        z > limit
     }
 
     /// The depth map.
@@ -247,4 +346,112 @@ impl SlbMap {
 #[inline]
 fn limits(at: &Located, receiver: u32) -> DepthLimits {
     DepthLimits { receiver, own: at.z_limit, other: at.z_other }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::{Affine3A, Quat, Vec3};
+    use rand::{Rng, SeedableRng};
+
+    use glam::{DVec2, Vec2};
+
+    use super::*;
+    use crate::camera::Projection;
+    use crate::csg::{ConvexPolyhedron, CsgCaster, CsgSolid, CsgTree, Primitive, Shape};
+    use crate::shadows::slb::solid::depth_at;
+
+    /// Two random primitives joined, intersected or one cut from the other,
+    /// within about a unit of the origin.
+    fn random_solid(rng: &mut rand::rngs::StdRng) -> CsgSolid {
+        let mut primitive = || {
+            let shape = match rng.gen_range(0..3) {
+                0 => Shape::Sphere,
+                1 => Shape::Frustum { bottom: 1.0, top: rng.gen_range(0.0..1.0) },
+                _ => Shape::Polyhedron(ConvexPolyhedron::unit_cube()),
+            };
+            let s = Vec3::new(rng.gen_range(0.3..0.9), rng.gen_range(0.3..0.9), rng.gen_range(0.3..0.9));
+            let r = Quat::from_euler(glam::EulerRot::XYZ, rng.gen_range(0.0..3.0), rng.gen_range(0.0..3.0), 0.0);
+            let t = Vec3::new(rng.gen_range(-0.4..0.4), rng.gen_range(-0.4..0.4), rng.gen_range(-0.4..0.4));
+            let transform = Affine3A::from_scale_rotation_translation(s, r, t);
+            Primitive { shape, transform, color: None, source: 0..0 }
+        };
+        let primitives = vec![primitive(), primitive()];
+        let (a, b) = (CsgTree::Leaf(0), CsgTree::Leaf(1));
+        let tree = match rng.gen_range(0..3) {
+            0 => CsgTree::Union(vec![a, b]),
+            1 => CsgTree::Intersection(vec![a, b]),
+            _ => CsgTree::Difference(Box::new(a), vec![b]),
+        };
+        CsgSolid { primitives, tree: Some(tree) }
+    }
+
+    /// A light looking at the origin from a random side, the solid taking
+    /// `share` of its view's height.
+    fn light(rng: &mut rand::rngs::StdRng, share: f32) -> Camera {
+        let from = Vec3::new(rng.gen_range(-1.0..1.0), rng.gen_range(0.5..1.0), rng.gen_range(-1.0..1.0)).normalize();
+        let ortho = rng.gen_bool(0.5);
+        let eye = from * 6.0;
+        let projection = if ortho {
+            Projection::Orthographic { height: 2.5 / share }
+        } else {
+            Projection::Perspective { fov_y_deg: (2.0 * (1.25 / share / 6.0f32).atan()).to_degrees() }
+        };
+        Camera { eye, target: Vec3::ZERO, up: Vec3::Y, near: 0.5, far: 20.0, projection, shift: Vec2::ZERO }
+    }
+
+    /// A CSG solid's outline band and layers decide coverage at random points of the
+    /// map as a ray through each point does, on random two-primitive
+    /// solids large (texel-centre lattice) and small (a finer one) in the
+    /// map: points within 2^-8 texel of a decision change along x are not
+    /// judged.
+    #[test]
+    fn the_outline_covers_what_rays_through_the_solid_meet() {
+        let mut rng = rand::rngs::StdRng::seed_from_u64(5);
+        let (n, bits) = (128u32, 12);
+        for share in [0.9, 0.05] {
+            let (mut wrong, mut judged) = (0, 0);
+            for _ in 0..12 {
+                let (solid, camera) = (random_solid(&mut rng), light(&mut rng, share));
+                let rays = camera.pixel_rays(Vec2::splat(n as f32));
+                let caster = CsgCaster::new(&solid);
+                let meets = |p: DVec2| depth_at(&caster, &rays, &camera, p).is_some();
+                let map = || {
+                    let centre = |k: usize| DVec2::new((k % n as usize) as f64 + 0.5, (k / n as usize) as f64 + 0.5);
+                    (0..(n * n) as usize)
+                        .map(|k| depth_at(&caster, &rays, &camera, centre(k)).map_or(0.0, |z| z as f32))
+                        .collect()
+                };
+                let (triangles, coverage) = solid_outline(&solid, 0, &camera, n, bits, map);
+                let slb = SilhouetteLineBuffer::build(n, n, bits, &triangles, std::slice::from_ref(&coverage));
+                let (x0, y0, w, h) = coverage.texels;
+                for _ in 0..4000 {
+                    let p = DVec2::new(
+                        rng.gen_range(x0 as f64..(x0 + w) as f64),
+                        rng.gen_range(y0 as f64..(y0 + h) as f64),
+                    );
+                    let near = 1.0 / 256.0;
+                    let truth = meets(p);
+                    if meets(p - DVec2::X * near) != truth || meets(p + DVec2::X * near) != truth {
+                        continue;
+                    }
+                    let (x, y) = (p.x as u32, p.y as u32);
+                    let decided = match slb.entry(x, y) {
+                        Some(e) => covered(
+                            &e,
+                            (p.x - f64::from(x)) as f32,
+                            (p.y - f64::from(y)) as f32,
+                            &DepthLimits::uniform(0.0),
+                            bits,
+                        ),
+                        None => coverage.depth[(y as usize - y0) * w + x as usize - x0] > 0.0,
+                    };
+                    judged += 1;
+                    wrong += usize::from(decided != truth);
+                }
+            }
+            assert!(judged > 20_000, "share {share}: only {judged} points");
+            eprintln!("share {share}: {wrong} of {judged}");
+            assert!(wrong * 1000 <= judged, "share {share}: {wrong} of {judged} points decided unlike the rays");
+        }
+    }
 }
