@@ -34,6 +34,9 @@ use super::light::LightTriangle;
 use super::line::{Layer, TexelDepth};
 use crate::camera::{Camera, PixelRays};
 use crate::csg::{CsgCaster, CsgSolid};
+use crate::scene::Scene;
+use crate::visibility::solids::draw_solids;
+use crate::visibility::VisibilityBuffer;
 
 /// Cells across a solid's projection below which its outline is traced on a
 /// finer lattice than the texels.
@@ -195,6 +198,34 @@ const CORNERS: [(usize, usize); 4] = [(0, 0), (1, 0), (1, 1), (0, 1)];
 /// Texels `(x0, y0, width, height)` of the map.
 type TexelRect = (usize, usize, usize, usize);
 
+/// The outline bands and coverages of the CSG solids among the casters
+/// `casters` marks, seen by `camera` in a `resolution`² map with `bits`-bit
+/// lines.
+#[must_use]
+pub fn solid_outlines(
+    scene: &Scene,
+    camera: &Camera,
+    resolution: u32,
+    casters: &[bool],
+    bits: u32,
+) -> (Vec<LightTriangle>, Vec<SolidCoverage>) {
+    let (mut triangles, mut coverages) = (Vec::new(), Vec::new());
+    for (object, o) in scene.objects.iter().enumerate().filter(|&(i, _)| casters.get(i) == Some(&true)) {
+        let Some(solid) = o.solid() else { continue };
+        // The solid alone, as the map would hold it.
+        let map_depth = || {
+            let mut alone = VisibilityBuffer::depth_only(resolution, resolution);
+            draw_solids(scene, camera, |i| i == object, &mut alone);
+            alone.depths().to_vec()
+        };
+        let world = solid.transformed(&o.transform);
+        let (outline, coverage) = solid_outline(&world, object as u32, camera, resolution, bits, map_depth);
+        triangles.extend(outline);
+        coverages.push(coverage);
+    }
+    (triangles, coverages)
+}
+
 /// The triangles of `solid`'s outline band and its coverage of the texel
 /// centres, seen by `camera` in a `resolution`² map with `bits`-bit lines.
 /// `map_depth` gives the solid's reversed depth at every texel centre (0
@@ -220,13 +251,13 @@ pub fn solid_outline(
             .map(|k| sample(lattice.at(k % lattice.nx, k / lattice.nx)))
             .collect();
         let centre = |k: usize| DVec2::new((x0 + k % w) as f64 + 0.5, (y0 + k / w) as f64 + 0.5);
-        (depth, (0..w * h).into_par_iter().map(|k| sample(centre(k))).collect())
+        (depth, Some((0..w * h).into_par_iter().map(|k| sample(centre(k))).collect()))
     } else {
         // The texel centres are the lattice: the solid's own map, cut to it.
         let map = map_depth();
         let n = resolution as usize;
         let rect: Vec<f32> = (0..h).flat_map(|j| &map[(y0 + j) * n + x0..(y0 + j) * n + x0 + w]).copied().collect();
-        (rect.clone(), rect)
+        (rect, None)
     };
     let view = LightView { lattice, depth: &depth, caster: &caster, rays: &rays, camera, steps: (bits + 4).min(20) };
     let crossings = Crossings::new(&view);
@@ -251,7 +282,8 @@ pub fn solid_outline(
             square_triangles(&view, &crossings, (i, j), across, object, k as u32)
         })
         .collect();
-    (triangles, SolidCoverage { object, lattice, band, texels, depth: centres })
+    let depth = centres.unwrap_or(depth);
+    (triangles, SolidCoverage { object, lattice, band, texels, depth })
 }
 
 /// Where the outline crosses each side of the lattice's squares whose ends

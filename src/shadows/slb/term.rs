@@ -29,12 +29,11 @@ use super::buffer::SilhouetteLineBuffer;
 use super::light::light_triangles;
 use super::line::SilhouetteLine;
 use super::region::{covered, DepthLimits};
-use super::solid::solid_outline;
+use super::solid::solid_outlines;
 use crate::camera::Camera;
 use crate::scene::{Scene, ShadowSettings};
 use crate::shadows::footprint::{PixelView, Receiver, ReceiverLanes};
 use crate::shadows::map::{DepthMap, Located, LocatedLanes};
-use crate::visibility::solids::draw_solids;
 use crate::visibility::{VisibilityBuffer, Workers};
 
 /// One light view's depth map and silhouette-line buffer.
@@ -98,20 +97,8 @@ impl SlbMap {
         let map = DepthMap::render(scene, camera, resolution, casters, workers, depth);
         let bits = bits.clamp(4, 16);
         let mut triangles = light_triangles(scene, camera, resolution, casters);
-        let mut solids = Vec::new();
-        for (object, o) in scene.objects.iter().enumerate().filter(|&(i, _)| casters.get(i) == Some(&true)) {
-            let Some(solid) = o.solid() else { continue };
-            // The solid alone, as the map would hold it.
-            let map_depth = || {
-                let mut alone = VisibilityBuffer::depth_only(resolution, resolution);
-                draw_solids(scene, camera, |i| i == object, &mut alone);
-                alone.depths().to_vec()
-            };
-            let world = solid.transformed(&o.transform);
-            let (outline, coverage) = solid_outline(&world, object as u32, camera, resolution, bits, map_depth);
-            triangles.extend(outline);
-            solids.push(coverage);
-        }
+        let (outlines, solids) = solid_outlines(scene, camera, resolution, casters, bits);
+        triangles.extend(outlines);
         let slb = SilhouetteLineBuffer::build(resolution, resolution, bits, &triangles, &solids);
         SlbMap { map, slb, view: None }
     }
@@ -358,7 +345,7 @@ mod tests {
     use super::*;
     use crate::camera::Projection;
     use crate::csg::{ConvexPolyhedron, CsgCaster, CsgSolid, CsgTree, Primitive, Shape};
-    use crate::shadows::slb::solid::depth_at;
+    use crate::shadows::slb::solid::{depth_at, solid_outline};
 
     /// Two random primitives joined, intersected or one cut from the other,
     /// within about a unit of the origin.
