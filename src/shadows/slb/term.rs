@@ -285,10 +285,8 @@ impl SlbMap {
 
     /// Whether the map's surface at texel `(x, y)` hides a receiver held to
     /// `limits` (by the bias of the object it belongs to). The texel's object
-    /// is read only where its depth lies between the two limits: the item
-    /// buffer is twice the depth map's size, and reading it at every lookup
-    /// was a quarter of the SLB's shading time (its cache misses; `perf` on
-    /// the 1920×1080 demo).
+    /// is read only where its depth lies between the two limits, which alone
+    /// it decides (the item buffer is twice the depth map's size).
     #[inline]
     fn map_hides(&self, x: u32, y: u32, limits: &DepthLimits) -> bool {
         let z = self.map.texel_depth(x, y);
