@@ -42,6 +42,12 @@ fn slb_agrees_with_shadow_rays_on_the_example_scenes_better_than_maps() {
     }
 }
 
+/// A 45° camera at `eye` looking at the origin, far plane `far`.
+fn looking_at_origin(eye: Vec3, far: f32) -> Camera {
+    let projection = Projection::Perspective { fov_y_deg: 45.0 };
+    Camera { eye, target: Vec3::ZERO, up: Vec3::Y, near: 0.1, far, projection, shift: Vec2::ZERO }
+}
+
 /// A CSG solid of two primitives (sphere, cylinder or cone, box) joined,
 /// intersected or one cut from the other, placed at random.
 fn random_solid(rng: &mut StdRng, name: String) -> Object {
@@ -73,15 +79,7 @@ fn random_solid(rng: &mut StdRng, name: String) -> Object {
 /// a spot or a directional light from a random direction, seen from above at
 /// an angle.
 fn random_scene(rng: &mut StdRng) -> Scene {
-    let camera = Camera {
-        eye: Vec3::new(rng.gen_range(-3.0..3.0), 6.0, 6.0),
-        target: Vec3::ZERO,
-        up: Vec3::Y,
-        near: 0.1,
-        far: 50.0,
-        projection: Projection::Perspective { fov_y_deg: 45.0 },
-        shift: Vec2::ZERO,
-    };
+    let camera = looking_at_origin(Vec3::new(rng.gen_range(-3.0..3.0), 6.0, 6.0), 50.0);
     let mut scene = common::scene_with(shapes::plane(), camera, 160, 120, false);
     scene.objects[0].transform = Affine3A::from_scale(Vec3::splat(12.0));
     scene.materials.push(Material::default());
@@ -306,15 +304,7 @@ fn the_slb_examples_agree_with_shadow_rays_better_than_maps() {
 /// box's bias, not the floor's (the map keeps each texel's object).
 #[test]
 fn long_grazing_shadows_stay_with_the_view_16_times_wider() {
-    let camera = Camera {
-        eye: Vec3::new(0.0, 7.0, 9.0),
-        target: Vec3::ZERO,
-        up: Vec3::Y,
-        near: 0.1,
-        far: 60.0,
-        projection: Projection::Perspective { fov_y_deg: 45.0 },
-        shift: Vec2::ZERO,
-    };
+    let camera = looking_at_origin(Vec3::new(0.0, 7.0, 9.0), 60.0);
     let mut scene = common::scene_with(shapes::plane(), camera, 320, 200, false);
     scene.objects[0].transform = Affine3A::from_scale(Vec3::splat(30.0));
     let cube = Arc::new(shapes::cube());

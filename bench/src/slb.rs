@@ -64,21 +64,21 @@ fn methods() -> Vec<Method> {
     out
 }
 
-/// Cubes on a floor in a 7 × 7 grid under a sun 12° above the horizon.
-fn grid_of_boxes() -> Scene {
-    let camera = Camera {
-        eye: Vec3::new(0.0, 9.0, 13.0),
-        target: Vec3::new(0.0, 0.0, 0.5),
-        up: Vec3::Y,
-        near: 0.1,
-        far: 80.0,
-        projection: Projection::Perspective { fov_y_deg: 45.0 },
-        shift: Vec2::ZERO,
-    };
+/// A `side`-wide floor seen from `eye` looking at `target` (45°, far plane
+/// `far`), its material the default.
+fn over_a_floor(eye: Vec3, target: Vec3, far: f32, side: f32) -> Scene {
+    let projection = Projection::Perspective { fov_y_deg: 45.0 };
+    let camera = Camera { eye, target, up: Vec3::Y, near: 0.1, far, projection, shift: Vec2::ZERO };
     let mut scene = Scene::new(640, 360, camera);
     scene.materials.push(Material::default());
     let plane = Arc::new(shapes::plane());
-    scene.objects.push(Object::mesh("floor", plane, Affine3A::from_scale(Vec3::splat(40.0)), 0));
+    scene.objects.push(Object::mesh("floor", plane, Affine3A::from_scale(Vec3::splat(side)), 0));
+    scene
+}
+
+/// Cubes on a floor in a 7 × 7 grid under a sun 12° above the horizon.
+fn grid_of_boxes() -> Scene {
+    let mut scene = over_a_floor(Vec3::new(0.0, 9.0, 13.0), Vec3::new(0.0, 0.0, 0.5), 80.0, 40.0);
     let cube = Arc::new(shapes::cube());
     for i in 0..7 {
         for j in 0..7 {
@@ -121,19 +121,7 @@ fn torus(rings: u32, sides: u32) -> Mesh {
 /// A tilted torus over a floor under a spot light: its hole lets light through
 /// and its ring shadows itself.
 fn torus_scene() -> Scene {
-    let camera = Camera {
-        eye: Vec3::new(0.0, 3.5, 4.5),
-        target: Vec3::new(0.0, 0.5, 0.0),
-        up: Vec3::Y,
-        near: 0.1,
-        far: 50.0,
-        projection: Projection::Perspective { fov_y_deg: 45.0 },
-        shift: Vec2::ZERO,
-    };
-    let mut scene = Scene::new(640, 360, camera);
-    scene.materials.push(Material::default());
-    let plane = Arc::new(shapes::plane());
-    scene.objects.push(Object::mesh("floor", plane, Affine3A::from_scale(Vec3::splat(20.0)), 0));
+    let mut scene = over_a_floor(Vec3::new(0.0, 3.5, 4.5), Vec3::new(0.0, 0.5, 0.0), 50.0, 20.0);
     let turn = glam::Quat::from_rotation_x(0.6) * glam::Quat::from_rotation_z(0.3);
     let transform = Affine3A::from_rotation_translation(turn, Vec3::new(0.0, 1.1, 0.0));
     scene.objects.push(Object::mesh("torus", Arc::new(torus(96, 48)), transform, 0));
