@@ -12,8 +12,8 @@ use glam::{Affine3A, Vec2, Vec3};
 use kage::camera::{Camera, Projection};
 use kage::raytrace::shadow_truth::{self, ShadowRays};
 use kage::scene::mesh::shapes;
-use kage::scene::{Light, LightKind, Material, Mesh, Object, ShadowMethod, ShadowSettings};
-use kage::shadows::{Receiver, ShadowTerm};
+use kage::scene::{Light, LightKind, Material, Object, ShadowMethod, ShadowSettings};
+use kage::shadows::ShadowTerm;
 use kage::{RenderOptions, Renderer, Scene};
 use miette::{miette, Result};
 
@@ -94,37 +94,13 @@ fn grid_of_boxes() -> Scene {
     scene
 }
 
-/// A torus (ring radius 1, tube 0.35) as `rings` × `sides` quads, about the y axis.
-fn torus(rings: u32, sides: u32) -> Mesh {
-    let mut m = Mesh::default();
-    for i in 0..rings {
-        let a = std::f32::consts::TAU * i as f32 / rings as f32;
-        for j in 0..sides {
-            let b = std::f32::consts::TAU * j as f32 / sides as f32;
-            let n = Vec3::new(b.cos() * a.cos(), b.sin(), b.cos() * a.sin());
-            m.positions.push(Vec3::new(a.cos(), 0.0, a.sin()) + n * 0.35);
-            m.normals.push(n);
-            m.uvs.push(Vec2::new(i as f32 / rings as f32, j as f32 / sides as f32));
-        }
-    }
-    let at = |i: u32, j: u32| (i % rings) * sides + j % sides;
-    for i in 0..rings {
-        for j in 0..sides {
-            let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
-            m.triangles.push([a, c, b]);
-            m.triangles.push([a, d, c]);
-        }
-    }
-    m
-}
-
 /// A tilted torus over a floor under a spot light: its hole lets light through
 /// and its ring shadows itself.
 fn torus_scene() -> Scene {
     let mut scene = over_a_floor(Vec3::new(0.0, 3.5, 4.5), Vec3::new(0.0, 0.5, 0.0), 50.0, 20.0);
     let turn = glam::Quat::from_rotation_x(0.6) * glam::Quat::from_rotation_z(0.3);
     let transform = Affine3A::from_rotation_translation(turn, Vec3::new(0.0, 1.1, 0.0));
-    scene.objects.push(Object::mesh("torus", Arc::new(torus(96, 48)), transform, 0));
+    scene.objects.push(Object::mesh("torus", Arc::new(shapes::torus(96, 48, 0.35)), transform, 0));
     let position = Vec3::new(-2.5, 5.0, 1.5);
     let kind = LightKind::Spot {
         position,
@@ -219,7 +195,7 @@ fn errors(scene: &Scene, truth: &Truth) -> Result<(f64, f64)> {
     let frame = kage::render(scene, &options).map_err(|e| miette!("{e}"))?;
     let terms = ShadowTerm::build_all(scene);
     let (wrong, total) = truth.rays.misclassified(&frame.visibility, |light, q| {
-        let receiver = Receiver::of_object(q.object);
+        let receiver = q.receiver();
         terms[light].casts().then(|| terms[light].lit(q.surface.position, q.cos_theta, &receiver))
     });
     let (mut sum, mut n) = (0.0, 0);

@@ -12,6 +12,7 @@ use super::TraceScene;
 use crate::camera::{PixelRays, Ray};
 use crate::scene::{Light, LightKind, Scene};
 use crate::shading::{ObjectFrames, SurfacePoint};
+use crate::shadows::Receiver;
 use crate::visibility::VisibilityBuffer;
 
 /// N·L at or below which a point is not compared: the shadow term hardly
@@ -27,8 +28,19 @@ pub struct ShadowQuery<'a> {
     pub surface: &'a SurfacePoint,
     /// Its object.
     pub object: u32,
+    /// The unit normal of its triangle's plane, by the triangle's winding (a
+    /// solid's: its outward normal).
+    pub plane: Vec3,
     /// N·L there.
     pub cos_theta: f32,
+}
+
+impl ShadowQuery<'_> {
+    /// The receiver a shadow method is asked about: the object and its plane.
+    #[must_use]
+    pub fn receiver(&self) -> Receiver {
+        Receiver { object: self.object, plane: self.plane }
+    }
 }
 
 /// Shadow rays cast from points of one scene.
@@ -89,13 +101,14 @@ impl<'a> ShadowRays<'a> {
                         continue;
                     }
                     let ray = self.rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
-                    let s = self.frames.surface_at(self.scene, vb, x, y, &ray);
+                    let triangle = self.frames.prepare_at(self.scene, vb, x, y, &ray);
+                    let (s, plane) = (triangle.surface(&ray), triangle.geometry().geometric);
                     for (i, light) in self.scene.lights.iter().enumerate() {
                         let cos_theta = s.normal.dot(light.incident(s.position).to_light);
                         if cos_theta <= GRAZING {
                             continue;
                         }
-                        let query = ShadowQuery { pixel: (x, y), surface: &s, object: item.object, cos_theta };
+                        let query = ShadowQuery { pixel: (x, y), surface: &s, object: item.object, plane, cos_theta };
                         let Some(decided) = decide(i, &query) else { continue };
                         wrong += usize::from(self.reaches(&s, light) != (decided >= 0.5));
                         total += 1;

@@ -205,11 +205,53 @@ pub mod shapes {
         }
         m
     }
+
+    /// A torus about the y axis at the origin: a ring of radius 1 swept by a
+    /// tube of radius `tube`, as `rings` × `sides` quads (at least 3 × 3),
+    /// smooth normals, counter-clockwise outward.
+    #[must_use]
+    pub fn torus(rings: u32, sides: u32, tube: f32) -> Mesh {
+        let (rings, sides) = (rings.max(3), sides.max(3));
+        let mut m = Mesh::default();
+        for i in 0..rings {
+            let a = std::f32::consts::TAU * i as f32 / rings as f32;
+            for j in 0..sides {
+                let b = std::f32::consts::TAU * j as f32 / sides as f32;
+                let n = Vec3::new(b.cos() * a.cos(), b.sin(), b.cos() * a.sin());
+                m.positions.push(Vec3::new(a.cos(), 0.0, a.sin()) + n * tube);
+                m.normals.push(n);
+                m.uvs.push(Vec2::new(i as f32 / rings as f32, j as f32 / sides as f32));
+            }
+        }
+        let at = |i: u32, j: u32| (i % rings) * sides + j % sides;
+        for i in 0..rings {
+            for j in 0..sides {
+                let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+                m.triangles.push([a, c, b]);
+                m.triangles.push([a, d, c]);
+            }
+        }
+        m
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Every built-in closed shape winds its triangles counter-clockwise
+    /// seen from outside: each face normal agrees with its vertices' normals.
+    #[test]
+    fn built_in_shapes_wind_outward() {
+        for (name, m) in [("cube", shapes::cube()), ("sphere", shapes::sphere(8)), ("torus", shapes::torus(12, 8, 0.3))]
+        {
+            for t in &m.triangles {
+                let n = face_normal(&m.positions, *t);
+                let smooth: Vec3 = t.iter().map(|&i| m.normals[i as usize]).sum();
+                assert!(n.dot(smooth) > 0.0, "{name}: triangle {t:?} winds inward");
+            }
+        }
+    }
 
     #[test]
     fn rejects_nan_and_empty_and_drops_degenerates() {

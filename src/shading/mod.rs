@@ -209,7 +209,10 @@ pub fn shade_into_scalar(scene: &Scene, vb: &VisibilityBuffer, image: &mut Linea
                 let ray = rays.ray(Vec2::new(x as f32 + 0.5 + dx, y as f32 + 0.5 + dy));
                 frames.surface_at(scene, vb, x as u32, y as u32, &ray)
             };
-            let mut s = at(0.0, 0.0);
+            let centre = rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
+            let triangle = frames.prepare_at(scene, vb, x as u32, y as u32, &centre);
+            let receiver = Receiver { object: item.object, plane: triangle.geometry().geometric };
+            let mut s = triangle.surface(&centre);
             // Ray differentials: the same triangle met one pixel right and one below.
             s.duv = [at(1.0, 0.0).uv - s.uv, at(0.0, 1.0).uv - s.uv];
             let k = phong::sample_maps(&scene.materials[s.material], &mut s);
@@ -219,11 +222,8 @@ pub fn shade_into_scalar(scene: &Scene, vb: &VisibilityBuffer, image: &mut Linea
                     continue;
                 }
                 let cos_theta = s.normal.dot(light.incident(s.position).to_light);
-                let shadow = if cos_theta > 0.0 {
-                    ShadowTerm::mean_lit(terms, s.position, cos_theta, &Receiver::of_object(item.object))
-                } else {
-                    1.0
-                };
+                let shadow =
+                    if cos_theta > 0.0 { ShadowTerm::mean_lit(terms, s.position, cos_theta, &receiver) } else { 1.0 };
                 phong::add_light(&mut acc, light, &k, &s, shadow);
             }
             *px = acc.total();

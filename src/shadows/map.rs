@@ -176,6 +176,17 @@ impl DepthMap {
         }
     }
 
+    /// The direction from `p` towards the light (not normalised).
+    #[inline]
+    #[must_use]
+    pub fn towards_light(&self, p: Vec3) -> Vec3 {
+        if self.ortho {
+            -self.axis
+        } else {
+            self.eye - p
+        }
+    }
+
     /// The reversed depth the map holds at texel `(x, y)` (0: nothing).
     #[inline]
     #[must_use]

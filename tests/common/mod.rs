@@ -170,7 +170,7 @@ pub fn view_distance(cam: &Camera, d: f32) -> f32 {
 /// light that casts shadows.
 pub fn terms_vs_rays(scene: &Scene, terms: &[ShadowTerm]) -> (usize, usize) {
     decisions_vs_rays(scene, |light, at| {
-        let receiver = kage::shadows::Receiver::of_object(at.object);
+        let receiver = at.receiver();
         terms[light].casts().then(|| terms[light].lit(at.surface.position, at.cos_theta, &receiver))
     })
 }

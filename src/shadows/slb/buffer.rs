@@ -28,7 +28,7 @@
 use rayon::prelude::*;
 
 use super::light::LightTriangle;
-use super::line::{Layer, SilhouetteLine, TexelDepth};
+use super::line::{Facing, Layer, SilhouetteLine, TexelDepth};
 use super::solid::SolidCoverage;
 use super::walk::{Edge, WalkPoint, WALK_BITS};
 
@@ -130,6 +130,7 @@ struct Snapped {
     object: u32,
     polygon: u32,
     open: u8,
+    facing: Facing,
 }
 
 impl Snapped {
@@ -145,7 +146,7 @@ impl Snapped {
         let dy = ((c.z - a.z) * (b.x - a.x) - (b.z - a.z) * (c.x - a.x)) / det;
         let plane = (a.z - dx * a.x - dy * a.y, dx, dy);
         let turn = if area > 0 { 1 } else { -1 };
-        Some(Snapped { p, turn, plane, object: t.object, polygon: t.polygon, open: t.open })
+        Some(Snapped { p, turn, plane, object: t.object, polygon: t.polygon, open: t.open, facing: t.facing })
     }
 
     fn depth(&self, x: i64, y: i64) -> TexelDepth {
@@ -293,7 +294,8 @@ impl SilhouetteLineBuffer {
                         if t.covers_centre(x, y) {
                             let texel = k as u32;
                             let whole = t.covers_texel(x, y);
-                            out.push((texel, Layer { depth: t.depth(x, y), count: 1, object: t.object }, whole));
+                            let layer = Layer { depth: t.depth(x, y), count: 1, object: t.object, facing: t.facing };
+                            out.push((texel, layer, whole));
                         }
                         k += 1;
                     }
@@ -338,7 +340,7 @@ impl SilhouetteLineBuffer {
             for rec in &records[r..r_end] {
                 if rec.exact_centre_inside != rec.line.centre_inside {
                     let count = if rec.line.centre_inside { 1 } else { -1 };
-                    here.push(Layer { depth: rec.line.depth, count, object: rec.line.object });
+                    here.push(Layer { depth: rec.line.depth, count, object: rec.line.object, facing: rec.line.facing });
                 }
             }
             // §3.3.3: a triangle over the whole texel hides what lies behind it
@@ -517,7 +519,7 @@ fn walk_edge(t: &Snapped, i: usize, width: u32, height: u32, bits: u32, out: &mu
             return;
         }
         let mut line = SilhouetteLine::new(&v, edge.line, edge.slope, left, bits);
-        (line.polygon, line.object) = (t.polygon, t.object);
+        (line.polygon, line.object, line.facing) = (t.polygon, t.object, t.facing);
         line.depth = t.depth(i64::from(v.x), i64::from(v.y));
         let c = centre(i64::from(v.x), i64::from(v.y));
         // The exact edge's side of the centre, counted only where the

@@ -6,6 +6,7 @@
 use glam::{DMat4, DVec3, DVec4, Mat4};
 use rayon::prelude::*;
 
+use super::line::Facing;
 use crate::camera::Camera;
 use crate::scene::Scene;
 use crate::visibility::{ClipPlanes, MAX_CLIPPED};
@@ -24,6 +25,24 @@ pub struct LightTriangle {
     /// and is not walked (a side of a solid's outline band lying inside the
     /// solid; 0 for a mesh's triangles).
     pub open: u8,
+    /// Which way it faces the light (a mesh's triangle by its winding; a
+    /// solid's outline band: not known).
+    pub facing: Facing,
+}
+
+/// How a mesh triangle with corners `points` (texel coordinates, y down)
+/// faces the light: one wound counter-clockwise about its normal runs
+/// clockwise on the map (y down) when the normal points at the light.
+fn facing(points: &[DVec3; 3]) -> Facing {
+    let [a, b, c] = points;
+    let turn = (b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y);
+    if turn < 0.0 {
+        Facing::Light
+    } else if turn > 0.0 {
+        Facing::Away
+    } else {
+        Facing::Unknown
+    }
 }
 
 /// Texels of band beyond the map's sides that clipping keeps.
@@ -65,17 +84,54 @@ pub fn light_triangles(scene: &Scene, camera: &Camera, resolution: u32, casters:
                 let object = i as u32;
                 let polygon = t as u32;
                 if ca | cb | cc == 0 {
-                    out.push(LightTriangle { points: corners.map(to_texels), object, polygon, open: 0 });
+                    let points = corners.map(to_texels);
+                    out.push(LightTriangle { points, object, polygon, open: 0, facing: facing(&points) });
                     continue;
                 }
                 let mut poly = [DVec4::ZERO; MAX_CLIPPED];
                 let k = planes.clip(corners, ca | cb | cc, &mut poly);
                 for j in 1..k.saturating_sub(1) {
                     let points = [poly[0], poly[j], poly[j + 1]].map(to_texels);
-                    out.push(LightTriangle { points, object, polygon, open: 0 });
+                    out.push(LightTriangle { points, object, polygon, open: 0, facing: facing(&points) });
                 }
             }
             out.into_iter()
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use std::sync::Arc;
+
+    use glam::{Affine3A, Vec2, Vec3};
+
+    use super::*;
+    use crate::camera::Projection;
+    use crate::scene::mesh::shapes;
+    use crate::scene::{Material, Object};
+
+    /// A light at `eye` looking at the origin.
+    fn light_at(eye: Vec3, projection: Projection) -> Camera {
+        Camera { eye, target: Vec3::ZERO, up: Vec3::Z, near: 0.1, far: 20.0, projection, shift: Vec2::ZERO }
+    }
+
+    /// A triangle whose winding normal points at the light faces it, one
+    /// seen from its back faces away, for perspective and orthographic
+    /// lights alike (the receiver's side of the same test is [`Facing::of`]).
+    #[test]
+    fn a_triangle_wound_towards_the_light_faces_it() {
+        let mut scene = Scene::new(8, 8, light_at(Vec3::Y, Projection::Perspective { fov_y_deg: 40.0 }));
+        scene.materials.push(Material::default());
+        scene.objects.push(Object::mesh("plane", Arc::new(shapes::plane()), Affine3A::IDENTITY, 0));
+        for projection in [Projection::Perspective { fov_y_deg: 60.0 }, Projection::Orthographic { height: 3.0 }] {
+            for (eye, want) in [(Vec3::Y * 4.0, Facing::Light), (-Vec3::Y * 4.0, Facing::Away)] {
+                let camera = light_at(eye + Vec3::X * 0.3, projection);
+                let triangles = light_triangles(&scene, &camera, 64, &[true]);
+                assert_eq!(triangles.len(), 2);
+                assert!(triangles.iter().all(|t| t.facing == want), "from {eye}: {triangles:?}");
+                assert_eq!(Facing::of(Vec3::Y, eye), want);
+            }
+        }
+    }
 }

@@ -34,6 +34,43 @@ impl TexelDepth {
     }
 }
 
+/// Which way a surface faces the light, by its triangle's winding (the side
+/// its vertices run counter-clockwise around).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Facing {
+    /// Towards the light.
+    Light,
+    /// Away from it.
+    Away,
+    /// Not known (a solid's outline band, a receiver whose plane is not given).
+    #[default]
+    Unknown,
+}
+
+impl Facing {
+    /// How a surface whose winding normal is `normal` faces a light that lies
+    /// towards `to_light` (zero `normal`: not known).
+    #[must_use]
+    pub fn of(normal: glam::Vec3, to_light: glam::Vec3) -> Facing {
+        let d = normal.dot(to_light);
+        if normal == glam::Vec3::ZERO || !d.is_finite() {
+            Facing::Unknown
+        } else if d > 0.0 {
+            Facing::Light
+        } else {
+            Facing::Away
+        }
+    }
+
+    /// Whether both are known and differ: a surface of one facing cannot be
+    /// the sheet a point of the other lies on.
+    #[inline]
+    #[must_use]
+    pub fn opposes(self, other: Facing) -> bool {
+        matches!((self, other), (Facing::Light, Facing::Away) | (Facing::Away, Facing::Light))
+    }
+}
+
 /// A surface over an edge texel's centre, counted `count` times (a correction
 /// counts −1).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -44,6 +81,8 @@ pub struct Layer {
     pub count: i32,
     /// The object it belongs to.
     pub object: u32,
+    /// Which way it faces the light.
+    pub facing: Facing,
 }
 
 /// A silhouette line's record in one texel.
@@ -74,6 +113,8 @@ pub struct SilhouetteLine {
     pub object: u32,
     /// The depth plane of that polygon over the texel.
     pub depth: TexelDepth,
+    /// Which way that polygon faces the light.
+    pub facing: Facing,
     /// Whether the texel's centre lies on the polygon's side of this line as
     /// stored (quantised): the reference the eye pass counts crossings from.
     pub centre_inside: bool,
@@ -107,6 +148,7 @@ impl SilhouetteLine {
             polygon: 0,
             object: 0,
             depth: TexelDepth::default(),
+            facing: Facing::Unknown,
             centre_inside: false,
         };
         record.centre_inside = record.strictly_inside(0.5, 0.5, bits);

@@ -32,20 +32,23 @@
 //! the texel ([`DepthLimits`]).
 
 use super::buffer::Entry;
-use super::line::SilhouetteLine;
+use super::line::{Facing, SilhouetteLine, TexelDepth};
 use super::walk::Major;
 use crate::shadows::footprint::UNKNOWN_RECEIVER;
 
 /// The reversed depths a caster surface must exceed to hide a receiver: one
-/// for surfaces of the receiver's own object (with the slope bias its own
-/// surface needs, sampled away from the point), one for every other object's.
+/// for surfaces of the receiver's own object that may be the sheet it lies
+/// on (with the slope bias that sheet needs, sampled away from the point),
+/// one for every other surface.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DepthLimits {
     /// The receiver's object ([`UNKNOWN_RECEIVER`]: not known).
     pub receiver: u32,
+    /// Which way the receiver's own triangle faces the light.
+    pub facing: Facing,
     /// The limit for the receiver's own surfaces.
     pub own: f32,
-    /// The limit for other objects' surfaces.
+    /// The limit for other surfaces.
     pub other: f32,
 }
 
@@ -53,7 +56,39 @@ impl DepthLimits {
     /// One limit for every surface (the receiver unknown).
     #[must_use]
     pub const fn uniform(z_limit: f32) -> DepthLimits {
-        DepthLimits { receiver: UNKNOWN_RECEIVER, own: z_limit, other: z_limit }
+        DepthLimits { receiver: UNKNOWN_RECEIVER, facing: Facing::Unknown, own: z_limit, other: z_limit }
+    }
+
+    /// Whether a surface of `object` facing `facing`, of depth `depth` over
+    /// the texel, lies nearer the light than the receiver at `point` allows,
+    /// its depth read at `sampled` (where the buffer knows it exactly: the
+    /// centre a layer covers, where the way crosses a line).
+    ///
+    /// A surface of the receiver's own object that faces the light the other
+    /// way than the receiver's triangle cannot be the sheet the receiver lies
+    /// on, so it is held to the small bias of other objects' surfaces: an
+    /// object shadows itself as closely as it shadows others (a closed mesh
+    /// always puts a surface facing away from the light between a point it
+    /// shadows and the light). It must be nearer both at `sampled` and at
+    /// the point (its plane carried there): a surface seen nearly edge-on
+    /// from the light changes depth fast, and read at one of the two alone
+    /// it may seem to pass in front of a point it does not cover.
+    #[inline]
+    #[must_use]
+    pub fn hides(
+        &self,
+        object: u32,
+        facing: Facing,
+        depth: &TexelDepth,
+        sampled: (f32, f32),
+        point: (f32, f32),
+    ) -> bool {
+        let own = object == self.receiver || self.receiver == UNKNOWN_RECEIVER;
+        if own && facing.opposes(self.facing) {
+            depth.at(point.0, point.1).min(depth.at(sampled.0, sampled.1)) > self.other
+        } else {
+            depth.at(sampled.0, sampled.1) > self.of(object)
+        }
     }
 
     /// The limit for a surface of `object`.
@@ -93,7 +128,7 @@ pub fn surfaces_over(entry: &Entry<'_>, mx: f32, my: f32, limits: &DepthLimits, 
     // line's where the way crosses it (its edge's own depth): never a plane
     // carried past the polygon it belongs to.
     for layer in entry.layers {
-        let nearer = layer.depth.at(0.5, 0.5) > limits.of(layer.object);
+        let nearer = limits.hides(layer.object, layer.facing, &layer.depth, (0.5, 0.5), (mx, my));
         tally.add(layer.object, layer.count, nearer);
     }
     for line in entry.lines {
@@ -101,8 +136,8 @@ pub fn surfaces_over(entry: &Entry<'_>, mx: f32, my: f32, limits: &DepthLimits, 
         if inside == line.centre_inside {
             continue;
         }
-        if let Some((x, y)) = crossing_from_centre(line, mx, my, bits) {
-            let nearer = line.depth.at(x, y) > limits.of(line.object);
+        if let Some(crossing) = crossing_from_centre(line, mx, my, bits) {
+            let nearer = limits.hides(line.object, line.facing, &line.depth, crossing, (mx, my));
             tally.add(line.object, if inside { 1 } else { -1 }, nearer);
         }
     }
@@ -303,7 +338,13 @@ mod tests {
             .map(|i| {
                 let (p, q) = (outline[i], outline[(i + 1) % n]);
                 let v = |(x, y): (f64, f64)| DVec3::new(x, y, 0.9);
-                LightTriangle { points: [v(centre), v(p), v(q)], object: 0, polygon: i as u32, open: 0 }
+                LightTriangle {
+                    points: [v(centre), v(p), v(q)],
+                    object: 0,
+                    polygon: i as u32,
+                    open: 0,
+                    facing: Facing::Unknown,
+                }
             })
             .collect();
         (outline, tris)

@@ -31,7 +31,7 @@ use glam::{DVec2, DVec3, Vec2};
 use rayon::prelude::*;
 
 use super::light::LightTriangle;
-use super::line::{Layer, TexelDepth};
+use super::line::{Facing, Layer, TexelDepth};
 use crate::camera::{Camera, PixelRays};
 use crate::csg::{CsgCaster, CsgSolid};
 use crate::scene::Scene;
@@ -123,7 +123,12 @@ impl SolidCoverage {
             return None;
         }
         let z = self.depth[(y - y0) * w + (x - x0)];
-        (z > 0.0).then_some(Layer { depth: TexelDepth { c: z, dx: 0.0, dy: 0.0 }, count: 1, object: self.object })
+        (z > 0.0).then_some(Layer {
+            depth: TexelDepth { c: z, dx: 0.0, dy: 0.0 },
+            count: 1,
+            object: self.object,
+            facing: Facing::Unknown,
+        })
     }
 }
 
@@ -463,6 +468,7 @@ fn fan(v: &[(Corner, Option<usize>)], across: [bool; 4], object: u32, polygon: u
         if t + 1 == last && open_edge(last) {
             open |= 4;
         }
-        out.push(LightTriangle { points: [v[0].0, v[t].0, v[t + 1].0], object, polygon, open });
+        let points = [v[0].0, v[t].0, v[t + 1].0];
+        out.push(LightTriangle { points, object, polygon, open, facing: Facing::Unknown });
     }
 }

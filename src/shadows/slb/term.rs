@@ -27,7 +27,7 @@ use wide::f32x8;
 
 use super::buffer::SilhouetteLineBuffer;
 use super::light::light_triangles;
-use super::line::SilhouetteLine;
+use super::line::{Facing, SilhouetteLine};
 use super::region::{covered, DepthLimits};
 use super::solid::solid_outlines;
 use crate::camera::Camera;
@@ -134,9 +134,10 @@ impl SlbMap {
         settings: &ShadowSettings,
         receiver: &Receiver,
     ) -> f32 {
+        let facing = Facing::of(receiver.plane, self.map.towards_light(p));
         match self.footprint(p, at, settings, receiver) {
-            Some(footprint) => self.footprint_share(p, footprint, cos_theta, settings, receiver.object),
-            None => self.lit_at(at.u, at.v, &limits(at, receiver.object)),
+            Some(footprint) => self.footprint_share(p, footprint, cos_theta, settings, (receiver.object, facing)),
+            None => self.lit_at(at.u, at.v, &limits(at, receiver.object, facing)),
         }
     }
 
@@ -225,16 +226,17 @@ impl SlbMap {
     }
 
     /// The lit share of the footprint around `p` (a point of object
-    /// `receiver`): [`FOOTPRINT_GRID`]² points of it, each decided — or, with
-    /// one line under it, each given the decision of its side of the line,
-    /// found at one point of each side.
+    /// `receiver.0` whose triangle faces the light as `receiver.1` says):
+    /// [`FOOTPRINT_GRID`]² points of it, each decided — or, with one line
+    /// under it, each given the decision of its side of the line, found at
+    /// one point of each side.
     fn footprint_share(
         &self,
         p: Vec3,
         footprint: Footprint,
         cos_theta: f32,
         settings: &ShadowSettings,
-        receiver: u32,
+        (receiver, facing): (u32, Facing),
     ) -> f32 {
         let [right, down] = footprint.axes;
         let step = 1.0 / FOOTPRINT_GRID as f32;
@@ -242,7 +244,7 @@ impl SlbMap {
         let decide = |i: usize, j: usize| {
             let q = p + right * offset(i) + down * offset(j);
             match self.map.locate(q, cos_theta, settings, 1.0) {
-                Some(at) => self.lit_at(at.u, at.v, &limits(&at, receiver)),
+                Some(at) => self.lit_at(at.u, at.v, &limits(&at, receiver, facing)),
                 None => 1.0,
             }
         };
@@ -327,10 +329,11 @@ impl SlbMap {
     }
 }
 
-/// The depth limits of a point located at `at` on object `receiver`.
+/// The depth limits of a point located at `at` on object `receiver`, its
+/// triangle facing the light as `facing` says.
 #[inline]
-fn limits(at: &Located, receiver: u32) -> DepthLimits {
-    DepthLimits { receiver, own: at.z_limit, other: at.z_other }
+fn limits(at: &Located, receiver: u32, facing: Facing) -> DepthLimits {
+    DepthLimits { receiver, facing, own: at.z_limit, other: at.z_other }
 }
 
 #[cfg(test)]
