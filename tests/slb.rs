@@ -112,9 +112,9 @@ fn random_scene(rng: &mut StdRng) -> Scene {
 /// decisions equal shadow rays on at least 99.9% of the visible points the
 /// light faces, at scale 1 and with the virtual projection space 16 and 64
 /// times wider, where a texel holds a whole caster and its contact with the
-/// floor. Wider, a solid's own surfaces (a union's inner corner, a cut's
-/// walls) are held to the map's bias, which grows with the texel: those
-/// points are counted apart, and held to 5%.
+/// floor. The points on solids are also counted on their own, held to 1%:
+/// where a solid shadows itself (a union's inner corner, a cut's walls) no
+/// line records the step, and a ray through the solid decides.
 #[test]
 fn slb_decisions_equal_shadow_rays_on_random_scenes_at_scales_1_16_and_64() {
     let mut rng = StdRng::seed_from_u64(36);
@@ -125,20 +125,20 @@ fn slb_decisions_equal_shadow_rays_on_random_scenes_at_scales_1_16_and_64() {
             scene.lights[0].shadow.scale = scale;
             let terms = ShadowTerm::build_all(&scene);
             let on_solid = |o: u32| scene.objects[o as usize].solid().is_some();
-            let judge = |solids: bool| {
+            let judge = |solids_only: bool| {
                 common::decisions_vs_rays(&scene, |light, at| {
                     let receiver = at.receiver();
-                    let apart = scale > 1.0 && on_solid(at.object);
-                    (apart == solids).then(|| terms[light].lit(at.surface.position, at.cos_theta, &receiver))
+                    (!solids_only || on_solid(at.object))
+                        .then(|| terms[light].lit(at.surface.position, at.cos_theta, &receiver))
                 })
             };
             let ((w, t), (sw, st)) = (judge(false), judge(true));
             (wrong, total, solid_wrong, solid_total) = (wrong + w, total + t, solid_wrong + sw, solid_total + st);
         }
-        eprintln!("scale {scale}: {wrong} of {total} disagree; on solids apart {solid_wrong} of {solid_total}");
+        eprintln!("scale {scale}: {wrong} of {total} disagree; on solids {solid_wrong} of {solid_total}");
         assert!(total > 30_000, "scale {scale}: only {total} tests");
         assert!((wrong as f64) <= 0.001 * total as f64, "scale {scale}: {wrong} of {total} disagree with shadow rays");
-        assert!(solid_wrong * 20 <= solid_total, "scale {scale}: {solid_wrong} of {solid_total} on solids");
+        assert!(solid_wrong * 100 <= solid_total, "scale {scale}: {solid_wrong} of {solid_total} on solids");
     }
 }
 
@@ -165,7 +165,7 @@ fn a_closed_mesh_keeps_only_its_outline() {
         &[true],
         kage::visibility::Workers::All,
         kage::visibility::VisibilityBuffer::depth_only(0, 0),
-        8,
+        &kage::scene::ShadowSettings::SLB,
     );
     let slb = map.buffer();
     let stats = slb.stats();

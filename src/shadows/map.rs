@@ -8,12 +8,12 @@
 //! the surface normal and the light. The constant term absorbs depth quantisation;
 //! the slope term the depth change across one texel of a surface the light grazes.
 
-use glam::{Mat4, Vec3};
+use glam::{Mat4, Vec2, Vec3};
 use wide::f32x8;
 
 use crate::scene::{Scene, ShadowSettings};
 
-use crate::camera::{Camera, Projection};
+use crate::camera::{Camera, PixelRays, Projection};
 use crate::visibility::{rasterize_casters, VisibilityBuffer, Workers};
 
 /// Largest tan θ the slope bias uses (θ ≈ 84°); beyond it the bias would push
@@ -67,6 +67,8 @@ pub struct LocatedLanes {
 #[derive(Debug, Clone)]
 pub struct DepthMap {
     view_proj: Mat4,
+    /// The light's rays through the texels.
+    rays: PixelRays,
     eye: Vec3,
     axis: Vec3,
     resolution: u32,
@@ -116,6 +118,7 @@ impl DepthMap {
         };
         DepthMap {
             view_proj: camera.view_projection(1.0),
+            rays: camera.pixel_rays(Vec2::splat(resolution as f32)),
             eye: camera.eye,
             axis: (camera.target - camera.eye).normalize(),
             resolution,
@@ -176,6 +179,18 @@ impl DepthMap {
         }
     }
 
+    /// The distance along the light's axis of a surface the map holds at
+    /// reversed depth `z` (above 0), and the world size of a texel there.
+    #[must_use]
+    pub fn distance_and_texel(&self, z: f32) -> (f32, f32) {
+        if self.ortho {
+            (self.far - z * (self.far - self.near), self.texel)
+        } else {
+            let d = self.near / z;
+            (d, self.texel * d)
+        }
+    }
+
     /// The direction from `p` towards the light (not normalised).
     #[inline]
     #[must_use]
@@ -185,6 +200,31 @@ impl DepthMap {
         } else {
             self.eye - p
         }
+    }
+
+    /// The reversed depth at which the plane through `p` with normal `n`
+    /// crosses the light's ray through the centre of texel `(x, y)`, brought
+    /// `bias` world units nearer the light: what a surface seen there must
+    /// exceed to lie in front of that plane. `None` where the ray runs along
+    /// the plane or the limit is at the light.
+    #[must_use]
+    pub fn plane_limit(&self, p: Vec3, n: Vec3, (x, y): (u32, u32), bias: f32) -> Option<f32> {
+        let ray = self.rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
+        let along = n.dot(ray.dir);
+        if along.abs() < 1e-6 {
+            return None;
+        }
+        let q = ray.origin + ray.dir * (n.dot(p - ray.origin) / along);
+        self.reversed((q - self.eye).dot(self.axis) - bias)
+    }
+
+    /// The unit direction from `p` to the light and the distance to it
+    /// (infinite for a directional light's orthographic map).
+    #[must_use]
+    pub fn ray_to_light(&self, p: Vec3) -> (Vec3, f32) {
+        let to = self.towards_light(p);
+        let distance = if self.ortho { f32::INFINITY } else { to.length() };
+        (to.normalize_or(-self.axis), distance)
     }
 
     /// The reversed depth the map holds at texel `(x, y)` (0: nothing).

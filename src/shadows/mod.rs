@@ -35,7 +35,7 @@ pub enum ShadowTerm {
     /// No shadow: the light reaches every point.
     Unshadowed,
     /// One map (spot, directional).
-    Map(DepthMap, ShadowSettings),
+    Map(Box<DepthMap>, ShadowSettings),
     /// Six maps around a point (point lights, wide spots): +x, −x, +y, −y, +z, −z,
     /// each at half the configured resolution.
     Cube(Box<[DepthMap; 6]>, Vec3, ShadowSettings),
@@ -70,7 +70,7 @@ impl ShadowTerm {
         };
         let lines = |cam: Camera, most: u32, pool: &mut MapPool| {
             let res = map_resolution(&settings, most, &view, (w, h), &cam, bounds);
-            SlbMap::render(scene, &cam, res, &casters, pool.workers, pool.take(), settings.bits)
+            SlbMap::render(scene, &cam, res, &casters, pool.workers, pool.take(), &settings)
         };
         // A cube's six faces take half the resolution: 1.5 single maps of memory.
         let (single, face) = (settings.resolution.max(1), (settings.resolution / 2).max(16));
@@ -80,7 +80,7 @@ impl ShadowTerm {
             if slb {
                 ShadowTerm::Slb(Box::new(lines(cam, single, pool)), settings)
             } else {
-                ShadowTerm::Map(map(cam, single, pool), settings)
+                ShadowTerm::Map(Box::new(map(cam, single, pool)), settings)
             }
         };
         match placement(light, bounds) {
@@ -474,7 +474,7 @@ impl MapPool {
     pub fn recycle(&mut self, term: ShadowTerm) {
         match term {
             ShadowTerm::Unshadowed => {}
-            ShadowTerm::Map(map, _) => self.free.push(map.into_buffer()),
+            ShadowTerm::Map(map, _) => self.free.push((*map).into_buffer()),
             ShadowTerm::Cube(faces, ..) => self.free.extend(faces.into_iter().map(DepthMap::into_buffer)),
             ShadowTerm::Slb(map, _) => self.free.push(map.into_buffer()),
             ShadowTerm::SlbCube(faces, ..) => self.free.extend(faces.into_iter().map(SlbMap::into_buffer)),

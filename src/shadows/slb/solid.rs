@@ -203,18 +203,23 @@ const CORNERS: [(usize, usize); 4] = [(0, 0), (1, 0), (1, 1), (0, 1)];
 /// Texels `(x0, y0, width, height)` of the map.
 type TexelRect = (usize, usize, usize, usize);
 
-/// The outline bands and coverages of the CSG solids among the casters
-/// `casters` marks, seen by `camera` in a `resolution`² map with `bits`-bit
-/// lines.
+/// What the light pass keeps of the CSG solids among a light's casters.
+#[derive(Debug, Default)]
+pub struct SolidOutlines {
+    /// Their outline bands' triangles.
+    pub triangles: Vec<LightTriangle>,
+    /// Where each covers the texel centres.
+    pub coverages: Vec<SolidCoverage>,
+    /// Each solid in world space, ready for rays, with its object.
+    pub casters: Vec<(u32, CsgCaster)>,
+}
+
+/// The outline bands, coverages and casters of the CSG solids among the
+/// casters `casters` marks, seen by `camera` in a `resolution`² map with
+/// `bits`-bit lines.
 #[must_use]
-pub fn solid_outlines(
-    scene: &Scene,
-    camera: &Camera,
-    resolution: u32,
-    casters: &[bool],
-    bits: u32,
-) -> (Vec<LightTriangle>, Vec<SolidCoverage>) {
-    let (mut triangles, mut coverages) = (Vec::new(), Vec::new());
+pub fn solid_outlines(scene: &Scene, camera: &Camera, resolution: u32, casters: &[bool], bits: u32) -> SolidOutlines {
+    let mut out = SolidOutlines::default();
     for (object, o) in scene.objects.iter().enumerate().filter(|&(i, _)| casters.get(i) == Some(&true)) {
         let Some(solid) = o.solid() else { continue };
         // The solid alone, as the map would hold it.
@@ -224,11 +229,12 @@ pub fn solid_outlines(
             alone.depths().to_vec()
         };
         let world = solid.transformed(&o.transform);
-        let (outline, coverage) = solid_outline(&world, object as u32, camera, resolution, bits, map_depth);
-        triangles.extend(outline);
-        coverages.push(coverage);
+        let (outline, coverage, caster) = traced_outline(&world, object as u32, camera, resolution, bits, map_depth);
+        out.triangles.extend(outline);
+        out.coverages.push(coverage);
+        out.casters.push((object as u32, caster));
     }
-    (triangles, coverages)
+    out
 }
 
 /// The triangles of `solid`'s outline band and its coverage of the texel
@@ -245,6 +251,19 @@ pub fn solid_outline(
     bits: u32,
     map_depth: impl FnOnce() -> Vec<f32>,
 ) -> (Vec<LightTriangle>, SolidCoverage) {
+    let (triangles, coverage, _) = traced_outline(solid, object, camera, resolution, bits, map_depth);
+    (triangles, coverage)
+}
+
+/// [`solid_outline`], with the caster its rays were cast through.
+fn traced_outline(
+    solid: &CsgSolid,
+    object: u32,
+    camera: &Camera,
+    resolution: u32,
+    bits: u32,
+    map_depth: impl FnOnce() -> Vec<f32>,
+) -> (Vec<LightTriangle>, SolidCoverage, CsgCaster) {
     let caster = CsgCaster::new(solid);
     let rays = camera.pixel_rays(Vec2::splat(resolution as f32));
     let sample = |p: DVec2| depth_at(&caster, &rays, camera, p).map_or(0.0, |z| z as f32);
@@ -288,7 +307,7 @@ pub fn solid_outline(
         })
         .collect();
     let depth = centres.unwrap_or(depth);
-    (triangles, SolidCoverage { object, lattice, band, texels, depth })
+    (triangles, SolidCoverage { object, lattice, band, texels, depth }, caster)
 }
 
 /// Where the outline crosses each side of the lattice's squares whose ends

@@ -29,8 +29,10 @@ use super::buffer::SilhouetteLineBuffer;
 use super::light::light_triangles;
 use super::line::{Facing, SilhouetteLine};
 use super::region::{covered, DepthLimits};
-use super::solid::solid_outlines;
+use super::solid::{solid_outlines, SolidCoverage};
 use crate::camera::Camera;
+use crate::camera::Ray;
+use crate::csg::CsgCaster;
 use crate::scene::{Scene, ShadowSettings};
 use crate::shadows::footprint::{PixelView, Receiver, ReceiverLanes};
 use crate::shadows::map::{DepthMap, Located, LocatedLanes};
@@ -41,6 +43,15 @@ use crate::visibility::{VisibilityBuffer, Workers};
 pub struct SlbMap {
     map: DepthMap,
     slb: SilhouetteLineBuffer,
+    /// The CSG solids among the casters, in world space, with their objects:
+    /// a solid's outline is traced into lines, but not where one part of it
+    /// lies nearer the light than another that covers the map beside it (its
+    /// steps), so a point of a solid next to such a step is decided by a ray
+    /// through that solid.
+    solids: Vec<(u32, CsgCaster)>,
+    /// One bit per texel: a step or a sharp crease of a solid's depth lies
+    /// between texel centres within one texel of it ([`solid_steps`]).
+    steps: Vec<u64>,
     /// The frame's pixel rays, for antialiased lookups ([`SlbMap::set_view`]).
     view: Option<PixelView>,
 }
@@ -79,7 +90,7 @@ const MAX_SCANNED_REACH: f32 = 8.0;
 impl SlbMap {
     /// Renders the depth map of the casters `casters` marks through `camera`
     /// into `depth` (resized to `resolution`²) and builds the buffer of their
-    /// silhouettes with `bits`-bit lines.
+    /// silhouettes with the lines and bias `settings` give.
     #[must_use]
     pub fn render(
         scene: &Scene,
@@ -88,19 +99,20 @@ impl SlbMap {
         casters: &[bool],
         workers: Workers,
         depth: VisibilityBuffer,
-        bits: u32,
+        settings: &ShadowSettings,
     ) -> SlbMap {
         let mut depth = depth;
         // Which object each texel holds: a texel no outline crosses is held to
         // that object's bias (the receiver's own, or the small one of others).
         depth.keep_items(true);
         let map = DepthMap::render(scene, camera, resolution, casters, workers, depth);
-        let bits = bits.clamp(4, 16);
+        let bits = settings.bits.clamp(4, 16);
         let mut triangles = light_triangles(scene, camera, resolution, casters);
-        let (outlines, solids) = solid_outlines(scene, camera, resolution, casters, bits);
-        triangles.extend(outlines);
-        let slb = SilhouetteLineBuffer::build(resolution, resolution, bits, &triangles, &solids);
-        SlbMap { map, slb, view: None }
+        let solids = solid_outlines(scene, camera, resolution, casters, bits);
+        triangles.extend(solids.triangles);
+        let slb = SilhouetteLineBuffer::build(resolution, resolution, bits, &triangles, &solids.coverages);
+        let steps = solid_steps(&map, &solids.coverages, settings.bias / settings.scale.max(1.0));
+        SlbMap { map, slb, solids: solids.casters, steps, view: None }
     }
 
     /// Sets the pixel rays of the frame the lookups are for: antialiased
@@ -134,10 +146,12 @@ impl SlbMap {
         settings: &ShadowSettings,
         receiver: &Receiver,
     ) -> f32 {
-        let facing = Facing::of(receiver.plane, self.map.towards_light(p));
         match self.footprint(p, at, settings, receiver) {
-            Some(footprint) => self.footprint_share(p, footprint, cos_theta, settings, (receiver.object, facing)),
-            None => self.lit_at(at.u, at.v, &limits(at, receiver.object, facing)),
+            Some(footprint) => self.footprint_share(p, footprint, cos_theta, settings, receiver),
+            None => {
+                let facing = Facing::of(receiver.plane, self.map.towards_light(p));
+                self.lit_point(p, receiver.plane, at, &limits(at, receiver.object, facing), settings)
+            }
         }
     }
 
@@ -225,26 +239,27 @@ impl SlbMap {
         found.map_or(Under::Nothing, Under::One)
     }
 
-    /// The lit share of the footprint around `p` (a point of object
-    /// `receiver.0` whose triangle faces the light as `receiver.1` says):
+    /// The lit share of the footprint around `p` (a point of `receiver`):
     /// [`FOOTPRINT_GRID`]² points of it, each decided — or, with one line
     /// under it, each given the decision of its side of the line, found at
     /// one point of each side.
+    #[inline(never)]
     fn footprint_share(
         &self,
         p: Vec3,
         footprint: Footprint,
         cos_theta: f32,
         settings: &ShadowSettings,
-        (receiver, facing): (u32, Facing),
+        receiver: &Receiver,
     ) -> f32 {
+        let facing = Facing::of(receiver.plane, self.map.towards_light(p));
         let [right, down] = footprint.axes;
         let step = 1.0 / FOOTPRINT_GRID as f32;
         let offset = |k: usize| (k as f32 + 0.5) * step - 0.5;
         let decide = |i: usize, j: usize| {
             let q = p + right * offset(i) + down * offset(j);
             match self.map.locate(q, cos_theta, settings, 1.0) {
-                Some(at) => self.lit_at(at.u, at.v, &limits(&at, receiver, facing)),
+                Some(at) => self.lit_point(q, receiver.plane, &at, &limits(&at, receiver.object, facing), settings),
                 None => 1.0,
             }
         };
@@ -268,10 +283,70 @@ impl SlbMap {
         lit * step * step
     }
 
+    /// The term at `p` on a receiver with plane normal `plane` (zero: not
+    /// known), located at `at`, held to `limits`: [`SlbMap::lit_at`], or next
+    /// to a step of a CSG solid over itself, [`SlbMap::lit_past_step`].
+    #[inline(always)]
+    fn lit_point(&self, p: Vec3, plane: Vec3, at: &Located, limits: &DepthLimits, settings: &ShadowSettings) -> f32 {
+        let t = at.v as usize * self.map.resolution() as usize + at.u as usize;
+        if self.steps.get(t / 64).is_some_and(|w| w >> (t % 64) & 1 == 1) {
+            if let Some(lit) = self.lit_past_step(p, plane, at, limits, settings) {
+                return lit;
+            }
+        }
+        self.lit_at(at.u, at.v, limits)
+    }
+
+    /// Where the receiver is a CSG solid that one of the four texel centres
+    /// round `p` shows in front of the receiver's plane (a step of the solid
+    /// over itself, which no line records): the solid's own part of the term
+    /// by a ray from `p` through it, the lines and the map deciding for the
+    /// other objects alone. `None` elsewhere.
+    #[cold]
+    #[inline(never)]
+    fn lit_past_step(
+        &self,
+        p: Vec3,
+        plane: Vec3,
+        at: &Located,
+        limits: &DepthLimits,
+        settings: &ShadowSettings,
+    ) -> Option<f32> {
+        let (_, solid) = self.solids.iter().find(|(o, _)| *o == limits.receiver)?;
+        // Past the small bias, as another object's surface is held to it.
+        let bias = at.texel * settings.bias / settings.scale.max(1.0);
+        if !self.own_step_near(p, plane, at, limits, bias) {
+            return None;
+        }
+        let others = DepthLimits { own: f32::INFINITY, ..*limits };
+        if self.lit_at(at.u, at.v, &others) == 0.0 {
+            return Some(0.0);
+        }
+        let (dir, distance) = self.map.ray_to_light(p);
+        Some(if solid.first_hit(&Ray { origin: p, dir }, bias, distance).is_some() { 0.0 } else { 1.0 })
+    }
+
+    /// Whether one of the four texel centres round `p` (located at `at`)
+    /// shows the receiver's own object nearer the light than `bias` in front
+    /// of the receiver's plane through `p` (its normal `plane`; not known,
+    /// nearer than the small limit of `limits`).
+    fn own_step_near(&self, p: Vec3, plane: Vec3, at: &Located, limits: &DepthLimits, bias: f32) -> bool {
+        let n = self.map.resolution();
+        let (x0, y0) = ((at.u - 0.5).floor().max(0.0) as u32, (at.v - 0.5).floor().max(0.0) as u32);
+        let in_front = |x: u32, y: u32| {
+            let z = self.map.texel_depth(x, y);
+            if z <= limits.other || self.map.texel_object(x, y) != Some(limits.receiver) {
+                return false;
+            }
+            plane == Vec3::ZERO || self.map.plane_limit(p, plane, (x, y), bias).is_none_or(|limit| z > limit)
+        };
+        (y0..(y0 + 2).min(n)).any(|y| (x0..(x0 + 2).min(n)).any(|x| in_front(x, y)))
+    }
+
     /// The term at texel coordinates `(u, v)` (inside the map) for a receiver
     /// held to `limits`: the map where no silhouette crosses the texel, the
     /// lines where one does.
-    #[inline]
+    #[inline(always)]
     fn lit_at(&self, u: f32, v: f32, limits: &DepthLimits) -> f32 {
         let (x, y) = (u as u32, v as u32);
         let hidden = match self.slb.entry(x, y) {
@@ -325,8 +400,65 @@ impl SlbMap {
     /// Bytes held by the map and the buffer.
     #[must_use]
     pub fn memory_bytes(&self) -> usize {
-        self.map.memory_bytes() + self.slb.memory_bytes()
+        self.map.memory_bytes() + self.slb.memory_bytes() + self.steps.len() * 8
     }
+}
+
+/// The texels of `map` within one texel of a place where a CSG solid's own
+/// depth (`coverages`, at the texel centres) breaks between two neighbouring
+/// centres — a step, where one part of the solid lies in front of another,
+/// or a crease sharp enough to hide one: the difference between the two
+/// centres' distances is off the slope on either side (the differences to
+/// the next centres out, where the solid covers them; with neither, any
+/// difference) by more than `bias` texels, the small bias another object's
+/// surface is held to; and every texel of a solid less than a few dozen
+/// texels across (traced on a finer lattice). A point
+/// there may lie on either side of the break within its texel, which the
+/// map's centres cannot tell; the eye pass looks closer
+/// ([`SlbMap::lit_point`]). One bit per texel (none without solids).
+fn solid_steps(map: &DepthMap, coverages: &[SolidCoverage], bias: f32) -> Vec<u64> {
+    if coverages.is_empty() {
+        return Vec::new();
+    }
+    let n = map.resolution() as usize;
+    let mut bits = vec![0u64; (n * n).div_ceil(64)];
+    for c in coverages {
+        let (x0, y0, w, h) = c.texels;
+        let at = |i: isize, j: isize| -> Option<(f32, f32)> {
+            let inside = i >= 0 && j >= 0 && (i as usize) < w && (j as usize) < h;
+            let z = if inside { c.depth[j as usize * w + i as usize] } else { 0.0 };
+            (z > 0.0).then(|| map.distance_and_texel(z))
+        };
+        let breaks = |i: isize, j: isize, (di, dj): (isize, isize)| {
+            let (Some((a, texel)), Some((b, _))) = (at(i, j), at(i + di, j + dj)) else { return false };
+            let step = b - a;
+            let before = at(i - di, j - dj).map(|(p, _)| a - p);
+            let after = at(i + 2 * di, j + 2 * dj).map(|(q, _)| q - b);
+            [before, after].into_iter().flatten().all(|s| (step - s).abs() > texel * bias)
+        };
+        let mut mark = |i: isize, j: isize| {
+            for y in (y0 as isize + j - 1).max(0)..=(y0 as isize + j + 1).min(n as isize - 1) {
+                for x in (x0 as isize + i - 1).max(0)..=(x0 as isize + i + 1).min(n as isize - 1) {
+                    let t = y as usize * n + x as usize;
+                    bits[t / 64] |= 1 << (t % 64);
+                }
+            }
+        };
+        // A solid traced on a finer lattice than the texels is a few texels
+        // across: a step may lie between any of its centres.
+        let small = c.lattice.step < 1.0;
+        for j in 0..h as isize {
+            for i in 0..w as isize {
+                for d in [(1, 0), (0, 1)] {
+                    if small && at(i, j).is_some() || breaks(i, j, d) {
+                        mark(i, j);
+                        mark(i + d.0, j + d.1);
+                    }
+                }
+            }
+        }
+    }
+    bits
 }
 
 /// The depth limits of a point located at `at` on object `receiver`, its
