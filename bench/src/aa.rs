@@ -1,13 +1,17 @@
 //! `kage bench --aa`: seed 004's edge pass and jittered passes against a 16 × 16
 //! supersampled truth (256 jittered passes), on the example scenes and two real
 //! models: RMSE on edge pixels (those an object's outline crosses) and over the
-//! image, and ms per frame.
+//! image, and ms per frame. A second table puts the same scenes under point
+//! lights with silhouette-line-buffer shadows (seed 000), 0/1 and antialiased,
+//! beside the edge pass: what the shadow term's own antialiasing adds where
+//! the edge pass cannot reach (shadow boundaries).
 
 use std::path::Path;
 
 use glam::Vec2;
 use kage::image::LinearImage;
-use kage::scene::{Antialias, EdgeFilter, EdgeMode, EdgeSelection};
+use kage::raytrace::shadow_truth;
+use kage::scene::{Antialias, EdgeFilter, EdgeMode, EdgeSelection, ShadowMethod, ShadowSettings};
 use kage::visibility::VisibilityBuffer;
 use kage::{RenderOptions, Renderer, Scene};
 use miette::{miette, Result};
@@ -100,6 +104,12 @@ pub fn run(aa: &AaArgs) -> Result<()> {
             write_crop(dir, &label, [&aliased, &edged, &truth], &mask, scene.width)?;
         }
     }
+    print_footnote(args);
+    slb_boundaries(args)
+}
+
+/// The first table's footnote.
+fn print_footnote(args: &Common) {
     println!(
         "\n{}x{}, truth = {TRUTH_PASSES} jittered passes (16 x 16 per pixel); edge pixels = pixels an object's \
          outline crosses (their truth samples see more than one object, or an object and the background); 3 x 3 \
@@ -107,6 +117,60 @@ pub fn run(aa: &AaArgs) -> Result<()> {
          adds the pixels beside an outline (their error is shading: shadows, reflections); median of {} frames \
          (jittered rows: 3); x aliased = median over those frames of each frame's time over an aliased frame's \
          rendered just before it; 2 threads.",
+        args.width, args.height, args.frames
+    );
+}
+
+/// `scene` with every light a point (no size) and every shadowed light's
+/// shadows by the silhouette-line buffer, its boundary antialiased or not.
+fn with_slb(scene: &Scene, antialias: bool) -> Scene {
+    let mut s = scene.clone();
+    s.lights.iter_mut().for_each(|l| l.size = 0.0);
+    let slb = ShadowSettings { antialias, ..ShadowSettings::SLB };
+    s.lights.iter_mut().filter(|l| l.shadow.method != ShadowMethod::None).for_each(|l| l.shadow = slb);
+    s
+}
+
+/// Pixels along a shadow boundary of any light in `scene`'s frame (its 0/1
+/// terms change within the pixel's 3 × 3 neighbourhood, on one object).
+fn shadow_boundaries(scene: &Scene) -> Result<Vec<bool>> {
+    let options = RenderOptions { shadow_images: true, ..RenderOptions::default() };
+    let f = kage::render(scene, &options).map_err(|e| miette!("{e}"))?;
+    let mut mask = vec![false; (scene.width * scene.height) as usize];
+    for term in &f.shadows {
+        for (x, y, _) in shadow_truth::boundary_pixels(&f.visibility, term.pixels()) {
+            mask[(y * scene.width + x) as usize] = true;
+        }
+    }
+    Ok(mask)
+}
+
+/// The second table: the scenes under point lights with SLB shadows, the
+/// default edge pass with the 0/1 and the antialiased term, against 256
+/// jittered passes of the 0/1 term (exact hard shadows at every sample).
+fn slb_boundaries(args: &Common) -> Result<()> {
+    println!(
+        "\n| scene | SLB shadows | ms/frame | edge-pixel RMSE | 3 x 3 mask RMSE | shadow-boundary RMSE | image RMSE |"
+    );
+    println!("|---|---|---:|---:|---:|---:|---:|");
+    for (label, scene) in scenes(args)? {
+        let hard = with_slb(&scene, false);
+        let truth = frame(&hard, Antialias::Jitter(TRUTH_PASSES), 1)?.0;
+        let (_, _, vb) = frame(&hard, Antialias::None, 1)?;
+        let masks = [crossed(&hard), silhouettes(&vb), shadow_boundaries(&hard)?];
+        for (name, antialias) in [("0/1", false), ("antialiased", true)] {
+            let (image, (ms, _, _), _) = frame(&with_slb(&scene, antialias), Antialias::default(), args.frames)?;
+            let [edge, near, boundary] = masks.each_ref().map(|m| rmse(&image, &truth, Some(m)));
+            println!(
+                "| {label} | {name} | {ms:.1} | {edge:.4} | {near:.4} | {boundary:.4} | {:.4} |",
+                rmse(&image, &truth, None)
+            );
+        }
+    }
+    println!(
+        "\n{}x{}, every light a point with SLB shadows (1024², k = 8), the default edge pass; truth = \
+         {TRUTH_PASSES} jittered passes with the 0/1 SLB term (hard shadows decided at every sample); shadow-boundary \
+         pixels = pixels whose 3 x 3 neighbourhood's 0/1 terms differ, on one object; median of {} frames; 2 threads.",
         args.width, args.height, args.frames
     );
     Ok(())
