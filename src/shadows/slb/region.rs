@@ -27,9 +27,16 @@
 //! centre it covers and for a line where the way crosses it, never carried
 //! past its polygon), which is the per-line depth test that lets an object
 //! shadow itself; each object is counted on its own, and adds nothing where
-//! it does not reach the point. The receiver's own surfaces are held to the
-//! full depth bias, every other object's to a bias that does not grow with
-//! the texel ([`DepthLimits`]).
+//! it does not reach the point. Another object's surfaces are held to a bias
+//! that does not grow with the texel ([`DepthLimits`]); so are the receiver's
+//! own surfaces that face the light the other way than the receiver's
+//! triangle (by their winding), which cannot be the sheet it lies on — a
+//! closed mesh always puts such a surface between a point it shadows and the
+//! light. The rest of its own surfaces keep the full depth bias: one of them
+//! may be the receiver's sheet, sampled away from the point. (Measured on
+//! the scanned meshes of `kage-bench slb` at 1024²: the bunny's
+//! misclassified points 55 → 28, the dragon's 86 → 51, fewer than a 16K²
+//! map's.)
 
 use super::buffer::Entry;
 use super::line::{Facing, SilhouetteLine, TexelDepth};

@@ -25,7 +25,11 @@
 //! becomes chords at most a cell long, off by 1/(8r) of a cell for a circle
 //! of radius r cells (1/256 at r = 32). An outline that crosses a square's
 //! side twice, or a part narrower than a cell lying between samples, is
-//! missed as a shadow map misses what lies between its texel centres.
+//! missed as a shadow map misses what lies between its texel centres. The
+//! band follows where the solid covers the map, not where one part of it
+//! lies in front of another: those steps are left to the eye pass, which
+//! casts a ray through the solid from a point next to one
+//! ([`SolidOutlines::casters`]).
 
 use glam::{DVec2, DVec3, Vec2};
 use rayon::prelude::*;

@@ -9,6 +9,16 @@
 //! no line crosses once the view was 16 times wider: 3.2% of its lit tests
 //! wrong, 0.026% with the ids; `kage-bench slb`.)
 //!
+//! A CSG solid's lines follow where it covers the map, not where one of its
+//! parts lies in front of another (a step of its depth): the light pass
+//! marks the texels round the steps and sharp creases of each solid's depth
+//! at the texel centres, and there a point of the solid whose neighbouring
+//! centres show the solid in front of the point's plane is decided by a ray
+//! through that solid (the lines and the map decide for the other objects).
+//! On OpenSCAD's printer part `mk3_x_end.csg` at 1024² this takes the
+//! misclassified points from 15 to 2 at scale 1 and from 1,213 to 36 at
+//! scale 64, for 35 ms more shading at 1920×1080 (`kage-bench slb`).
+//!
 //! Antialiased, a point whose pixel's footprint on the receiver's plane
 //! ([`PixelView::footprint`]) has a stored line passing through it (its
 //! bounding box in texels) is decided at 4 × 4 points of the footprint and
