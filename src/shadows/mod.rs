@@ -11,6 +11,7 @@
 mod footprint;
 mod map;
 pub mod slb;
+pub mod soft;
 
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
