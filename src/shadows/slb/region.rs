@@ -133,7 +133,8 @@ pub fn surfaces_over(entry: &Entry<'_>, mx: f32, my: f32, limits: &DepthLimits, 
     let mut tally = ObjectTally::default();
     // A layer's depth at the centre it covers (as a shadow map samples it); a
     // line's where the way crosses it (its edge's own depth): never a plane
-    // carried past the polygon it belongs to.
+    // carried past the polygon it belongs to alone (a surface held to the
+    // small bias must also be nearer at the point: `DepthLimits::hides`).
     for layer in entry.layers {
         let nearer = limits.hides(layer.object, layer.facing, &layer.depth, (0.5, 0.5), (mx, my));
         tally.add(layer.object, layer.count, nearer);

@@ -233,7 +233,7 @@ pub fn solid_outlines(scene: &Scene, camera: &Camera, resolution: u32, casters: 
             alone.depths().to_vec()
         };
         let world = solid.transformed(&o.transform);
-        let (outline, coverage, caster) = traced_outline(&world, object as u32, camera, resolution, bits, map_depth);
+        let (outline, coverage, caster) = solid_outline(&world, object as u32, camera, resolution, bits, map_depth);
         out.triangles.extend(outline);
         out.coverages.push(coverage);
         out.casters.push((object as u32, caster));
@@ -241,26 +241,14 @@ pub fn solid_outlines(scene: &Scene, camera: &Camera, resolution: u32, casters: 
     out
 }
 
-/// The triangles of `solid`'s outline band and its coverage of the texel
-/// centres, seen by `camera` in a `resolution`² map with `bits`-bit lines.
-/// `map_depth` gives the solid's reversed depth at every texel centre (0
-/// where it is absent), asked for only when the texels are the lattice.
-/// `solid` is in world space; its triangles belong to object `object`.
+/// The triangles of `solid`'s outline band, its coverage of the texel
+/// centres and the caster its rays were cast through, seen by `camera` in a
+/// `resolution`² map with `bits`-bit lines. `map_depth` gives the solid's
+/// reversed depth at every texel centre (0 where it is absent), asked for
+/// only when the texels are the lattice. `solid` is in world space; its
+/// triangles belong to object `object`.
 #[must_use]
 pub fn solid_outline(
-    solid: &CsgSolid,
-    object: u32,
-    camera: &Camera,
-    resolution: u32,
-    bits: u32,
-    map_depth: impl FnOnce() -> Vec<f32>,
-) -> (Vec<LightTriangle>, SolidCoverage) {
-    let (triangles, coverage, _) = traced_outline(solid, object, camera, resolution, bits, map_depth);
-    (triangles, coverage)
-}
-
-/// [`solid_outline`], with the caster its rays were cast through.
-fn traced_outline(
     solid: &CsgSolid,
     object: u32,
     camera: &Camera,

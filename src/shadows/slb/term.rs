@@ -551,7 +551,7 @@ mod tests {
                         .map(|k| depth_at(&caster, &rays, &camera, centre(k)).map_or(0.0, |z| z as f32))
                         .collect()
                 };
-                let (triangles, coverage) = solid_outline(&solid, 0, &camera, n, bits, map);
+                let (triangles, coverage, _) = solid_outline(&solid, 0, &camera, n, bits, map);
                 let slb = SilhouetteLineBuffer::build(n, n, bits, &triangles, std::slice::from_ref(&coverage));
                 let (x0, y0, w, h) = coverage.texels;
                 for _ in 0..4000 {
