@@ -1,0 +1,268 @@
+//! A pixel's light visibility from two hard shadows (seed 001 §3): shadowed
+//! in both is umbra (V = 0), in neither lit (V = 1), in one penumbra, where
+//! V = D1 / (D1 + D2) with D1 the screen distance to the nearest umbra pixel
+//! and D2 to the nearest lit one — 0 beside the umbra, 1 beside the light.
+//! (The paper's eq. 3.4 writes C = D2 / (D1 + D2) and calls C → 0 black,
+//! which would make a pixel next to the umbra white: its own text asks for
+//! D1 / (D1 + D2).)
+//!
+//! Two ways to the distances. [`visibility_searched`] is the paper's: a
+//! search outwards from every N-th pixel in x and y, the pixels between
+//! interpolated bilinearly (§3.3.3; its eqs. 3.6 and 3.7 swap the weights of
+//! the two neighbours, so a linear ramp would not come back: ordinary
+//! bilinear weights here). [`visibility_exact`] is kage's: two exact
+//! distance transforms ([`super::edt`]) give D1 and D2 for every pixel at
+//! once, in time linear in the pixels, and may be kept from crossing depth
+//! discontinuities. A penumbra pixel that reaches no umbra (the two hard
+//! shadows of a thin occluder need not overlap) or no lit pixel is half lit:
+//! it is in one of the two hard shadows.
+
+use super::edt::{squared_distances_apart, UNREACHED};
+
+/// What the two hard shadows say of a pixel.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Zone {
+    /// Reached by both hard lights.
+    Lit,
+    /// Shadowed from one of them.
+    Penumbra,
+    /// Shadowed from both.
+    Umbra,
+}
+
+/// V from the distances to the nearest umbra and lit pixels (either may be
+/// infinite: not reached).
+#[inline]
+fn from_distances(d1: f32, d2: f32) -> f32 {
+    if d1.is_finite() && d2.is_finite() && d1 + d2 > 0.0 {
+        d1 / (d1 + d2)
+    } else {
+        0.5
+    }
+}
+
+/// Light visibility of every pixel of a `width` × `height` image of
+/// `zones` (row by row) by exact distance transforms, never measuring a
+/// distance between neighbours that `apart` says lie apart (`(x, y)` and
+/// the pixel right of or below it).
+///
+/// # Panics
+///
+/// If `zones` does not hold `width` × `height` values.
+#[must_use]
+pub fn visibility_exact(
+    zones: &[Zone],
+    width: usize,
+    height: usize,
+    apart: impl Fn((usize, usize), (usize, usize)) -> bool + Copy,
+) -> Vec<f32> {
+    let mask = |z: Zone| zones.iter().map(|&v| v == z).collect::<Vec<bool>>();
+    let to_umbra = squared_distances_apart(&mask(Zone::Umbra), width, height, apart);
+    let to_lit = squared_distances_apart(&mask(Zone::Lit), width, height, apart);
+    let root = |d: f32| if d == UNREACHED { f32::INFINITY } else { d.sqrt() };
+    zones
+        .iter()
+        .zip(to_umbra.iter().zip(&to_lit))
+        .map(|(z, (&u, &l))| match z {
+            Zone::Lit => 1.0,
+            Zone::Umbra => 0.0,
+            Zone::Penumbra => from_distances(root(u), root(l)),
+        })
+        .collect()
+}
+
+/// Light visibility by the paper's search: at every `n`-th pixel in x and y
+/// (and the last row and column), the nearest umbra and lit pixels found by
+/// looking in square rings outwards up to `reach` pixels; every other pixel
+/// interpolated bilinearly from the four samples round it, where it is
+/// penumbra (umbra and lit pixels keep 0 and 1).
+///
+/// # Panics
+///
+/// If `zones` does not hold `width` × `height` values or `n` is 0.
+#[must_use]
+pub fn visibility_searched(zones: &[Zone], width: usize, height: usize, n: usize, reach: usize) -> Vec<f32> {
+    assert_eq!(zones.len(), width * height, "zones of {width} × {height}");
+    assert!(n > 0, "a sample every n ≥ 1 pixels");
+    let zone = |x: usize, y: usize| zones[y * width + x];
+    let sample = |x: usize, y: usize| match zone(x, y) {
+        Zone::Lit => 1.0,
+        Zone::Umbra => 0.0,
+        Zone::Penumbra => {
+            let (d1, d2) = nearest(zones, width, height, (x, y), reach);
+            from_distances(d1, d2)
+        }
+    };
+    let grid = |len: usize| -> Vec<usize> {
+        let mut at: Vec<usize> = (0..len).step_by(n).collect();
+        if at.last() != Some(&(len - 1)) {
+            at.push(len - 1);
+        }
+        at
+    };
+    if width == 0 || height == 0 {
+        return Vec::new();
+    }
+    let (gx, gy) = (grid(width), grid(height));
+    let samples: Vec<f32> =
+        gy.iter().flat_map(|&y| gx.iter().map(move |&x| (x, y))).map(|(x, y)| sample(x, y)).collect();
+    let mut out = vec![0.0; width * height];
+    for y in 0..height {
+        for x in 0..width {
+            out[y * width + x] = match zone(x, y) {
+                Zone::Lit => 1.0,
+                Zone::Umbra => 0.0,
+                Zone::Penumbra => bilinear(&samples, (&gx, &gy), (x, y)),
+            };
+        }
+    }
+    out
+}
+
+/// The value at pixel `(x, y)` interpolated bilinearly from `samples` taken
+/// at columns `gx` and rows `gy` (increasing, the first 0 and the last the
+/// image's last): each of the four samples round the pixel weighted by the
+/// pixel's nearness to it along each axis.
+#[must_use]
+pub fn bilinear(samples: &[f32], (gx, gy): (&[usize], &[usize]), (x, y): (usize, usize)) -> f32 {
+    let cell = |g: &[usize], v: usize| {
+        let i = g.partition_point(|&s| s <= v).saturating_sub(1).min(g.len().saturating_sub(2));
+        let (a, b) = (g[i], g[(i + 1).min(g.len() - 1)]);
+        let t = if b > a { (v - a) as f32 / (b - a) as f32 } else { 0.0 };
+        (i, (i + 1).min(g.len() - 1), t)
+    };
+    let ((i0, i1, s), (j0, j1, t)) = (cell(gx, x), cell(gy, y));
+    let at = |i: usize, j: usize| samples[j * gx.len() + i];
+    (at(i0, j0) * (1.0 - s) + at(i1, j0) * s) * (1.0 - t) + (at(i0, j1) * (1.0 - s) + at(i1, j1) * s) * t
+}
+
+/// Distances from `(x, y)` to the nearest umbra and nearest lit pixel within
+/// `reach` (infinite where none is), looking in square rings outwards: a
+/// ring at Chebyshev distance r holds Euclidean distances r to r·√2, so the
+/// search stops once r passes the nearest found.
+fn nearest(zones: &[Zone], width: usize, height: usize, (x, y): (usize, usize), reach: usize) -> (f32, f32) {
+    let (mut umbra, mut lit) = (f32::INFINITY, f32::INFINITY);
+    for r in 1..=reach as i64 {
+        if r as f32 > umbra.max(lit) {
+            break;
+        }
+        let (cx, cy) = (x as i64, y as i64);
+        let ring = (-r..=r).flat_map(|d| [(cx + d, cy - r), (cx + d, cy + r), (cx - r, cy + d), (cx + r, cy + d)]);
+        for (u, v) in ring {
+            if u < 0 || v < 0 || u >= width as i64 || v >= height as i64 {
+                continue;
+            }
+            let d = (((u - cx).pow(2) + (v - cy).pow(2)) as f32).sqrt();
+            match zones[v as usize * width + u as usize] {
+                Zone::Umbra => umbra = umbra.min(d),
+                Zone::Lit => lit = lit.min(d),
+                Zone::Penumbra => {}
+            }
+        }
+    }
+    (umbra, lit)
+}
+
+#[cfg(test)]
+mod tests {
+    use rand::{Rng, SeedableRng};
+
+    use super::*;
+
+    /// Umbra left of `a`, penumbra to `b`, lit beyond, in a `w` × `h` image.
+    fn straight(w: usize, h: usize, a: usize, b: usize) -> Vec<Zone> {
+        (0..w * h)
+            .map(|i| match i % w {
+                x if x < a => Zone::Umbra,
+                x if x <= b => Zone::Penumbra,
+                _ => Zone::Lit,
+            })
+            .collect()
+    }
+
+    /// V is 0 on the umbra, 1 on the lit side, rises strictly across a
+    /// straight penumbra, and is D1 / (D1 + D2) there — by the transform and
+    /// by the paper's search at every pixel.
+    #[test]
+    fn visibility_is_0_in_the_umbra_1_in_the_light_and_rises_across_the_penumbra() {
+        let (w, h, a, b) = (60, 9, 20, 40);
+        let zones = straight(w, h, a, b);
+        let exact = visibility_exact(&zones, w, h, |_, _| false);
+        let searched = visibility_searched(&zones, w, h, 1, 64);
+        for v in [&exact, &searched] {
+            for y in 0..h {
+                let row = &v[y * w..(y + 1) * w];
+                assert!(row[..a].iter().all(|&v| v == 0.0) && row[b + 1..].iter().all(|&v| v == 1.0));
+                assert!(row[a..=b].windows(2).all(|p| p[0] < p[1]), "row {y}: {row:?}");
+                let x = 30;
+                let (d1, d2) = ((x - (a - 1)) as f32, ((b + 1) - x) as f32);
+                assert!((row[x] - d1 / (d1 + d2)).abs() < 1e-6, "{} at x = {x}", row[x]);
+            }
+        }
+    }
+
+    /// Bilinear weights reconstruct a linear ramp exactly from samples every
+    /// n pixels (swapped weights, as the paper prints them, would not).
+    #[test]
+    fn bilinear_interpolation_reconstructs_a_linear_ramp() {
+        let (w, h) = (37, 23);
+        for n in [1, 3, 5, 10] {
+            let grid = |len: usize| {
+                let mut g: Vec<usize> = (0..len).step_by(n).collect();
+                if g.last() != Some(&(len - 1)) {
+                    g.push(len - 1);
+                }
+                g
+            };
+            let (gx, gy) = (grid(w), grid(h));
+            let f = |x: usize, y: usize| 0.25 + 0.013 * x as f32 - 0.021 * y as f32;
+            let samples: Vec<f32> = gy.iter().flat_map(|&y| gx.iter().map(move |&x| f(x, y))).collect();
+            for y in 0..h {
+                for x in 0..w {
+                    let v = bilinear(&samples, (&gx, &gy), (x, y));
+                    assert!((v - f(x, y)).abs() < 1e-5, "n = {n}, ({x}, {y}): {v} against {}", f(x, y));
+                }
+            }
+        }
+    }
+
+    /// The paper's search at every pixel finds the same distances as the
+    /// transforms, on random zones.
+    #[test]
+    fn the_search_at_every_pixel_agrees_with_the_transforms() {
+        let mut rng = rand::rngs::StdRng::seed_from_u64(3);
+        for _ in 0..30 {
+            let (w, h) = (rng.gen_range(2..30), rng.gen_range(2..30));
+            let zones: Vec<Zone> = (0..w * h)
+                .map(|_| [Zone::Lit, Zone::Penumbra, Zone::Penumbra, Zone::Umbra][rng.gen_range(0..4)])
+                .collect();
+            let exact = visibility_exact(&zones, w, h, |_, _| false);
+            let searched = visibility_searched(&zones, w, h, 1, 64);
+            for (i, (a, b)) in exact.iter().zip(&searched).enumerate() {
+                assert!((a - b).abs() < 1e-5, "pixel {i}: transform {a}, search {b}");
+            }
+        }
+    }
+
+    /// A depth discontinuity keeps the distances apart: a penumbra on a floor
+    /// behind a plate does not measure to the plate's umbra, so the floor's
+    /// pixels next to the plate take their visibility from the floor alone.
+    #[test]
+    fn distances_do_not_cross_a_depth_discontinuity() {
+        let (w, h) = (30, 10);
+        // Columns 0..10: a plate in front, all umbra; 10..: the floor,
+        // penumbra to column 20, lit beyond.
+        let zones: Vec<Zone> = (0..w * h)
+            .map(|i| match i % w {
+                x if x < 10 => Zone::Umbra,
+                x if x <= 20 => Zone::Penumbra,
+                _ => Zone::Lit,
+            })
+            .collect();
+        let plate_edge = |a: (usize, usize), b: (usize, usize)| a.0 == 9 && b.0 == 10;
+        let aware = visibility_exact(&zones, w, h, plate_edge);
+        let naive = visibility_exact(&zones, w, h, |_, _| false);
+        assert!(naive[12] < 0.3, "without the cut the plate's umbra darkens the floor: {}", naive[12]);
+        assert_eq!(aware[12], 0.5, "with it, no umbra on the floor: half lit");
+    }
+}
