@@ -43,7 +43,7 @@ struct Method {
 }
 
 /// Maps 512² … 16K², 3 × 3 PCF on 2K², the SLB 1K² at k = 4 / 8 / 16 and, at
-/// k = 8, scales 4 / 16 / 64 / 256.
+/// k = 8, scales 4 / 16 / 64 / 256 / 1024 (the paper's Fig. 8 and 9 go to 1024).
 fn methods() -> Vec<Method> {
     let map = |resolution: u32, pcf: u32| ShadowSettings { resolution, by_need: false, pcf, ..ShadowSettings::MAP };
     let mut out: Vec<Method> = [512, 1024, 2048, 4096, 8192, 16384]
@@ -57,7 +57,7 @@ fn methods() -> Vec<Method> {
             settings: ShadowSettings { bits, ..ShadowSettings::SLB },
         });
     }
-    for scale in [4.0, 16.0, 64.0, 256.0] {
+    for scale in [4.0, 16.0, 64.0, 256.0, 1024.0] {
         let settings = ShadowSettings { scale, ..ShadowSettings::SLB };
         out.push(Method { name: format!("SLB 1024², k = 8, scale {scale}"), settings });
     }
