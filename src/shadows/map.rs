@@ -23,7 +23,8 @@ const MAX_SLOPE: f32 = 8.0;
 /// The constant bias, in texels, against surfaces of other objects than the
 /// receiver ([`Located::z_other`]).
 #[inline]
-fn other_bias(settings: &ShadowSettings) -> f32 {
+#[must_use]
+pub fn other_bias(settings: &ShadowSettings) -> f32 {
     settings.bias / settings.scale.max(1.0)
 }
 

@@ -39,6 +39,7 @@ use super::line::{Facing, Layer, TexelDepth};
 use crate::camera::{Camera, PixelRays};
 use crate::csg::{CsgCaster, CsgSolid};
 use crate::scene::Scene;
+use crate::shadows::map::DepthMap;
 use crate::visibility::solids::draw_solids;
 use crate::visibility::VisibilityBuffer;
 
@@ -482,4 +483,62 @@ fn fan(v: &[(Corner, Option<usize>)], across: [bool; 4], object: u32, polygon: u
         let points = [v[0].0, v[t].0, v[t + 1].0];
         out.push(LightTriangle { points, object, polygon, open, facing: Facing::Unknown });
     }
+}
+
+/// The texels of `map` within one texel of a place where a CSG solid's own
+/// depth (`coverages`, at the texel centres) breaks between two neighbouring
+/// centres — a step, where one part of the solid lies in front of another,
+/// or a crease sharp enough to hide one: the difference between the two
+/// centres' distances is off the slope on either side (the differences to
+/// the next centres out, where the solid covers them; with neither, any
+/// difference) by more than `bias` texels, the small bias another object's
+/// surface is held to; and every texel of a solid less than a few dozen
+/// texels across (traced on a finer lattice). A point
+/// there may lie on either side of the break within its texel, which the
+/// map's centres cannot tell; the eye pass looks closer
+/// ([`super::SlbMap`]). One bit per texel (none without solids).
+#[must_use]
+pub fn solid_steps(map: &DepthMap, coverages: &[SolidCoverage], bias: f32) -> Vec<u64> {
+    if coverages.is_empty() {
+        return Vec::new();
+    }
+    let n = map.resolution() as usize;
+    let mut bits = vec![0u64; (n * n).div_ceil(64)];
+    for c in coverages {
+        let (x0, y0, w, h) = c.texels;
+        let at = |i: isize, j: isize| -> Option<(f32, f32)> {
+            let inside = i >= 0 && j >= 0 && (i as usize) < w && (j as usize) < h;
+            let z = if inside { c.depth[j as usize * w + i as usize] } else { 0.0 };
+            (z > 0.0).then(|| map.distance_and_texel(z))
+        };
+        let breaks = |i: isize, j: isize, (di, dj): (isize, isize)| {
+            let (Some((a, texel)), Some((b, _))) = (at(i, j), at(i + di, j + dj)) else { return false };
+            let step = b - a;
+            let before = at(i - di, j - dj).map(|(p, _)| a - p);
+            let after = at(i + 2 * di, j + 2 * dj).map(|(q, _)| q - b);
+            [before, after].into_iter().flatten().all(|s| (step - s).abs() > texel * bias)
+        };
+        let mut mark = |i: isize, j: isize| {
+            for y in (y0 as isize + j - 1).max(0)..=(y0 as isize + j + 1).min(n as isize - 1) {
+                for x in (x0 as isize + i - 1).max(0)..=(x0 as isize + i + 1).min(n as isize - 1) {
+                    let t = y as usize * n + x as usize;
+                    bits[t / 64] |= 1 << (t % 64);
+                }
+            }
+        };
+        // A solid traced on a finer lattice than the texels is a few texels
+        // across: a step may lie between any of its centres.
+        let small = c.lattice.step < 1.0;
+        for j in 0..h as isize {
+            for i in 0..w as isize {
+                for d in [(1, 0), (0, 1)] {
+                    if small && at(i, j).is_some() || breaks(i, j, d) {
+                        mark(i, j);
+                        mark(i + d.0, j + d.1);
+                    }
+                }
+            }
+        }
+    }
+    bits
 }

@@ -39,13 +39,13 @@ use super::buffer::SilhouetteLineBuffer;
 use super::light::light_triangles;
 use super::line::{Facing, SilhouetteLine};
 use super::region::{covered, DepthLimits};
-use super::solid::{solid_outlines, SolidCoverage};
+use super::solid::{solid_outlines, solid_steps};
 use crate::camera::Camera;
 use crate::camera::Ray;
 use crate::csg::CsgCaster;
 use crate::scene::{Scene, ShadowSettings};
 use crate::shadows::footprint::{PixelView, Receiver, ReceiverLanes};
-use crate::shadows::map::{DepthMap, Located, LocatedLanes};
+use crate::shadows::map::{other_bias, DepthMap, Located, LocatedLanes};
 use crate::visibility::{VisibilityBuffer, Workers};
 
 /// One light view's depth map and silhouette-line buffer.
@@ -60,7 +60,7 @@ pub struct SlbMap {
     /// through that solid.
     solids: Vec<(u32, CsgCaster)>,
     /// One bit per texel: a step or a sharp crease of a solid's depth lies
-    /// between texel centres within one texel of it ([`solid_steps`]).
+    /// between texel centres within one texel of it ([`solid_steps`](super::solid::solid_steps)).
     steps: Vec<u64>,
     /// The frame's pixel rays, for antialiased lookups ([`SlbMap::set_view`]).
     view: Option<PixelView>,
@@ -121,7 +121,7 @@ impl SlbMap {
         let solids = solid_outlines(scene, camera, resolution, casters, bits);
         triangles.extend(solids.triangles);
         let slb = SilhouetteLineBuffer::build(resolution, resolution, bits, &triangles, &solids.coverages);
-        let steps = solid_steps(&map, &solids.coverages, settings.bias / settings.scale.max(1.0));
+        let steps = solid_steps(&map, &solids.coverages, other_bias(settings));
         SlbMap { map, slb, solids: solids.casters, steps, view: None }
     }
 
@@ -324,7 +324,7 @@ impl SlbMap {
     ) -> Option<f32> {
         let (_, solid) = self.solids.iter().find(|(o, _)| *o == limits.receiver)?;
         // Past the small bias, as another object's surface is held to it.
-        let bias = at.texel * settings.bias / settings.scale.max(1.0);
+        let bias = at.texel * other_bias(settings);
         if !self.own_step_near(p, plane, at, limits, bias) {
             return None;
         }
@@ -412,63 +412,6 @@ impl SlbMap {
     pub fn memory_bytes(&self) -> usize {
         self.map.memory_bytes() + self.slb.memory_bytes() + self.steps.len() * 8
     }
-}
-
-/// The texels of `map` within one texel of a place where a CSG solid's own
-/// depth (`coverages`, at the texel centres) breaks between two neighbouring
-/// centres — a step, where one part of the solid lies in front of another,
-/// or a crease sharp enough to hide one: the difference between the two
-/// centres' distances is off the slope on either side (the differences to
-/// the next centres out, where the solid covers them; with neither, any
-/// difference) by more than `bias` texels, the small bias another object's
-/// surface is held to; and every texel of a solid less than a few dozen
-/// texels across (traced on a finer lattice). A point
-/// there may lie on either side of the break within its texel, which the
-/// map's centres cannot tell; the eye pass looks closer
-/// ([`SlbMap::lit_point`]). One bit per texel (none without solids).
-fn solid_steps(map: &DepthMap, coverages: &[SolidCoverage], bias: f32) -> Vec<u64> {
-    if coverages.is_empty() {
-        return Vec::new();
-    }
-    let n = map.resolution() as usize;
-    let mut bits = vec![0u64; (n * n).div_ceil(64)];
-    for c in coverages {
-        let (x0, y0, w, h) = c.texels;
-        let at = |i: isize, j: isize| -> Option<(f32, f32)> {
-            let inside = i >= 0 && j >= 0 && (i as usize) < w && (j as usize) < h;
-            let z = if inside { c.depth[j as usize * w + i as usize] } else { 0.0 };
-            (z > 0.0).then(|| map.distance_and_texel(z))
-        };
-        let breaks = |i: isize, j: isize, (di, dj): (isize, isize)| {
-            let (Some((a, texel)), Some((b, _))) = (at(i, j), at(i + di, j + dj)) else { return false };
-            let step = b - a;
-            let before = at(i - di, j - dj).map(|(p, _)| a - p);
-            let after = at(i + 2 * di, j + 2 * dj).map(|(q, _)| q - b);
-            [before, after].into_iter().flatten().all(|s| (step - s).abs() > texel * bias)
-        };
-        let mut mark = |i: isize, j: isize| {
-            for y in (y0 as isize + j - 1).max(0)..=(y0 as isize + j + 1).min(n as isize - 1) {
-                for x in (x0 as isize + i - 1).max(0)..=(x0 as isize + i + 1).min(n as isize - 1) {
-                    let t = y as usize * n + x as usize;
-                    bits[t / 64] |= 1 << (t % 64);
-                }
-            }
-        };
-        // A solid traced on a finer lattice than the texels is a few texels
-        // across: a step may lie between any of its centres.
-        let small = c.lattice.step < 1.0;
-        for j in 0..h as isize {
-            for i in 0..w as isize {
-                for d in [(1, 0), (0, 1)] {
-                    if small && at(i, j).is_some() || breaks(i, j, d) {
-                        mark(i, j);
-                        mark(i + d.0, j + d.1);
-                    }
-                }
-            }
-        }
-    }
-    bits
 }
 
 /// The depth limits of a point located at `at` on object `receiver`, its

@@ -93,17 +93,10 @@ pub fn visibility_searched(zones: &[Zone], width: usize, height: usize, n: usize
             from_distances(d1, d2)
         }
     };
-    let grid = |len: usize| -> Vec<usize> {
-        let mut at: Vec<usize> = (0..len).step_by(n).collect();
-        if at.last() != Some(&(len - 1)) {
-            at.push(len - 1);
-        }
-        at
-    };
     if width == 0 || height == 0 {
         return Vec::new();
     }
-    let (gx, gy) = (grid(width), grid(height));
+    let (gx, gy) = (sampled(width, n), sampled(height, n));
     let samples: Vec<f32> =
         gy.iter().flat_map(|&y| gx.iter().map(move |&x| (x, y))).map(|(x, y)| sample(x, y)).collect();
     let mut out = vec![0.0; width * height];
@@ -117,6 +110,15 @@ pub fn visibility_searched(zones: &[Zone], width: usize, height: usize, n: usize
         }
     }
     out
+}
+
+/// Every `n`-th of `len` (> 0) positions, and the last.
+fn sampled(len: usize, n: usize) -> Vec<usize> {
+    let mut at: Vec<usize> = (0..len).step_by(n).collect();
+    if at.last() != Some(&(len - 1)) {
+        at.push(len - 1);
+    }
+    at
 }
 
 /// The value at pixel `(x, y)` interpolated bilinearly from `samples` taken
@@ -207,14 +209,7 @@ mod tests {
     fn bilinear_interpolation_reconstructs_a_linear_ramp() {
         let (w, h) = (37, 23);
         for n in [1, 3, 5, 10] {
-            let grid = |len: usize| {
-                let mut g: Vec<usize> = (0..len).step_by(n).collect();
-                if g.last() != Some(&(len - 1)) {
-                    g.push(len - 1);
-                }
-                g
-            };
-            let (gx, gy) = (grid(w), grid(h));
+            let (gx, gy) = (sampled(w, n), sampled(h, n));
             let f = |x: usize, y: usize| 0.25 + 0.013 * x as f32 - 0.021 * y as f32;
             let samples: Vec<f32> = gy.iter().flat_map(|&y| gx.iter().map(move |&x| f(x, y))).collect();
             for y in 0..h {
