@@ -106,12 +106,51 @@ pub enum ShadowMethod {
     /// silhouette lines in the texels they cross, so shadow edges are exact
     /// inside a texel ([`ShadowSettings::bits`], [`ShadowSettings::scale`]).
     Slb,
+    /// Soft shadows from two hard shadows (seed 001): maps from two points on
+    /// the line through the light and a focus point; a pixel shadowed in
+    /// both is umbra, in one penumbra, lit by its screen distances to the
+    /// nearest umbra and lit pixels ([`ShadowSettings::focus`],
+    /// [`ShadowSettings::search`], [`ShadowSettings::penumbra`],
+    /// [`ShadowSettings::hard`]).
+    Soft,
+    /// Percentage-closer soft shadows (Fernando 2005): one map from the
+    /// light's centre, a blocker search sized by the light, then a filter as
+    /// wide as the penumbra the blockers' mean depth gives
+    /// ([`ShadowSettings::blockers`], [`ShadowSettings::filter`]).
+    Pcss,
 }
 
 impl ShadowMethod {
     /// Every method, by its name in scene files and on the command line.
-    pub const NAMES: [(&'static str, ShadowMethod); 3] =
-        [("none", ShadowMethod::None), ("map", ShadowMethod::Map), ("slb", ShadowMethod::Slb)];
+    pub const NAMES: [(&'static str, ShadowMethod); 5] = [
+        ("none", ShadowMethod::None),
+        ("map", ShadowMethod::Map),
+        ("slb", ShadowMethod::Slb),
+        ("soft", ShadowMethod::Soft),
+        ("pcss", ShadowMethod::Pcss),
+    ];
+}
+
+/// How a two-map penumbra's visibility V = D1 / (D1 + D2) becomes the shadow
+/// term.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum PenumbraFalloff {
+    /// V itself: the term rises linearly across the penumbra.
+    #[default]
+    Linear,
+    /// 3V² − 2V³: flat at both ends, as a disc light's penumbra is.
+    Smooth,
+}
+
+/// Which hard shadows a two-map soft shadow is made of.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum HardShadows {
+    /// Plain depth maps (the paper's).
+    #[default]
+    Map,
+    /// Silhouette-line buffers (seed 000): the penumbra's borders exact
+    /// inside a texel.
+    Slb,
 }
 
 /// A light's shadow technique and its parameters.
@@ -150,6 +189,26 @@ pub struct ShadowSettings {
     /// on the receiver where a shadow's edge passes near, so the edge is
     /// antialiased (off: lit or not at the pixel's centre).
     pub antialias: bool,
+    /// Two-map soft shadows: the point the two maps' line runs through from
+    /// the light, where the penumbra matches the light's (`None`: the
+    /// centre of the shadow casters' bounds).
+    pub focus: Option<Vec3>,
+    /// Two-map soft shadows: search for the nearest umbra and lit pixels at
+    /// every `search`-th pixel and interpolate between (the paper's; 0: an
+    /// exact distance transform at every pixel).
+    pub search: u32,
+    /// Two-map soft shadows: how visibility rises across the penumbra.
+    pub penumbra: PenumbraFalloff,
+    /// Two-map soft shadows: keep distances from crossing depth
+    /// discontinuities of the eye's view (a floor's penumbra does not reach
+    /// onto a plate in front of it).
+    pub depth_aware: bool,
+    /// Two-map soft shadows: what the two hard shadows are.
+    pub hard: HardShadows,
+    /// PCSS: taps of the blocker search.
+    pub blockers: u32,
+    /// PCSS: taps of the filter.
+    pub filter: u32,
 }
 
 impl Default for ShadowSettings {
@@ -175,7 +234,7 @@ impl Light {
             LightKind::Point { position } | LightKind::Spot { position, .. } => position,
             LightKind::Directional { .. } => return vec![self.clone()],
         };
-        if self.size <= 0.0 || n == 1 || self.shadow.method == ShadowMethod::None {
+        if self.size <= 0.0 || n == 1 || !matches!(self.shadow.method, ShadowMethod::Map | ShadowMethod::Slb) {
             return vec![self.clone()];
         }
         let axis = (towards - position).normalize_or(Vec3::NEG_Y);
@@ -214,6 +273,13 @@ impl ShadowSettings {
         bits: 8,
         scale: 1.0,
         antialias: true,
+        focus: None,
+        search: 0,
+        penumbra: PenumbraFalloff::Linear,
+        depth_aware: true,
+        hard: HardShadows::Map,
+        blockers: 16,
+        filter: 16,
     };
 
     /// The silhouette-line buffer's defaults: a 1024² map, 8-bit lines, scale

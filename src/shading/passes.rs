@@ -29,10 +29,11 @@ use std::time::Instant;
 use glam::{Vec2, Vec3};
 
 use super::reflection_map::{add_reflection_map, flat_background};
+use super::surface::screen_surfaces;
 use super::{shade_pass, Blend, Component, ComponentSet, Lighting, ShadingPass, SubpixelShading};
 use crate::image::LinearImage;
 use crate::scene::{Light, Scene};
-use crate::shadows::{MapPool, PixelView, ShadowTerm};
+use crate::shadows::{MapPool, PixelView, ScreenSurfaces, ShadowTerm};
 use crate::visibility::VisibilityBuffer;
 
 /// What the passes of one frame cost.
@@ -87,22 +88,35 @@ fn frame_lights_within(scene: &Scene, (lo, hi): (Vec3, Vec3)) -> Vec<FrameLight>
     scene.lights.iter().map(|l| FrameLight { light: l.clone(), samples: l.jittered(centre) }).collect()
 }
 
-/// The shadow terms of `light`'s samples (taken from `pool`: last frame's where
-/// they still hold), timed into `stats`, set to look up `scene`'s view
-/// ([`light_view`]).
-fn terms(
-    scene: &Scene,
-    light: &FrameLight,
+/// What a frame's shadow terms are built from: the scene, its visibility
+/// buffer, the casters' bounds, and the surfaces its pixels show (found
+/// once, when a per-pixel term first needs them).
+struct ShadowFrame<'a> {
+    scene: &'a Scene,
+    vb: &'a VisibilityBuffer,
     bounds: (Vec3, Vec3),
-    pool: &mut MapPool,
-    stats: &mut PassStats,
-) -> Vec<ShadowTerm> {
-    let t = Instant::now();
-    let mut terms = pool.terms(scene, &light.samples, bounds);
-    stats.shadow_ms += t.elapsed().as_secs_f64() * 1e3;
-    let view = light_view(scene, light);
-    terms.iter_mut().for_each(|t| t.set_view(view));
-    terms
+    surfaces: Option<ScreenSurfaces>,
+}
+
+impl ShadowFrame<'_> {
+    /// The shadow terms of `light`'s samples (taken from `pool`: last frame's
+    /// where they still hold), set to look up the scene's view
+    /// ([`light_view`]), per-pixel terms computed at every pixel, all timed
+    /// into `stats`.
+    fn terms(&mut self, light: &FrameLight, pool: &mut MapPool, stats: &mut PassStats) -> Vec<ShadowTerm> {
+        let t = Instant::now();
+        let mut terms = pool.terms(self.scene, &light.samples, self.bounds);
+        let view = light_view(self.scene, light);
+        for term in &mut terms {
+            term.set_view(view);
+            if term.per_pixel() {
+                let (scene, vb) = (self.scene, self.vb);
+                term.prepare(self.surfaces.get_or_insert_with(|| screen_surfaces(scene, vb)));
+            }
+        }
+        stats.shadow_ms += t.elapsed().as_secs_f64() * 1e3;
+        terms
+    }
 }
 
 /// The view `light`'s shadow terms look up `scene`'s pixels through: its
@@ -147,12 +161,13 @@ pub fn shade_lit_beside(
     let mut budget = FUSED_SHADOW_BUDGET;
     let bounds = scene.caster_bounds().unwrap_or_default();
     let lights = frame_lights_within(scene, bounds);
+    let mut frame = ShadowFrame { scene, vb, bounds, surfaces: None };
     let (mut fused, mut own) = (Vec::new(), Vec::new());
     for light in &lights {
         let bytes: usize = light.samples.iter().map(|s| ShadowTerm::bytes_needed(s, bounds)).sum();
         if light.light.only.is_none() && bytes <= budget {
             budget -= bytes;
-            fused.push((light, terms(scene, light, bounds, pool, &mut stats)));
+            fused.push((light, frame.terms(light, pool, &mut stats)));
         } else {
             own.push(light);
         }
@@ -169,7 +184,7 @@ pub fn shade_lit_beside(
         light.samples.iter().zip(terms).for_each(|(s, term)| pool.keep(scene, s, bounds, term));
     }
     for frame_light in own {
-        let terms = terms(scene, frame_light, bounds, pool, &mut stats);
+        let terms = frame.terms(frame_light, pool, &mut stats);
         let light = &frame_light.light;
         stats.shadow_bytes = stats.shadow_bytes.max(terms.iter().map(ShadowTerm::memory_bytes).sum());
         let receivers = light.only.as_ref().map(|only| (0..scene.objects.len()).map(|i| only.contains(&i)).collect());

@@ -10,7 +10,10 @@
 
 use glam::{Affine3A, Mat3A, Vec2, Vec3};
 
+use rayon::prelude::*;
+
 use crate::scene::Scene;
+use crate::shadows::{Receiver, ScreenSurfaces, VisibleSurface};
 
 use crate::camera::Ray;
 use crate::visibility::{ItemId, VisibilityBuffer};
@@ -265,4 +268,31 @@ pub fn intersect_plane(ray: &Ray, a: Vec3, e1: Vec3, e2: Vec3) -> (f32, Vec2) {
     let tvec = ray.origin - a;
     let qvec = tvec.cross(e1);
     (e2.dot(qvec) * inv, Vec2::new(tvec.dot(pvec) * inv, ray.dir.dot(qvec) * inv))
+}
+
+/// The surface each pixel of `vb` shows (at the pixel's centre: position,
+/// shading normal, and its object and triangle plane as a shadow's
+/// receiver), seen through `scene`'s camera: what a per-pixel shadow term is
+/// computed from.
+#[must_use]
+pub fn screen_surfaces(scene: &Scene, vb: &VisibilityBuffer) -> ScreenSurfaces {
+    let w = vb.width() as usize;
+    let frames = ObjectFrames::new(scene);
+    let rays = scene.camera.pixel_rays(Vec2::new(vb.width() as f32, vb.height() as f32));
+    let mut surfaces = vec![None; w * vb.height() as usize];
+    surfaces.par_chunks_mut(w.max(1)).enumerate().for_each(|(y, row)| {
+        for (x, slot) in row.iter_mut().enumerate() {
+            let (x, y) = (x as u32, y as u32);
+            let item = vb.item(x, y);
+            if item.is_none() {
+                continue;
+            }
+            let ray = rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
+            let triangle = frames.prepare_at(scene, vb, x, y, &ray);
+            let s = triangle.surface(&ray);
+            let receiver = Receiver { object: item.object, plane: triangle.geometry().geometric };
+            *slot = Some(VisibleSurface { position: s.position, normal: s.normal, receiver });
+        }
+    });
+    ScreenSurfaces::new(scene.camera, vb.width(), vb.height(), surfaces)
 }

@@ -228,6 +228,27 @@ impl DepthMap {
         (to.normalize_or(-self.axis), distance)
     }
 
+    /// The world size of one texel at distance `along` the light's axis.
+    #[inline]
+    #[must_use]
+    pub fn texel_size(&self, along: f32) -> f32 {
+        if self.ortho {
+            self.texel
+        } else {
+            self.texel * along
+        }
+    }
+
+    /// The reversed depth the map holds at the texel holding texel
+    /// coordinates `(u, v)`, or at the nearest texel of the map's border
+    /// for coordinates outside it.
+    #[inline]
+    #[must_use]
+    pub fn texel_depth_clamped(&self, u: f32, v: f32) -> f32 {
+        let last = self.resolution.saturating_sub(1) as f32;
+        self.texel_depth(u.floor().clamp(0.0, last) as u32, v.floor().clamp(0.0, last) as u32)
+    }
+
     /// The reversed depth the map holds at texel `(x, y)` (0: nothing).
     #[inline]
     #[must_use]

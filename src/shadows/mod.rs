@@ -10,6 +10,8 @@
 
 mod footprint;
 mod map;
+pub mod pcss;
+pub mod screen;
 pub mod slb;
 pub mod soft;
 
@@ -19,9 +21,12 @@ use wide::f32x8;
 
 pub use footprint::{PixelView, Receiver, ReceiverLanes, UNKNOWN_RECEIVER};
 pub use map::{DepthMap, Located, LocatedLanes};
+pub use pcss::PcssLight;
+pub use screen::{ScreenSurfaces, ScreenTerm, VisibleSurface};
 pub use slb::SlbMap;
+pub use soft::TwoMaps;
 
-use crate::scene::{GeometryKey, Light, LightKind, Scene, ShadowMethod, ShadowSettings};
+use crate::scene::{GeometryKey, HardShadows, Light, LightKind, Scene, ShadowMethod, ShadowSettings};
 
 use crate::camera::{Camera, Projection};
 use crate::visibility::{VisibilityBuffer, Workers};
@@ -44,6 +49,12 @@ pub enum ShadowTerm {
     Slb(Box<SlbMap>, ShadowSettings),
     /// Six of them around a point.
     SlbCube(Box<[SlbMap; 6]>, Vec3, ShadowSettings),
+    /// Soft shadows from two hard shadows (seed 001), computed per pixel of
+    /// the frame ([`ShadowTerm::prepare`]).
+    Soft(Box<TwoMaps>),
+    /// Percentage-closer soft shadows over a hard term's maps (a `Map` or a
+    /// `Cube`).
+    Pcss(Box<ShadowTerm>, PcssLight),
 }
 
 impl ShadowTerm {
@@ -60,6 +71,11 @@ impl ShadowTerm {
     /// buffers taken from `pool` (give them back with [`MapPool::recycle`]).
     #[must_use]
     pub fn build_within(scene: &Scene, light: &Light, bounds: (Vec3, Vec3), pool: &mut MapPool) -> ShadowTerm {
+        match light.shadow.method {
+            ShadowMethod::Soft => return ShadowTerm::build_soft(scene, light, bounds, pool),
+            ShadowMethod::Pcss => return ShadowTerm::build_pcss(scene, light, bounds, pool),
+            _ => {}
+        }
         let settings = light.shadow;
         let view = *pool.view(scene);
         let casters = pool.casters(scene);
@@ -122,16 +138,55 @@ impl ShadowTerm {
         }
     }
 
+    /// The two-map soft term of `light`: its hard shadows (by
+    /// [`ShadowSettings::hard`]) from the two points of seed 001, or its
+    /// hard shadow alone where it has no size.
+    fn build_soft(scene: &Scene, light: &Light, bounds: (Vec3, Vec3), pool: &mut MapPool) -> ShadowTerm {
+        let method = match light.shadow.hard {
+            HardShadows::Map => ShadowMethod::Map,
+            HardShadows::Slb => ShadowMethod::Slb,
+        };
+        let hard = ShadowSettings { samples: 1, ..light.shadow.with_method(method) };
+        let mut build = |l: &Light| ShadowTerm::build_within(scene, &Light { shadow: hard, ..l.clone() }, bounds, pool);
+        match TwoMaps::build(light, bounds, &mut build) {
+            Some(two) => ShadowTerm::Soft(Box::new(two)),
+            None => build(light),
+        }
+    }
+
+    /// The PCSS term of `light`: a hard map (or cube) from its centre, read
+    /// by [`pcss::lit`].
+    fn build_pcss(scene: &Scene, light: &Light, bounds: (Vec3, Vec3), pool: &mut MapPool) -> ShadowTerm {
+        let hard = ShadowSettings { samples: 1, pcf: 1, ..light.shadow.with_method(ShadowMethod::Map) };
+        let term = ShadowTerm::build_within(scene, &Light { shadow: hard, ..light.clone() }, bounds, pool);
+        let (size, at) = match light.kind {
+            LightKind::Point { position } | LightKind::Spot { position, .. } => (light.size.max(0.0), position),
+            LightKind::Directional { .. } => return term,
+        };
+        // The nearest caster: the distance to the casters' bounds (a light
+        // among them: a small share of the way to their centre).
+        let centre = (bounds.0 + bounds.1) * 0.5;
+        let outside = (bounds.0 - at).max(at - bounds.1).max(Vec3::ZERO).length();
+        let nearest = outside.max(0.05 * (centre - at).length()).max(f32::MIN_POSITIVE);
+        ShadowTerm::Pcss(Box::new(term), PcssLight { size, nearest })
+    }
+
     /// Bytes the maps of `light` hold at most (before they are rendered) in a
-    /// scene with these bounds: at the full configured resolution.
+    /// scene with these bounds: at the full configured resolution (a soft
+    /// term's two maps; its per-pixel term is the frame's and not counted).
     #[must_use]
     pub fn bytes_needed(light: &Light, bounds: (Vec3, Vec3)) -> usize {
         let res = light.shadow.resolution.max(1) as usize;
         let texel = std::mem::size_of::<f32>();
-        match placement(light, bounds) {
+        let one = match placement(light, bounds) {
             Placement::None => 0,
             Placement::Cone { .. } | Placement::Parallel { .. } => res * res * texel,
             Placement::Cube { .. } => 6 * (res / 2).max(16).pow(2) * texel,
+        };
+        if light.shadow.method == ShadowMethod::Soft {
+            2 * one
+        } else {
+            one
         }
     }
 
@@ -148,7 +203,25 @@ impl ShadowTerm {
         match self {
             ShadowTerm::Slb(map, _) => map.set_view(view),
             ShadowTerm::SlbCube(faces, ..) => faces.iter_mut().for_each(|f| f.set_view(view)),
+            ShadowTerm::Soft(two) => two.set_view(view),
             _ => {}
+        }
+    }
+
+    /// Whether this term is computed per pixel of the frame, and needs
+    /// [`ShadowTerm::prepare`] before its lookups.
+    #[must_use]
+    pub fn per_pixel(&self) -> bool {
+        matches!(self, ShadowTerm::Soft(_))
+    }
+
+    /// Computes a per-pixel term at every pixel of the frame whose surfaces
+    /// are `surfaces` (others have nothing to compute). Its lookups of
+    /// points the frame's pixels show read the result; other points (a
+    /// reflection's) are decided on their own.
+    pub fn prepare(&mut self, surfaces: &ScreenSurfaces) {
+        if let ShadowTerm::Soft(two) = self {
+            two.prepare(surfaces);
         }
     }
 
@@ -168,6 +241,12 @@ impl ShadowTerm {
             ShadowTerm::Cube(faces, centre, s) => faces[cube_face(p - *centre)].lit(p, cos_theta, s),
             ShadowTerm::Slb(map, s) => map.lit(p, cos_theta, s, receiver),
             ShadowTerm::SlbCube(faces, centre, s) => faces[cube_face(p - *centre)].lit(p, cos_theta, s, receiver),
+            ShadowTerm::Soft(two) => two.lit(p, cos_theta, receiver),
+            ShadowTerm::Pcss(hard, light) => match hard.as_ref() {
+                ShadowTerm::Map(map, s) => pcss::lit(map, p, cos_theta, s, light),
+                ShadowTerm::Cube(faces, centre, s) => pcss::lit(&faces[cube_face(p - *centre)], p, cos_theta, s, light),
+                other => other.lit(p, cos_theta, receiver),
+            },
         }
     }
 
@@ -189,7 +268,7 @@ impl ShadowTerm {
                 f32x8::new(std::array::from_fn(|i| faces[face[i]].lit(Vec3::new(x[i], y[i], z[i]), c[i], s)))
             }
             ShadowTerm::Slb(map, s) => map.lit_lanes(p, cos_theta, s, receivers),
-            ShadowTerm::SlbCube(..) => {
+            ShadowTerm::SlbCube(..) | ShadowTerm::Soft(_) | ShadowTerm::Pcss(..) => {
                 let (x, y, z, c) = (p[0].to_array(), p[1].to_array(), p[2].to_array(), cos_theta.to_array());
                 f32x8::new(std::array::from_fn(|i| self.lit(Vec3::new(x[i], y[i], z[i]), c[i], &receivers.lane(i))))
             }
@@ -229,6 +308,8 @@ impl ShadowTerm {
             ShadowTerm::Cube(f, ..) => f.iter().map(DepthMap::memory_bytes).sum(),
             ShadowTerm::Slb(m, _) => m.memory_bytes(),
             ShadowTerm::SlbCube(f, ..) => f.iter().map(SlbMap::memory_bytes).sum(),
+            ShadowTerm::Soft(two) => two.memory_bytes(),
+            ShadowTerm::Pcss(hard, _) => hard.memory_bytes(),
         }
     }
 }
@@ -479,6 +560,8 @@ impl MapPool {
             ShadowTerm::Cube(faces, ..) => self.free.extend(faces.into_iter().map(DepthMap::into_buffer)),
             ShadowTerm::Slb(map, _) => self.free.push(map.into_buffer()),
             ShadowTerm::SlbCube(faces, ..) => self.free.extend(faces.into_iter().map(SlbMap::into_buffer)),
+            ShadowTerm::Soft(two) => two.into_hard().into_iter().for_each(|t| self.recycle(t)),
+            ShadowTerm::Pcss(hard, _) => self.recycle(*hard),
         }
     }
 

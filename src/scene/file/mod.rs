@@ -18,8 +18,8 @@ use toml::Spanned;
 use super::load::{self, AssetSource, LoadedModel};
 use super::mesh::shapes;
 use super::{
-    box_corners, framing, Body, Environment, Falloff, Light, LightKind, Material, Object, Scene, ShadowMethod,
-    ShadowSettings, Texture, Up,
+    box_corners, framing, Body, Environment, Falloff, HardShadows, Light, LightKind, Material, Object, PenumbraFalloff,
+    Scene, ShadowMethod, ShadowSettings, Texture, Up,
 };
 use crate::camera::{Camera, Projection};
 use crate::csg::openscad::{CsgOptions, Geometry};
@@ -313,6 +313,13 @@ struct ShadowRec {
     bits: Option<Spanned<i64>>,
     scale: Option<Spanned<f32>>,
     antialias: Option<bool>,
+    focus: Option<V3>,
+    search: Option<Spanned<i64>>,
+    falloff: Option<PenumbraRec>,
+    depth_aware: Option<bool>,
+    hard: Option<HardRec>,
+    blockers: Option<Spanned<i64>>,
+    filter: Option<Spanned<i64>>,
 }
 
 #[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default)]
@@ -320,6 +327,24 @@ struct ShadowRec {
 enum ShadowMethodRec {
     None,
     #[default]
+    Map,
+    Slb,
+    Soft,
+    Pcss,
+}
+
+/// `falloff = "linear" | "smooth"` of a two-map penumbra.
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+enum PenumbraRec {
+    Linear,
+    Smooth,
+}
+
+/// `hard = "map" | "slb"`: the hard shadows of a two-map soft shadow.
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+enum HardRec {
     Map,
     Slb,
 }

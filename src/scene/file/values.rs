@@ -201,6 +201,8 @@ impl SceneFile {
             ShadowMethodRec::None => ShadowMethod::None,
             ShadowMethodRec::Map => ShadowMethod::Map,
             ShadowMethodRec::Slb => ShadowMethod::Slb,
+            ShadowMethodRec::Soft => ShadowMethod::Soft,
+            ShadowMethodRec::Pcss => ShadowMethod::Pcss,
         });
         let count = |v: &Option<Spanned<i64>>, lo: i64, hi: i64, what: &str| -> Result<Option<u32>> {
             match v {
@@ -218,6 +220,23 @@ impl SceneFile {
         s.samples = count(&r.samples, 1, 256, "shadow samples")?.unwrap_or(s.samples);
         s.bits = count(&r.bits, 4, 16, "shadow bits")?.unwrap_or(s.bits);
         s.antialias = r.antialias.unwrap_or(s.antialias);
+        s.search = count(&r.search, 0, 64, "shadow search")?.unwrap_or(s.search);
+        s.blockers = count(&r.blockers, 1, 256, "shadow blockers")?.unwrap_or(s.blockers);
+        s.filter = count(&r.filter, 1, 256, "shadow filter")?.unwrap_or(s.filter);
+        s.depth_aware = r.depth_aware.unwrap_or(s.depth_aware);
+        s.focus = r.focus.map(Vec3::from).or(s.focus);
+        if let Some(p) = r.falloff {
+            s.penumbra = match p {
+                PenumbraRec::Linear => PenumbraFalloff::Linear,
+                PenumbraRec::Smooth => PenumbraFalloff::Smooth,
+            };
+        }
+        if let Some(h) = r.hard {
+            s.hard = match h {
+                HardRec::Map => HardShadows::Map,
+                HardRec::Slb => HardShadows::Slb,
+            };
+        }
         if let Some(scale) = &r.scale {
             let v = *scale.get_ref();
             if !(v.is_finite() && v > 0.0) {

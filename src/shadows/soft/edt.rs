@@ -16,6 +16,8 @@
 //! distance reaches a pixel only along a path (down a column, then along a
 //! row) that crosses no cut.
 
+use rayon::prelude::*;
+
 /// A squared distance no pixel reaches: the mask holds no set pixel on any
 /// path that crosses no cut.
 pub const UNREACHED: f32 = f32::INFINITY;
@@ -45,24 +47,33 @@ pub fn squared_distances_apart(
     mask: &[bool],
     width: usize,
     height: usize,
-    apart: impl Fn((usize, usize), (usize, usize)) -> bool,
+    apart: impl Fn((usize, usize), (usize, usize)) -> bool + Sync,
 ) -> Vec<f32> {
     assert_eq!(mask.len(), width * height, "a mask of {width} × {height}");
-    let mut scratch = Envelope::with_capacity(width.max(height));
-    // Down each column: the squared distance to the nearest set pixel of the
-    // same column.
-    let mut columns: Vec<f32> = mask.iter().map(|&m| if m { 0.0 } else { UNREACHED }).collect();
-    let mut line = vec![0.0f32; height];
-    for x in 0..width {
-        line.iter_mut().enumerate().for_each(|(y, v)| *v = columns[y * width + x]);
-        scratch.transform_runs(&mut line, |y| apart((x, y), (x, y + 1)));
-        line.iter().enumerate().for_each(|(y, &v)| columns[y * width + x] = v);
+    if width == 0 || height == 0 {
+        return Vec::new();
     }
+    // Down each column (transposed, so each column is one slice and the
+    // columns run in parallel): the squared distance to the nearest set
+    // pixel of the same column.
+    let mut columns = vec![UNREACHED; width * height];
+    columns.par_chunks_mut(height).enumerate().for_each_init(
+        || Envelope::with_capacity(height),
+        |scratch, (x, column)| {
+            column.iter_mut().enumerate().for_each(|(y, v)| *v = if mask[y * width + x] { 0.0 } else { UNREACHED });
+            scratch.transform_runs(column, |y| apart((x, y), (x, y + 1)));
+        },
+    );
     // Along each row, over the columns' distances.
-    for (y, row) in columns.chunks_mut(width.max(1)).enumerate() {
-        scratch.transform_runs(row, |x| apart((x, y), (x + 1, y)));
-    }
-    columns
+    let mut rows = vec![UNREACHED; width * height];
+    rows.par_chunks_mut(width).enumerate().for_each_init(
+        || Envelope::with_capacity(width),
+        |scratch, (y, row)| {
+            row.iter_mut().enumerate().for_each(|(x, v)| *v = columns[x * height + y]);
+            scratch.transform_runs(row, |x| apart((x, y), (x + 1, y)));
+        },
+    );
+    rows
 }
 
 /// The lower envelope's working arrays, kept from line to line.

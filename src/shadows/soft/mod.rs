@@ -1,9 +1,207 @@
-//! Soft shadows from two hard shadows (seed 001, Tsutsumi): a pixel shadowed
-//! in the hard shadows of two points on either side of the light is umbra,
-//! in one of them penumbra, and a penumbra pixel's visibility comes from its
-//! screen distances to the nearest umbra and the nearest lit pixel
-//! ([`penumbra`]: by the paper's search every N pixels, or by an exact
-//! distance transform, [`edt`], for every pixel at once).
+//! Soft shadows from two hard shadows (seed 001, Tsutsumi 2005, §3): two
+//! hard shadows from L1 = L + l·P and L2 = L − l·P, on the line through the
+//! light L and a focus point G (P = (L − G)/|L − G|, eqs. 3.1–3.2); in the
+//! eye's view a pixel shadowed in both is umbra, in one penumbra, in neither
+//! lit, and a penumbra pixel's visibility comes from its screen distances to
+//! the nearest umbra and the nearest lit pixel ([`penumbra`]: by the paper's
+//! search every N pixels, or by an exact distance transform, [`edt`], for
+//! every pixel at once, optionally kept from crossing the view's depth
+//! discontinuities).
+//!
+//! # How far apart the two points are
+//!
+//! The two points lie along the axis, so an occluder's edge at distance `a`
+//! from the light and `h` from the axis, over a receiver `b` beyond it, casts
+//! two hard edges about 2·l·h·b/a² apart (each moves by l·sin θ·b/a, θ ≈ h/a
+//! the edge's angle off the axis), where a disc light of radius `r` casts a
+//! penumbra 2·r·b/a wide. The two agree for edges at h = ρ:
+//! l = r·|L − G|/ρ, with ρ the casters' lateral half-extent about the axis
+//! (the root mean square of their bounds' half-extents across P): the
+//! penumbra matches the disc's where the casters' outline is, and is h/ρ
+//! times the disc's elsewhere — none for an edge on the axis through G,
+//! twice as wide for one twice as far out. l is kept below half the way to
+//! the focus (L2 must stay on the light's side of the casters) and, for a
+//! light inside the casters' bounds (a lamp in a room), below half the way
+//! to the bounds' side behind it (L1 stays in the room): there the penumbra
+//! is narrower than the disc's.
+//!
+//! A directional light has no size in kage (the reference's shadows from it
+//! are hard), and neither has a light of size 0: their soft term is their
+//! hard one.
 
 pub mod edt;
 pub mod penumbra;
+
+use glam::Vec3;
+use rayon::prelude::*;
+
+use super::screen::{ScreenSurfaces, ScreenTerm};
+use super::{PixelView, Receiver, ShadowTerm};
+use crate::scene::{Light, LightKind, PenumbraFalloff, ShadowSettings};
+use penumbra::{visibility_exact, visibility_searched, Zone};
+
+/// Farthest the paper's search looks for an umbra or lit pixel, in pixels: a
+/// penumbra pixel that finds neither within it is half lit.
+pub const SEARCH_REACH: usize = 128;
+
+/// A light's soft shadow from two hard shadows.
+#[derive(Debug, Clone)]
+pub struct TwoMaps {
+    /// The hard shadows from L1 (away from the focus) and L2 (towards it).
+    hard: [ShadowTerm; 2],
+    /// L1 and L2.
+    points: [Vec3; 2],
+    /// The light's centre L.
+    centre: Vec3,
+    settings: ShadowSettings,
+    /// The term at every pixel of the frame it was last prepared for.
+    screen: Option<ScreenTerm>,
+}
+
+impl TwoMaps {
+    /// The soft term of `light` (its hard shadows built by `hard` for each of
+    /// the two lights moved to L1 and L2), with the casters within `bounds`;
+    /// `None` when the light has no size or no position (directional).
+    pub fn build(light: &Light, bounds: (Vec3, Vec3), mut hard: impl FnMut(&Light) -> ShadowTerm) -> Option<TwoMaps> {
+        let centre = match light.kind {
+            LightKind::Point { position } | LightKind::Spot { position, .. } => position,
+            LightKind::Directional { .. } => return None,
+        };
+        let focus = light.shadow.focus.unwrap_or((bounds.0 + bounds.1) * 0.5);
+        let points = two_points(centre, light.size, focus, bounds)?;
+        let moved = |to: Vec3| {
+            let kind = match light.kind {
+                LightKind::Spot { direction, inner, outer, .. } => {
+                    LightKind::Spot { position: to, direction, inner, outer }
+                }
+                _ => LightKind::Point { position: to },
+            };
+            Light { kind, ..light.clone() }
+        };
+        let hard = points.map(|p| hard(&moved(p)));
+        Some(TwoMaps { hard, points, centre, settings: light.shadow, screen: None })
+    }
+
+    /// L1 and L2.
+    #[must_use]
+    pub fn points(&self) -> [Vec3; 2] {
+        self.points
+    }
+
+    /// The two hard terms.
+    #[must_use]
+    pub fn hard(&self) -> &[ShadowTerm; 2] {
+        &self.hard
+    }
+
+    /// Takes the two hard terms (their maps' buffers back to a pool).
+    #[must_use]
+    pub fn into_hard(self) -> [ShadowTerm; 2] {
+        self.hard
+    }
+
+    /// Sets the pixel rays the hard terms look up through.
+    pub fn set_view(&mut self, view: Option<PixelView>) {
+        self.hard.iter_mut().for_each(|h| h.set_view(view));
+    }
+
+    /// Computes the term at every pixel of `surfaces` (seed 001 §3.2–3.3):
+    /// the zones from the two hard shadows, then visibility from the
+    /// distances, shaped by the falloff.
+    pub fn prepare(&mut self, surfaces: &ScreenSurfaces) {
+        let (w, h) = (surfaces.width as usize, surfaces.height as usize);
+        let zones: Vec<Zone> = surfaces.surfaces.par_iter().map(|s| self.zone(s.as_ref())).collect();
+        let s = &self.settings;
+        let mut v = match s.search {
+            0 if s.depth_aware => visibility_exact(&zones, w, h, |a, b| surfaces.apart(a, b)),
+            0 => visibility_exact(&zones, w, h, |_, _| false),
+            n => visibility_searched(&zones, w, h, n as usize, SEARCH_REACH),
+        };
+        if s.penumbra == PenumbraFalloff::Smooth {
+            v.iter_mut().for_each(|v| *v = *v * *v * (3.0 - 2.0 * *v));
+        }
+        self.screen = Some(ScreenTerm::new(surfaces, v));
+    }
+
+    /// The zone of a pixel showing `surface`: umbra where it faces away from
+    /// the light's centre, else by the two hard shadows; lit where nothing
+    /// is seen.
+    fn zone(&self, surface: Option<&super::screen::VisibleSurface>) -> Zone {
+        let Some(s) = surface else { return Zone::Lit };
+        let facing = |at: Vec3| s.normal.dot((at - s.position).normalize_or(Vec3::ZERO));
+        if facing(self.centre) <= 0.0 {
+            return Zone::Umbra;
+        }
+        let lit = |k: usize| self.hard[k].lit(s.position, facing(self.points[k]).max(1e-3), &s.receiver) >= 0.5;
+        match (lit(0), lit(1)) {
+            (true, true) => Zone::Lit,
+            (false, false) => Zone::Umbra,
+            _ => Zone::Penumbra,
+        }
+    }
+
+    /// The term at `p` on `receiver` with N·L = `cos_theta`: the prepared
+    /// frame's where a pixel shows `p`, else from the two hard shadows
+    /// alone (1 lit in both, ½ in one, 0 in neither).
+    #[must_use]
+    pub fn lit(&self, p: Vec3, cos_theta: f32, receiver: &Receiver) -> f32 {
+        if let Some(v) = self.screen.as_ref().and_then(|s| s.at(p)) {
+            return v;
+        }
+        0.5 * (self.hard[0].lit(p, cos_theta, receiver) + self.hard[1].lit(p, cos_theta, receiver))
+    }
+
+    /// The term at every pixel of the frame last prepared, row by row.
+    #[must_use]
+    pub fn screen(&self) -> Option<&ScreenTerm> {
+        self.screen.as_ref()
+    }
+
+    /// Bytes held by the maps and the per-pixel term.
+    #[must_use]
+    pub fn memory_bytes(&self) -> usize {
+        self.hard.iter().map(ShadowTerm::memory_bytes).sum::<usize>()
+            + self.screen.as_ref().map_or(0, ScreenTerm::memory_bytes)
+    }
+}
+
+/// L1 and L2 for a light at `centre` of radius `size`, focused on `focus`,
+/// casters within `bounds` (see the module's doc for the derivation); `None`
+/// for a light of no size or one at the focus.
+#[must_use]
+pub fn two_points(centre: Vec3, size: f32, focus: Vec3, bounds: (Vec3, Vec3)) -> Option<[Vec3; 2]> {
+    let to_light = centre - focus;
+    let d = to_light.length();
+    if size <= 0.0 || d <= f32::EPSILON {
+        return None;
+    }
+    let p = to_light / d;
+    let half = (bounds.1 - bounds.0) * 0.5;
+    // Root mean square of the bounds' half-extents across P.
+    let across = (half * half).dot(Vec3::ONE - p * p) * 0.5;
+    let rho = across.sqrt().max(d * 1e-3);
+    let mut l = size * d / rho;
+    l = l.min(0.5 * d);
+    if let Some(exit) = exit_distance(centre, p, bounds) {
+        l = l.min(0.5 * exit);
+    }
+    Some([centre + p * l, centre - p * l])
+}
+
+/// How far a ray from `from` (inside `bounds`) along `dir` runs before it
+/// leaves them; `None` when `from` lies outside.
+fn exit_distance(from: Vec3, dir: Vec3, (lo, hi): (Vec3, Vec3)) -> Option<f32> {
+    if from.cmplt(lo).any() || from.cmpgt(hi).any() {
+        return None;
+    }
+    let t = |o: f32, d: f32, lo: f32, hi: f32| {
+        if d > 0.0 {
+            (hi - o) / d
+        } else if d < 0.0 {
+            (lo - o) / d
+        } else {
+            f32::INFINITY
+        }
+    };
+    Some(t(from.x, dir.x, lo.x, hi.x).min(t(from.y, dir.y, lo.y, hi.y)).min(t(from.z, dir.z, lo.z, hi.z)))
+}

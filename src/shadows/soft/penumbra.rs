@@ -54,11 +54,13 @@ pub fn visibility_exact(
     zones: &[Zone],
     width: usize,
     height: usize,
-    apart: impl Fn((usize, usize), (usize, usize)) -> bool + Copy,
+    apart: impl Fn((usize, usize), (usize, usize)) -> bool + Copy + Sync,
 ) -> Vec<f32> {
     let mask = |z: Zone| zones.iter().map(|&v| v == z).collect::<Vec<bool>>();
-    let to_umbra = squared_distances_apart(&mask(Zone::Umbra), width, height, apart);
-    let to_lit = squared_distances_apart(&mask(Zone::Lit), width, height, apart);
+    let (to_umbra, to_lit) = rayon::join(
+        || squared_distances_apart(&mask(Zone::Umbra), width, height, apart),
+        || squared_distances_apart(&mask(Zone::Lit), width, height, apart),
+    );
     let root = |d: f32| if d == UNREACHED { f32::INFINITY } else { d.sqrt() };
     zones
         .iter()

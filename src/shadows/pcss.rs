@@ -1,0 +1,113 @@
+//! Percentage-closer soft shadows (Fernando, "Percentage-Closer Soft
+//! Shadows", SIGGRAPH 2005 sketch), as game engines ship them (Bevy,
+//! Filament): one map from the light's centre; around the receiver's texel a
+//! blocker search as wide as the light's disc seen from the receiver through
+//! the nearest casters; the blockers' mean distance `d_b` gives the penumbra
+//! (d − d_b)·r/d_b at the receiver (d its distance, r the light's radius),
+//! and a percentage-closer filter that wide decides the term.
+//!
+//! Both searches take their taps from a Vogel disc (a golden-angle spiral, as
+//! Bevy's), turned by an angle hashed from the point, so neighbouring pixels
+//! sample different texels and the pattern becomes fine noise instead of
+//! bands. A light of size 0 gives radius-0 searches: every tap reads the
+//! receiver's texel and the term is the hard map's.
+
+use glam::Vec3;
+
+use super::map::DepthMap;
+use crate::scene::ShadowSettings;
+
+/// Widest search or filter, in texels: past it a tap is too sparse to tell
+/// anything and reads far from the receiver's own depth.
+pub const MAX_RADIUS: f32 = 64.0;
+
+/// The golden angle, radians: successive spiral taps turn by it.
+const GOLDEN_ANGLE: f32 = 2.399_963;
+
+/// A light's size and where its casters begin: what the searches are sized
+/// by.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PcssLight {
+    /// The light's radius, world units.
+    pub size: f32,
+    /// Distance along each map's axis to the nearest caster (at least the
+    /// map's near plane): the blocker search covers what the disc's cone
+    /// from the receiver reaches there.
+    pub nearest: f32,
+}
+
+/// The PCSS term of `map` at `p` with N·L = `cos_theta`: 1 lit, 0 in
+/// shadow, between in a penumbra.
+#[must_use]
+pub fn lit(map: &DepthMap, p: Vec3, cos_theta: f32, settings: &ShadowSettings, light: &PcssLight) -> f32 {
+    let Some((_, _, d)) = map.project(p) else { return 1.0 };
+    let texel_per_world = |at: f32| 1.0 / map.texel_size(at).max(f32::MIN_POSITIVE);
+    // The disc seen from p through the nearest casters: radius r·(d − n)/d
+    // at distance n, in texels there.
+    let nearest = light.nearest.min(d);
+    let search = (light.size * (d - nearest) / d * texel_per_world(nearest)).min(MAX_RADIUS);
+    let Some(at) = map.locate(p, cos_theta, settings, 1.0) else { return 1.0 };
+    let turn = hash_angle(p);
+    let (mut sum, mut found) = (0.0, 0u32);
+    for (du, dv) in spiral(settings.blockers, search, turn) {
+        let z = map.texel_depth_clamped(at.u + du, at.v + dv);
+        if z > at.z_limit {
+            sum += map.distance_and_texel(z).0;
+            found += 1;
+        }
+    }
+    if found == 0 {
+        return 1.0;
+    }
+    let blocker = (sum / found as f32).max(f32::MIN_POSITIVE);
+    // The penumbra's half-width at the receiver, in texels there.
+    let radius = (light.size * (d - blocker).max(0.0) / blocker * texel_per_world(d)).min(MAX_RADIUS);
+    let Some(at) = map.locate(p, cos_theta, settings, 1.0 + radius.min(8.0)) else { return 1.0 };
+    let n = settings.filter.max(1);
+    let lit =
+        spiral(n, radius, turn + 1.0).filter(|&(du, dv)| map.texel_depth_clamped(at.u + du, at.v + dv) <= at.z_limit);
+    lit.count() as f32 / n as f32
+}
+
+/// `n` taps of a Vogel disc of `radius` turned by `turn` radians: tap i at
+/// radius·√((i + ½)/n), angle i·(golden angle) + turn.
+fn spiral(n: u32, radius: f32, turn: f32) -> impl Iterator<Item = (f32, f32)> {
+    let n = n.max(1);
+    (0..n).map(move |i| {
+        let r = radius * ((i as f32 + 0.5) / n as f32).sqrt();
+        let (s, c) = (i as f32 * GOLDEN_ANGLE + turn).sin_cos();
+        (r * c, r * s)
+    })
+}
+
+/// An angle in [0, 2π) hashed from `p`'s bits: the same point always turns
+/// its taps the same way.
+fn hash_angle(p: Vec3) -> f32 {
+    let mut h = p.x.to_bits().wrapping_mul(0x9E37_79B1) ^ p.y.to_bits().rotate_left(11).wrapping_mul(0x85EB_CA77);
+    h ^= p.z.to_bits().rotate_left(21).wrapping_mul(0xC2B2_AE3D);
+    h ^= h >> 15;
+    h = h.wrapping_mul(0x2C1B_3C6D);
+    h ^= h >> 12;
+    (h >> 8) as f32 / (1u32 << 24) as f32 * std::f32::consts::TAU
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn spiral_taps_fill_the_disc_evenly() {
+        let taps: Vec<(f32, f32)> = spiral(64, 2.0, 0.3).collect();
+        assert!(taps.iter().all(|(x, y)| x.hypot(*y) <= 2.0));
+        // Each quarter of the disc holds about a quarter of the taps.
+        for q in 0..4 {
+            let inside =
+                taps.iter().filter(|(x, y)| (*x >= 0.0) == (q & 1 == 0) && (*y >= 0.0) == (q & 2 == 0)).count();
+            assert!((12..=20).contains(&inside), "quarter {q}: {inside}");
+        }
+        // Half the taps within the radius's 1/√2 (equal area).
+        let inner = taps.iter().filter(|(x, y)| x.hypot(*y) <= 2.0 / 2f32.sqrt()).count();
+        assert_eq!(inner, 32);
+        assert!(spiral(16, 0.0, 1.0).all(|t| t == (0.0, 0.0)));
+    }
+}
