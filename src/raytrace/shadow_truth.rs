@@ -8,8 +8,10 @@
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
+use super::tracer::occluded_towards;
 use super::TraceScene;
 use crate::camera::{PixelRays, Ray};
+use crate::sampling::{concentric_disc, hash3, stratified};
 use crate::scene::{Light, LightKind, Scene};
 use crate::shading::{ObjectFrames, SurfacePoint};
 use crate::shadows::Receiver;
@@ -150,6 +152,46 @@ impl<'a> ShadowRays<'a> {
                     }
                 }
                 Some(lit as f32 / (n * n) as f32)
+            })
+            .collect()
+    }
+
+    /// Light `light`'s area-light term at the centre of every pixel of `vb`
+    /// (row by row): the share of `per_axis` × `per_axis` stratified,
+    /// jittered points of its disc (radius `size`, facing the point, as the
+    /// reference renderer's) that a shadow ray from the pixel's surface
+    /// reaches; 0 where the surface faces away from the light's centre,
+    /// `None` where no object is seen. A light without a size is one point.
+    #[must_use]
+    pub fn area_visibility(&self, vb: &VisibilityBuffer, light: usize, per_axis: u32) -> Vec<Option<f32>> {
+        let light = &self.scene.lights[light];
+        let (w, h) = (vb.width(), vb.height());
+        let m = per_axis.max(1);
+        (0..w * h)
+            .into_par_iter()
+            .map(|i| {
+                let (x, y) = (i % w, i / w);
+                if vb.item(x, y).is_none() {
+                    return None;
+                }
+                let ray = self.rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
+                let s = self.frames.prepare_at(self.scene, vb, x, y, &ray).surface(&ray);
+                if s.normal.dot(light.incident(s.position).to_light) <= 0.0 {
+                    return Some(0.0);
+                }
+                let position = match light.kind {
+                    LightKind::Point { position } | LightKind::Spot { position, .. } if light.size > 0.0 => position,
+                    _ => return Some(f32::from(u8::from(self.reaches(&s, light)))),
+                };
+                let origin = s.position + s.normal * self.epsilon;
+                let (u, v) = (position - s.position).normalize_or(Vec3::Y).any_orthonormal_pair();
+                let lit: u32 = (0..m * m)
+                    .map(|k| {
+                        let d = concentric_disc(stratified(k, m, hash3(x, y, k)));
+                        u32::from(!occluded_towards(&self.trace, origin, position + light.size * (u * d.x + v * d.y)))
+                    })
+                    .sum();
+                Some(lit as f32 / (m * m) as f32)
             })
             .collect()
     }

@@ -135,10 +135,12 @@ impl ShadowMethod {
 /// term.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum PenumbraFalloff {
-    /// V itself: the term rises linearly across the penumbra.
-    #[default]
+    /// V itself: the term rises linearly across the penumbra (the paper).
     Linear,
-    /// 3V² − 2V³: flat at both ends, as a disc light's penumbra is.
+    /// The share of a disc a straight edge uncovers having swept V of the
+    /// way across it: a disc light's own penumbra profile, flat at both
+    /// ends.
+    #[default]
     Smooth,
 }
 
@@ -275,7 +277,7 @@ impl ShadowSettings {
         antialias: true,
         focus: None,
         search: 0,
-        penumbra: PenumbraFalloff::Linear,
+        penumbra: PenumbraFalloff::Smooth,
         depth_aware: true,
         hard: HardShadows::Map,
         blockers: 16,

@@ -30,12 +30,16 @@ pub enum Zone {
     Umbra,
 }
 
-/// V from the distances to the nearest umbra and lit pixels (either may be
-/// infinite: not reached).
+/// V from the distances to the centres of the nearest umbra and lit pixels
+/// (either may be infinite: not reached), measured to those zones' borders,
+/// half a pixel nearer: (D1 − ½)/(D1 + D2 − 1). Across a straight penumbra
+/// n pixels wide the k-th pixel then gets (k − ½)/n, the ramp from the
+/// umbra's border to the light's sampled at its centre (D1/(D1 + D2) would
+/// stretch the ramp by a pixel).
 #[inline]
 fn from_distances(d1: f32, d2: f32) -> f32 {
-    if d1.is_finite() && d2.is_finite() && d1 + d2 > 0.0 {
-        d1 / (d1 + d2)
+    if d1.is_finite() && d2.is_finite() && d1 + d2 > 1.0 {
+        ((d1 - 0.5) / (d1 + d2 - 1.0)).clamp(0.0, 1.0)
     } else {
         0.5
     }

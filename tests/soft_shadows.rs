@@ -1,0 +1,159 @@
+//! Soft shadows (seed 001's two maps, PCSS) against the ray-traced area-light
+//! truth: the penumbra of a sphere over a plane widens with its height as the
+//! truth's does, and PCSS under a light of no size is the hard map.
+
+use std::path::Path;
+
+use glam::Vec3;
+use kage::raytrace::shadow_truth::ShadowRays;
+use kage::scene::file::SceneFile;
+use kage::scene::load::FileSystem;
+use kage::scene::{Scene, ShadowMethod, ShadowSettings};
+use kage::shadows::{Receiver, ShadowTerm};
+use kage::{render, RenderOptions};
+
+/// Pixels across the strip the camera shows, and its world width.
+const ACROSS: u32 = 1024;
+const WORLD: f32 = 6.0;
+
+/// A sphere of radius 0.5 centred `height` over a floor, a light of radius
+/// 0.3 six units up straight above it, seen from above through an
+/// orthographic strip across the shadow's middle; its light's shadows by
+/// `shadow` (a scene file's inline table).
+fn sphere_over_plane(height: f32, shadow: &str) -> Scene {
+    let text = format!(
+        r#"
+[image]
+width = {ACROSS}
+height = 8
+[camera]
+projection = "orthographic"
+height = {h}
+eye = [0.0, 10.0, 0.0]
+target = [0.0, 0.0, 0.0]
+up = [0.0, 0.0, -1.0]
+[[light]]
+type = "point"
+position = [0.0, 6.0, 0.0]
+size = 0.3
+shadow = {shadow}
+[[material]]
+name = "white"
+kd = [1.0, 1.0, 1.0]
+ks = [0.0, 0.0, 0.0]
+[[object]]
+shape = "plane"
+scale = 20.0
+material = "white"
+[[object]]
+shape = "sphere"
+translate = [0.0, {height}, 0.0]
+scale = 0.5
+"#,
+        h = WORLD * 8.0 / ACROSS as f32,
+    );
+    let file = SceneFile::parse(&text, Path::new("sphere.toml")).expect("the scene parses");
+    file.build(&FileSystem { base: ".".into() }).expect("the scene builds")
+}
+
+/// The world width, on the floor right of the shadow's centre, over which
+/// the term `v` (one value per pixel of the strip's middle row; `None`
+/// where the sphere is seen) rises from 0.1 to 0.9, the crossings placed
+/// between pixels by linear interpolation.
+fn penumbra_width(v: &[Option<f32>]) -> f32 {
+    let crossing = |level: f32| {
+        let mut last: Option<(usize, f32)> = None;
+        for (x, t) in v.iter().enumerate().skip(ACROSS as usize / 2) {
+            let Some(t) = *t else { continue };
+            if let Some((px, pt)) = last {
+                if pt < level && t >= level {
+                    return px as f32 + (level - pt) / (t - pt) * (x - px) as f32;
+                }
+            }
+            last = Some((x, t));
+        }
+        panic!("the term never crosses {level}: {v:?}");
+    };
+    (crossing(0.9) - crossing(0.1)) * WORLD / ACROSS as f32
+}
+
+/// The middle row of `scene`'s shadow term by the renderer (`None` off the
+/// floor), and by 32 × 32 rays over the light's disc.
+fn renderer_and_truth(scene: &Scene) -> (Vec<Option<f32>>, Vec<Option<f32>>) {
+    let frame = render(scene, &RenderOptions { shadow_images: true, ..RenderOptions::default() }).unwrap();
+    let row = 4 * ACROSS as usize;
+    let floor = |x: usize| frame.visibility.items()[row + x].object == 0;
+    let term = frame.shadows[0].pixels()[row..row + ACROSS as usize].iter().enumerate();
+    let ours = term.map(|(x, p)| floor(x).then_some(p.x)).collect();
+    let truth = ShadowRays::new(scene).area_visibility(&frame.visibility, 0, 32);
+    let truth = truth[row..row + ACROSS as usize].iter().enumerate().map(|(x, t)| t.filter(|_| floor(x))).collect();
+    (ours, truth)
+}
+
+#[test]
+fn a_two_map_penumbra_widens_with_height_as_the_truth_does() {
+    let mut widths = Vec::new();
+    for height in [1.0, 2.0, 3.0] {
+        let (ours, truth) = renderer_and_truth(&sphere_over_plane(height, r#"{ method = "soft" }"#));
+        let (w, t) = (penumbra_width(&ours), penumbra_width(&truth));
+        eprintln!("sphere at {height}: penumbra {w:.4} (truth {t:.4})");
+        assert!((w / t - 1.0).abs() < 0.1, "sphere at {height}: penumbra {w} against the truth's {t}");
+        widths.push(w);
+    }
+    assert!(widths[0] < widths[1] && widths[1] < widths[2], "the penumbra widens: {widths:?}");
+}
+
+#[test]
+fn pcss_under_a_light_of_no_size_is_the_hard_map() {
+    let mut scene = sphere_over_plane(1.5, r#"{ method = "pcss" }"#);
+    scene.lights[0].size = 0.0;
+    let pcss = ShadowTerm::build(&scene, &scene.lights[0]);
+    assert!(matches!(pcss, ShadowTerm::Pcss(..)));
+    let mut hard = scene.lights[0].clone();
+    hard.shadow = ShadowSettings { samples: 1, ..hard.shadow.with_method(ShadowMethod::Map) };
+    let hard = ShadowTerm::build(&scene, &hard);
+    let (mut shadowed, mut total) = (0, 0);
+    for i in 0..200 {
+        for j in 0..200 {
+            let p = Vec3::new(-1.5 + 3.0 * i as f32 / 199.0, 0.0, -1.5 + 3.0 * j as f32 / 199.0);
+            let (a, b) = (pcss.lit(p, 1.0, &Receiver::of_object(0)), hard.lit(p, 1.0, &Receiver::of_object(0)));
+            assert_eq!(a, b, "at {p}");
+            shadowed += usize::from(b < 1.0);
+            total += 1;
+        }
+    }
+    assert!(shadowed * 10 > total && shadowed < total, "{shadowed} of {total} shadowed");
+}
+
+#[test]
+fn pcss_penumbra_widens_with_height() {
+    let widths: Vec<f32> = [1.0, 2.0, 3.0]
+        .into_iter()
+        .map(|h| penumbra_width(&renderer_and_truth(&sphere_over_plane(h, r#"{ method = "pcss", filter = 64 }"#)).0))
+        .collect();
+    eprintln!("pcss penumbrae: {widths:?}");
+    assert!(widths[0] < widths[1] && widths[1] < widths[2], "the penumbra widens: {widths:?}");
+}
+
+/// The shading passes read the same per-pixel term the shadow image shows:
+/// on the floor (white, diffuse, no ambient) each pixel is N·L times it.
+#[test]
+fn the_passes_shade_with_the_per_pixel_term() {
+    let scene = sphere_over_plane(2.0, r#"{ method = "soft" }"#);
+    let frame = render(&scene, &RenderOptions { shadow_images: true, ..RenderOptions::default() }).unwrap();
+    let row = 4 * ACROSS as usize;
+    let (mut compared, mut penumbra) = (0, 0);
+    for x in 0..ACROSS as usize {
+        if frame.visibility.items()[row + x].object != 0 {
+            continue;
+        }
+        let p = Vec3::new((x as f32 + 0.5) / ACROSS as f32 * WORLD - WORLD / 2.0, 0.0, 0.0);
+        let cos = (Vec3::new(0.0, 6.0, 0.0) - p).normalize().y;
+        let term = frame.shadows[0].pixels()[row + x].x;
+        let shaded = frame.image.pixels()[row + x].x;
+        assert!((shaded - cos * term).abs() < 2e-3, "pixel {x}: shaded {shaded}, N·L × term {}", cos * term);
+        compared += 1;
+        penumbra += usize::from(term > 0.05 && term < 0.95);
+    }
+    assert!(compared > 500 && penumbra > 20, "{compared} floor pixels, {penumbra} in the penumbra");
+}
