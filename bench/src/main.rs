@@ -13,6 +13,7 @@ mod raster;
 mod rays;
 mod share;
 mod slb;
+mod soft;
 
 use std::path::PathBuf;
 
@@ -61,6 +62,10 @@ enum Command {
     /// and PCF: misclassified points and boundary RMSE against shadow rays,
     /// bytes, light pass, eye pass and frame milliseconds.
     Slb(slb::SlbArgs),
+    /// Soft shadows: seed 001's two maps (the paper's search, the exact
+    /// distance transform, depth-aware, on maps or SLBs), PCSS and the
+    /// jittered light against the ray-traced area-light truth.
+    Soft(soft::SoftArgs),
 }
 
 /// What every table takes.
@@ -122,5 +127,6 @@ fn main() -> miette::Result<()> {
         Command::CsgPreview(args) => csg::run_preview(&args),
         Command::ShadowShare(args) => share::run(&args),
         Command::Slb(args) => slb::run(&args),
+        Command::Soft(args) => soft::run(&args),
     }
 }

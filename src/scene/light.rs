@@ -144,6 +144,19 @@ pub enum PenumbraFalloff {
     Smooth,
 }
 
+/// Where a two-map soft shadow's two points lie on the line through the
+/// light and the focus.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum TwoPoints {
+    /// L ± l·P, l making the penumbra as wide as the disc light's (the
+    /// paper's pair; the penumbra lies a little outwards of the disc's).
+    Paper,
+    /// Unequally far either side, each hard edge on one border of the disc
+    /// light's penumbra.
+    #[default]
+    Matched,
+}
+
 /// Which hard shadows a two-map soft shadow is made of.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum HardShadows {
@@ -207,6 +220,8 @@ pub struct ShadowSettings {
     pub depth_aware: bool,
     /// Two-map soft shadows: what the two hard shadows are.
     pub hard: HardShadows,
+    /// Two-map soft shadows: where the two points lie.
+    pub points: TwoPoints,
     /// PCSS: taps of the blocker search.
     pub blockers: u32,
     /// PCSS: taps of the filter.
@@ -280,6 +295,7 @@ impl ShadowSettings {
         penumbra: PenumbraFalloff::Smooth,
         depth_aware: true,
         hard: HardShadows::Map,
+        points: TwoPoints::Matched,
         blockers: 16,
         filter: 16,
     };

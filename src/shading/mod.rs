@@ -35,7 +35,7 @@ pub use lanes::{Blend, Lighting};
 pub use passes::{frame_lights, shade_lit, shade_lit_beside, FrameLight, PassStats, Target};
 pub use phong::{Component, ComponentSet, Components};
 pub use subpixel::{SubpixelSample, SubpixelShading};
-pub use surface::{ObjectFrames, PreparedTriangle, SurfacePoint};
+pub use surface::{screen_surfaces, ObjectFrames, PreparedTriangle, SurfacePoint};
 
 use phong::Coefficients;
 

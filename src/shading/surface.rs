@@ -279,20 +279,30 @@ pub fn screen_surfaces(scene: &Scene, vb: &VisibilityBuffer) -> ScreenSurfaces {
     let w = vb.width() as usize;
     let frames = ObjectFrames::new(scene);
     let rays = scene.camera.pixel_rays(Vec2::new(vb.width() as f32, vb.height() as f32));
-    let mut surfaces = vec![None; w * vb.height() as usize];
-    surfaces.par_chunks_mut(w.max(1)).enumerate().for_each(|(y, row)| {
-        for (x, slot) in row.iter_mut().enumerate() {
-            let (x, y) = (x as u32, y as u32);
-            let item = vb.item(x, y);
-            if item.is_none() {
-                continue;
-            }
-            let ray = rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
-            let triangle = frames.prepare_at(scene, vb, x, y, &ray);
-            let s = triangle.surface(&ray);
-            let receiver = Receiver { object: item.object, plane: triangle.geometry().geometric };
-            *slot = Some(VisibleSurface { position: s.position, normal: s.normal, receiver });
-        }
-    });
+    let mut surfaces = Vec::new();
+    // A mesh triangle is prepared once for the run of pixels showing it (a
+    // solid's tangent plane is each pixel's own), kept in place; the
+    // surfaces are written in place, in parallel.
+    (0..w * vb.height() as usize)
+        .into_par_iter()
+        .map_init(
+            || None::<PreparedTriangle>,
+            |last, i| {
+                let (x, y) = ((i % w) as u32, (i / w) as u32);
+                let item = vb.item(x, y);
+                if item.is_none() {
+                    return None;
+                }
+                let ray = rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
+                if item.primitive().is_some() || last.as_ref().is_none_or(|t| t.item != item) {
+                    *last = Some(frames.prepare_at(scene, vb, x, y, &ray));
+                }
+                let triangle = last.as_ref().expect("prepared above");
+                let s = triangle.surface(&ray);
+                let receiver = Receiver { object: item.object, plane: triangle.geometric };
+                Some(VisibleSurface { position: s.position, normal: s.normal, receiver })
+            },
+        )
+        .collect_into_vec(&mut surfaces);
     ScreenSurfaces::new(scene.camera, vb.width(), vb.height(), surfaces)
 }

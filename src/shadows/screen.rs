@@ -18,7 +18,7 @@ use crate::camera::{Camera, Projection};
 pub struct VisibleSurface {
     /// World position.
     pub position: Vec3,
-    /// Unit shading normal.
+    /// Unit shading normal, on the side the eye sees.
     pub normal: Vec3,
     /// Its object and plane, as a shadow's receiver.
     pub receiver: Receiver,
@@ -39,6 +39,9 @@ pub struct ScreenSurfaces {
     /// Per pixel: bit 0 set where it lies apart from the pixel right of it,
     /// bit 1 from the one below ([`ScreenSurfaces::lie_apart`]).
     cuts: Vec<u8>,
+    /// Per pixel: the world size of its footprint on its surface (0 where
+    /// none is seen).
+    footprints: Vec<f32>,
     /// A pixel's world size per unit distance along the view (perspective)
     /// or absolute (orthographic).
     pixel_scale: f32,
@@ -60,7 +63,18 @@ impl ScreenSurfaces {
             Projection::Orthographic { height } => height,
         } / height.max(1) as f32;
         let forward = (camera.target - camera.eye).normalize_or(Vec3::NEG_Z);
-        let mut s = ScreenSurfaces { camera, width, height, surfaces, cuts: Vec::new(), pixel_scale, forward };
+        let mut s = ScreenSurfaces {
+            camera,
+            width,
+            height,
+            surfaces,
+            cuts: Vec::new(),
+            footprints: Vec::new(),
+            pixel_scale,
+            forward,
+        };
+        let footprints: Vec<f32> = s.surfaces.par_iter().map(|v| v.as_ref().map_or(0.0, |v| s.footprint(v))).collect();
+        s.footprints = footprints;
         let w = width as usize;
         let cuts: Vec<u8> = (0..s.surfaces.len())
             .into_par_iter()
@@ -88,6 +102,13 @@ impl ScreenSurfaces {
     #[must_use]
     pub fn at(&self, x: usize, y: usize) -> Option<&VisibleSurface> {
         self.surfaces[y * self.width as usize + x].as_ref()
+    }
+
+    /// The world size of pixel `i`'s footprint on its surface (row by row;
+    /// 0 where no object is seen).
+    #[must_use]
+    pub fn footprint_at(&self, i: usize) -> f32 {
+        self.footprints[i]
     }
 
     /// The world size of one pixel's footprint on `v`'s surface: a pixel
@@ -120,7 +141,11 @@ impl ScreenSurfaces {
         match (self.at(a.0, a.1), self.at(b.0, b.1)) {
             (None, None) => false,
             (Some(_), None) | (None, Some(_)) => true,
-            (Some(s), Some(t)) => (s.position - t.position).length() > 4.0 * self.footprint(s).max(self.footprint(t)),
+            (Some(s), Some(t)) => {
+                let w = self.width as usize;
+                let most = self.footprints[a.1 * w + a.0].max(self.footprints[b.1 * w + b.0]);
+                (s.position - t.position).length_squared() > 16.0 * most * most
+            }
         }
     }
 }
@@ -162,8 +187,8 @@ impl ScreenTerm {
             Projection::Orthographic { .. } => Some((c.target - c.eye).normalize_or(Vec3::NEG_Z)),
         };
         let distance = |p: Vec3| axis.map_or((p - c.eye).length(), |a| (p - c.eye).dot(a));
-        let distances = surfaces.surfaces.iter().map(|s| s.map_or(f32::NAN, |s| distance(s.position))).collect();
-        let reach = surfaces.surfaces.iter().map(|s| s.map_or(0.0, |s| 2.0 * surfaces.footprint(&s))).collect();
+        let distances = surfaces.surfaces.par_iter().map(|s| s.map_or(f32::NAN, |s| distance(s.position))).collect();
+        let reach = surfaces.footprints.par_iter().map(|f| 2.0 * f).collect();
         let view_proj = surfaces.camera.view_projection(w as f32 / h.max(1) as f32);
         ScreenTerm { view_proj, width: w, height: h, eye: c.eye, axis, distances, reach, values }
     }

@@ -19,7 +19,7 @@ use super::load::{self, AssetSource, LoadedModel};
 use super::mesh::shapes;
 use super::{
     box_corners, framing, Body, Environment, Falloff, HardShadows, Light, LightKind, Material, Object, PenumbraFalloff,
-    Scene, ShadowMethod, ShadowSettings, Texture, Up,
+    Scene, ShadowMethod, ShadowSettings, Texture, TwoPoints, Up,
 };
 use crate::camera::{Camera, Projection};
 use crate::csg::openscad::{CsgOptions, Geometry};
@@ -318,6 +318,7 @@ struct ShadowRec {
     falloff: Option<PenumbraRec>,
     depth_aware: Option<bool>,
     hard: Option<HardRec>,
+    points: Option<PointsRec>,
     blockers: Option<Spanned<i64>>,
     filter: Option<Spanned<i64>>,
 }
@@ -339,6 +340,14 @@ enum ShadowMethodRec {
 enum PenumbraRec {
     Linear,
     Smooth,
+}
+
+/// `points = "paper" | "matched"`: where a two-map soft shadow's points lie.
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+enum PointsRec {
+    Paper,
+    Matched,
 }
 
 /// `hard = "map" | "slb"`: the hard shadows of a two-map soft shadow.

@@ -231,6 +231,12 @@ impl SceneFile {
                 PenumbraRec::Smooth => PenumbraFalloff::Smooth,
             };
         }
+        if let Some(p) = r.points {
+            s.points = match p {
+                PointsRec::Paper => TwoPoints::Paper,
+                PointsRec::Matched => TwoPoints::Matched,
+            };
+        }
         if let Some(h) = r.hard {
             s.hard = match h {
                 HardRec::Map => HardShadows::Map,

@@ -8,25 +8,33 @@
 //! every pixel at once, optionally kept from crossing the view's depth
 //! discontinuities).
 //!
-//! # How far apart the two points are
+//! # Where the two points are
 //!
-//! The two points lie along the axis. An occluder's edge `ρ` off the axis at
-//! distance `a` from the light, over a receiver `b` beyond it, casts its hard
-//! edge from a light moved `t` away along the axis at ρ·(1 + b/(a + t)) from
-//! the axis, so the two hard edges lie ρ·b·2l/(a² − l²) apart, where a disc
-//! light of radius `r` casts a penumbra 2·r·b/a wide. The two agree, for
-//! every receiver distance b, when r·l² + ρ·a·l − r·a² = 0:
-//! l = a·(√(ρ² + 4r²) − ρ)/(2r) (≈ r·a/ρ for a small light). kage takes a =
-//! |L − G| and ρ the casters' lateral half-extent about the axis (the root
-//! mean square of their bounds' half-extents across P): the penumbra matches
-//! the disc's where the casters' outline is — the test of a sphere under its
-//! light holds it to 10% of the ray-traced truth at three heights — and
-//! elsewhere it is about h/ρ times the disc's for an edge h off the axis:
-//! none on the axis through G, twice as wide twice as far out. l is kept
-//! below half the way to the focus (L2 stays on the light's side of the
-//! casters) and, for a light inside the casters' bounds (a lamp in a room),
-//! below half the way to the bounds' side behind it (L1 stays in the room):
-//! there the penumbra is narrower than the disc's.
+//! Both lie on the axis through L and G. An occluder's edge `ρ` off the axis
+//! at distance `a` from the light, over a receiver `b` beyond it, casts its
+//! hard edge from a light moved `t` along the axis (away from G) at
+//! ρ·(1 + b/(a + t)) from the axis; a disc light of radius `r` casts a
+//! penumbra r·b/a either side of its centre's hard edge. The paper puts the
+//! points at L ± l·P; kage's default (`points = "matched"`) moves them
+//! unequally so each hard edge lands on one border of the disc's penumbra,
+//! for every receiver distance b: t₁ = r·a/(ρ − r) away from G (the umbra's
+//! border) and t₂ = r·a/(ρ + r) towards it (the penumbra's outer border).
+//! The paper's symmetric pair (`points = "paper"`, l = a·(√(ρ² + 4r²) −
+//! ρ)/(2r), which makes the penumbra as wide as the disc's) shifts the
+//! penumbra outwards by about r·b·l/(ρ·a) — a sixth of its width for a
+//! light half as wide as the occluder's outline.
+//!
+//! kage takes a = |L − G| and ρ the casters' lateral half-extent about the
+//! axis (the root mean square of their bounds' half-extents across P): the
+//! penumbra matches the disc's where the casters' outline is — the test of a
+//! sphere under its light holds its width to 10% of the ray-traced truth at
+//! three heights — and elsewhere it is about h/ρ times the disc's for an
+//! edge h off the axis: none on the axis through G, twice as wide twice as
+//! far out. L1 is kept within 8a of the light (for ρ ≤ r it would go to
+//! infinity), L2 within half the way to the focus (on the light's side of
+//! the casters), and, for a light inside the casters' bounds (a lamp in a
+//! room), L1 within half the way to the bounds' side behind it (in the
+//! room): there the penumbra is narrower than the disc's.
 //!
 //! # How visibility rises across the penumbra
 //!
@@ -46,9 +54,11 @@ pub mod penumbra;
 use glam::Vec3;
 use rayon::prelude::*;
 
-use super::screen::{ScreenSurfaces, ScreenTerm};
-use super::{PixelView, Receiver, ShadowTerm};
-use crate::scene::{Light, LightKind, PenumbraFalloff, ShadowSettings};
+use wide::f32x8;
+
+use super::screen::{ScreenSurfaces, ScreenTerm, VisibleSurface};
+use super::{PixelView, Receiver, ReceiverLanes, ShadowTerm, UNKNOWN_RECEIVER};
+use crate::scene::{Light, LightKind, PenumbraFalloff, ShadowSettings, TwoPoints};
 use penumbra::{visibility_exact, visibility_searched, Zone};
 
 /// Farthest the paper's search looks for an umbra or lit pixel, in pixels: a
@@ -79,7 +89,7 @@ impl TwoMaps {
             LightKind::Directional { .. } => return None,
         };
         let focus = light.shadow.focus.unwrap_or((bounds.0 + bounds.1) * 0.5);
-        let points = two_points(centre, light.size, focus, bounds)?;
+        let points = two_points(centre, light.size, focus, bounds, light.shadow.points)?;
         let moved = |to: Vec3| {
             let kind = match light.kind {
                 LightKind::Spot { direction, inner, outer, .. } => {
@@ -121,7 +131,7 @@ impl TwoMaps {
     /// distances, shaped by the falloff.
     pub fn prepare(&mut self, surfaces: &ScreenSurfaces) {
         let (w, h) = (surfaces.width as usize, surfaces.height as usize);
-        let zones: Vec<Zone> = surfaces.surfaces.par_iter().map(|s| self.zone(s.as_ref())).collect();
+        let zones: Vec<Zone> = surfaces.surfaces.par_chunks(8).flat_map_iter(|eight| self.zones(eight)).collect();
         let s = &self.settings;
         let mut v = match s.search {
             0 if s.depth_aware => visibility_exact(&zones, w, h, |a, b| surfaces.apart(a, b)),
@@ -134,21 +144,35 @@ impl TwoMaps {
         self.screen = Some(ScreenTerm::new(surfaces, v));
     }
 
-    /// The zone of a pixel showing `surface`: umbra where it faces away from
-    /// the light's centre, else by the two hard shadows; lit where nothing
-    /// is seen.
-    fn zone(&self, surface: Option<&super::screen::VisibleSurface>) -> Zone {
-        let Some(s) = surface else { return Zone::Lit };
-        let facing = |at: Vec3| s.normal.dot((at - s.position).normalize_or(Vec3::ZERO));
-        if facing(self.centre) <= 0.0 {
-            return Zone::Umbra;
-        }
-        let lit = |k: usize| self.hard[k].lit(s.position, facing(self.points[k]).max(1e-3), &s.receiver) >= 0.5;
-        match (lit(0), lit(1)) {
-            (true, true) => Zone::Lit,
-            (false, false) => Zone::Umbra,
-            _ => Zone::Penumbra,
-        }
+    /// The zones of up to eight pixels showing `surfaces`: umbra where a
+    /// surface faces away from the light's centre, else by the two hard
+    /// shadows (looked up eight at a time); lit where nothing is seen.
+    fn zones(&self, surfaces: &[Option<VisibleSurface>]) -> Vec<Zone> {
+        let lane = |i: usize| surfaces.get(i).copied().flatten();
+        let facing = |s: &VisibleSurface, at: Vec3| s.normal.dot((at - s.position).normalize_or(Vec3::ZERO));
+        let of =
+            |f: &dyn Fn(&VisibleSurface) -> f32| f32x8::new(std::array::from_fn(|i| lane(i).map_or(0.0, |s| f(&s))));
+        let p = [of(&|s| s.position.x), of(&|s| s.position.y), of(&|s| s.position.z)];
+        let receivers = ReceiverLanes {
+            objects: std::array::from_fn(|i| lane(i).map_or(UNKNOWN_RECEIVER, |s| s.receiver.object)),
+            planes: [of(&|s| s.receiver.plane.x), of(&|s| s.receiver.plane.y), of(&|s| s.receiver.plane.z)],
+        };
+        let lit = |k: usize| {
+            let cos = of(&|s| facing(s, self.points[k]).max(1e-3));
+            self.hard[k].lit_lanes(p, cos, &receivers).to_array()
+        };
+        let (a, b) = (lit(0), lit(1));
+        (0..surfaces.len())
+            .map(|i| match lane(i) {
+                None => Zone::Lit,
+                Some(s) if facing(&s, self.centre) <= 0.0 => Zone::Umbra,
+                Some(_) => match (a[i] >= 0.5, b[i] >= 0.5) {
+                    (true, true) => Zone::Lit,
+                    (false, false) => Zone::Umbra,
+                    _ => Zone::Penumbra,
+                },
+            })
+            .collect()
     }
 
     /// The term at `p` on `receiver` with N·L = `cos_theta`: the prepared
@@ -177,26 +201,33 @@ impl TwoMaps {
 }
 
 /// L1 and L2 for a light at `centre` of radius `size`, focused on `focus`,
-/// casters within `bounds` (see the module's doc for the derivation); `None`
-/// for a light of no size or one at the focus.
+/// casters within `bounds`, placed as `placing` says (see the module's doc
+/// for the derivation); `None` for a light of no size or one at the focus.
 #[must_use]
-pub fn two_points(centre: Vec3, size: f32, focus: Vec3, bounds: (Vec3, Vec3)) -> Option<[Vec3; 2]> {
+pub fn two_points(centre: Vec3, size: f32, focus: Vec3, bounds: (Vec3, Vec3), placing: TwoPoints) -> Option<[Vec3; 2]> {
     let to_light = centre - focus;
-    let d = to_light.length();
-    if size <= 0.0 || d <= f32::EPSILON {
+    let a = to_light.length();
+    if size <= 0.0 || a <= f32::EPSILON {
         return None;
     }
-    let p = to_light / d;
+    let p = to_light / a;
     let half = (bounds.1 - bounds.0) * 0.5;
     // Root mean square of the bounds' half-extents across P.
-    let across = (half * half).dot(Vec3::ONE - p * p) * 0.5;
-    let rho = across.sqrt().max(d * 1e-3);
-    let mut l = d * ((rho * rho + 4.0 * size * size).sqrt() - rho) / (2.0 * size);
-    l = l.min(0.5 * d);
-    if let Some(exit) = exit_distance(centre, p, bounds) {
-        l = l.min(0.5 * exit);
-    }
-    Some([centre + p * l, centre - p * l])
+    let rho = ((half * half).dot(Vec3::ONE - p * p) * 0.5).sqrt().max(a * 1e-3);
+    let r = size;
+    let (away, towards) = match placing {
+        TwoPoints::Matched => {
+            let away = if rho > r { r * a / (rho - r) } else { f32::INFINITY };
+            (away, r * a / (rho + r))
+        }
+        TwoPoints::Paper => {
+            let l = a * ((rho * rho + 4.0 * r * r).sqrt() - rho) / (2.0 * r);
+            (l, l)
+        }
+    };
+    let behind = exit_distance(centre, p, bounds).map_or(f32::INFINITY, |exit| 0.5 * exit);
+    let (away, towards) = (away.min(8.0 * a).min(behind), towards.min(0.5 * a));
+    Some([centre + p * away, centre - p * towards])
 }
 
 /// The share of a disc a straight edge uncovers when it has swept a share
@@ -243,17 +274,31 @@ mod tests {
         assert!((disc_share(0.25) - segment).abs() < 1e-5);
     }
 
-    /// For a small light l ≈ r·a/ρ; both points on the line through the
-    /// light and the focus, on either side of the light, equally far.
+    /// The paper's pair: for a small light l ≈ r·a/ρ, both points on the
+    /// line through the light and the focus, on either side of the light,
+    /// equally far. The matched pair puts each hard edge on a border of the
+    /// disc's penumbra.
     #[test]
     fn the_two_points_straddle_the_light_on_the_line_to_the_focus() {
         let bounds = (Vec3::new(-0.5, 0.5, -0.5), Vec3::new(0.5, 1.5, 0.5));
         let (centre, focus) = (Vec3::new(0.0, 20.0, 0.0), Vec3::Y);
-        let [l1, l2] = two_points(centre, 0.01, focus, bounds).unwrap();
+        let [l1, l2] = two_points(centre, 0.01, focus, bounds, TwoPoints::Paper).unwrap();
         assert!(((l1 - centre).length() - 0.01 * 19.0 / 0.5).abs() < 1e-3);
         assert!(((l1 + l2) * 0.5 - centre).length() < 1e-4);
         assert!((l1 - focus).normalize().dot((centre - focus).normalize()) > 0.99999);
         assert!(l1.y > centre.y && l2.y < centre.y);
-        assert!(two_points(centre, 0.0, focus, bounds).is_none());
+        assert!(two_points(centre, 0.0, focus, bounds, TwoPoints::Paper).is_none());
+        // Matched: each hard edge of an edge ρ = 0.5 off the axis, 19 from the
+        // light, lands r·b/a either side of the centre's, for any b.
+        let [l1, l2] = two_points(centre, 0.2, focus, bounds, TwoPoints::Matched).unwrap();
+        let edge = |light: Vec3, b: f32| {
+            let (a, h) = (light.y - 1.0, 0.5);
+            h * (a + b) / a
+        };
+        for b in [0.5, 1.0, 3.0] {
+            let (mid, spread) = (edge(centre, b), 0.2 * b / 19.0);
+            assert!((edge(l1, b) - (mid - spread)).abs() < 1e-4, "umbra border at b = {b}");
+            assert!((edge(l2, b) - (mid + spread)).abs() < 1e-4, "outer border at b = {b}");
+        }
     }
 }
