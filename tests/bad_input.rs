@@ -59,6 +59,13 @@ fn semantic_errors_point_at_the_value() {
     let e =
         parse_err(&format!("[[light]]\ntype = \"point\"\nposition = [0, 1, 0]\nshadow = {{ pcf = 0 }}\n{OK_OBJECT}"));
     assert!(e.starts_with("bad.toml:4:18") && e.contains("pcf must be between 1 and 15"), "{e}");
+    let light = "[[light]]\ntype = \"point\"\nposition = [0, 1, 0]\nsize = 0.2\n";
+    let e = parse_err(&format!("{light}shadow = {{ method = \"soft\", search = 100 }}\n{OK_OBJECT}"));
+    assert!(e.starts_with("bad.toml:5:38") && e.contains("shadow search must be between 0 and 64"), "{e}");
+    let e = parse_err(&format!("{light}shadow = {{ method = \"soft\", falloff = \"cubic\" }}\n{OK_OBJECT}"));
+    assert!(e.starts_with("bad.toml:5") && e.contains("unknown variant `cubic`"), "{e}");
+    let e = parse_err(&format!("{light}shadow = {{ method = \"pcss\", filter = 0 }}\n{OK_OBJECT}"));
+    assert!(e.starts_with("bad.toml:5:38") && e.contains("shadow filter must be between 1 and 256"), "{e}");
     let e = parse_err(&format!("[[light]]\ntype = \"point\"\nposition = [0, 1, 0]\nonly = [\"teapot\"]\n{OK_OBJECT}"));
     assert!(e.starts_with("bad.toml:4:9") && e.contains("no [[object]] named 'teapot'"), "{e}");
     let e = parse_err(&format!("[image]\nantialias = {{ method = \"blur\" }}\n{OK_OBJECT}"));

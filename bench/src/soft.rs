@@ -242,7 +242,16 @@ pub fn run(args: &SoftArgs) -> Result<()> {
         let base = with(&scene, &ShadowSettings::MAP, check);
         let frame = kage::render(&base, &RenderOptions::default()).map_err(|e| miette!("{e}"))?;
         let key = key_light(&base).expect("scenes have a key light");
-        let truth = ShadowRays::new(&base).area_visibility(&frame.visibility, key, args.truth_rays);
+        let mut truth = ShadowRays::new(&base).area_visibility(&frame.visibility, key, args.truth_rays);
+        // Surfaces the light grazes (N·L ≤ 0.1 at the centre) are left out:
+        // there a mesh's shading normal and its facets disagree on what the
+        // light reaches, for every method alike.
+        let surfaces = kage::shading::screen_surfaces(&base, &frame.visibility);
+        for (t, s) in truth.iter_mut().zip(&surfaces.surfaces) {
+            if s.is_some_and(|s| s.normal.dot(base.lights[key].incident(s.position).to_light) <= 0.1) {
+                *t = None;
+            }
+        }
         let mut crops = vec![("truth".to_string(), truth_image(&truth, args.check))];
         for method in methods() {
             let (term, image) = term(&with(&scene, &method.settings, check))?;
@@ -264,7 +273,8 @@ pub fn run(args: &SoftArgs) -> Result<()> {
     println!(
         "\nThe key light's shadow term (the scene's first point light with a size; the other lights unshadowed) \
          against {0} × {0} stratified, jittered shadow rays over its disc at each pixel centre, at {1}²: RMSE and \
-         largest error over the penumbra (truth strictly between 0 and 1) and over every pixel showing an object. \
+         largest error over the penumbra (truth strictly between 0 and 1) and over every pixel showing an object, \
+         surfaces the light grazes (N·L ≤ 0.1) left out. \
          Frame times (every map rendered again each frame; the default edge pass) at {1}² and {2}×{3}, and the \
          shadow stage's share (maps and the per-pixel soft term), median of {4} frames after a warm-up; 2 threads.",
         args.truth_rays, args.check, c.width, c.height, c.frames
