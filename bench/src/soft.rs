@@ -102,7 +102,8 @@ scale = 0.5
 }
 
 /// The Cornell box of the shared assets, a light of radius 0.2 under its
-/// ceiling lamp, seen through its open side.
+/// ceiling lamp (far enough below the ceiling that its disc, turned to face
+/// each point, stays in the room), seen through its open side.
 fn cornell_box(assets: &Path) -> Result<Scene> {
     let mesh = assets.join("scenes/cornell-box/CornellBox-Original.obj");
     parse(&format!(
@@ -113,7 +114,7 @@ target = [0.0, 1.0, 0.0]
 fov = 40
 [[light]]
 type = "point"
-position = [0.0, 1.9, -0.03]
+position = [0.0, 1.7, -0.03]
 intensity = 0.8
 ambient = 0.15
 size = 0.2
