@@ -5,14 +5,14 @@
 //! light the term is 0 (the light cannot reach it, whatever the maps say);
 //! where no object is seen it is 1.
 
-use glam::{Vec2, Vec3};
+use glam::Vec3;
 use rayon::prelude::*;
 
 use super::passes::{frame_lights, light_view};
-use super::surface::{screen_surfaces, ObjectFrames};
+use super::surface::screen_surfaces;
 use crate::image::LinearImage;
 use crate::scene::Scene;
-use crate::shadows::{MapPool, Receiver};
+use crate::shadows::MapPool;
 use crate::visibility::VisibilityBuffer;
 
 /// Writes every light's shadow term at the pixels of `vb` into `images` (one
@@ -22,8 +22,7 @@ use crate::visibility::VisibilityBuffer;
 pub fn shadow_term_images(scene: &Scene, vb: &VisibilityBuffer, pool: &mut MapPool, images: &mut Vec<LinearImage>) {
     let (w, h) = (vb.width(), vb.height());
     images.resize_with(scene.lights.len(), LinearImage::default);
-    let shaded = shaded_surfaces(scene, vb);
-    let mut screen = None;
+    let surfaces = screen_surfaces(scene, vb);
     let bounds = scene.caster_bounds().unwrap_or_default();
     for (image, light) in images.iter_mut().zip(frame_lights(scene)) {
         image.resize(w, h);
@@ -33,15 +32,15 @@ pub fn shadow_term_images(scene: &Scene, vb: &VisibilityBuffer, pool: &mut MapPo
             pool.with_term(scene, sample, bounds, |term| {
                 term.set_view(view);
                 if term.per_pixel() {
-                    term.prepare(screen.get_or_insert_with(|| screen_surfaces(scene, vb)));
+                    term.prepare(&surfaces);
                 }
-                image.pixels_mut().par_iter_mut().zip(&shaded).for_each(|(px, surface)| {
+                image.pixels_mut().par_iter_mut().zip(&surfaces.surfaces).for_each(|(px, surface)| {
                     let lit = match surface {
                         None => 1.0,
-                        Some((p, n, receiver)) => {
-                            let cos_theta = n.dot(light.light.incident(*p).to_light);
+                        Some(s) => {
+                            let cos_theta = s.normal.dot(light.light.incident(s.position).to_light);
                             if cos_theta > 0.0 {
-                                term.lit(*p, cos_theta, receiver)
+                                term.lit(s.position, cos_theta, &s.receiver)
                             } else {
                                 0.0
                             }
@@ -52,29 +51,4 @@ pub fn shadow_term_images(scene: &Scene, vb: &VisibilityBuffer, pool: &mut MapPo
             });
         }
     }
-}
-
-/// The position and shading normal of the surface each pixel of `vb` shows
-/// (at the pixel's centre), and that surface as a shadow's receiver (its
-/// object and plane), row by row; `None` where no object is seen.
-fn shaded_surfaces(scene: &Scene, vb: &VisibilityBuffer) -> Vec<Option<(Vec3, Vec3, Receiver)>> {
-    let w = vb.width() as usize;
-    let frames = ObjectFrames::new(scene);
-    let rays = scene.camera.pixel_rays(Vec2::new(vb.width() as f32, vb.height() as f32));
-    let mut out = vec![None; w * vb.height() as usize];
-    out.par_chunks_mut(w.max(1)).enumerate().for_each(|(y, row)| {
-        for (x, slot) in row.iter_mut().enumerate() {
-            let (x, y) = (x as u32, y as u32);
-            let item = vb.item(x, y);
-            if item.is_none() {
-                continue;
-            }
-            let ray = rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
-            let triangle = frames.prepare_at(scene, vb, x, y, &ray);
-            let s = triangle.surface(&ray);
-            let receiver = Receiver { object: item.object, plane: triangle.geometry().geometric };
-            *slot = Some((s.position, s.normal, receiver));
-        }
-    });
-    out
 }
