@@ -21,6 +21,19 @@ const WORLD: f32 = 6.0;
 /// orthographic strip across the shadow's middle; its light's shadows by
 /// `shadow` (a scene file's inline table).
 fn sphere_over_plane(height: f32, shadow: &str) -> Scene {
+    let sphere = format!("shape = \"sphere\"\ntranslate = [0.0, {height}, 0.0]\nscale = 0.5");
+    under_the_light(&sphere, shadow)
+}
+
+/// A rod 0.04 thick (thinner than the penumbra its light casts under it),
+/// 1.5 over the floor and 0.6 off the light's axis, across the strip.
+fn rod(shadow: &str) -> Scene {
+    under_the_light("shape = \"cube\"\ntranslate = [0.6, 1.5, 0.0]\nscale = [0.04, 0.04, 3.0]", shadow)
+}
+
+/// A floor and the object `object` (a scene file's object keys) under the
+/// light of [`sphere_over_plane`].
+fn under_the_light(object: &str, shadow: &str) -> Scene {
     let text = format!(
         r#"
 [image]
@@ -46,13 +59,11 @@ shape = "plane"
 scale = 20.0
 material = "white"
 [[object]]
-shape = "sphere"
-translate = [0.0, {height}, 0.0]
-scale = 0.5
+{object}
 "#,
         h = WORLD * 8.0 / ACROSS as f32,
     );
-    let file = SceneFile::parse(&text, Path::new("sphere.toml")).expect("the scene parses");
+    let file = SceneFile::parse(&text, Path::new("strip.toml")).expect("the scene parses");
     file.build(&FileSystem { base: ".".into() }).expect("the scene builds")
 }
 
@@ -101,6 +112,45 @@ fn a_two_map_penumbra_widens_with_height_as_the_truth_does() {
         widths.push(w);
     }
     assert!(widths[0] < widths[1] && widths[1] < widths[2], "the penumbra widens: {widths:?}");
+}
+
+/// Four points round the light bound the penumbra as the disc does wherever
+/// an edge lies: the sphere's penumbra widths hold too.
+#[test]
+fn a_ring_of_points_gives_the_sphere_its_penumbra() {
+    for height in [1.0, 3.0] {
+        let (ours, truth) = renderer_and_truth(&sphere_over_plane(height, r#"{ method = "soft", points = "ring" }"#));
+        let (w, t) = (penumbra_width(&ours), penumbra_width(&truth));
+        eprintln!("sphere at {height}, ring: penumbra {w:.4} (truth {t:.4})");
+        assert!((w / t - 1.0).abs() < 0.15, "sphere at {height}: penumbra {w} against the truth's {t}");
+    }
+}
+
+/// A rod thinner than its penumbra, on the line from the light to the
+/// focus: two points on that line cast one hard shadow twice (an umbra where
+/// the truth is mostly lit); the ring's four hard shadows do not overlap, and
+/// where a pixel reaches no umbra it takes the share of points that reach
+/// it — no umbra, and the error down by 40% (the lit gaps between the four
+/// shadows remain).
+#[test]
+fn a_ring_of_points_keeps_a_thin_rods_shadow_out_of_umbra() {
+    let rmse = |ours: &[Option<f32>], truth: &[Option<f32>]| {
+        let d: Vec<f32> = ours.iter().zip(truth).filter_map(|(a, b)| Some(a.as_ref()? - b.as_ref()?)).collect();
+        (d.iter().map(|d| d * d).sum::<f32>() / d.len() as f32).sqrt()
+    };
+    let (paired, truth) = renderer_and_truth(&rod(r#"{ method = "soft" }"#));
+    let (ring, _) = renderer_and_truth(&rod(r#"{ method = "soft", points = "ring" }"#));
+    let darkest = |v: &[Option<f32>]| v.iter().flatten().copied().fold(1.0f32, f32::min);
+    let (e_paired, e_ring) = (rmse(&paired, &truth), rmse(&ring, &truth));
+    eprintln!(
+        "rod: darkest truth {:.3}, pair {:.3}, ring {:.3}; RMSE pair {e_paired:.4}, ring {e_ring:.4}",
+        darkest(&truth),
+        darkest(&paired),
+        darkest(&ring)
+    );
+    assert!(darkest(&truth) > 0.5, "the truth is never umbra under the rod: {}", darkest(&truth));
+    assert!(darkest(&ring) >= 0.5, "the ring's term stays out of umbra: {}", darkest(&ring));
+    assert!(e_ring < 0.65 * e_paired, "RMSE ring {e_ring} against the pair's {e_paired}");
 }
 
 #[test]

@@ -12,7 +12,7 @@ use kage::image::LinearImage;
 use kage::raytrace::shadow_truth::ShadowRays;
 use kage::scene::file::SceneFile;
 use kage::scene::load::FileSystem;
-use kage::scene::{HardShadows, LightKind, PenumbraFalloff, Scene, ShadowMethod, ShadowSettings, TwoPoints};
+use kage::scene::{HardShadows, LightKind, PenumbraFalloff, PenumbraPoints, Scene, ShadowMethod, ShadowSettings};
 use kage::{RenderOptions, Renderer};
 use miette::{miette, Result};
 
@@ -32,9 +32,17 @@ pub struct SoftArgs {
     /// Only scenes whose name contains this.
     #[arg(long)]
     only: Option<String>,
+    /// Only methods whose name contains this.
+    #[arg(long)]
+    method: Option<String>,
     /// Also write crops of each method beside the truth here.
     #[arg(long)]
     crops: Option<PathBuf>,
+    /// Instead: the two-map method's defects (double shadows of thin
+    /// occluders, false umbra where different occluders' shadows overlap)
+    /// on scenes made to show them.
+    #[arg(long)]
+    defects: bool,
 }
 
 /// A row of the table: a name and the key light's shadow settings.
@@ -43,13 +51,37 @@ struct Method {
     settings: ShadowSettings,
 }
 
+/// The rows of the defects' table.
+fn defect_methods() -> Vec<Method> {
+    let soft = ShadowSettings { method: ShadowMethod::Soft, ..ShadowSettings::MAP };
+    vec![
+        Method { name: "two maps (default)", settings: soft },
+        Method { name: "ring of four", settings: ShadowSettings { points: PenumbraPoints::Ring, ..soft } },
+        Method {
+            name: "the paper (N = 1, linear)",
+            settings: ShadowSettings {
+                search: 1,
+                penumbra: PenumbraFalloff::Linear,
+                depth_aware: false,
+                points: PenumbraPoints::Paper,
+                ..soft
+            },
+        },
+        Method {
+            name: "PCSS 32/64",
+            settings: ShadowSettings { method: ShadowMethod::Pcss, blockers: 32, filter: 64, ..ShadowSettings::MAP },
+        },
+        Method { name: "jittered light, 16", settings: ShadowSettings { samples: 16, ..ShadowSettings::MAP } },
+    ]
+}
+
 fn methods() -> Vec<Method> {
     let soft = ShadowSettings { method: ShadowMethod::Soft, ..ShadowSettings::MAP };
     let paper = |search| ShadowSettings {
         search,
         penumbra: PenumbraFalloff::Linear,
         depth_aware: false,
-        points: TwoPoints::Paper,
+        points: PenumbraPoints::Paper,
         ..soft
     };
     let pcss =
@@ -68,6 +100,7 @@ fn methods() -> Vec<Method> {
         },
         Method { name: "same + disc falloff (default)", settings: soft },
         Method { name: "same, on SLB hard shadows", settings: ShadowSettings { hard: HardShadows::Slb, ..soft } },
+        Method { name: "ring of four points", settings: ShadowSettings { points: PenumbraPoints::Ring, ..soft } },
         Method { name: "PCSS 16/16", settings: pcss(16, 16) },
         Method { name: "PCSS 32/64", settings: pcss(32, 64) },
         Method { name: "jittered light, 16", settings: jittered(16) },
@@ -99,6 +132,40 @@ translate = [0.0, {height}, 0.0]
 scale = 0.5
 "#
     ))
+}
+
+/// Scenes that show the two-map method's defects, under a light of radius
+/// 0.3 five units up: a rod thinner than its penumbra is wide (its two hard
+/// shadows do not overlap: a double shadow), and two crossed grilles of
+/// slats at two heights (one slat's shadow from one point overlaps another
+/// slat's from the other: false umbra).
+fn defect_scenes() -> Result<Vec<(String, Scene)>> {
+    let head = r#"
+[camera]
+eye = [0.0, 5.0, 4.0]
+target = [0.0, 0.0, 0.0]
+fov = 40
+[[light]]
+type = "point"
+position = [0.3, 5.0, 0.2]
+intensity = 0.9
+ambient = 0.1
+size = 0.3
+[[object]]
+shape = "plane"
+scale = 20.0
+"#;
+    let cube = |scale: [f32; 3], at: [f32; 3], turn: f32| {
+        format!("[[object]]\nshape = \"cube\"\nscale = {scale:?}\ntranslate = {at:?}\nrotate = [0.0, {turn}, 0.0]\n")
+    };
+    let rod = format!("{head}{}", cube([3.0, 0.04, 0.04], [0.0, 1.5, 0.0], 30.0));
+    let mut grilles = head.to_string();
+    for k in -3..=3 {
+        let x = k as f32 * 0.3;
+        grilles += &cube([0.1, 0.05, 2.4], [x, 1.0, 0.0], 0.0);
+        grilles += &cube([2.4, 0.05, 0.1], [0.0, 2.0, x + 0.12], 0.0);
+    }
+    Ok(vec![("thin rod".to_string(), parse(&rod)?), ("two grilles".to_string(), parse(&grilles)?)])
 }
 
 /// The Cornell box of the shared assets, a light of radius 0.2 under its
@@ -222,7 +289,7 @@ fn timed(scene: &Scene, frames: usize) -> Result<(f64, f64)> {
     Ok((median(&mut frame), median(&mut shadow)))
 }
 
-/// Prints the table.
+/// Prints the table (or, with `--defects`, the defects' table).
 ///
 /// # Errors
 ///
@@ -230,39 +297,44 @@ fn timed(scene: &Scene, frames: usize) -> Result<(f64, f64)> {
 pub fn run(args: &SoftArgs) -> Result<()> {
     let c = &args.common;
     let check = (args.check, args.check);
+    let extra = if args.defects { " false umbra | false lit |" } else { "" };
     println!(
-        "| scene | method | penumbra RMSE | penumbra max | image RMSE | image max | ms {0}² | ms {1}×{2} | of which \
-         shadows |",
+        "| scene | method | penumbra RMSE | penumbra max | image RMSE | image max |{extra} ms {0}² | ms {1}×{2} | of \
+         which shadows |",
         args.check, c.width, c.height
     );
-    println!("|---|---|---:|---:|---:|---:|---:|---:|---:|");
-    for (name, scene) in scenes(c)? {
+    println!("|---|---|---:|---:|---:|---:|{}---:|---:|---:|", if args.defects { "---:|---:|" } else { "" });
+    let (scenes, methods) = if args.defects { (defect_scenes()?, defect_methods()) } else { (scenes(c)?, methods()) };
+    for (name, scene) in scenes {
         if args.only.as_ref().is_some_and(|o| !name.contains(o.as_str())) {
             continue;
         }
-        let base = with(&scene, &ShadowSettings::MAP, check);
-        let frame = kage::render(&base, &RenderOptions::default()).map_err(|e| miette!("{e}"))?;
-        let key = key_light(&base).expect("scenes have a key light");
-        let mut truth = ShadowRays::new(&base).area_visibility(&frame.visibility, key, args.truth_rays);
-        // Surfaces the light grazes (N·L ≤ 0.1 at the centre) are left out:
-        // there a mesh's shading normal and its facets disagree on what the
-        // light reaches, for every method alike.
-        let surfaces = kage::shading::screen_surfaces(&base, &frame.visibility);
-        for (t, s) in truth.iter_mut().zip(&surfaces.surfaces) {
-            if s.is_some_and(|s| s.normal.dot(base.lights[key].incident(s.position).to_light) <= 0.1) {
-                *t = None;
-            }
-        }
+        let truth = truth(&scene, check.0, args.truth_rays)?;
         let mut crops = vec![("truth".to_string(), truth_image(&truth, args.check))];
-        for method in methods() {
+        for method in &methods {
+            if args.method.as_ref().is_some_and(|m| !method.name.contains(m.as_str())) {
+                continue;
+            }
             let (term, image) = term(&with(&scene, &method.settings, check))?;
             let (p_rmse, p_max) = errors(&term, &truth, |t| t > 0.0 && t < 1.0);
             let (i_rmse, i_max) = errors(&term, &truth, |_| true);
+            let defects = if args.defects {
+                let share = |wrong: &dyn Fn(f32, f32) -> bool| {
+                    let seen = term.iter().zip(&truth).filter_map(|(t, r)| t.zip(*r));
+                    let (bad, all) = seen.fold((0, 0), |(b, a), (t, r)| (b + usize::from(wrong(t, r)), a + 1));
+                    100.0 * bad as f64 / all.max(1) as f64
+                };
+                let umbra = share(&|t, r| t <= 0.05 && r >= 0.25);
+                let lit = share(&|t, r| t >= 0.95 && r <= 0.75);
+                format!(" {umbra:.2}% | {lit:.2}% |")
+            } else {
+                String::new()
+            };
             let (small, _) = timed(&with(&scene, &method.settings, check), c.frames)?;
             let (large, shadow) = timed(&with(&scene, &method.settings, (c.width, c.height)), c.frames)?;
             println!(
-                "| {name} | {} | {p_rmse:.4} | {p_max:.3} | {i_rmse:.4} | {i_max:.3} | {small:.1} | {large:.1} | \
-                 {shadow:.1} |",
+                "| {name} | {} | {p_rmse:.4} | {p_max:.3} | {i_rmse:.4} | {i_max:.3} |{defects} {small:.1} | \
+                 {large:.1} | {shadow:.1} |",
                 method.name
             );
             crops.push((method.name.to_string(), image));
@@ -275,12 +347,42 @@ pub fn run(args: &SoftArgs) -> Result<()> {
         "\nThe key light's shadow term (the scene's first point light with a size; the other lights unshadowed) \
          against {0} × {0} stratified, jittered shadow rays over its disc at each pixel centre, at {1}²: RMSE and \
          largest error over the penumbra (truth strictly between 0 and 1) and over every pixel showing an object, \
-         surfaces the light grazes (N·L ≤ 0.1) left out. \
+         surfaces the light grazes (N·L ≤ 0.1) left out.{5} \
          Frame times (every map rendered again each frame; the default edge pass) at {1}² and {2}×{3}, and the \
          shadow stage's share (maps and the per-pixel soft term), median of {4} frames after a warm-up; 2 threads.",
-        args.truth_rays, args.check, c.width, c.height, c.frames
+        args.truth_rays,
+        args.check,
+        c.width,
+        c.height,
+        c.frames,
+        if args.defects {
+            " False umbra: the share of those pixels a method calls dark (≤ 0.05) where the truth is at least a \
+             quarter lit; false lit: called lit (≥ 0.95) where the truth is at most three quarters lit."
+        } else {
+            ""
+        }
     );
     Ok(())
+}
+
+/// The key light's visibility by rays over its disc at every pixel of
+/// `scene` at `side`², `None` where no object is seen or the light grazes
+/// the surface.
+fn truth(scene: &Scene, side: u32, rays: u32) -> Result<Vec<Option<f32>>> {
+    let base = with(scene, &ShadowSettings::MAP, (side, side));
+    let frame = kage::render(&base, &RenderOptions::default()).map_err(|e| miette!("{e}"))?;
+    let key = key_light(&base).expect("scenes have a key light");
+    let mut truth = ShadowRays::new(&base).area_visibility(&frame.visibility, key, rays);
+    // Surfaces the light grazes (N·L ≤ 0.1 at the centre) are left out:
+    // there a mesh's shading normal and its facets disagree on what the
+    // light reaches, for every method alike.
+    let surfaces = kage::shading::screen_surfaces(&base, &frame.visibility);
+    for (t, s) in truth.iter_mut().zip(&surfaces.surfaces) {
+        if s.is_some_and(|s| s.normal.dot(base.lights[key].incident(s.position).to_light) <= 0.1) {
+            *t = None;
+        }
+    }
+    Ok(truth)
 }
 
 /// The truth as a grey image (1 where no object is seen).

@@ -144,17 +144,20 @@ pub enum PenumbraFalloff {
     Smooth,
 }
 
-/// Where a two-map soft shadow's two points lie on the line through the
-/// light and the focus.
+/// Where the points a two-map soft shadow's hard shadows are cast from lie.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum TwoPoints {
-    /// L ± l·P, l making the penumbra as wide as the disc light's (the
+pub enum PenumbraPoints {
+    /// Two on the line through the light and the focus, L ± l·P, l making
+    /// the penumbra as wide as the disc light's at the casters' outline (the
     /// paper's pair; the penumbra lies a little outwards of the disc's).
     Paper,
-    /// Unequally far either side, each hard edge on one border of the disc
-    /// light's penumbra.
+    /// Two on that line, unequally far either side, each hard edge on one
+    /// border of the disc light's penumbra at the casters' outline.
     #[default]
     Matched,
+    /// Four across the light, on a square round its centre facing the
+    /// focus: the penumbra as wide as the disc's wherever the edge is.
+    Ring,
 }
 
 /// Which hard shadows a two-map soft shadow is made of.
@@ -221,7 +224,7 @@ pub struct ShadowSettings {
     /// Two-map soft shadows: what the two hard shadows are.
     pub hard: HardShadows,
     /// Two-map soft shadows: where the two points lie.
-    pub points: TwoPoints,
+    pub points: PenumbraPoints,
     /// PCSS: taps of the blocker search.
     pub blockers: u32,
     /// PCSS: taps of the filter.
@@ -295,7 +298,7 @@ impl ShadowSettings {
         penumbra: PenumbraFalloff::Smooth,
         depth_aware: true,
         hard: HardShadows::Map,
-        points: TwoPoints::Matched,
+        points: PenumbraPoints::Matched,
         blockers: 16,
         filter: 16,
     };

@@ -20,7 +20,9 @@ use glam::{Affine3A, Vec3};
 
 pub use environment::Environment;
 pub use framing::framing;
-pub use light::{Falloff, HardShadows, Light, LightKind, PenumbraFalloff, ShadowMethod, ShadowSettings, TwoPoints};
+pub use light::{
+    Falloff, HardShadows, Light, LightKind, PenumbraFalloff, PenumbraPoints, ShadowMethod, ShadowSettings,
+};
 pub use material::{ComponentMaps, Material, NormalMap};
 pub use mesh::Mesh;
 pub use settings::{Antialias, EdgeFilter, EdgeMode, EdgeSelection, Exposure, Fog, FogMode, TranslucencyOrder, Up};

@@ -19,7 +19,7 @@ use super::load::{self, AssetSource, LoadedModel};
 use super::mesh::shapes;
 use super::{
     box_corners, framing, Body, Environment, Falloff, HardShadows, Light, LightKind, Material, Object, PenumbraFalloff,
-    Scene, ShadowMethod, ShadowSettings, Texture, TwoPoints, Up,
+    PenumbraPoints, Scene, ShadowMethod, ShadowSettings, Texture, Up,
 };
 use crate::camera::{Camera, Projection};
 use crate::csg::openscad::{CsgOptions, Geometry};
@@ -342,12 +342,13 @@ enum PenumbraRec {
     Smooth,
 }
 
-/// `points = "paper" | "matched"`: where a two-map soft shadow's points lie.
+/// `points = "paper" | "matched" | "ring"`: where a two-map soft shadow's points lie.
 #[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
 #[serde(rename_all = "kebab-case")]
 enum PointsRec {
     Paper,
     Matched,
+    Ring,
 }
 
 /// `hard = "map" | "slb"`: the hard shadows of a two-map soft shadow.

@@ -233,8 +233,9 @@ impl SceneFile {
         }
         if let Some(p) = r.points {
             s.points = match p {
-                PointsRec::Paper => TwoPoints::Paper,
-                PointsRec::Matched => TwoPoints::Matched,
+                PointsRec::Paper => PenumbraPoints::Paper,
+                PointsRec::Matched => PenumbraPoints::Matched,
+                PointsRec::Ring => PenumbraPoints::Ring,
             };
         }
         if let Some(h) = r.hard {

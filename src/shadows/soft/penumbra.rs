@@ -14,8 +14,8 @@
 //! distance transforms ([`super::edt`]) give D1 and D2 for every pixel at
 //! once, in time linear in the pixels, and may be kept from crossing depth
 //! discontinuities. A penumbra pixel that reaches no umbra (the two hard
-//! shadows of a thin occluder need not overlap) or no lit pixel is half lit:
-//! it is in one of the two hard shadows.
+//! shadows of a thin occluder need not overlap) or no lit pixel takes a value
+//! its caller gives: the share of the hard shadows' points that reach it.
 
 use super::edt::{squared_distances_apart, UNREACHED};
 
@@ -37,18 +37,15 @@ pub enum Zone {
 /// umbra's border to the light's sampled at its centre (D1/(D1 + D2) would
 /// stretch the ramp by a pixel).
 #[inline]
-fn from_distances(d1: f32, d2: f32) -> f32 {
-    if d1.is_finite() && d2.is_finite() && d1 + d2 > 1.0 {
-        ((d1 - 0.5) / (d1 + d2 - 1.0)).clamp(0.0, 1.0)
-    } else {
-        0.5
-    }
+fn from_distances(d1: f32, d2: f32) -> Option<f32> {
+    (d1.is_finite() && d2.is_finite() && d1 + d2 > 1.0).then(|| ((d1 - 0.5) / (d1 + d2 - 1.0)).clamp(0.0, 1.0))
 }
 
 /// Light visibility of every pixel of a `width` × `height` image of
 /// `zones` (row by row) by exact distance transforms, never measuring a
 /// distance between neighbours that `apart` says lie apart (`(x, y)` and
-/// the pixel right of or below it).
+/// the pixel right of or below it); a penumbra pixel that reaches no umbra
+/// or no lit pixel takes `unreached(i)` (`i` its index).
 ///
 /// # Panics
 ///
@@ -59,6 +56,7 @@ pub fn visibility_exact(
     width: usize,
     height: usize,
     apart: impl Fn((usize, usize), (usize, usize)) -> bool + Copy + Sync,
+    unreached: impl Fn(usize) -> f32,
 ) -> Vec<f32> {
     let mask = |z: Zone| zones.iter().map(|&v| v == z).collect::<Vec<bool>>();
     let (to_umbra, to_lit) = rayon::join(
@@ -69,10 +67,11 @@ pub fn visibility_exact(
     zones
         .iter()
         .zip(to_umbra.iter().zip(&to_lit))
-        .map(|(z, (&u, &l))| match z {
+        .enumerate()
+        .map(|(i, (z, (&u, &l)))| match z {
             Zone::Lit => 1.0,
             Zone::Umbra => 0.0,
-            Zone::Penumbra => from_distances(root(u), root(l)),
+            Zone::Penumbra => from_distances(root(u), root(l)).unwrap_or_else(|| unreached(i)),
         })
         .collect()
 }
@@ -81,13 +80,21 @@ pub fn visibility_exact(
 /// (and the last row and column), the nearest umbra and lit pixels found by
 /// looking in square rings outwards up to `reach` pixels; every other pixel
 /// interpolated bilinearly from the four samples round it, where it is
-/// penumbra (umbra and lit pixels keep 0 and 1).
+/// penumbra (umbra and lit pixels keep 0 and 1). A sample that reaches no
+/// umbra or no lit pixel takes `unreached(i)` (`i` its pixel's index).
 ///
 /// # Panics
 ///
 /// If `zones` does not hold `width` × `height` values or `n` is 0.
 #[must_use]
-pub fn visibility_searched(zones: &[Zone], width: usize, height: usize, n: usize, reach: usize) -> Vec<f32> {
+pub fn visibility_searched(
+    zones: &[Zone],
+    width: usize,
+    height: usize,
+    n: usize,
+    reach: usize,
+    unreached: impl Fn(usize) -> f32,
+) -> Vec<f32> {
     assert_eq!(zones.len(), width * height, "zones of {width} × {height}");
     assert!(n > 0, "a sample every n ≥ 1 pixels");
     let zone = |x: usize, y: usize| zones[y * width + x];
@@ -96,7 +103,7 @@ pub fn visibility_searched(zones: &[Zone], width: usize, height: usize, n: usize
         Zone::Umbra => 0.0,
         Zone::Penumbra => {
             let (d1, d2) = nearest(zones, width, height, (x, y), reach);
-            from_distances(d1, d2)
+            from_distances(d1, d2).unwrap_or_else(|| unreached(y * width + x))
         }
     };
     if width == 0 || height == 0 {
@@ -195,8 +202,8 @@ mod tests {
     fn visibility_is_0_in_the_umbra_1_in_the_light_and_rises_across_the_penumbra() {
         let (w, h, a, b) = (60, 9, 20, 40);
         let zones = straight(w, h, a, b);
-        let exact = visibility_exact(&zones, w, h, |_, _| false);
-        let searched = visibility_searched(&zones, w, h, 1, 64);
+        let exact = visibility_exact(&zones, w, h, |_, _| false, |_| 0.5);
+        let searched = visibility_searched(&zones, w, h, 1, 64, |_| 0.5);
         for v in [&exact, &searched] {
             for y in 0..h {
                 let row = &v[y * w..(y + 1) * w];
@@ -237,8 +244,8 @@ mod tests {
             let zones: Vec<Zone> = (0..w * h)
                 .map(|_| [Zone::Lit, Zone::Penumbra, Zone::Penumbra, Zone::Umbra][rng.gen_range(0..4)])
                 .collect();
-            let exact = visibility_exact(&zones, w, h, |_, _| false);
-            let searched = visibility_searched(&zones, w, h, 1, 64);
+            let exact = visibility_exact(&zones, w, h, |_, _| false, |_| 0.5);
+            let searched = visibility_searched(&zones, w, h, 1, 64, |_| 0.5);
             for (i, (a, b)) in exact.iter().zip(&searched).enumerate() {
                 assert!((a - b).abs() < 1e-5, "pixel {i}: transform {a}, search {b}");
             }
@@ -261,8 +268,8 @@ mod tests {
             })
             .collect();
         let plate_edge = |a: (usize, usize), b: (usize, usize)| a.0 == 9 && b.0 == 10;
-        let aware = visibility_exact(&zones, w, h, plate_edge);
-        let naive = visibility_exact(&zones, w, h, |_, _| false);
+        let aware = visibility_exact(&zones, w, h, plate_edge, |_| 0.5);
+        let naive = visibility_exact(&zones, w, h, |_, _| false, |_| 0.5);
         assert!(naive[12] < 0.3, "without the cut the plate's umbra darkens the floor: {}", naive[12]);
         assert_eq!(aware[12], 0.5, "with it, no umbra on the floor: half lit");
     }
