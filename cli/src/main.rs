@@ -4,6 +4,7 @@
 //! the offending line of a scene file.
 
 mod report;
+mod view;
 
 use std::path::{Path, PathBuf};
 
@@ -33,6 +34,10 @@ enum Command {
     /// Render a scene file (.toml) or a model (.obj, .stl, .gltf, .glb, or an
     /// OpenSCAD .csg); with no input, the built-in demo scene.
     Render(RenderArgs),
+    /// Open a window on a scene file or a model (the demo with none): orbit,
+    /// pan and zoom, switch shadow methods and antialiasing, see each pass;
+    /// reloads when the file changes. H in the window lists the keys.
+    View(view::ViewArgs),
     /// Measure image A against reference B: RMSE, PSNR, max error, share over a
     /// threshold, mask disagreement; optionally write a false-colour difference.
     Compare(CompareArgs),
@@ -350,6 +355,7 @@ fn main() -> miette::Result<()> {
     match cli.command {
         Command::Render(args) => render_command(&args).map_err(report::to_report),
         Command::Compare(args) => compare_command(&args).map_err(report::to_report),
+        Command::View(args) => view::run(&args).map_err(|e| miette::miette!("{e}")),
     }
 }
 

@@ -1,0 +1,103 @@
+//! What the viewer shows: the demo, a scene file or a model, loaded again
+//! when it (or a file beside it) changes, with the toggles that change how a
+//! model is loaded (the ground, a `.csg` model's exact or faceted quadrics).
+
+use std::path::{Path, PathBuf};
+
+use kage::csg::openscad::{CsgOptions, Geometry};
+use kage::scene::demo::demo_scene;
+use kage::scene::framing::CameraOverride;
+use kage::scene::model::{self, ModelOptions};
+use kage::scene::{file, Scene};
+use kage::Limits;
+
+use super::state::Toggles;
+
+/// Window size when neither the command line nor the scene file gives one.
+pub const DEFAULT_SIZE: (u32, u32) = (1280, 720);
+
+/// Extensions of files a change to which reloads the scene (the scene, its
+/// models, their materials and textures).
+const WATCHED: [&str; 12] = ["toml", "obj", "mtl", "stl", "gltf", "glb", "bin", "csg", "png", "jpg", "jpeg", "exr"];
+
+/// A file to show, or the demo.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Source {
+    /// The file (`None`: the built-in demo).
+    pub path: Option<PathBuf>,
+}
+
+impl Source {
+    /// Loads the scene with `toggles`' ground and CSG geometry; its size
+    /// stays the file's (a scene file's `[image]`) or [`DEFAULT_SIZE`].
+    ///
+    /// # Errors
+    ///
+    /// The library's message (with file, line and column for a scene or
+    /// `.csg` file) when the file cannot be read or understood.
+    pub fn load(&self, toggles: &Toggles) -> Result<Scene, String> {
+        let Some(path) = &self.path else { return demo_scene().map_err(|e| e.to_string()) };
+        let ext = extension(path);
+        match ext.as_str() {
+            "toml" => file::load_scene(path).map_err(|e| e.to_string()),
+            "obj" | "stl" | "gltf" | "glb" | "csg" => {
+                let options = ModelOptions {
+                    csg: CsgOptions {
+                        geometry: if toggles.exact_csg { Geometry::Exact } else { Geometry::Faceted },
+                        skip_unsupported: true,
+                    },
+                    up: None,
+                    ground: toggles.ground,
+                    file_camera: false,
+                    camera: CameraOverride::default(),
+                    limits: Limits::default(),
+                };
+                model::scene_for_model_with(path, DEFAULT_SIZE.0, DEFAULT_SIZE.1, &options).map_err(|e| e.to_string())
+            }
+            _ => Err(format!(
+                "{}: kage view opens scene files (.toml) and models (.obj, .stl, .gltf, .glb, .csg)",
+                path.display()
+            )),
+        }
+    }
+
+    /// The folder whose files are watched for changes (the file's own).
+    #[must_use]
+    pub fn folder(&self) -> Option<PathBuf> {
+        let path = self.path.as_ref()?;
+        let parent = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+        Some(parent.to_path_buf())
+    }
+
+    /// Whether a change to `path` should reload the scene.
+    #[must_use]
+    pub fn is_watched(path: &Path) -> bool {
+        WATCHED.contains(&extension(path).as_str())
+    }
+}
+
+fn extension(path: &Path) -> String {
+    path.extension().and_then(|e| e.to_str()).unwrap_or_default().to_ascii_lowercase()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A scene file that does not parse reports its file, line and column;
+    /// an unknown kind of file says what the viewer opens.
+    #[test]
+    fn bad_files_say_where_and_why() {
+        let dir = std::env::temp_dir().join(format!("kage-view-source-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let scene = dir.join("broken.toml");
+        std::fs::write(&scene, "[camera]\neye = \"up\"\n").unwrap();
+        let e = Source { path: Some(scene.clone()) }.load(&Toggles::default()).unwrap_err();
+        assert!(e.contains("broken.toml:2:"), "{e}");
+        let e = Source { path: Some(dir.join("notes.txt")) }.load(&Toggles::default()).unwrap_err();
+        assert!(e.contains("kage view opens"), "{e}");
+        assert!(Source { path: None }.load(&Toggles::default()).is_ok(), "the demo loads");
+        assert!(Source::is_watched(Path::new("a/part.STL")) && !Source::is_watched(Path::new("notes.txt")));
+        std::fs::remove_dir_all(&dir).ok();
+    }
+}

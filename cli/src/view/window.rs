@@ -1,0 +1,495 @@
+//! The window: winit for events, softbuffer for a CPU frame buffer (X11 or
+//! Wayland, no GPU). Each turn of the event loop takes the input that
+//! arrived, then renders one refinement step and shows it; input that
+//! arrives while a step renders starts the refinement over before the next.
+
+use std::collections::VecDeque;
+use std::num::NonZeroU32;
+use std::path::{Path, PathBuf};
+use std::rc::Rc;
+use std::time::{Duration, Instant};
+
+use kage::Scene;
+use notify::Watcher;
+use winit::application::ApplicationHandler;
+use winit::dpi::PhysicalSize;
+use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
+use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop, EventLoopProxy};
+use winit::keyboard::{Key as WinitKey, NamedKey};
+use winit::window::{Window, WindowId};
+
+use super::hud::Text;
+use super::orbit::Orbit;
+use super::refine::Refiner;
+use super::script::Action;
+use super::source::Source;
+use super::state::{Button, Display, Input, Key, Request, Smoothing, Step, Viewer, MAX_PASSES};
+
+/// The colour of a load error drawn over the image (0xRRGGBB).
+pub const ERROR_COLOUR: u32 = 0x00ff_4040;
+
+/// What wakes the event loop from outside it.
+#[derive(Debug, Clone)]
+pub enum Wake {
+    /// A watched file changed.
+    FileChanged,
+}
+
+/// How `kage view` starts.
+#[derive(Debug, Clone)]
+pub struct Start {
+    /// What to show.
+    pub source: Source,
+    /// Window size asked on the command line.
+    pub size: Option<(u32, u32)>,
+    /// Scripted input.
+    pub script: Vec<Action>,
+    /// Worker threads.
+    pub threads: Option<usize>,
+}
+
+/// Runs the viewer until its window closes.
+///
+/// # Errors
+///
+/// When no window can be opened (no display) or the event loop fails.
+pub fn run(start: Start) -> Result<(), String> {
+    let event_loop = EventLoop::<Wake>::with_user_event().build().map_err(|e| format!("no window: {e}"))?;
+    let mut app = App::new(start, event_loop.create_proxy());
+    event_loop.run_app(&mut app).map_err(|e| e.to_string())?;
+    app.failure.map_or(Ok(()), Err)
+}
+
+/// The mouse: where it was and which buttons are held.
+#[derive(Debug, Default)]
+struct Mouse {
+    at: Option<(f64, f64)>,
+    left: bool,
+    middle: bool,
+    right: bool,
+    shift: bool,
+}
+
+struct Surface {
+    window: Rc<Window>,
+    surface: softbuffer::Surface<Rc<Window>, Rc<Window>>,
+}
+
+struct App {
+    viewer: Viewer,
+    source: Source,
+    scene: Option<Scene>,
+    refiner: Refiner,
+    text: Text,
+    script: VecDeque<Action>,
+    sleep_until: Option<Instant>,
+    surface: Option<Surface>,
+    mouse: Mouse,
+    proxy: EventLoopProxy<Wake>,
+    watcher: Option<notify::RecommendedWatcher>,
+    /// Seconds of the last frames, for the HUD's rate.
+    frame_times: VecDeque<f64>,
+    step: Option<Step>,
+    screenshots: u32,
+    failure: Option<String>,
+    /// The window's contents as last presented (0RGB), and their size.
+    presented: (Vec<u32>, usize, usize),
+}
+
+impl App {
+    fn new(start: Start, proxy: EventLoopProxy<Wake>) -> App {
+        let loaded = start.source.load(&super::state::Toggles::default());
+        let (scene, error) = match loaded {
+            Ok(s) => (Some(s), None),
+            Err(e) => (None, Some(e)),
+        };
+        let size = start.size.unwrap_or_else(|| match (&scene, start.source.path.as_deref()) {
+            (Some(s), Some(p)) if p.extension().is_some_and(|e| e.eq_ignore_ascii_case("toml")) => (s.width, s.height),
+            _ => super::source::DEFAULT_SIZE,
+        });
+        let mut viewer = viewer_for(scene.as_ref(), size);
+        viewer.error = error;
+        let mut app = App {
+            viewer,
+            source: start.source,
+            scene,
+            refiner: Refiner::new(start.threads),
+            text: Text::new(),
+            script: start.script.into(),
+            sleep_until: None,
+            surface: None,
+            mouse: Mouse::default(),
+            proxy,
+            watcher: None,
+            frame_times: VecDeque::new(),
+            step: None,
+            screenshots: 0,
+            failure: None,
+            presented: (Vec::new(), 0, 0),
+        };
+        app.watch();
+        app
+    }
+
+    /// Watches the source's folder (again, after a new file is opened).
+    fn watch(&mut self) {
+        self.watcher = None;
+        let Some(folder) = self.source.folder() else { return };
+        let proxy = self.proxy.clone();
+        let handler = move |event: notify::Result<notify::Event>| {
+            if let Ok(e) = event {
+                let relevant = matches!(e.kind, notify::EventKind::Create(_) | notify::EventKind::Modify(_));
+                if relevant && e.paths.iter().any(|p| Source::is_watched(p)) {
+                    proxy.send_event(Wake::FileChanged).ok();
+                }
+            }
+        };
+        match notify::recommended_watcher(handler) {
+            Ok(mut w) => match w.watch(&folder, notify::RecursiveMode::NonRecursive) {
+                Ok(()) => self.watcher = Some(w),
+                Err(e) => eprintln!("warning: not watching {}: {e}", folder.display()),
+            },
+            Err(e) => eprintln!("warning: no file watching: {e}"),
+        }
+    }
+
+    fn input(&mut self, event_loop: &ActiveEventLoop, input: Input) {
+        match self.viewer.apply(input) {
+            Request::Nothing | Request::Render => {}
+            Request::Redraw => self.request_redraw(),
+            Request::Reload => self.reload(false),
+            Request::Open(path) => {
+                self.source = Source { path: Some(path) };
+                self.reload(true);
+                self.watch();
+            }
+            Request::Screenshot => {
+                self.screenshots += 1;
+                let path = PathBuf::from(format!("kage-view-{}.png", self.screenshots));
+                self.screenshot(&path);
+            }
+            Request::Quit => event_loop.exit(),
+        }
+    }
+
+    /// Loads the source again: the camera kept, or (`fresh`) the new
+    /// scene's own. A failure keeps the last good scene and shows the error.
+    fn reload(&mut self, fresh: bool) {
+        match self.source.load(&self.viewer.toggles) {
+            Ok(scene) => {
+                if fresh {
+                    let keep = (self.viewer.toggles, self.viewer.display, self.viewer.hud);
+                    self.viewer = viewer_for(Some(&scene), self.viewer.size);
+                    (self.viewer.toggles, self.viewer.display, self.viewer.hud) = keep;
+                } else if let Some(bounds) = scene.bounds() {
+                    self.viewer.bounds = bounds;
+                }
+                self.viewer.error = None;
+                self.scene = Some(scene);
+            }
+            Err(e) => {
+                eprintln!("{e}");
+                self.viewer.error = Some(e);
+            }
+        }
+        self.request_redraw();
+    }
+
+    fn screenshot(&mut self, path: &Path) {
+        let shown = &self.refiner.shown;
+        match kage::output::write_image(&shown.image, path, shown.scale, shown.tone) {
+            Ok(()) => println!("wrote {}", path.display()),
+            Err(e) => eprintln!("screenshot {}: {e}", path.display()),
+        }
+    }
+
+    /// Writes the window's contents as last presented to a PNG.
+    fn capture(&mut self, path: &Path) {
+        self.present();
+        let (pixels, w, h) = &self.presented;
+        let mut image = kage::image::LinearImage::new(*w as u32, *h as u32);
+        for (out, &p) in image.pixels_mut().iter_mut().zip(pixels) {
+            let c = |s: u32| kage::image::srgb_to_linear(((p >> s) & 0xff) as f32 / 255.0);
+            *out = glam::Vec3::new(c(16), c(8), c(0));
+        }
+        match kage::output::write_image(&image, path, 1.0, kage::image::ToneCurve::Clip) {
+            Ok(()) => println!("wrote {}", path.display()),
+            Err(e) => eprintln!("capture {}: {e}", path.display()),
+        }
+    }
+
+    fn request_redraw(&self) {
+        if let Some(s) = &self.surface {
+            s.window.request_redraw();
+        }
+    }
+
+    /// Runs the script's actions that are due; false while it waits.
+    fn run_script(&mut self, event_loop: &ActiveEventLoop) {
+        while let Some(action) = self.script.front().cloned() {
+            if let Some(until) = self.sleep_until {
+                if Instant::now() < until {
+                    event_loop.set_control_flow(ControlFlow::WaitUntil(until));
+                    return;
+                }
+                self.sleep_until = None;
+            }
+            match action {
+                Action::Wait if !self.viewer.at_rest() => return,
+                Action::Wait => {}
+                Action::Sleep(s) => {
+                    self.script.pop_front();
+                    self.sleep_until = Some(Instant::now() + Duration::from_secs_f32(s));
+                    continue;
+                }
+                Action::Input(input) => self.input(event_loop, input),
+                Action::Screenshot(path) => self.screenshot(&path),
+                Action::Capture(path) => self.capture(&path),
+                Action::Copy(from, to) => {
+                    if let Err(e) = std::fs::copy(&from, &to) {
+                        self.failure = Some(format!("script: copy {} to {}: {e}", from.display(), to.display()));
+                        event_loop.exit();
+                    }
+                }
+                Action::Quit => event_loop.exit(),
+            }
+            self.script.pop_front();
+        }
+    }
+
+    /// Renders the next refinement step, if any.
+    fn refine(&mut self) -> bool {
+        let Some(scene) = &self.scene else {
+            while self.viewer.step().is_some() {}
+            return false;
+        };
+        let Some(step) = self.viewer.step() else { return false };
+        let start = Instant::now();
+        if let Err(e) = self.refiner.render(scene, &self.viewer, step) {
+            self.viewer.error = Some(e.to_string());
+            while self.viewer.step().is_some() {}
+        }
+        self.frame_times.push_back(start.elapsed().as_secs_f64());
+        if self.frame_times.len() > 10 {
+            self.frame_times.pop_front();
+        }
+        self.step = Some(step);
+        true
+    }
+
+    /// Shows the image, the HUD, the keys and any error.
+    fn present(&mut self) {
+        let Some(s) = &mut self.surface else { return };
+        let size = s.window.inner_size();
+        let (Some(w), Some(h)) = (NonZeroU32::new(size.width), NonZeroU32::new(size.height)) else { return };
+        if s.surface.resize(w, h).is_err() {
+            return;
+        }
+        let Ok(mut buffer) = s.surface.buffer_mut() else { return };
+        let (bw, bh) = (size.width as usize, size.height as usize);
+        buffer.fill(0x0020_2020);
+        let shown = &self.refiner.shown;
+        let (iw, ih) = (shown.image.width() as usize, shown.image.height() as usize);
+        if iw > 0 {
+            let rgb = shown.image.to_srgb8_toned(shown.scale, shown.tone);
+            for y in 0..ih.min(bh) {
+                for x in 0..iw.min(bw) {
+                    let p = &rgb[3 * (y * iw + x)..3 * (y * iw + x) + 3];
+                    buffer[y * bw + x] = u32::from(p[0]) << 16 | u32::from(p[1]) << 8 | u32::from(p[2]);
+                }
+            }
+        }
+        if self.viewer.hud {
+            let lines = hud_lines(&self.viewer, &self.refiner, self.step, &self.frame_times);
+            self.text.draw(&mut buffer, (bw, bh), (8, 8), &lines, 0x00e0_e0e0);
+        }
+        if self.viewer.help {
+            let sheet = cheat_sheet();
+            let x = bw.saturating_sub(self.text.size(&sheet).0 + 8);
+            self.text.draw(&mut buffer, (bw, bh), (x, 8), &sheet, 0x00ff_ffff);
+        }
+        if let Some(e) = &self.viewer.error {
+            let lines: Vec<String> = e.lines().map(str::to_string).collect();
+            let y = bh.saturating_sub(self.text.size(&lines).1 + 8);
+            self.text.draw(&mut buffer, (bw, bh), (8, y), &lines, ERROR_COLOUR);
+        }
+        self.presented = (buffer.to_vec(), bw, bh);
+        buffer.present().ok();
+    }
+}
+
+/// A viewer of `scene` (or of nothing) in a window of `size`.
+fn viewer_for(scene: Option<&Scene>, size: (u32, u32)) -> Viewer {
+    let bounds = scene.and_then(Scene::bounds).unwrap_or((glam::Vec3::splat(-1.0), glam::Vec3::ONE));
+    let orbit = scene.map_or_else(
+        || Orbit {
+            target: glam::Vec3::ZERO,
+            distance: 5.0,
+            view: Default::default(),
+            fov_y_deg: 40.0,
+            orthographic: false,
+        },
+        |s| Orbit::from_camera(&s.camera),
+    );
+    Viewer::new(orbit, bounds, size)
+}
+
+fn hud_lines(viewer: &Viewer, refiner: &Refiner, step: Option<Step>, times: &VecDeque<f64>) -> Vec<String> {
+    let shown = &refiner.shown;
+    let st = &shown.stats;
+    let mean = times.iter().sum::<f64>() / times.len().max(1) as f64;
+    let stage = match step {
+        None => "-".to_string(),
+        Some(Step::Quick) => "quick".to_string(),
+        Some(Step::Full) => "full".to_string(),
+        Some(Step::Pass(n)) => format!("pass {n}/{MAX_PASSES}"),
+    };
+    let smoothing = match viewer.toggles.smoothing {
+        Smoothing::None => "none",
+        Smoothing::Edge => "edge",
+        Smoothing::Progressive => "progressive",
+    };
+    vec![
+        format!("{:.1} fps  {}x{}  {stage}", 1.0 / mean.max(1e-6), viewer.size.0, viewer.size.1),
+        format!(
+            "ms: visibility {:.1}  shadows {:.1}  shading {:.1}  traced {:.1}  edges {:.1}",
+            st.visibility_ms, st.shadow_ms, st.shading_ms, st.traced_ms, st.edge_ms
+        ),
+        format!("{} triangles  {} passes averaged", shown.triangles, shown.passes),
+        format!(
+            "shadows {}  smoothing {smoothing}  show {}{}",
+            viewer.toggles.shadows.name(),
+            viewer.display.name(),
+            if viewer.display == Display::Image { "" } else { " (V: next)" }
+        ),
+    ]
+}
+
+/// The keys, as H shows them.
+#[must_use]
+pub fn cheat_sheet() -> Vec<String> {
+    [
+        "left drag   orbit",
+        "middle/shift+left drag   pan",
+        "wheel       zoom",
+        "F           frame all",
+        "1 3 7 9     front right top iso",
+        "5           perspective/ortho",
+        "Home        reset camera",
+        "S           shadow method",
+        "A           antialiasing",
+        "R           traced reflections",
+        "G           fog",
+        "P           ground plane",
+        "C           CSG exact/faceted",
+        "V           show: image, passes,",
+        "            shadow, depth, normals, ids",
+        "Z           HUD    H  this sheet",
+        "F12         screenshot",
+        "Esc, Q      quit",
+    ]
+    .map(str::to_string)
+    .to_vec()
+}
+
+impl ApplicationHandler<Wake> for App {
+    fn resumed(&mut self, event_loop: &ActiveEventLoop) {
+        if self.surface.is_some() {
+            return;
+        }
+        let title = self.source.path.as_ref().map_or("kage: demo".to_string(), |p| format!("kage: {}", p.display()));
+        let attributes = Window::default_attributes()
+            .with_title(title)
+            .with_inner_size(PhysicalSize::new(self.viewer.size.0, self.viewer.size.1));
+        let opened = event_loop.create_window(attributes).map_err(|e| e.to_string()).and_then(|window| {
+            let window = Rc::new(window);
+            let context = softbuffer::Context::new(window.clone()).map_err(|e| e.to_string())?;
+            let surface = softbuffer::Surface::new(&context, window.clone()).map_err(|e| e.to_string())?;
+            Ok(Surface { window, surface })
+        });
+        match opened {
+            Ok(s) => self.surface = Some(s),
+            Err(e) => {
+                self.failure = Some(format!("no window: {e}"));
+                event_loop.exit();
+            }
+        }
+    }
+
+    fn user_event(&mut self, event_loop: &ActiveEventLoop, event: Wake) {
+        match event {
+            Wake::FileChanged => self.input(event_loop, Input::FileChanged),
+        }
+    }
+
+    fn window_event(&mut self, event_loop: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
+        match event {
+            WindowEvent::CloseRequested => event_loop.exit(),
+            WindowEvent::Resized(size) => self.input(event_loop, Input::Resize(size.width, size.height)),
+            WindowEvent::RedrawRequested => self.present(),
+            WindowEvent::ModifiersChanged(m) => self.mouse.shift = m.state().shift_key(),
+            WindowEvent::MouseInput { state, button, .. } => {
+                let down = state == ElementState::Pressed;
+                match button {
+                    MouseButton::Left => self.mouse.left = down,
+                    MouseButton::Middle => self.mouse.middle = down,
+                    MouseButton::Right => self.mouse.right = down,
+                    _ => {}
+                }
+            }
+            WindowEvent::CursorMoved { position, .. } => {
+                let last = self.mouse.at.replace((position.x, position.y));
+                let button = if self.mouse.left {
+                    Some(Button::Left)
+                } else if self.mouse.middle {
+                    Some(Button::Middle)
+                } else if self.mouse.right {
+                    Some(Button::Right)
+                } else {
+                    None
+                };
+                if let (Some((x, y)), Some(button)) = (last, button) {
+                    let (dx, dy) = ((position.x - x) as f32, (position.y - y) as f32);
+                    self.input(event_loop, Input::Drag { button, dx, dy, shift: self.mouse.shift });
+                }
+            }
+            WindowEvent::MouseWheel { delta, .. } => {
+                let steps = match delta {
+                    MouseScrollDelta::LineDelta(_, y) => y,
+                    MouseScrollDelta::PixelDelta(p) => (p.y / 50.0) as f32,
+                };
+                self.input(event_loop, Input::Wheel(steps));
+            }
+            WindowEvent::KeyboardInput { event, .. } if event.state == ElementState::Pressed => {
+                let key = match event.logical_key {
+                    WinitKey::Named(NamedKey::Home) => Some(Key::Home),
+                    WinitKey::Named(NamedKey::F12) => Some(Key::F12),
+                    WinitKey::Named(NamedKey::Escape) => Some(Key::Escape),
+                    WinitKey::Character(c) => c.chars().next().map(|c| Key::Char(c.to_ascii_lowercase())),
+                    _ => None,
+                };
+                if let Some(key) = key {
+                    self.input(event_loop, Input::Key(key));
+                }
+            }
+            WindowEvent::DroppedFile(path) => self.input(event_loop, Input::Dropped(path)),
+            _ => {}
+        }
+    }
+
+    fn about_to_wait(&mut self, event_loop: &ActiveEventLoop) {
+        if self.surface.is_none() {
+            return;
+        }
+        self.run_script(event_loop);
+        if event_loop.exiting() {
+            return;
+        }
+        if self.refine() {
+            self.present();
+            event_loop.set_control_flow(ControlFlow::Poll);
+        } else if self.sleep_until.is_none() {
+            event_loop.set_control_flow(if self.script.is_empty() { ControlFlow::Wait } else { ControlFlow::Poll });
+        }
+    }
+}

@@ -1,0 +1,186 @@
+//! `kage view` end to end under a virtual X server (Xvfb, installed by
+//! `.ci/run` when missing; these tests skip with a message without it):
+//! scripted input, screenshots against `kage render`, live reload, and a
+//! broken scene file that keeps the window alive with its error drawn.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use image::{GenericImageView, RgbImage};
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("kage-view-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// Whether a virtual X server can be started (says why not when not).
+fn have_xvfb() -> bool {
+    let ok = Command::new("xvfb-run").arg("--help").output().is_ok();
+    if !ok {
+        eprintln!("skipped: xvfb-run is not installed (apt-get install xvfb; .ci/run does)");
+    }
+    ok
+}
+
+/// Runs `kage view args...` under Xvfb: whether it exited cleanly, and what
+/// it printed.
+fn view(args: &[&str]) -> (bool, String) {
+    let out = Command::new("xvfb-run")
+        .args(["-a", "-s", "-screen 0 1280x1024x24", env!("CARGO_BIN_EXE_kage"), "view"])
+        .args(args)
+        .output()
+        .unwrap();
+    let text = format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
+    (out.status.success(), text)
+}
+
+fn kage(args: &[&str]) {
+    let out = Command::new(env!("CARGO_BIN_EXE_kage")).args(args).output().unwrap();
+    assert!(out.status.success(), "kage {args:?}: {}", String::from_utf8_lossy(&out.stderr));
+}
+
+fn read(path: &Path) -> RgbImage {
+    image::open(path).unwrap_or_else(|e| panic!("{}: {e}", path.display())).to_rgb8()
+}
+
+/// RMSE of two images' channels in [0, 1].
+fn rmse(a: &RgbImage, b: &RgbImage) -> f64 {
+    assert_eq!(a.dimensions(), b.dimensions());
+    let sum: f64 =
+        a.as_raw().iter().zip(b.as_raw()).map(|(&x, &y)| ((f64::from(x) - f64::from(y)) / 255.0).powi(2)).sum();
+    (sum / a.as_raw().len() as f64).sqrt()
+}
+
+fn scene(shape: &str, colour: &str) -> String {
+    format!(
+        r#"
+[image]
+width = 200
+height = 150
+[camera]
+eye = [2.0, 2.0, 4.0]
+target = [0.0, 0.3, 0.0]
+[[light]]
+type = "point"
+position = [3.0, 5.0, 2.0]
+[[material]]
+name = "paint"
+kd = {colour}
+[[object]]
+shape = "plane"
+scale = 6.0
+[[object]]
+shape = "{shape}"
+material = "paint"
+translate = [0.0, 0.6, 0.0]
+scale = 0.6
+"#
+    )
+}
+
+/// With the edge pass chosen (A twice: progressive → none → edge) and the
+/// refinement done, the viewer's screenshot is `kage render` of the same
+/// scene and camera.
+#[test]
+fn a_screenshot_equals_the_render_of_the_same_camera() {
+    if !have_xvfb() {
+        return;
+    }
+    let dir = scratch("equal");
+    let file = dir.join("scene.toml");
+    std::fs::write(&file, scene("sphere", "[0.8, 0.3, 0.2]")).unwrap();
+    std::fs::write(dir.join("run.script"), "key a\nkey a\nwait\nscreenshot shot.png\nquit\n").unwrap();
+    let (ok, out) = view(&[file.to_str().unwrap(), "--script", dir.join("run.script").to_str().unwrap()]);
+    assert!(ok, "{out}");
+    let reference = dir.join("render.png");
+    kage(&["render", file.to_str().unwrap(), "-o", reference.to_str().unwrap()]);
+    let e = rmse(&read(&dir.join("shot.png")), &read(&reference));
+    assert!(e < 1e-3, "RMSE {e}");
+}
+
+/// The script edits the scene file: the viewer reloads it, keeps its camera
+/// (a turned one), and shows the new scene as `kage render` does from there.
+#[test]
+fn an_edited_scene_file_is_shown_again() {
+    if !have_xvfb() {
+        return;
+    }
+    let dir = scratch("reload");
+    let file = dir.join("scene.toml");
+    std::fs::write(&file, scene("sphere", "[0.8, 0.3, 0.2]")).unwrap();
+    std::fs::write(dir.join("edited.toml"), scene("cube", "[0.2, 0.3, 0.8]")).unwrap();
+    let script = "key a\nkey a\nwait\nscreenshot before.png\ncopy edited.toml scene.toml\nsleep 1.5\nwait\n\
+                  screenshot after.png\nquit\n";
+    std::fs::write(dir.join("run.script"), script).unwrap();
+    let (ok, out) = view(&[file.to_str().unwrap(), "--script", dir.join("run.script").to_str().unwrap()]);
+    assert!(ok, "{out}");
+    let (before, after) = (read(&dir.join("before.png")), read(&dir.join("after.png")));
+    assert!(rmse(&before, &after) > 0.01, "the change is shown");
+    let reference = dir.join("render.png");
+    kage(&["render", file.to_str().unwrap(), "-o", reference.to_str().unwrap()]);
+    let e = rmse(&after, &read(&reference));
+    assert!(e < 1e-3, "RMSE {e} against kage render of the edited file");
+}
+
+/// A broken edit keeps the process alive (the script goes on to quit
+/// cleanly), the last good scene stays on screen and the error is drawn
+/// over it in red, naming the file and line.
+#[test]
+fn a_broken_scene_file_keeps_the_window_and_draws_the_error() {
+    if !have_xvfb() {
+        return;
+    }
+    let dir = scratch("broken");
+    let file = dir.join("scene.toml");
+    std::fs::write(&file, scene("sphere", "[0.8, 0.3, 0.2]")).unwrap();
+    std::fs::write(dir.join("broken.toml"), "[camera]\neye = \"up\"\n").unwrap();
+    let script = "key z\nkey a\nwait\ncapture good.png\ncopy broken.toml scene.toml\nsleep 1.5\nwait\n\
+                  capture bad.png\nscreenshot image.png\nquit\n";
+    std::fs::write(dir.join("run.script"), script).unwrap();
+    let (ok, out) = view(&[file.to_str().unwrap(), "--script", dir.join("run.script").to_str().unwrap()]);
+    assert!(ok, "the viewer exits cleanly after the bad edit: {out}");
+    assert!(out.contains("scene.toml:2:"), "the error names file and line: {out}");
+    let red = |img: &RgbImage| img.pixels().filter(|p| p[0] > 200 && p[1] < 120 && p[2] < 120).count();
+    let (good, bad) = (read(&dir.join("good.png")), read(&dir.join("bad.png")));
+    assert!(red(&bad) > red(&good) + 30, "red error text drawn: {} against {}", red(&bad), red(&good));
+    // Above the error box the window still shows the last good image.
+    let top = |img: &RgbImage| img.view(0, 0, 200, 60).to_image();
+    assert!(rmse(&top(&good), &top(&bad)) < 1e-3, "the last good scene stays");
+    let shown = read(&dir.join("image.png"));
+    assert!(shown.dimensions() == (200, 150));
+}
+
+/// Left to rest, the progressive refinement averages 64 jittered passes:
+/// the demo as `kage render --antialias jitter:64` renders it. The window
+/// with the HUD and the keys is the README's picture (written there when
+/// `KAGE_UPDATE_DOCS` is set).
+#[test]
+fn the_refined_demo_equals_64_jittered_passes() {
+    if !have_xvfb() {
+        return;
+    }
+    let dir = scratch("refined");
+    std::fs::write(dir.join("run.script"), "wait\nscreenshot shot.png\nkey h\ncapture window.png\nquit\n").unwrap();
+    let (ok, out) = view(&["--width", "960", "--height", "540", "--script", dir.join("run.script").to_str().unwrap()]);
+    assert!(ok, "{out}");
+    let reference = dir.join("render.png");
+    kage(&[
+        "render",
+        "--width",
+        "960",
+        "--height",
+        "540",
+        "--antialias",
+        "jitter:64",
+        "-o",
+        reference.to_str().unwrap(),
+    ]);
+    let e = rmse(&read(&dir.join("shot.png")), &read(&reference));
+    assert!(e < 1e-3, "RMSE {e}");
+    if std::env::var_os("KAGE_UPDATE_DOCS").is_some() {
+        let docs = Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/images/view.png");
+        std::fs::copy(dir.join("window.png"), &docs).unwrap();
+        eprintln!("wrote {}", docs.display());
+    }
+}
