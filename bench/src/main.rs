@@ -14,6 +14,7 @@ mod rays;
 mod share;
 mod slb;
 mod soft;
+mod view;
 
 use std::path::PathBuf;
 
@@ -66,6 +67,10 @@ enum Command {
     /// distance transform, depth-aware, on maps or SLBs), PCSS and the
     /// jittered light against the ray-traced area-light truth.
     Soft(soft::SoftArgs),
+    /// The preview window (`kage view`, under Xvfb) orbiting a scene beside
+    /// f3d offscreen on Mesa: launch to first image, ms per frame, time to the
+    /// 64-pass image.
+    View(view::ViewArgs),
 }
 
 /// What every table takes.
@@ -128,5 +133,6 @@ fn main() -> miette::Result<()> {
         Command::ShadowShare(args) => share::run(&args),
         Command::Slb(args) => slb::run(&args),
         Command::Soft(args) => soft::run(&args),
+        Command::View(args) => view::run(&args),
     }
 }

@@ -39,7 +39,7 @@ fn model(path: &Path, (w, h): (u32, u32)) -> Result<Scene> {
 }
 
 /// The corpus `.csg` model whose frame takes the median time at `size`.
-fn median_csg(dir: &Path, size: (u32, u32), frames: usize) -> Result<Option<PathBuf>> {
+pub(crate) fn median_csg(dir: &Path, size: (u32, u32), frames: usize) -> Result<Option<PathBuf>> {
     let Ok(entries) = std::fs::read_dir(dir) else { return Ok(None) };
     let mut files: Vec<PathBuf> =
         entries.flatten().map(|e| e.path()).filter(|p| p.extension().is_some_and(|e| e == "csg")).collect();

@@ -36,6 +36,11 @@ pub struct ViewArgs {
     /// Worker threads (default: one per core).
     #[arg(long)]
     pub threads: Option<usize>,
+    /// When the window closes, print the time to the first image, the quick
+    /// frames' median time while the camera moved, and the time from the
+    /// last input to the fully refined image.
+    #[arg(long)]
+    pub timings: bool,
 }
 
 /// Runs `kage view`.
@@ -60,5 +65,6 @@ pub fn run(args: &ViewArgs) -> Result<(), String> {
         size,
         script,
         threads: args.threads,
+        timings: args.timings,
     })
 }

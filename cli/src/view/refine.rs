@@ -5,7 +5,7 @@
 
 use glam::{Vec2, Vec3};
 use kage::image::{LinearImage, ToneCurve};
-use kage::scene::{Antialias, Scene, ShadowMethod};
+use kage::scene::{Antialias, Light, Scene, ShadowMethod, ShadowSettings};
 use kage::shading::ComponentSet;
 use kage::{FrameStats, RenderOptions, Renderer};
 
@@ -29,8 +29,6 @@ pub struct Shown {
     pub stats: FrameStats,
     /// Jittered passes in `image` (0: a single frame).
     pub passes: u32,
-    /// Triangles of the scene's meshes.
-    pub triangles: usize,
 }
 
 /// Renders steps and keeps the accumulation of jittered passes.
@@ -76,7 +74,6 @@ impl Refiner {
         let frame = renderer.render(&scene)?;
         let image = shown_image(&scene, frame, viewer.display);
         let is_image = viewer.display == Display::Image;
-        let triangles = base.triangle_count();
         let stats = frame.stats;
         match step {
             Step::Pass(n) => {
@@ -90,13 +87,13 @@ impl Refiner {
                     let mut mean = self.sum.clone();
                     let k = 1.0 / self.passes as f32;
                     mean.pixels_mut().iter_mut().for_each(|p| *p *= k);
-                    self.shown = Shown { image: mean, passes: self.passes, stats, triangles, ..self.shown.clone() };
+                    self.shown = Shown { image: mean, passes: self.passes, stats, ..self.shown.clone() };
                 }
             }
             Step::Quick | Step::Full => {
                 let (scale, tone) =
                     if is_image { (scene.exposure.scale(&image), scene.tone) } else { (1.0, ToneCurve::Clip) };
-                self.shown = Shown { image, scale, tone, stats, passes: 0, triangles };
+                self.shown = Shown { image, scale, tone, stats, passes: 0 };
             }
         }
         Ok(())
@@ -127,6 +124,13 @@ pub fn scene_for(base: &Scene, viewer: &Viewer, step: Step) -> Scene {
             light.shadow.samples = 1;
         }
     }
+    if step == Step::Quick {
+        // A moving camera: each light's costlier shadows (jittered maps,
+        // silhouette-line buffers, the per-pixel soft term) as one plain map.
+        for light in scene.lights.iter_mut().filter(|l| costly(l)) {
+            light.shadow = ShadowSettings { samples: 1, ..light.shadow.with_method(ShadowMethod::Map) };
+        }
+    }
     if !t.fog {
         scene.fog = None;
     }
@@ -142,6 +146,14 @@ pub fn scene_for(base: &Scene, viewer: &Viewer, step: Step) -> Scene {
         scene.camera = shifted(&scene.camera, offset, viewer.size);
     }
     scene
+}
+
+/// Whether a light's shadows cost more than one plain map (jittered maps
+/// over its disc, a silhouette-line buffer, the two-map soft term).
+#[must_use]
+pub fn costly(light: &Light) -> bool {
+    let jittered = light.size > 0.0 && light.shadow.samples > 1 && light.shadow.method == ShadowMethod::Map;
+    jittered || matches!(light.shadow.method, ShadowMethod::Slb | ShadowMethod::Soft)
 }
 
 /// `camera` with its image shifted by `offset` pixels (y down).

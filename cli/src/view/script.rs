@@ -1,5 +1,6 @@
 //! Scripted input for `kage view --script FILE`: the events a user would
-//! make, one per line, for tests and recordings.
+//! make, one per line, for tests and recordings; each input is followed by
+//! the frame it asks for (120 `drag` lines: a 120-frame orbit).
 //!
 //! ```text
 //! # a comment

@@ -1,6 +1,8 @@
 //! What the viewer shows: the demo, a scene file or a model, loaded again
 //! when it (or a file beside it) changes, with the toggles that change how a
 //! model is loaded (the ground, a `.csg` model's exact or faceted quadrics).
+//! An OpenSCAD `.scad` file is turned into a `.csg` by `openscad -o` (when
+//! `openscad` is on the PATH) at every load.
 
 use std::path::{Path, PathBuf};
 
@@ -18,7 +20,8 @@ pub const DEFAULT_SIZE: (u32, u32) = (1280, 720);
 
 /// Extensions of files a change to which reloads the scene (the scene, its
 /// models, their materials and textures).
-const WATCHED: [&str; 12] = ["toml", "obj", "mtl", "stl", "gltf", "glb", "bin", "csg", "png", "jpg", "jpeg", "exr"];
+const WATCHED: [&str; 13] =
+    ["toml", "obj", "mtl", "stl", "gltf", "glb", "bin", "csg", "scad", "png", "jpg", "jpeg", "exr"];
 
 /// A file to show, or the demo.
 #[derive(Debug, Clone, PartialEq)]
@@ -40,22 +43,16 @@ impl Source {
         let ext = extension(path);
         match ext.as_str() {
             "toml" => file::load_scene(path).map_err(|e| e.to_string()),
-            "obj" | "stl" | "gltf" | "glb" | "csg" => {
-                let options = ModelOptions {
-                    csg: CsgOptions {
-                        geometry: if toggles.exact_csg { Geometry::Exact } else { Geometry::Faceted },
-                        skip_unsupported: true,
-                    },
-                    up: None,
-                    ground: toggles.ground,
-                    file_camera: false,
-                    camera: CameraOverride::default(),
-                    limits: Limits::default(),
-                };
-                model::scene_for_model_with(path, DEFAULT_SIZE.0, DEFAULT_SIZE.1, &options).map_err(|e| e.to_string())
+            "scad" => {
+                let csg = openscad_to_csg(path)?;
+                let scene = model_scene(&csg, toggles);
+                std::fs::remove_file(&csg).ok();
+                scene
             }
+            "obj" | "stl" | "gltf" | "glb" | "csg" => model_scene(path, toggles),
             _ => Err(format!(
-                "{}: kage view opens scene files (.toml) and models (.obj, .stl, .gltf, .glb, .csg)",
+                "{}: kage view opens scene files (.toml), models (.obj, .stl, .gltf, .glb, .csg) and OpenSCAD files \
+                 (.scad)",
                 path.display()
             )),
         }
@@ -73,6 +70,50 @@ impl Source {
     #[must_use]
     pub fn is_watched(path: &Path) -> bool {
         WATCHED.contains(&extension(path).as_str())
+    }
+}
+
+/// A model file framed on its ground, as `kage render FILE` sets it up,
+/// with the toggles' ground and CSG geometry.
+fn model_scene(path: &Path, toggles: &Toggles) -> Result<Scene, String> {
+    let options = ModelOptions {
+        csg: CsgOptions {
+            geometry: if toggles.exact_csg { Geometry::Exact } else { Geometry::Faceted },
+            skip_unsupported: true,
+        },
+        up: None,
+        ground: toggles.ground,
+        file_camera: false,
+        camera: CameraOverride::default(),
+        limits: Limits::default(),
+    };
+    model::scene_for_model_with(path, DEFAULT_SIZE.0, DEFAULT_SIZE.1, &options).map_err(|e| e.to_string())
+}
+
+/// Runs `openscad -o <temporary>.csg scad`: the `.csg` written (outside the
+/// watched folder, so writing it reloads nothing).
+///
+/// # Errors
+///
+/// When `openscad` is not on the PATH, or what it says when it fails.
+fn openscad_to_csg(scad: &Path) -> Result<PathBuf, String> {
+    let stem = scad.file_stem().and_then(|s| s.to_str()).unwrap_or("model");
+    let csg = std::env::temp_dir().join(format!("kage-view-{}-{stem}.csg", std::process::id()));
+    let run = std::process::Command::new("openscad").arg("-o").arg(&csg).arg(scad).output();
+    match run {
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Err(format!(
+            "{}: showing a .scad file needs OpenSCAD: `openscad` is not on the PATH (install it, or open the .csg \
+             that `openscad -o model.csg model.scad` writes)",
+            scad.display()
+        )),
+        Err(e) => Err(format!("{}: openscad: {e}", scad.display())),
+        Ok(out) if !out.status.success() || !csg.exists() => {
+            let said = String::from_utf8_lossy(&out.stderr);
+            let errors: Vec<&str> = said.lines().filter(|l| l.contains("ERROR") || l.contains("WARNING")).collect();
+            let shown = if errors.is_empty() { said.trim().to_string() } else { errors.join("\n") };
+            Err(format!("{}: openscad failed:\n{shown}", scad.display()))
+        }
+        Ok(_) => Ok(csg),
     }
 }
 
@@ -96,6 +137,19 @@ mod tests {
         assert!(e.contains("broken.toml:2:"), "{e}");
         let e = Source { path: Some(dir.join("notes.txt")) }.load(&Toggles::default()).unwrap_err();
         assert!(e.contains("kage view opens"), "{e}");
+        let scad = dir.join("part.scad");
+        std::fs::write(&scad, "cube([1, 2, 3]);\n").unwrap();
+        let loaded = Source { path: Some(scad) }.load(&Toggles::default());
+        match loaded {
+            Ok(scene) => assert!(!scene.objects.is_empty(), "OpenSCAD's cube is shown"),
+            Err(e) => assert!(e.contains("`openscad` is not on the PATH"), "{e}"),
+        }
+        std::fs::write(dir.join("bad.scad"), "cube([1, 2, 3]\n").unwrap();
+        let loaded = Source { path: Some(dir.join("bad.scad")) }.load(&Toggles::default());
+        match loaded {
+            Ok(_) => panic!("a .scad that does not parse loads"),
+            Err(e) => assert!(e.contains("openscad failed") || e.contains("not on the PATH"), "{e}"),
+        }
         assert!(Source { path: None }.load(&Toggles::default()).is_ok(), "the demo loads");
         assert!(Source::is_watched(Path::new("a/part.STL")) && !Source::is_watched(Path::new("notes.txt")));
         std::fs::remove_dir_all(&dir).ok();

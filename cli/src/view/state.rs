@@ -250,6 +250,9 @@ pub struct Viewer {
     pub size: (u32, u32),
     /// The last load's error, shown over the last good scene.
     pub error: Option<String>,
+    /// Whether the scene's own shadows cost more than plain maps (jittered
+    /// maps, silhouette-line buffers, two-map soft shadows).
+    pub costly_scene: bool,
     /// The next step of the refinement; `None` when it is done.
     next: Option<Step>,
 }
@@ -269,6 +272,7 @@ impl Viewer {
             help: false,
             size,
             error: None,
+            costly_scene: false,
             next: Some(Step::Quick),
         }
     }
@@ -374,7 +378,8 @@ impl Viewer {
     /// Whether the quick frame would render the same as the full one (no
     /// edge pass wanted, no costlier shadows).
     fn quick_is_full(&self) -> bool {
-        self.toggles.smoothing == Smoothing::None && !self.toggles.shadows.costly()
+        let scene_costly = self.toggles.shadows == Shadows::Scene && self.costly_scene;
+        self.toggles.smoothing == Smoothing::None && !self.toggles.shadows.costly() && !scene_costly
     }
 
     fn after_full(&self) -> Option<Step> {
@@ -449,6 +454,13 @@ mod tests {
         assert_eq!((v.step(), v.step(), v.step()), (Some(Step::Quick), Some(Step::Full), None));
         v.toggles.smoothing = Smoothing::None;
         v.toggles.shadows = Shadows::All(ShadowMethod::Soft);
+        v.apply(Input::Wheel(1.0));
+        assert_eq!((v.step(), v.step(), v.step()), (Some(Step::Quick), Some(Step::Full), None));
+        // The scene's own jittered lights count as costly too.
+        v.toggles.shadows = Shadows::Scene;
+        v.apply(Input::Wheel(1.0));
+        assert_eq!((v.step(), v.step()), (Some(Step::Quick), None));
+        v.costly_scene = true;
         v.apply(Input::Wheel(1.0));
         assert_eq!((v.step(), v.step(), v.step()), (Some(Step::Quick), Some(Step::Full), None));
     }

@@ -46,6 +46,8 @@ pub struct Start {
     pub script: Vec<Action>,
     /// Worker threads.
     pub threads: Option<usize>,
+    /// Print frame timings when the window closes.
+    pub timings: bool,
 }
 
 /// Runs the viewer until its window closes.
@@ -54,10 +56,60 @@ pub struct Start {
 ///
 /// When no window can be opened (no display) or the event loop fails.
 pub fn run(start: Start) -> Result<(), String> {
+    let started = Instant::now();
     let event_loop = EventLoop::<Wake>::with_user_event().build().map_err(|e| format!("no window: {e}"))?;
+    let timings = start.timings;
     let mut app = App::new(start, event_loop.create_proxy());
+    app.clock.started = started;
     event_loop.run_app(&mut app).map_err(|e| e.to_string())?;
+    if timings {
+        println!("{}", app.clock.summary());
+    }
     app.failure.map_or(Ok(()), Err)
+}
+
+/// When frames were shown: for `--timings` and benchmarks.
+#[derive(Debug)]
+struct Clock {
+    started: Instant,
+    first_image: Option<Duration>,
+    /// Milliseconds of each quick frame (while the camera moves).
+    quick_ms: Vec<f64>,
+    /// The last input that started the refinement over.
+    last_input: Option<Instant>,
+    /// From an input to the refinement's end, each time it ended.
+    to_rest: Vec<Duration>,
+}
+
+impl Clock {
+    fn new() -> Clock {
+        Clock {
+            started: Instant::now(),
+            first_image: None,
+            quick_ms: Vec::new(),
+            last_input: None,
+            to_rest: Vec::new(),
+        }
+    }
+
+    /// A line of figures: time to the first image, quick frames (median ms
+    /// and frames per second), input to fully refined (last and median).
+    fn summary(&self) -> String {
+        let mut quick = self.quick_ms.clone();
+        quick.sort_by(f64::total_cmp);
+        let median_quick = quick.get(quick.len() / 2).copied().unwrap_or(f64::NAN);
+        let mut rest: Vec<f64> = self.to_rest.iter().map(|d| d.as_secs_f64() * 1e3).collect();
+        rest.sort_by(f64::total_cmp);
+        format!(
+            "first image {:.0} ms; {} quick frames, median {median_quick:.1} ms ({:.1} fps); refined {} times, median \
+             {:.0} ms after the input",
+            self.first_image.map_or(f64::NAN, |d| d.as_secs_f64() * 1e3),
+            quick.len(),
+            1e3 / median_quick,
+            rest.len(),
+            rest.get(rest.len() / 2).copied().unwrap_or(f64::NAN)
+        )
+    }
 }
 
 /// The mouse: where it was and which buttons are held.
@@ -92,6 +144,7 @@ struct App {
     step: Option<Step>,
     screenshots: u32,
     failure: Option<String>,
+    clock: Clock,
     /// The window's contents as last presented (0RGB), and their size.
     presented: (Vec<u32>, usize, usize),
 }
@@ -125,6 +178,7 @@ impl App {
             step: None,
             screenshots: 0,
             failure: None,
+            clock: Clock::new(),
             presented: (Vec::new(), 0, 0),
         };
         app.watch();
@@ -154,7 +208,11 @@ impl App {
     }
 
     fn input(&mut self, event_loop: &ActiveEventLoop, input: Input) {
-        match self.viewer.apply(input) {
+        let request = self.viewer.apply(input);
+        if matches!(request, Request::Render | Request::Reload | Request::Open(_)) {
+            self.clock.last_input = Some(Instant::now());
+        }
+        match request {
             Request::Nothing | Request::Render => {}
             Request::Redraw => self.request_redraw(),
             Request::Reload => self.reload(false),
@@ -184,6 +242,7 @@ impl App {
                 } else if let Some(bounds) = scene.bounds() {
                     self.viewer.bounds = bounds;
                 }
+                self.viewer.costly_scene = scene.lights.iter().any(super::refine::costly);
                 self.viewer.error = None;
                 self.scene = Some(scene);
             }
@@ -224,7 +283,8 @@ impl App {
         }
     }
 
-    /// Runs the script's actions that are due; false while it waits.
+    /// Runs the script's actions that are due, up to its next input (one a
+    /// frame) or until it waits.
     fn run_script(&mut self, event_loop: &ActiveEventLoop) {
         while let Some(action) = self.script.front().cloned() {
             if let Some(until) = self.sleep_until {
@@ -242,7 +302,13 @@ impl App {
                     self.sleep_until = Some(Instant::now() + Duration::from_secs_f32(s));
                     continue;
                 }
-                Action::Input(input) => self.input(event_loop, input),
+                Action::Input(input) => {
+                    // One input a frame, as a user's events arrive: the
+                    // frame it asks for renders before the next.
+                    self.script.pop_front();
+                    self.input(event_loop, input);
+                    return;
+                }
                 Action::Screenshot(path) => self.screenshot(&path),
                 Action::Capture(path) => self.capture(&path),
                 Action::Copy(from, to) => {
@@ -269,7 +335,16 @@ impl App {
             self.viewer.error = Some(e.to_string());
             while self.viewer.step().is_some() {}
         }
-        self.frame_times.push_back(start.elapsed().as_secs_f64());
+        let took = start.elapsed();
+        self.frame_times.push_back(took.as_secs_f64());
+        if step == Step::Quick {
+            self.clock.quick_ms.push(took.as_secs_f64() * 1e3);
+        }
+        if self.viewer.at_rest() {
+            if let Some(at) = self.clock.last_input.take() {
+                self.clock.to_rest.push(at.elapsed());
+            }
+        }
         if self.frame_times.len() > 10 {
             self.frame_times.pop_front();
         }
@@ -314,13 +389,16 @@ impl App {
             self.text.draw(&mut buffer, (bw, bh), (8, y), &lines, ERROR_COLOUR);
         }
         self.presented = (buffer.to_vec(), bw, bh);
-        buffer.present().ok();
+        if buffer.present().is_ok() && iw > 0 && self.clock.first_image.is_none() {
+            self.clock.first_image = Some(self.clock.started.elapsed());
+        }
     }
 }
 
 /// A viewer of `scene` (or of nothing) in a window of `size`.
 fn viewer_for(scene: Option<&Scene>, size: (u32, u32)) -> Viewer {
     let bounds = scene.and_then(Scene::bounds).unwrap_or((glam::Vec3::splat(-1.0), glam::Vec3::ONE));
+    let costly = scene.is_some_and(|s| s.lights.iter().any(super::refine::costly));
     let orbit = scene.map_or_else(
         || Orbit {
             target: glam::Vec3::ZERO,
@@ -331,7 +409,9 @@ fn viewer_for(scene: Option<&Scene>, size: (u32, u32)) -> Viewer {
         },
         |s| Orbit::from_camera(&s.camera),
     );
-    Viewer::new(orbit, bounds, size)
+    let mut viewer = Viewer::new(orbit, bounds, size);
+    viewer.costly_scene = costly;
+    viewer
 }
 
 fn hud_lines(viewer: &Viewer, refiner: &Refiner, step: Option<Step>, times: &VecDeque<f64>) -> Vec<String> {
@@ -355,7 +435,7 @@ fn hud_lines(viewer: &Viewer, refiner: &Refiner, step: Option<Step>, times: &Vec
             "ms: visibility {:.1}  shadows {:.1}  shading {:.1}  traced {:.1}  edges {:.1}",
             st.visibility_ms, st.shadow_ms, st.shading_ms, st.traced_ms, st.edge_ms
         ),
-        format!("{} triangles  {} passes averaged", shown.triangles, shown.passes),
+        format!("{} triangles  {} solids  {} passes averaged", st.raster.triangles, st.raster.solids, shown.passes),
         format!(
             "shadows {}  smoothing {smoothing}  show {}{}",
             viewer.toggles.shadows.name(),
