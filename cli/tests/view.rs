@@ -152,33 +152,58 @@ fn a_broken_scene_file_keeps_the_window_and_draws_the_error() {
 }
 
 /// Left to rest, the progressive refinement averages 64 jittered passes:
-/// the demo as `kage render --antialias jitter:64` renders it. The window
-/// with the HUD and the keys is the README's picture (written there when
-/// `KAGE_UPDATE_DOCS` is set).
+/// a scene without area lights as `kage render --antialias jitter:64`
+/// renders it.
 #[test]
-fn the_refined_demo_equals_64_jittered_passes() {
+fn the_refined_image_equals_64_jittered_passes() {
     if !have_xvfb() {
         return;
     }
     let dir = scratch("refined");
+    let file = dir.join("scene.toml");
+    std::fs::write(&file, scene("cube", "[0.3, 0.7, 0.3]")).unwrap();
+    std::fs::write(dir.join("run.script"), "wait\nscreenshot shot.png\nquit\n").unwrap();
+    let (ok, out) = view(&[file.to_str().unwrap(), "--script", dir.join("run.script").to_str().unwrap()]);
+    assert!(ok, "{out}");
+    let reference = dir.join("render.png");
+    kage(&["render", file.to_str().unwrap(), "--antialias", "jitter:64", "-o", reference.to_str().unwrap()]);
+    let e = rmse(&read(&dir.join("shot.png")), &read(&reference));
+    assert!(e < 1e-3, "RMSE {e}");
+}
+
+/// The demo's lights have a size: its refined passes shadow each from a
+/// point of the disc of its own (64 in all), where `jitter:64` repeats the
+/// light's 8 in every pass — the same image but for the penumbrae' finer
+/// grain (measured: RMSE 0.004, 1.7% of pixels off by more than 1%). The
+/// window with the HUD and the keys is the README's picture (written there
+/// when `KAGE_UPDATE_DOCS` is set).
+#[test]
+fn the_refined_demo_differs_from_64_jittered_passes_only_in_its_penumbrae() {
+    if !have_xvfb() {
+        return;
+    }
+    let dir = scratch("demo");
     std::fs::write(dir.join("run.script"), "wait\nscreenshot shot.png\nkey h\ncapture window.png\nquit\n").unwrap();
-    let (ok, out) = view(&["--width", "960", "--height", "540", "--script", dir.join("run.script").to_str().unwrap()]);
+    let (ok, out) = view(&["--width", "480", "--height", "270", "--script", dir.join("run.script").to_str().unwrap()]);
     assert!(ok, "{out}");
     let reference = dir.join("render.png");
     kage(&[
         "render",
         "--width",
-        "960",
+        "480",
         "--height",
-        "540",
+        "270",
         "--antialias",
         "jitter:64",
         "-o",
         reference.to_str().unwrap(),
     ]);
     let e = rmse(&read(&dir.join("shot.png")), &read(&reference));
-    assert!(e < 1e-3, "RMSE {e}");
+    assert!(e < 0.01, "RMSE {e}");
     if std::env::var_os("KAGE_UPDATE_DOCS").is_some() {
+        let (ok, out) =
+            view(&["--width", "960", "--height", "540", "--script", dir.join("run.script").to_str().unwrap()]);
+        assert!(ok, "{out}");
         let docs = Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/images/view.png");
         std::fs::copy(dir.join("window.png"), &docs).unwrap();
         eprintln!("wrote {}", docs.display());

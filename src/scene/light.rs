@@ -229,6 +229,11 @@ pub struct ShadowSettings {
     pub blockers: u32,
     /// PCSS: taps of the filter.
     pub filter: u32,
+    /// Jittered maps: only the disc point of this number (1 to `samples`)
+    /// instead of all of them, so that `samples` frames, each with its own
+    /// point, averaged, give the light's whole soft shadow (a progressive
+    /// viewer's passes); `None`: every point in every frame.
+    pub only_sample: Option<u32>,
 }
 
 impl Default for ShadowSettings {
@@ -246,7 +251,7 @@ impl Light {
     /// still lit once, from its centre ([`crate::shading::FrameLight`]). Any other
     /// light is itself. The disc points are
     /// stratified (Halton 2, 3 through an area-preserving square-to-disc map), the
-    /// same on every frame.
+    /// same on every frame; [`ShadowSettings::only_sample`] keeps one of them.
     #[must_use]
     pub fn jittered(&self, towards: Vec3) -> Vec<Light> {
         let n = self.shadow.samples.max(1);
@@ -259,7 +264,11 @@ impl Light {
         }
         let axis = (towards - position).normalize_or(Vec3::NEG_Y);
         let (u, v) = axis.any_orthonormal_pair();
-        (1..=n)
+        let points = match self.shadow.only_sample {
+            Some(k) => (k.clamp(1, n))..=(k.clamp(1, n)),
+            None => 1..=n,
+        };
+        points
             .map(|i| {
                 let d = crate::sampling::concentric_disc(glam::Vec2::new(
                     crate::sampling::radical_inverse(i, 2),
@@ -301,6 +310,7 @@ impl ShadowSettings {
         points: PenumbraPoints::Matched,
         blockers: 16,
         filter: 16,
+        only_sample: None,
     };
 
     /// The silhouette-line buffer's defaults: a 1024² map, 8-bit lines, scale
@@ -361,5 +371,30 @@ impl Light {
             Falloff::InverseSquare => 1.0 / dist2,
         };
         Incident { to_light: d / dist2.sqrt(), radiance: scale * att }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `only_sample = k` keeps the k-th of the disc points every frame would
+    /// otherwise use, so frames 1..=n between them visit them all.
+    #[test]
+    fn one_sample_is_the_kth_of_the_whole_set() {
+        let light = Light {
+            size: 0.3,
+            shadow: ShadowSettings { samples: 16, ..ShadowSettings::MAP },
+            kind: LightKind::Point { position: Vec3::new(0.0, 5.0, 0.0) },
+            ..Light::default()
+        };
+        let all = light.jittered(Vec3::ZERO);
+        assert_eq!(all.len(), 16);
+        for k in 1..=16 {
+            let one = Light { shadow: ShadowSettings { only_sample: Some(k), ..light.shadow }, ..light.clone() };
+            let picked = one.jittered(Vec3::ZERO);
+            assert_eq!(picked.len(), 1);
+            assert_eq!(picked[0].kind, all[k as usize - 1].kind, "point {k}");
+        }
     }
 }

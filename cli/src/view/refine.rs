@@ -103,7 +103,8 @@ impl Refiner {
 /// `base` as `viewer` and `step` set it up: the orbit's camera at the
 /// window's size, the toggles' shadows, smoothing, fog; a quick step with
 /// plain maps in place of costlier shadows and no edge pass; a jittered pass
-/// shifted to its sub-pixel point (those of `--antialias jitter:64`).
+/// shifted to its sub-pixel point (those of `--antialias jitter:64`), each
+/// jittered light shadowed from that pass's own point of its disc.
 #[must_use]
 pub fn scene_for(base: &Scene, viewer: &Viewer, step: Step) -> Scene {
     let mut scene = base.clone();
@@ -142,8 +143,16 @@ pub fn scene_for(base: &Scene, viewer: &Viewer, step: Step) -> Scene {
         _ => Antialias::None,
     };
     if let Step::Pass(n) = step {
-        let offset = Antialias::Jitter(MAX_PASSES).offsets()[(n.clamp(1, MAX_PASSES) - 1) as usize];
+        let n = n.clamp(1, MAX_PASSES);
+        let offset = Antialias::Jitter(MAX_PASSES).offsets()[(n - 1) as usize];
         scene.camera = shifted(&scene.camera, offset, viewer.size);
+        // A jittered light is shadowed from one point of its disc a pass, a
+        // new one each pass: 64 passes average 64 points, for the cost of one
+        // map a pass instead of all of them.
+        for light in scene.lights.iter_mut().filter(|l| jittered(l)) {
+            light.shadow.samples = MAX_PASSES;
+            light.shadow.only_sample = Some(n);
+        }
     }
     scene
 }
@@ -152,8 +161,12 @@ pub fn scene_for(base: &Scene, viewer: &Viewer, step: Step) -> Scene {
 /// over its disc, a silhouette-line buffer, the two-map soft term).
 #[must_use]
 pub fn costly(light: &Light) -> bool {
-    let jittered = light.size > 0.0 && light.shadow.samples > 1 && light.shadow.method == ShadowMethod::Map;
-    jittered || matches!(light.shadow.method, ShadowMethod::Slb | ShadowMethod::Soft)
+    jittered(light) || matches!(light.shadow.method, ShadowMethod::Slb | ShadowMethod::Soft)
+}
+
+/// Whether a light's soft shadow comes from maps jittered over its disc.
+fn jittered(light: &Light) -> bool {
+    light.size > 0.0 && light.shadow.samples > 1 && matches!(light.shadow.method, ShadowMethod::Map | ShadowMethod::Slb)
 }
 
 /// `camera` with its image shifted by `offset` pixels (y down).
