@@ -374,14 +374,16 @@ impl App {
                 }
             }
         }
+        let mut below_hud = 8;
         if self.viewer.hud {
             let lines = hud_lines(&self.viewer, &self.refiner, self.step, &self.frame_times);
             self.text.draw(&mut buffer, (bw, bh), (8, 8), &lines, 0x00e0_e0e0);
+            below_hud += self.text.size(&lines).1 + 8;
         }
         if self.viewer.help {
             let sheet = cheat_sheet();
             let x = bw.saturating_sub(self.text.size(&sheet).0 + 8);
-            self.text.draw(&mut buffer, (bw, bh), (x, 8), &sheet, 0x00ff_ffff);
+            self.text.draw(&mut buffer, (bw, bh), (x, below_hud), &sheet, 0x00ff_ffff);
         }
         if let Some(e) = &self.viewer.error {
             let lines: Vec<String> = e.lines().map(str::to_string).collect();
