@@ -288,7 +288,7 @@ pub fn run_random(args: &RandomArgs) -> Result<()> {
 }
 
 /// OpenSCAD's preview seconds per model, from the peers' TIMINGS.md table.
-fn openscad_preview_seconds(peers: &Path) -> std::collections::HashMap<String, f64> {
+pub(crate) fn openscad_preview_seconds(peers: &Path) -> std::collections::HashMap<String, f64> {
     let text = std::fs::read_to_string(peers.join("openscad/TIMINGS.md")).unwrap_or_default();
     text.lines()
         .filter_map(|l| {

@@ -30,6 +30,9 @@ pub struct ViewArgs {
     /// Frames of the orbit.
     #[arg(long, default_value_t = 120)]
     orbit: u32,
+    /// Only scenes whose name contains this (`scad`: only the saved `.scad`).
+    #[arg(long)]
+    only: Option<String>,
 }
 
 /// What a viewer did on one scene.
@@ -41,6 +44,8 @@ struct Run {
     frame_ms: f64,
     /// From the last input to the fully refined image, ms (kage only).
     refined_ms: Option<f64>,
+    /// From an input (a file saved) to the next image, ms (kage only).
+    new_image_ms: Option<f64>,
 }
 
 /// The scenes: a name, kage's file, and the file f3d opens (none for
@@ -75,12 +80,20 @@ fn scenes(c: &Common) -> Vec<(String, PathBuf, Option<PathBuf>)> {
 
 /// Runs kage's window on `file` (the demo when empty) through the orbit.
 fn kage_run(kage: &Path, file: &Path, c: &Common, orbit: u32) -> Result<Run> {
-    let dir = std::env::temp_dir().join(format!("kage-bench-view-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).into_diagnostic()?;
-    let script = dir.join("orbit.script");
     let mut text = String::from("wait\n");
     text += &"drag left 7.5 0\n".repeat(orbit as usize);
     text += "wait\nquit\n";
+    kage_scripted(kage, file, c, &text)
+}
+
+/// Runs kage's window on `file` (the demo when empty) with the script
+/// `text` (paths in it relative to `file`'s folder): its timings.
+fn kage_scripted(kage: &Path, file: &Path, c: &Common, text: &str) -> Result<Run> {
+    let dir = match file.parent() {
+        Some(p) if !p.as_os_str().is_empty() && !file.as_os_str().is_empty() => p.to_path_buf(),
+        _ => std::env::temp_dir(),
+    };
+    let script = dir.join(format!("kage-bench-view-{}.script", std::process::id()));
     std::fs::write(&script, text).into_diagnostic()?;
     let mut cmd = Command::new("xvfb-run");
     cmd.args(["-a", "-s", "-screen 0 1920x1080x24"]).arg(kage).arg("view");
@@ -89,22 +102,64 @@ fn kage_run(kage: &Path, file: &Path, c: &Common, orbit: u32) -> Result<Run> {
     }
     cmd.args(["--width", &c.width.to_string(), "--height", &c.height.to_string(), "--timings", "--script"]);
     let out = cmd.arg(&script).output().into_diagnostic()?;
+    std::fs::remove_file(&script).ok();
     let said = String::from_utf8_lossy(&out.stdout);
     if !out.status.success() {
         return Err(miette!("kage view {}: {}{}", file.display(), said, String::from_utf8_lossy(&out.stderr)));
     }
     let line = said.lines().find(|l| l.starts_with("first image")).ok_or_else(|| miette!("no timings: {said}"))?;
-    let number_after = |key: &str| -> Option<f64> {
-        let rest = &line[line.find(key)? + key.len()..];
-        rest.trim_start().split(|c: char| !(c.is_ascii_digit() || c == '.')).next()?.parse().ok()
-    };
     Ok(Run {
-        first_ms: number_after("first image").unwrap_or(f64::NAN),
-        frame_ms: number_after("median").unwrap_or(f64::NAN),
-        refined_ms: line
-            .rfind("median")
-            .and_then(|i| line[i + "median".len()..].trim_start().split(' ').next().and_then(|n| n.parse().ok())),
+        first_ms: number_after(line, "first image", "").unwrap_or(f64::NAN),
+        frame_ms: number_after(line, "quick frames", "median").unwrap_or(f64::NAN),
+        refined_ms: number_after(line, "refined", "median"),
+        new_image_ms: number_after(line, "new image", "median"),
     })
+}
+
+/// The number after `key` (and then after `then`, when not empty) in `line`.
+fn number_after(line: &str, key: &str, then: &str) -> Option<f64> {
+    let mut rest = &line[line.find(key)? + key.len()..];
+    if !then.is_empty() {
+        rest = &rest[rest.find(then)? + then.len()..];
+    }
+    rest.trim_start().split(|c: char| !(c.is_ascii_digit() || c == '.')).next()?.parse().ok()
+}
+
+/// The median corpus model's `.scad` saved again while `kage view` shows it:
+/// milliseconds from the change reaching the window to the new image
+/// (`openscad -o` to `.csg`, the load, the first frame), beside OpenSCAD's
+/// own preview of the model (the peers' TIMINGS.md).
+fn saved_scad(kage: &Path, c: &Common) -> Result<()> {
+    let Ok(Some(csg)) = crate::share::median_csg(&c.assets().join("csg"), (c.width, c.height), 3) else {
+        return Ok(());
+    };
+    let scad = csg.with_extension("scad");
+    if !scad.exists() || Command::new("openscad").arg("--version").output().is_err() {
+        eprintln!("skipped the .scad row (no {} or no openscad)", scad.display());
+        return Ok(());
+    }
+    let dir = std::env::temp_dir().join(format!("kage-bench-scad-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).into_diagnostic()?;
+    let model = dir.join("model.scad");
+    std::fs::copy(&scad, &model).into_diagnostic()?;
+    std::fs::copy(&scad, dir.join("saved.scad")).into_diagnostic()?;
+    let run = kage_scripted(kage, &model, c, "wait\ncopy saved.scad model.scad\nsleep 2\nwait\nquit\n")?;
+    let name = scad.file_stem().unwrap_or_default().to_string_lossy().into_owned();
+    let theirs = crate::csg::openscad_preview_seconds(&c.peers()).get(&name).copied();
+    println!("\n| model | kage: .scad saved → new image, ms | OpenSCAD 2021.01 preview, ms |");
+    println!("|---|---:|---:|");
+    println!(
+        "| {name}.scad | {} | {} |",
+        run.new_image_ms.map_or("–".to_string(), |v| format!("{v:.0}")),
+        theirs.map_or("–".to_string(), |s| format!("{:.0}", s * 1e3))
+    );
+    println!(
+        "\nkage: from the file watcher's event to the next image shown — `openscad -o model.csg model.scad`, the \
+         load, the first (quick) frame. OpenSCAD: `openscad --preview` of the same model to a 640×480 PNG, start-up \
+         included (../shared/peers/openscad/TIMINGS.md, the same kind of machine)."
+    );
+    std::fs::remove_dir_all(&dir).ok();
+    Ok(())
 }
 
 /// f3d's script: launch to first image, then the orbit's median frame.
@@ -141,7 +196,7 @@ fn f3d_run(python: &Path, file: &Path, c: &Common, orbit: u32) -> Option<Run> {
     }
     let said = String::from_utf8_lossy(&out.stdout);
     let mut v = said.split_whitespace().filter_map(|n| n.parse::<f64>().ok());
-    Some(Run { first_ms: v.next()?, frame_ms: v.next()?, refined_ms: None })
+    Some(Run { first_ms: v.next()?, frame_ms: v.next()?, refined_ms: None, new_image_ms: None })
 }
 
 /// Prints the table.
@@ -160,6 +215,9 @@ pub fn run(args: &ViewArgs) -> Result<()> {
     );
     println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|");
     for (name, file, f3d_file) in scenes(c) {
+        if args.only.as_ref().is_some_and(|o| !name.contains(o.as_str())) {
+            continue;
+        }
         let ours = kage_run(&kage, &file, c, args.orbit)?;
         let theirs = f3d_file.as_deref().and_then(|f| f3d_run(&args.python, f, c, args.orbit));
         let cell = |v: Option<f64>, digits: usize| v.map_or("–".to_string(), |v| format!("{v:.digits$}"));
@@ -174,6 +232,9 @@ pub fn run(args: &ViewArgs) -> Result<()> {
             cell(theirs.map(|t| 1e3 / t.frame_ms), 1),
             cell(theirs.map(|t| t.frame_ms / ours.frame_ms), 1),
         );
+    }
+    if args.only.as_ref().is_none_or(|o| o.contains("scad")) {
+        saved_scad(&kage, c)?;
     }
     println!(
         "\n{0}×{1}, 2 threads. kage: `kage view FILE --script` under Xvfb, {2} drags of 3° (one frame each: a quick \

@@ -79,6 +79,10 @@ struct Clock {
     last_input: Option<Instant>,
     /// From an input to the refinement's end, each time it ended.
     to_rest: Vec<Duration>,
+    /// The last input no frame has been shown for yet.
+    unanswered: Option<Instant>,
+    /// From an input to the first frame rendered after it.
+    to_image: Vec<Duration>,
 }
 
 impl Clock {
@@ -89,25 +93,29 @@ impl Clock {
             quick_ms: Vec::new(),
             last_input: None,
             to_rest: Vec::new(),
+            unanswered: None,
+            to_image: Vec::new(),
         }
     }
 
     /// A line of figures: time to the first image, quick frames (median ms
-    /// and frames per second), input to fully refined (last and median).
+    /// and frames per second), input to fully refined and input to the next
+    /// image (medians).
     fn summary(&self) -> String {
-        let mut quick = self.quick_ms.clone();
-        quick.sort_by(f64::total_cmp);
-        let median_quick = quick.get(quick.len() / 2).copied().unwrap_or(f64::NAN);
-        let mut rest: Vec<f64> = self.to_rest.iter().map(|d| d.as_secs_f64() * 1e3).collect();
-        rest.sort_by(f64::total_cmp);
+        let median = |mut v: Vec<f64>| {
+            v.sort_by(f64::total_cmp);
+            (v.len(), v.get(v.len() / 2).copied().unwrap_or(f64::NAN))
+        };
+        let ms = |d: &[Duration]| d.iter().map(|d| d.as_secs_f64() * 1e3).collect::<Vec<f64>>();
+        let (quick, median_quick) = median(self.quick_ms.clone());
+        let (rested, rest) = median(ms(&self.to_rest));
+        let (answered, answer) = median(ms(&self.to_image));
         format!(
-            "first image {:.0} ms; {} quick frames, median {median_quick:.1} ms ({:.1} fps); refined {} times, median \
-             {:.0} ms after the input",
+            "first image {:.0} ms; {quick} quick frames, median {median_quick:.1} ms ({:.1} fps); refined {rested} \
+             times, median {rest:.0} ms after the input; new image {answered} times, median {answer:.0} ms after the \
+             input",
             self.first_image.map_or(f64::NAN, |d| d.as_secs_f64() * 1e3),
-            quick.len(),
             1e3 / median_quick,
-            rest.len(),
-            rest.get(rest.len() / 2).copied().unwrap_or(f64::NAN)
         )
     }
 }
@@ -211,6 +219,7 @@ impl App {
         let request = self.viewer.apply(input);
         if matches!(request, Request::Render | Request::Reload | Request::Open(_)) {
             self.clock.last_input = Some(Instant::now());
+            self.clock.unanswered = self.clock.unanswered.or(self.clock.last_input);
         }
         match request {
             Request::Nothing | Request::Render => {}
@@ -339,6 +348,9 @@ impl App {
         self.frame_times.push_back(took.as_secs_f64());
         if step == Step::Quick {
             self.clock.quick_ms.push(took.as_secs_f64() * 1e3);
+        }
+        if let Some(at) = self.clock.unanswered.take() {
+            self.clock.to_image.push(at.elapsed());
         }
         if self.viewer.at_rest() {
             if let Some(at) = self.clock.last_input.take() {
