@@ -71,9 +71,12 @@ pub fn framed_camera(bounds: (Vec3, Vec3), aspect: f32, view: View, fov_y_deg: f
     fit_depth(camera, bounds)
 }
 
-/// +y, or for a view from straight above or below (where +y is the view
-/// axis) the direction the view's azimuth turns away from.
-fn up_for(dir: Vec3, view: View) -> Vec3 {
+/// The up direction of a camera looking from `view` (`dir`, its
+/// [`View::direction`]): +y, or for a view from straight above or below
+/// (where +y is the view axis) the direction the view's azimuth turns away
+/// from.
+#[must_use]
+pub fn up_for(dir: Vec3, view: View) -> Vec3 {
     if dir.cross(Vec3::Y).length_squared() > 1e-6 {
         Vec3::Y
     } else {

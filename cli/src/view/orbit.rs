@@ -5,7 +5,7 @@
 
 use glam::{Vec2, Vec3};
 use kage::camera::{Camera, Projection};
-use kage::scene::framing::{fit_depth, framed_camera, View};
+use kage::scene::framing::{self, fit_depth, framed_camera, View};
 
 /// Degrees the view turns per pixel the mouse is dragged.
 pub const DEGREES_PER_PIXEL: f32 = 0.4;
@@ -131,16 +131,9 @@ fn wrap_degrees(d: f32) -> f32 {
     }
 }
 
-/// +y, or for a view from straight above or below, the direction its
-/// azimuth turns away from.
+/// The up direction of a camera looking from `view`.
 fn up_for(view: View) -> Vec3 {
-    let dir = view.direction();
-    if dir.cross(Vec3::Y).length_squared() > 1e-6 {
-        Vec3::Y
-    } else {
-        let az = view.azimuth_deg.to_radians();
-        -Vec3::new(az.sin(), 0.0, az.cos()) * dir.y.signum()
-    }
+    framing::up_for(view.direction(), view)
 }
 
 #[cfg(test)]

@@ -3,7 +3,7 @@
 //! frame, jittered passes averaged), and what the window shows of the frame
 //! (the image, a component, the shadow term, depth, normals, items).
 
-use glam::{Vec2, Vec3};
+use glam::Vec3;
 use kage::image::{LinearImage, ToneCurve};
 use kage::scene::{Antialias, Light, Scene, ShadowMethod, ShadowSettings};
 use kage::shading::ComponentSet;
@@ -87,7 +87,8 @@ impl Refiner {
                     let mut mean = self.sum.clone();
                     let k = 1.0 / self.passes as f32;
                     mean.pixels_mut().iter_mut().for_each(|p| *p *= k);
-                    self.shown = Shown { image: mean, passes: self.passes, stats, ..self.shown.clone() };
+                    let (scale, tone) = (self.shown.scale, self.shown.tone);
+                    self.shown = Shown { image: mean, scale, tone, stats, passes: self.passes };
                 }
             }
             Step::Quick | Step::Full => {
@@ -145,7 +146,7 @@ pub fn scene_for(base: &Scene, viewer: &Viewer, step: Step) -> Scene {
     if let Step::Pass(n) = step {
         let n = n.clamp(1, MAX_PASSES);
         let offset = Antialias::Jitter(MAX_PASSES).offsets()[(n - 1) as usize];
-        scene.camera = shifted(&scene.camera, offset, viewer.size);
+        scene.camera = kage::resolve::jitter::shifted(&scene.camera, offset, viewer.size);
         // A jittered light is shadowed from one point of its disc a pass, a
         // new one each pass: 64 passes average 64 points, for the cost of one
         // map a pass instead of all of them.
@@ -167,12 +168,6 @@ pub fn costly(light: &Light) -> bool {
 /// Whether a light's soft shadow comes from maps jittered over its disc.
 fn jittered(light: &Light) -> bool {
     light.size > 0.0 && light.shadow.samples > 1 && matches!(light.shadow.method, ShadowMethod::Map | ShadowMethod::Slb)
-}
-
-/// `camera` with its image shifted by `offset` pixels (y down).
-fn shifted(camera: &kage::camera::Camera, offset: Vec2, (w, h): (u32, u32)) -> kage::camera::Camera {
-    let pixel = 2.0 / Vec2::new(w as f32, h as f32);
-    kage::camera::Camera { shift: camera.shift + Vec2::new(offset.x, -offset.y) * pixel, ..*camera }
 }
 
 /// What `display` shows of `frame` (rendered from `scene`), as linear colour.
