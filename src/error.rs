@@ -169,6 +169,10 @@ pub enum Error {
         /// The file.
         path: PathBuf,
     },
+    /// A frame was given up because its caller raised the stop flag
+    /// ([`crate::Renderer::render_or_stop`]).
+    #[error("the frame was stopped before it was done")]
+    Stopped,
     /// The output image could not be written.
     #[error("cannot write {}: {message}", path.display())]
     Output {

@@ -86,6 +86,24 @@ impl LinearImage {
         });
         out
     }
+
+    /// As [`LinearImage::to_srgb8_toned`], each pixel packed in a word as
+    /// window frame buffers take it (`0x00RRGGBB`), into `out` (resized to
+    /// the pixel count; its memory reused from call to call).
+    pub fn to_0rgb_toned_into(&self, scale: f32, tone: ToneCurve, out: &mut Vec<u32>) {
+        let encoder = &*SRGB8;
+        out.resize(self.pixels.len(), 0);
+        out.par_chunks_mut(1024).zip(self.pixels.par_chunks(1024)).for_each(|(out, pixels)| {
+            for (o, &p) in out.iter_mut().zip(pixels) {
+                let c = match tone {
+                    ToneCurve::Clip => p * scale,
+                    _ => tone.apply(p * scale),
+                };
+                let [r, g, b] = c.to_array().map(|v| u32::from(encoder.encode(v)));
+                *o = r << 16 | g << 8 | b;
+            }
+        });
+    }
 }
 
 /// The 8-bit sRGB code of a linear value in [0, 1] (clamped; NaN is 0):
@@ -177,6 +195,25 @@ mod tests {
         let odd = [-1.0, -0.0, 1.0, 1.5, f32::INFINITY, f32::NAN, f32::MIN_POSITIVE];
         for c in even.chain(starts).chain(odd) {
             assert_eq!(encoder.encode(c), curve(c), "linear {c} ({:#x})", c.to_bits());
+        }
+    }
+
+    /// The packed words hold the interleaved bytes' codes, for every tone
+    /// curve, and a reused buffer is resized to the image.
+    #[test]
+    fn packed_words_hold_the_interleaved_codes() {
+        let mut image = LinearImage::new(37, 3);
+        for (i, p) in image.pixels_mut().iter_mut().enumerate() {
+            *p = Vec3::new(i as f32 / 50.0, (i % 7) as f32 / 3.0, 1.0 - i as f32 / 111.0);
+        }
+        let mut words = vec![7; 5000];
+        for (_, tone) in ToneCurve::NAMES {
+            image.to_0rgb_toned_into(1.3, tone, &mut words);
+            let bytes = image.to_srgb8_toned(1.3, tone);
+            assert_eq!(words.len(), 111);
+            for (w, b) in words.iter().zip(bytes.chunks(3)) {
+                assert_eq!(*w, u32::from(b[0]) << 16 | u32::from(b[1]) << 8 | u32::from(b[2]));
+            }
         }
     }
 

@@ -4,7 +4,9 @@
 //!
 //! kage runs as a user runs it — `kage view FILE --script orbit --timings`
 //! under a virtual X server (Xvfb): 120 drags of 3° each, one frame each,
-//! then rest until the 64-pass image is done. f3d 4.0 (`pip install f3d`;
+//! then rest; 16 passes into the refinement an input (a zoom of no steps)
+//! gives up the pass rendering, and the refinement starts over and runs to
+//! its 64-pass image. f3d 4.0 (`pip install f3d`;
 //! the bench looks for it in the Python given by `--python`) loads the same
 //! model, turns its camera 3° per frame and renders each to an image. The
 //! two alternate, scene by scene, in one run.
@@ -46,6 +48,9 @@ struct Run {
     refined_ms: Option<f64>,
     /// From an input (a file saved) to the next image, ms (kage only).
     new_image_ms: Option<f64>,
+    /// From an input to the refinement step it made stale given up, ms
+    /// (kage only).
+    given_up_ms: Option<f64>,
 }
 
 /// The scenes: a name, kage's file, and the file f3d opens (none for
@@ -82,7 +87,7 @@ fn scenes(c: &Common) -> Vec<(String, PathBuf, Option<PathBuf>)> {
 fn kage_run(kage: &Path, file: &Path, c: &Common, orbit: u32) -> Result<Run> {
     let mut text = String::from("wait\n");
     text += &"drag left 7.5 0\n".repeat(orbit as usize);
-    text += "wait\nquit\n";
+    text += "wait 16\nwheel 0\nwait\nquit\n";
     kage_scripted(kage, file, c, &text)
 }
 
@@ -113,6 +118,7 @@ fn kage_scripted(kage: &Path, file: &Path, c: &Common, text: &str) -> Result<Run
         frame_ms: number_after(line, "quick frames", "median").unwrap_or(f64::NAN),
         refined_ms: number_after(line, "refined", "median"),
         new_image_ms: number_after(line, "new image", "median"),
+        given_up_ms: number_after(line, "given up", "median"),
     })
 }
 
@@ -196,7 +202,7 @@ fn f3d_run(python: &Path, file: &Path, c: &Common, orbit: u32) -> Option<Run> {
     }
     let said = String::from_utf8_lossy(&out.stdout);
     let mut v = said.split_whitespace().filter_map(|n| n.parse::<f64>().ok());
-    Some(Run { first_ms: v.next()?, frame_ms: v.next()?, refined_ms: None, new_image_ms: None })
+    Some(Run { first_ms: v.next()?, frame_ms: v.next()?, refined_ms: None, new_image_ms: None, given_up_ms: None })
 }
 
 /// Prints the table.
@@ -211,9 +217,10 @@ pub fn run(args: &ViewArgs) -> Result<()> {
     });
     println!(
         "| scene | kage first image ms | kage ms per orbit frame | kage fps | kage 64 passes done, ms after the last \
-         input | f3d first image ms | f3d ms per frame | f3d fps | kage fps / f3d fps |"
+         input | kage pass given up, ms after an input | f3d first image ms | f3d ms per frame | f3d fps | kage fps \
+         / f3d fps |"
     );
-    println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|");
+    println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
     for (name, file, f3d_file) in scenes(c) {
         if args.only.as_ref().is_some_and(|o| !name.contains(o.as_str())) {
             continue;
@@ -222,11 +229,12 @@ pub fn run(args: &ViewArgs) -> Result<()> {
         let theirs = f3d_file.as_deref().and_then(|f| f3d_run(&args.python, f, c, args.orbit));
         let cell = |v: Option<f64>, digits: usize| v.map_or("–".to_string(), |v| format!("{v:.digits$}"));
         println!(
-            "| {name} | {:.0} | {:.1} | {:.1} | {} | {} | {} | {} | {} |",
+            "| {name} | {:.0} | {:.1} | {:.1} | {} | {} | {} | {} | {} | {} |",
             ours.first_ms,
             ours.frame_ms,
             1e3 / ours.frame_ms,
             cell(ours.refined_ms, 0),
+            cell(ours.given_up_ms, 1),
             cell(theirs.map(|t| t.first_ms), 0),
             cell(theirs.map(|t| t.frame_ms), 1),
             cell(theirs.map(|t| 1e3 / t.frame_ms), 1),
@@ -238,7 +246,8 @@ pub fn run(args: &ViewArgs) -> Result<()> {
     }
     println!(
         "\n{0}×{1}, 2 threads. kage: `kage view FILE --script` under Xvfb, {2} drags of 3° (one frame each: a quick \
-         frame — no edge pass, plain maps for costlier shadows), then left to rest until 64 jittered passes are \
+         frame — no edge pass, plain maps for costlier shadows), then left to rest; after 16 jittered passes an \
+         input (a zoom of no steps) gives up the pass rendering, and the refinement runs again until 64 passes are \
          averaged; first image from the window's start (scene loaded, window open, first frame shown). f3d 4.0: \
          `f3d.Engine.create_egl()` offscreen on Mesa llvmpipe, the model added, `camera.azimuth(3)` and \
          `render_to_image()` per frame; first image from the interpreter's start. Medians over the orbit.",

@@ -153,7 +153,8 @@ fn a_broken_scene_file_keeps_the_window_and_draws_the_error() {
 
 /// Left to rest, the progressive refinement averages 64 jittered passes:
 /// a scene without area lights as `kage render --antialias jitter:64`
-/// renders it.
+/// renders it. Keys pressed halfway give up the step rendering (the
+/// refinement starts over and still ends on the same image).
 #[test]
 fn the_refined_image_equals_64_jittered_passes() {
     if !have_xvfb() {
@@ -162,13 +163,37 @@ fn the_refined_image_equals_64_jittered_passes() {
     let dir = scratch("refined");
     let file = dir.join("scene.toml");
     std::fs::write(&file, scene("cube", "[0.3, 0.7, 0.3]")).unwrap();
-    std::fs::write(dir.join("run.script"), "wait\nscreenshot shot.png\nquit\n").unwrap();
-    let (ok, out) = view(&[file.to_str().unwrap(), "--script", dir.join("run.script").to_str().unwrap()]);
+    std::fs::write(dir.join("run.script"), "wait 8\nkey r\nkey r\nwait\nscreenshot shot.png\nquit\n").unwrap();
+    let (ok, out) = view(&[file.to_str().unwrap(), "--timings", "--script", dir.join("run.script").to_str().unwrap()]);
     assert!(ok, "{out}");
+    let given_up = out.split(" steps given up").next().and_then(|s| s.rsplit(' ').next()).and_then(|n| n.parse().ok());
+    assert!(given_up.is_some_and(|n: u32| n >= 1), "a rendering step is given up for the keys: {out}");
     let reference = dir.join("render.png");
     kage(&["render", file.to_str().unwrap(), "--antialias", "jitter:64", "-o", reference.to_str().unwrap()]);
     let e = rmse(&read(&dir.join("shot.png")), &read(&reference));
     assert!(e < 1e-3, "RMSE {e}");
+}
+
+/// A file dropped on the window opens with its own camera, the toggles
+/// kept (here the edge pass): the screenshot is `kage render` of that file.
+#[test]
+fn a_dropped_file_opens() {
+    if !have_xvfb() {
+        return;
+    }
+    let dir = scratch("dropped");
+    let (first, other) = (dir.join("first.toml"), dir.join("other.toml"));
+    std::fs::write(&first, scene("sphere", "[0.8, 0.3, 0.2]")).unwrap();
+    let other_scene = scene("cube", "[0.2, 0.3, 0.8]").replace("eye = [2.0, 2.0, 4.0]", "eye = [-3.0, 1.5, 3.0]");
+    std::fs::write(&other, other_scene).unwrap();
+    let script = "key a\nkey a\nwait\ndrop other.toml\nwait\nscreenshot shot.png\nquit\n";
+    std::fs::write(dir.join("run.script"), script).unwrap();
+    let (ok, out) = view(&[first.to_str().unwrap(), "--script", dir.join("run.script").to_str().unwrap()]);
+    assert!(ok, "{out}");
+    let reference = dir.join("render.png");
+    kage(&["render", other.to_str().unwrap(), "-o", reference.to_str().unwrap()]);
+    let e = rmse(&read(&dir.join("shot.png")), &read(&reference));
+    assert!(e < 1e-3, "RMSE {e} against kage render of the dropped file");
 }
 
 /// The demo's lights have a size: its refined passes shadow each from a

@@ -16,6 +16,7 @@ mod budget;
 
 pub use budget::{MemoryNeeded, BYTES_PER_PIXEL, BYTES_PER_TRIANGLE};
 
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 use glam::{Vec2, Vec3};
@@ -51,6 +52,11 @@ pub struct RenderOptions {
     pub keep_shadow_maps: bool,
     /// Also write each light's shadow term on its own ([`Frame::shadows`]).
     pub shadow_images: bool,
+    /// Trace reflections and refraction at one pixel of each 2 × 2 block and
+    /// interpolate the others ([`crate::raytrace::traced::Refine::Sparse`]):
+    /// about a quarter of the traced term's rays, for the frames of a moving
+    /// camera. Ignored by edge-antialiased frames, which refine instead.
+    pub sparse_traced: bool,
 }
 
 impl Default for RenderOptions {
@@ -61,6 +67,7 @@ impl Default for RenderOptions {
             aovs: ComponentSet::EMPTY,
             keep_shadow_maps: true,
             shadow_images: false,
+            sparse_traced: false,
         }
     }
 }
@@ -215,6 +222,21 @@ impl Renderer {
         Ok(Renderer { pool, frame, options: *options, scratch: Scratch::default() })
     }
 
+    /// Renders the next frames as `options` say, keeping every buffer and
+    /// cache (a viewer's quick frames and refined ones differ in options,
+    /// not in scene).
+    ///
+    /// # Errors
+    ///
+    /// As [`Renderer::new`], when the thread count changes.
+    pub fn set_options(&mut self, options: &RenderOptions) -> Result<()> {
+        if options.threads != self.options.threads {
+            self.pool = thread_pool(options.threads)?;
+        }
+        self.options = *options;
+        Ok(())
+    }
+
     /// Renders `scene` (validated first) and returns the frame.
     ///
     /// # Errors
@@ -234,14 +256,33 @@ impl Renderer {
     ///
     /// As [`Renderer::render`].
     pub fn render_reporting(&mut self, scene: &Scene, progress: &(dyn Fn(u32, u32) + Sync)) -> Result<&Frame> {
+        self.render_watched(scene, progress, Stop(None))
+    }
+
+    /// As [`Renderer::render`], giving the frame up as soon as `stop` is
+    /// raised (by another thread: a viewer whose user moved on): checked
+    /// before each stage of each pass (visibility, shading with its shadow
+    /// maps, the traced term, fog and translucency with the edge pass), so
+    /// the call returns within one stage of the raise. The buffers are left
+    /// ready for the next frame.
+    ///
+    /// # Errors
+    ///
+    /// [`Error::Stopped`] when `stop` was raised before the frame was done;
+    /// otherwise as [`Renderer::render`].
+    pub fn render_or_stop(&mut self, scene: &Scene, stop: &AtomicBool) -> Result<&Frame> {
+        self.render_watched(scene, &|_, _| {}, Stop(Some(stop)))
+    }
+
+    fn render_watched(&mut self, scene: &Scene, progress: &(dyn Fn(u32, u32) + Sync), stop: Stop) -> Result<&Frame> {
         scene.validate()?;
         budget::check(scene)?;
         let (frame, scratch) = (&mut self.frame, &mut self.scratch);
         let options = &self.options;
         match &self.pool {
-            None => render_into(scene, frame, scratch, options, progress),
-            Some(pool) => pool.install(|| render_into(scene, frame, scratch, options, progress)),
-        }
+            None => render_into(scene, frame, scratch, options, progress, stop),
+            Some(pool) => pool.install(|| render_into(scene, frame, scratch, options, progress, stop)),
+        }?;
         Ok(&self.frame)
     }
 
@@ -282,13 +323,28 @@ pub fn render(scene: &Scene, options: &RenderOptions) -> Result<Frame> {
     Ok(r.into_frame())
 }
 
+/// A flag a caller may raise to give a frame up between its stages.
+#[derive(Debug, Clone, Copy)]
+struct Stop<'a>(Option<&'a AtomicBool>);
+
+impl Stop<'_> {
+    /// [`Error::Stopped`] once the flag is raised.
+    fn check(self) -> Result<()> {
+        match self.0 {
+            Some(flag) if flag.load(Ordering::Relaxed) => Err(Error::Stopped),
+            _ => Ok(()),
+        }
+    }
+}
+
 fn render_into(
     scene: &Scene,
     frame: &mut Frame,
     scratch: &mut Scratch,
     options: &RenderOptions,
     progress: &(dyn Fn(u32, u32) + Sync),
-) {
+    stop: Stop,
+) -> Result<()> {
     frame.stats = FrameStats::default();
     if !options.keep_shadow_maps {
         scratch.maps.forget();
@@ -300,12 +356,12 @@ fn render_into(
             Antialias::Edge(mode) => Some(EdgeOptions { mode, ..EdgeOptions::default() }),
             _ => None,
         };
-        render_pass(scene, frame, scratch, options, edges.as_ref());
+        render_pass(scene, frame, scratch, options, edges.as_ref(), stop)?;
         frame.aovs.iter_mut().zip(&mut scratch.aovs).for_each(|((_, a), s)| std::mem::swap(a, s));
         std::mem::swap(&mut frame.shadows, &mut scratch.shadows);
         progress(1, 1);
     } else {
-        render_jittered(scene, &offsets, frame, scratch, options, progress);
+        render_jittered(scene, &offsets, frame, scratch, options, progress, stop)?;
     }
     frame.stats.buffer_bytes = frame.visibility.memory_bytes()
         + std::mem::size_of_val(frame.image.pixels())
@@ -313,6 +369,7 @@ fn render_into(
         + (frame.aovs.len() + scratch.aovs.len() + frame.shadows.len() + scratch.shadows.len())
             * std::mem::size_of_val(frame.image.pixels())
         + scratch.maps.memory_bytes();
+    Ok(())
 }
 
 /// Makes the frame's component images (and one pass's, in `scratch`) the
@@ -343,7 +400,8 @@ fn render_jittered(
     scratch: &mut Scratch,
     options: &RenderOptions,
     progress: &(dyn Fn(u32, u32) + Sync),
-) {
+    stop: Stop,
+) -> Result<()> {
     scratch.accum.resize(scene.width, scene.height);
     scratch.accum.pixels_mut().fill(Vec3::ZERO);
     frame.aovs.iter_mut().for_each(|(_, a)| a.pixels_mut().fill(Vec3::ZERO));
@@ -353,35 +411,43 @@ fn render_jittered(
     scratch.maps.fit_to(Some(scene.camera));
     let weight = 1.0 / offsets.len() as f32;
     let mut pass = scene.clone();
-    for (done, &offset) in (1..).zip(offsets) {
-        pass.camera = jitter::shifted(&scene.camera, offset, (scene.width, scene.height));
-        render_pass(&pass, frame, scratch, options, None);
-        jitter::accumulate(&mut scratch.accum, &frame.image, weight);
-        frame.aovs.iter_mut().zip(&scratch.aovs).for_each(|((_, a), s)| jitter::accumulate(a, s, weight));
-        frame.shadows.iter_mut().zip(&scratch.shadows).for_each(|(a, s)| jitter::accumulate(a, s, weight));
-        progress(done, offsets.len() as u32);
-    }
+    let mut passes = || {
+        for (done, &offset) in (1..).zip(offsets) {
+            pass.camera = jitter::shifted(&scene.camera, offset, (scene.width, scene.height));
+            render_pass(&pass, frame, scratch, options, None, stop)?;
+            jitter::accumulate(&mut scratch.accum, &frame.image, weight);
+            frame.aovs.iter_mut().zip(&scratch.aovs).for_each(|((_, a), s)| jitter::accumulate(a, s, weight));
+            frame.shadows.iter_mut().zip(&scratch.shadows).for_each(|(a, s)| jitter::accumulate(a, s, weight));
+            progress(done, offsets.len() as u32);
+        }
+        Ok(())
+    };
+    let done = passes();
     scratch.maps.fit_to(None);
     std::mem::swap(&mut frame.image, &mut scratch.accum);
+    done
 }
 
 /// One visibility pass and everything shaded from it into `frame.image`, and
 /// the components `frame.aovs` names into `scratch.aovs` (same order) and the
 /// shadow terms into `scratch.shadows` when `options` asks for them, with the
 /// edge pass if `edges` asks for one; adds its timings to the frame's
-/// statistics.
+/// statistics. Given up before a stage once `stop` is raised.
 fn render_pass(
     scene: &Scene,
     frame: &mut Frame,
     scratch: &mut Scratch,
     options: &RenderOptions,
     edges: Option<&EdgeOptions>,
-) {
+    stop: Stop,
+) -> Result<()> {
+    stop.check()?;
     let ray_depth = options.ray_depth;
     let Frame { image, visibility, aovs, stats, .. } = frame;
     let Scratch { aovs: component_images, maps, trace, edges: edge_pass, subpixel, shadows, .. } = scratch;
     visibility.resize(scene.width, scene.height);
     stats.raster = stats.timed(Stage::Visibility, || visibility::rasterize(scene, visibility));
+    stop.check()?;
     let vb = &*visibility;
     image.resize(scene.width, scene.height);
     let mut images = PassImages::new(image, aovs, component_images);
@@ -397,13 +463,19 @@ fn render_pass(
     if options.shadow_images {
         shading::shadow_images::shadow_term_images(scene, vb, maps, shadows);
     }
+    stop.check()?;
     let builds = trace.builds();
-    let refine = if edges.is_some() { Refine::Contrast } else { Refine::Never };
+    let refine = match (edges, options.sparse_traced) {
+        (Some(_), _) => Refine::Contrast,
+        (None, true) => Refine::Sparse,
+        (None, false) => Refine::Never,
+    };
     let (traced, refined) =
         stats.timed(Stage::Traced, || traced_term(scene, vb, &mut images, subpixel, ray_depth, refine, trace));
     (stats.traced_pixels, stats.traced_refined) = (stats.traced_pixels + traced, stats.traced_refined + refined);
     let targets = &mut images.targets;
     stats.bvh_built |= trace.builds() > builds;
+    stop.check()?;
     // Translucent surfaces are drawn last, over everything opaque (seed 002 §3.4).
     let layers = visibility::fragments(scene, vb);
     let nothing_over = scene.fog.is_none() && layers.is_empty();
@@ -416,6 +488,7 @@ fn render_pass(
     stats.timed(Stage::Edges, || edge_pass.apply(scene, vb, targets, seen.as_deref(), trace));
     stats.edge_blends = edge_pass.blends();
     stats.passes += 1;
+    Ok(())
 }
 
 /// Per pixel, the share of its opaque surface's colour the image still shows
@@ -496,4 +569,50 @@ fn traced_term(
     };
     traced::trace_subpixel(scene, subpixel, ray_depth, trace);
     pixels
+}
+
+#[cfg(test)]
+mod tests {
+    use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
+
+    use super::{Renderer, Stop};
+    use crate::error::Error;
+    use crate::scene::{demo::demo_scene, Antialias};
+    use crate::RenderOptions;
+
+    fn small_demo(antialias: Antialias) -> crate::Scene {
+        let mut scene = demo_scene().expect("the demo loads");
+        (scene.width, scene.height, scene.antialias) = (96, 64, antialias);
+        scene
+    }
+
+    /// A raised flag gives the frame up before its first stage.
+    #[test]
+    fn a_raised_stop_gives_the_frame_up() {
+        let mut renderer = Renderer::new(&RenderOptions::default()).unwrap();
+        let stop = AtomicBool::new(true);
+        let out = renderer.render_or_stop(&small_demo(Antialias::None), &stop).map(|_| ());
+        assert!(matches!(out, Err(Error::Stopped)), "{out:?}");
+    }
+
+    /// Raised during the fourth of sixteen jittered passes, the frame stops
+    /// there; the renderer's next frame equals a fresh renderer's.
+    #[test]
+    fn a_stop_during_jittered_passes_ends_them_and_leaves_the_renderer_whole() {
+        let scene = small_demo(Antialias::Jitter(16));
+        let mut renderer = Renderer::new(&RenderOptions::default()).unwrap();
+        let (stop, passes) = (AtomicBool::new(false), AtomicU32::new(0));
+        let progress = |done: u32, _| {
+            passes.store(done, Ordering::Relaxed);
+            if done == 3 {
+                stop.store(true, Ordering::Relaxed);
+            }
+        };
+        let out = renderer.render_watched(&scene, &progress, Stop(Some(&stop))).map(|_| ());
+        assert!(matches!(out, Err(Error::Stopped)), "{out:?}");
+        assert_eq!(passes.load(Ordering::Relaxed), 3, "no pass after the raise");
+        let again = renderer.render(&scene).unwrap().image.clone();
+        let fresh = crate::render(&scene, &RenderOptions::default()).unwrap().image;
+        assert_eq!(again.pixels(), fresh.pixels());
+    }
 }

@@ -19,6 +19,17 @@
 //! about 1.25× as long, and inside the chrome ball the error against a 16-ray
 //! ray-traced truth falls from 0.037 to 0.013 RMSE (at 320×180: the test
 //! `reflections_are_refined_where_what_they_show_has_edges`).
+//!
+//! The other way, for a preview whose camera moves: [`Refine::Sparse`]
+//! traces one pixel of each 2 × 2 block and gives the others the mean of
+//! the nearest traced pixels that show the same object (a bilinear
+//! enlargement that stops at objects' outlines), tracing a pixel itself only
+//! where no such neighbour was traced. On `reflections.toml` at 320×180 it
+//! traces 25% of the rays, 0.026 RMSE from the full term and 0.029 from a
+//! ray-traced truth (the full term: 0.025; the test
+//! `a_sparse_traced_term_traces_fewer_rays_for_nearly_the_same_image`); on
+//! `showroom.toml` at 1280×720 the traced term of a frame falls from 46 to
+//! 16 ms on 2 cores.
 
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
@@ -49,6 +60,11 @@ pub enum Refine {
     /// Pixels that differ from a neighbour by more than [`REFINE_CONTRAST`]
     /// get four more samples.
     Contrast,
+    /// Fewer samples than pixels: one at the top-left pixel of each 2 × 2
+    /// block, and the others interpolated from those of the same object
+    /// (traced where there are none): about a quarter of the rays, for the
+    /// frames of a moving camera.
+    Sparse,
 }
 
 /// Adds traced reflection and refraction to `image`, refined as `refine`
@@ -107,7 +123,75 @@ pub fn add_traced(
             pixels.filter(|(_, t)| !t.x.is_nan()).for_each(|(px, t)| *px += *t);
             (count, refined)
         }
+        Refine::Sparse => {
+            // The samples at block corners, a grid of half the size.
+            let (cw, ch) = (w.div_ceil(2), h.div_ceil(2));
+            let mut corners = vec![Vec3::NAN; cw * ch];
+            let traced: usize = corners
+                .par_chunks_mut(cw)
+                .enumerate()
+                .map(|(cy, row)| {
+                    let mut count = 0;
+                    for (cx, c) in row.iter_mut().enumerate().filter(|(cx, _)| traces(2 * cx, 2 * cy)) {
+                        *c = sample(2 * cx, 2 * cy, Vec2::ZERO);
+                        count += 1;
+                    }
+                    count
+                })
+                .sum();
+            let object = |x: usize, y: usize| vb.item(x as u32, y as u32).object;
+            let rows = image.pixels_mut().par_chunks_mut(w).enumerate();
+            let filled_by_rays: usize = rows
+                .map(|(y, row)| {
+                    let mut count = 0;
+                    for (x, px) in row.iter_mut().enumerate().filter(|(x, _)| traces(*x, y)) {
+                        *px += interpolated(&corners, (w, h), x, y, |cx, cy| object(cx, cy) == object(x, y))
+                            .unwrap_or_else(|| {
+                                count += 1;
+                                sample(x, y, Vec2::ZERO)
+                            });
+                    }
+                    count
+                })
+                .sum();
+            (traced + filled_by_rays, 0)
+        }
     }
+}
+
+/// Pixel (`x`, `y`)'s value (of an image `size` pixels) from the traced
+/// block corners around it that `same(x, y)` accepts (`corners`: the samples
+/// at even pixels, a grid of half the size, NaN where none was traced): its
+/// own sample at a corner, else the mean of the accepted corners beside it
+/// (two along a row or column, four inside a block); `None` when none is
+/// accepted.
+fn interpolated(
+    corners: &[Vec3],
+    size: (usize, usize),
+    x: usize,
+    y: usize,
+    same: impl Fn(usize, usize) -> bool,
+) -> Option<Vec3> {
+    let (w, h) = size;
+    let cw = w.div_ceil(2);
+    let around = |v: usize, n: usize| {
+        if v.is_multiple_of(2) {
+            [Some(v), None]
+        } else {
+            [Some(v - 1), (v + 1 < n).then_some(v + 1)]
+        }
+    };
+    let (mut sum, mut count) = (Vec3::ZERO, 0u32);
+    for cy in around(y, h).into_iter().flatten() {
+        for cx in around(x, w).into_iter().flatten() {
+            let c = corners[(cy / 2) * cw + cx / 2];
+            if !c.x.is_nan() && same(cx, cy) {
+                sum += c;
+                count += 1;
+            }
+        }
+    }
+    (count > 0).then(|| sum / count as f32)
 }
 
 /// Traces again, at [`REFINE_OFFSETS`], every traced pixel of `traced` (rows

@@ -2,10 +2,11 @@
 //!
 //! [`state`] is what the viewer does with its input, apart from any window
 //! (tested without one); [`orbit`] is its camera; [`refine`] renders the
-//! refinement steps the state asks for; [`source`] loads what is shown and
-//! says which changes reload it; [`script`] reads scripted input;
-//! [`hud`] draws text; [`window`] ties them to a winit window with a
-//! softbuffer frame buffer.
+//! refinement steps the state asks for, and [`worker`] renders them on a
+//! thread of their own, each given up when input makes it stale; [`source`]
+//! loads what is shown and says which changes reload it; [`script`] reads
+//! scripted input; [`hud`] draws text; [`window`] ties them to a winit window
+//! with a softbuffer frame buffer.
 
 pub mod hud;
 pub mod orbit;
@@ -14,6 +15,7 @@ pub mod script;
 pub mod source;
 pub mod state;
 pub mod window;
+pub mod worker;
 
 use std::path::PathBuf;
 

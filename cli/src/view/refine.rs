@@ -3,11 +3,15 @@
 //! frame, jittered passes averaged), and what the window shows of the frame
 //! (the image, a component, the shadow term, depth, normals, items).
 
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Mutex, MutexGuard, PoisonError};
+
 use glam::Vec3;
 use kage::image::{LinearImage, ToneCurve};
 use kage::scene::{Antialias, Light, Scene, ShadowMethod, ShadowSettings};
 use kage::shading::ComponentSet;
 use kage::{FrameStats, RenderOptions, Renderer};
+use rayon::prelude::*;
 
 use super::state::{Display, Shadows, Smoothing, Step, Viewer, MAX_PASSES};
 
@@ -16,7 +20,9 @@ use super::state::{Display, Shadows, Smoothing, Step, Viewer, MAX_PASSES};
 pub const SHOWN_FROM_PASS: u32 = 4;
 
 /// What the window shows: linear colour, how to map it to the screen, and
-/// the frame it came from.
+/// the frame it came from. The rendering thread writes it in place (its
+/// buffers kept from frame to frame: a new 1280 × 720 image a frame costs
+/// page faults worth several milliseconds), the window copies `screen` out.
 #[derive(Debug, Clone, Default)]
 pub struct Shown {
     /// Linear colour, row by row.
@@ -29,33 +35,62 @@ pub struct Shown {
     pub stats: FrameStats,
     /// Jittered passes in `image` (0: a single frame).
     pub passes: u32,
+    /// `image` as the screen shows it: 0RGB words, 8-bit sRGB through the
+    /// tone curve (made on the rendering thread, in parallel).
+    pub screen: Vec<u32>,
+}
+
+/// The lock on what is shown (a thread that panicked holding it left
+/// nothing half-written that matters more than the window staying up).
+pub fn lock(shown: &Mutex<Shown>) -> MutexGuard<'_, Shown> {
+    shown.lock().unwrap_or_else(PoisonError::into_inner)
 }
 
 /// Renders steps and keeps the accumulation of jittered passes.
 pub struct Refiner {
-    renderer: Option<(RenderOptions, Renderer)>,
+    renderer: Option<Renderer>,
     threads: Option<usize>,
     /// The sum of the jittered passes so far.
     sum: LinearImage,
     passes: u32,
-    /// What is on screen.
-    pub shown: Shown,
+    /// A pass's image when what is shown is not the image itself.
+    pass_image: LinearImage,
+    /// The exposure and tone curve of the last full frame, which the average
+    /// of the passes keeps.
+    look: (f32, ToneCurve),
 }
 
 impl Refiner {
     /// A refiner rendering on `threads` workers (`None`: one per core).
     #[must_use]
     pub fn new(threads: Option<usize>) -> Refiner {
-        Refiner { renderer: None, threads, sum: LinearImage::default(), passes: 0, shown: Shown::default() }
+        Refiner {
+            renderer: None,
+            threads,
+            sum: LinearImage::default(),
+            passes: 0,
+            pass_image: LinearImage::default(),
+            look: (1.0, ToneCurve::Clip),
+        }
     }
 
-    /// Renders `step` of `base` as `viewer` sets it up; updates what is
-    /// shown (a jittered pass only once [`SHOWN_FROM_PASS`] are averaged).
+    /// Renders `step` of `base` as `viewer` sets it up, giving up between
+    /// stages once `stop` is raised, and writes what to show into `shown`
+    /// (a jittered pass only once [`SHOWN_FROM_PASS`] are averaged); returns
+    /// the frame's statistics.
     ///
     /// # Errors
     ///
-    /// When the scene cannot be rendered (too large for the limits).
-    pub fn render(&mut self, base: &Scene, viewer: &Viewer, step: Step) -> kage::error::Result<()> {
+    /// [`kage::Error::Stopped`] when `stop` was raised (`shown` is left as
+    /// it was); when the scene cannot be rendered (too large for the limits).
+    pub fn render(
+        &mut self,
+        base: &Scene,
+        viewer: &Viewer,
+        step: Step,
+        stop: &AtomicBool,
+        shown: &Mutex<Shown>,
+    ) -> kage::error::Result<FrameStats> {
         let scene = scene_for(base, viewer, step);
         let options = RenderOptions {
             threads: self.threads,
@@ -65,39 +100,63 @@ impl Refiner {
                 _ => ComponentSet::EMPTY,
             },
             shadow_images: viewer.display == Display::Shadow,
+            // A moving camera's reflections: a quarter of the rays.
+            sparse_traced: step == Step::Quick,
             ..RenderOptions::default()
         };
-        if self.renderer.as_ref().is_none_or(|(o, _)| *o != options) {
-            self.renderer = Some((options, Renderer::new(&options)?));
-        }
-        let (_, renderer) = self.renderer.as_mut().expect("made above");
-        let frame = renderer.render(&scene)?;
-        let image = shown_image(&scene, frame, viewer.display);
-        let is_image = viewer.display == Display::Image;
+        let renderer = match &mut self.renderer {
+            Some(r) => {
+                r.set_options(&options)?;
+                r
+            }
+            None => self.renderer.insert(Renderer::new(&options)?),
+        };
+        let frame = renderer.render_or_stop(&scene, stop)?;
         let stats = frame.stats;
-        match step {
-            Step::Pass(n) => {
-                if n == 1 || self.sum.width() != image.width() || self.sum.height() != image.height() {
-                    self.sum = LinearImage::new(image.width(), image.height());
-                    self.passes = 0;
-                }
-                self.sum.pixels_mut().iter_mut().zip(image.pixels()).for_each(|(s, p)| *s += *p);
-                self.passes += 1;
-                if self.passes >= SHOWN_FROM_PASS {
-                    let mut mean = self.sum.clone();
-                    let k = 1.0 / self.passes as f32;
-                    mean.pixels_mut().iter_mut().for_each(|p| *p *= k);
-                    let (scale, tone) = (self.shown.scale, self.shown.tone);
-                    self.shown = Shown { image: mean, scale, tone, stats, passes: self.passes };
-                }
+        let display = viewer.display;
+        let stopped = || stop.load(Ordering::Relaxed);
+        let Step::Pass(n) = step else {
+            let mut out = lock(shown);
+            if stopped() {
+                return Err(kage::Error::Stopped);
             }
-            Step::Quick | Step::Full => {
-                let (scale, tone) =
-                    if is_image { (scene.exposure.scale(&image), scene.tone) } else { (1.0, ToneCurve::Clip) };
-                self.shown = Shown { image, scale, tone, stats, passes: 0 };
-            }
+            display_image(&scene, frame, display, &mut out.image);
+            self.look = if display == Display::Image {
+                (scene.exposure.scale(&out.image), scene.tone)
+            } else {
+                (1.0, ToneCurve::Clip)
+            };
+            (out.scale, out.tone, out.stats, out.passes) = (self.look.0, self.look.1, stats, 0);
+            let Shown { image, scale, tone, screen, .. } = &mut *out;
+            image.to_0rgb_toned_into(*scale, *tone, screen);
+            return Ok(stats);
+        };
+        let image = if display == Display::Image {
+            &frame.image
+        } else {
+            display_image(&scene, frame, display, &mut self.pass_image);
+            &self.pass_image
+        };
+        if n == 1 || self.sum.width() != image.width() || self.sum.height() != image.height() {
+            self.sum = LinearImage::new(image.width(), image.height());
+            self.passes = 0;
         }
-        Ok(())
+        self.sum.pixels_mut().par_iter_mut().zip(image.pixels().par_iter()).for_each(|(s, p)| *s += *p);
+        self.passes += 1;
+        if self.passes < SHOWN_FROM_PASS {
+            return Ok(stats);
+        }
+        let mut out = lock(shown);
+        if stopped() {
+            return Err(kage::Error::Stopped);
+        }
+        let k = 1.0 / self.passes as f32;
+        out.image.resize(self.sum.width(), self.sum.height());
+        out.image.pixels_mut().par_iter_mut().zip(self.sum.pixels().par_iter()).for_each(|(o, s)| *o = *s * k);
+        (out.scale, out.tone, out.stats, out.passes) = (self.look.0, self.look.1, stats, self.passes);
+        let Shown { image, scale, tone, screen, .. } = &mut *out;
+        image.to_0rgb_toned_into(*scale, *tone, screen);
+        Ok(stats)
     }
 }
 
@@ -110,8 +169,7 @@ impl Refiner {
 pub fn scene_for(base: &Scene, viewer: &Viewer, step: Step) -> Scene {
     let mut scene = base.clone();
     (scene.width, scene.height) = viewer.size;
-    let bounds = base.bounds().unwrap_or(viewer.bounds);
-    scene.camera = viewer.orbit.camera(bounds);
+    scene.camera = viewer.orbit.camera(viewer.bounds);
     let t = viewer.toggles;
     let shadows = if step == Step::Quick && t.shadows.costly() { Shadows::All(ShadowMethod::Map) } else { t.shadows };
     for light in &mut scene.lights {
@@ -170,28 +228,28 @@ fn jittered(light: &Light) -> bool {
     light.size > 0.0 && light.shadow.samples > 1 && matches!(light.shadow.method, ShadowMethod::Map | ShadowMethod::Slb)
 }
 
-/// What `display` shows of `frame` (rendered from `scene`), as linear colour.
-fn shown_image(scene: &Scene, frame: &kage::Frame, display: Display) -> LinearImage {
-    let (w, h) = (frame.image.width(), frame.image.height());
-    let mut out = LinearImage::new(w, h);
+/// What `display` shows of `frame` (rendered from `scene`), as linear
+/// colour, into `out` (resized to the frame).
+fn display_image(scene: &Scene, frame: &kage::Frame, display: Display, out: &mut LinearImage) {
+    out.resize(frame.image.width(), frame.image.height());
     let vb = &frame.visibility;
+    let copy = |out: &mut LinearImage, from: &LinearImage| out.pixels_mut().copy_from_slice(from.pixels());
     match display {
-        Display::Image => return frame.image.clone(),
-        Display::Component(c) => {
-            if let Some((_, image)) = frame.aovs.iter().find(|(k, _)| *k == c) {
-                return image.clone();
-            }
-        }
+        Display::Image => copy(out, &frame.image),
+        Display::Component(c) => match frame.aovs.iter().find(|(k, _)| *k == c) {
+            Some((_, image)) => copy(out, image),
+            None => out.pixels_mut().fill(Vec3::ZERO),
+        },
         Display::Shadow => {
             let first = scene.lights.iter().position(|l| l.shadow.method != ShadowMethod::None);
-            if let Some(image) = first.and_then(|i| frame.shadows.get(i)) {
-                return image.clone();
+            match first.and_then(|i| frame.shadows.get(i)) {
+                Some(image) => copy(out, image),
+                None => out.pixels_mut().fill(Vec3::ONE),
             }
-            out.pixels_mut().fill(Vec3::ONE);
         }
         Display::Depth => {
-            let seen: Vec<f32> = vb.depths().iter().copied().filter(|d| d.is_finite()).collect();
-            let (near, far) = seen.iter().fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), &d| (a.min(d), b.max(d)));
+            let seen = vb.depths().iter().copied().filter(|d| d.is_finite());
+            let (near, far) = seen.fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), d| (a.min(d), b.max(d)));
             let span = (far - near).max(1e-9);
             for (p, &d) in out.pixels_mut().iter_mut().zip(vb.depths()) {
                 *p = if d.is_finite() { Vec3::splat(1.0 - 0.9 * (d - near) / span) } else { Vec3::ZERO };
@@ -209,7 +267,6 @@ fn shown_image(scene: &Scene, frame: &kage::Frame, display: Display) -> LinearIm
             }
         }
     }
-    out
 }
 
 /// A bright colour of its own for object `id`.

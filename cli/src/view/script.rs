@@ -8,10 +8,12 @@
 //! wheel 2                 # steps in (negative: out)
 //! key 1                   # a key: a letter or digit, home, f12, esc
 //! wait                    # until the image is fully refined
+//! wait 8                  # until 8 jittered passes are averaged on screen
 //! sleep 0.5               # seconds
 //! screenshot shot.png     # write the image shown (no HUD) to a PNG
 //! capture window.png      # write the window as it looks (HUD and all)
 //! copy edited.toml scene.toml   # copy a file (paths relative to the script)
+//! drop other.toml         # a file dropped on the window
 //! quit
 //! ```
 //!
@@ -29,6 +31,8 @@ pub enum Action {
     Input(Input),
     /// Wait until the refinement is done.
     Wait,
+    /// Wait until this many jittered passes are averaged on screen.
+    WaitPasses(u32),
     /// Wait this many seconds.
     Sleep(f32),
     /// Write the image shown to this PNG.
@@ -87,7 +91,11 @@ fn action(words: &[&str], base: &Path) -> Result<Action, String> {
         }
         "wheel" => Action::Input(Input::Wheel(number(words.get(1), "steps")?)),
         "key" => Action::Input(Input::Key(key(words.get(1).copied().ok_or("key needs a key")?)?)),
-        "wait" => Action::Wait,
+        "wait" => match words.get(1) {
+            None => Action::Wait,
+            passes => Action::WaitPasses(number(passes, "passes")?.max(0.0) as u32),
+        },
+        "drop" => Action::Input(Input::Dropped(path(words.get(1))?)),
         "sleep" => Action::Sleep(number(words.get(1), "seconds")?.max(0.0)),
         "screenshot" => Action::Screenshot(path(words.get(1))?),
         "capture" => Action::Capture(path(words.get(1))?),
@@ -95,7 +103,7 @@ fn action(words: &[&str], base: &Path) -> Result<Action, String> {
         "quit" => Action::Quit,
         other => {
             return Err(format!(
-                "unknown action `{other}` (drag, wheel, key, wait, sleep, screenshot, capture, copy, quit)"
+                "unknown action `{other}` (drag, wheel, key, wait, sleep, screenshot, capture, copy, drop, quit)"
             ))
         }
     })
@@ -120,7 +128,8 @@ mod tests {
     #[test]
     fn a_script_reads_into_actions() {
         let text = "# orbit, then look\ndrag left 40 -2\ndrag middle 1 2 shift\nwheel -1.5\nkey F\nkey home\n\
-                    wait\nsleep 0.25\nscreenshot out/a.png  # the result\ncapture w.png\ncopy b.toml a.toml\nquit\n";
+                    wait\nwait 8\nsleep 0.25\nscreenshot out/a.png  # the result\ncapture w.png\ncopy b.toml a.toml\n\
+                    drop c.toml\nquit\n";
         let actions = parse(text, Path::new("tests/run.script")).unwrap();
         assert_eq!(
             actions,
@@ -131,10 +140,12 @@ mod tests {
                 Action::Input(Input::Key(Key::Char('f'))),
                 Action::Input(Input::Key(Key::Home)),
                 Action::Wait,
+                Action::WaitPasses(8),
                 Action::Sleep(0.25),
                 Action::Screenshot(PathBuf::from("tests/out/a.png")),
                 Action::Capture(PathBuf::from("tests/w.png")),
                 Action::Copy(PathBuf::from("tests/b.toml"), PathBuf::from("tests/a.toml")),
+                Action::Input(Input::Dropped(PathBuf::from("tests/c.toml"))),
                 Action::Quit,
             ]
         );
@@ -150,6 +161,8 @@ mod tests {
             ("\n\nfly 3", "run.script:3: unknown action `fly`"),
             ("drag left 1 2 ctrl", "run.script:1: drag takes \"shift\""),
             ("screenshot", "run.script:1: screenshot needs a path"),
+            ("wait many", "run.script:1: passes must be a number"),
+            ("drop", "run.script:1: drop needs a path"),
         ] {
             let e = parse(text, Path::new("run.script")).unwrap_err();
             assert!(e.starts_with(what), "{text:?}: {e}");

@@ -255,6 +255,11 @@ pub struct Viewer {
     pub costly_scene: bool,
     /// The next step of the refinement; `None` when it is done.
     next: Option<Step>,
+    /// The step being rendered, if any.
+    rendering: Option<Step>,
+    /// Whether the step being rendered is stale: input came that a refinement
+    /// step gives way to.
+    stale: bool,
 }
 
 impl Viewer {
@@ -274,6 +279,8 @@ impl Viewer {
             error: None,
             costly_scene: false,
             next: Some(Step::Quick),
+            rendering: None,
+            stale: false,
         }
     }
 
@@ -306,6 +313,9 @@ impl Viewer {
         };
         if matches!(request, Request::Render | Request::Reload | Request::Open(_)) {
             self.next = Some(Step::Quick);
+            // A quick frame finishes (the next one shows the camera's newest
+            // place); anything costlier is given up at once.
+            self.stale |= self.rendering.is_some_and(|s| s != Step::Quick);
         }
         request
     }
@@ -354,10 +364,15 @@ impl Viewer {
         Request::Render
     }
 
-    /// The step the next frame renders, advancing the schedule; `None` when
-    /// the image is as refined as the toggles ask.
+    /// The step to render next, advancing the schedule; `None` when the
+    /// image is as refined as the toggles ask or a step is still rendering
+    /// ([`Viewer::rendered`] says when it is done).
     pub fn step(&mut self) -> Option<Step> {
+        if self.rendering.is_some() {
+            return None;
+        }
         let now = self.next?;
+        self.rendering = Some(now);
         self.next = match now {
             Step::Quick if self.quick_is_full() => self.after_full(),
             Step::Quick => Some(Step::Full),
@@ -368,11 +383,29 @@ impl Viewer {
         Some(now)
     }
 
+    /// The step being rendered is done (or given up).
+    pub fn rendered(&mut self) {
+        (self.rendering, self.stale) = (None, false);
+    }
+
+    /// The step being rendered, if any.
+    #[must_use]
+    pub fn rendering(&self) -> Option<Step> {
+        self.rendering
+    }
+
+    /// Whether the step being rendered should be given up: input since it
+    /// began starts the refinement over (a quick frame is never given up).
+    #[must_use]
+    pub fn stale(&self) -> bool {
+        self.stale
+    }
+
     /// Whether the next input would be a new start: the refinement has
-    /// nothing left to render.
+    /// nothing left to render and nothing is rendering.
     #[must_use]
     pub fn at_rest(&self) -> bool {
-        self.next.is_none()
+        self.next.is_none() && self.rendering.is_none()
     }
 
     /// Whether the quick frame would render the same as the full one (no
@@ -405,6 +438,36 @@ mod tests {
         Viewer::new(orbit, UNIT, (1280, 720))
     }
 
+    /// The next step, rendered at once.
+    fn next(v: &mut Viewer) -> Option<Step> {
+        let step = v.step();
+        v.rendered();
+        step
+    }
+
+    /// Input gives up a refinement step that is rendering, but not a quick
+    /// frame; nothing new is handed out while a step renders.
+    #[test]
+    fn input_gives_up_a_refinement_step_but_not_a_quick_frame() {
+        let mut v = viewer();
+        assert_eq!(v.step(), Some(Step::Quick));
+        assert_eq!(v.step(), None, "one step at a time");
+        v.apply(drag(Button::Left, 5.0, 0.0, false));
+        assert!(!v.stale(), "a quick frame finishes");
+        v.rendered();
+        assert_eq!(v.step(), Some(Step::Quick), "the camera's newest place");
+        v.rendered();
+        assert_eq!(v.step(), Some(Step::Full));
+        assert!(!v.at_rest());
+        v.apply(Input::Key(Key::Char('z')));
+        assert!(!v.stale(), "the HUD toggle leaves the image as it is");
+        v.apply(Input::Wheel(1.0));
+        assert!(v.stale(), "the full frame is given up");
+        v.rendered();
+        assert!(!v.stale());
+        assert_eq!(v.step(), Some(Step::Quick));
+    }
+
     fn drag(button: Button, dx: f32, dy: f32, shift: bool) -> Input {
         Input::Drag { button, dx, dy, shift }
     }
@@ -414,7 +477,7 @@ mod tests {
     fn a_resting_camera_refines_to_64_passes_then_stops() {
         let mut v = viewer();
         let mut steps = Vec::new();
-        while let Some(s) = v.step() {
+        while let Some(s) = next(&mut v) {
             steps.push(s);
             assert!(steps.len() < 100, "the schedule ends");
         }
@@ -430,15 +493,15 @@ mod tests {
     fn input_starts_the_refinement_over() {
         let mut v = viewer();
         for _ in 0..10 {
-            v.step();
+            next(&mut v);
         }
         assert_eq!(v.apply(drag(Button::Left, 5.0, 0.0, false)), Request::Render);
-        assert_eq!(v.step(), Some(Step::Quick));
-        assert_eq!(v.step(), Some(Step::Full));
+        assert_eq!(next(&mut v), Some(Step::Quick));
+        assert_eq!(next(&mut v), Some(Step::Full));
         assert_eq!(v.apply(Input::Key(Key::Char('x'))), Request::Nothing);
-        assert_eq!(v.step(), Some(Step::Pass(1)));
+        assert_eq!(next(&mut v), Some(Step::Pass(1)));
         assert_eq!(v.apply(Input::Key(Key::Char('z'))), Request::Redraw, "the HUD is drawn over the frame");
-        assert_eq!(v.step(), Some(Step::Pass(2)));
+        assert_eq!(next(&mut v), Some(Step::Pass(2)));
     }
 
     /// Without smoothing or costly shadows the quick frame is the final one;
@@ -448,21 +511,21 @@ mod tests {
         let mut v = viewer();
         v.apply(Input::Key(Key::Char('a')));
         assert_eq!(v.toggles.smoothing, Smoothing::None);
-        assert_eq!((v.step(), v.step()), (Some(Step::Quick), None));
+        assert_eq!((next(&mut v), next(&mut v)), (Some(Step::Quick), None));
         v.apply(Input::Key(Key::Char('a')));
         assert_eq!(v.toggles.smoothing, Smoothing::Edge);
-        assert_eq!((v.step(), v.step(), v.step()), (Some(Step::Quick), Some(Step::Full), None));
+        assert_eq!((next(&mut v), next(&mut v), next(&mut v)), (Some(Step::Quick), Some(Step::Full), None));
         v.toggles.smoothing = Smoothing::None;
         v.toggles.shadows = Shadows::All(ShadowMethod::Soft);
         v.apply(Input::Wheel(1.0));
-        assert_eq!((v.step(), v.step(), v.step()), (Some(Step::Quick), Some(Step::Full), None));
+        assert_eq!((next(&mut v), next(&mut v), next(&mut v)), (Some(Step::Quick), Some(Step::Full), None));
         // The scene's own jittered lights count as costly too.
         v.toggles.shadows = Shadows::Scene;
         v.apply(Input::Wheel(1.0));
-        assert_eq!((v.step(), v.step()), (Some(Step::Quick), None));
+        assert_eq!((next(&mut v), next(&mut v)), (Some(Step::Quick), None));
         v.costly_scene = true;
         v.apply(Input::Wheel(1.0));
-        assert_eq!((v.step(), v.step(), v.step()), (Some(Step::Quick), Some(Step::Full), None));
+        assert_eq!((next(&mut v), next(&mut v), next(&mut v)), (Some(Step::Quick), Some(Step::Full), None));
     }
 
     /// Left drag orbits, shift + left and middle pan, the wheel zooms, the
@@ -535,7 +598,7 @@ mod tests {
         let path = PathBuf::from("part.stl");
         assert_eq!(v.apply(Input::Dropped(path.clone())), Request::Open(path));
         assert_eq!(v.apply(Input::FileChanged), Request::Reload);
-        assert_eq!(v.step(), Some(Step::Quick), "a reload starts the refinement over");
+        assert_eq!(next(&mut v), Some(Step::Quick), "a reload starts the refinement over");
     }
 
     /// A resize to the same size or to nothing changes nothing.

@@ -1,12 +1,15 @@
 //! The window: winit for events, softbuffer for a CPU frame buffer (X11 or
-//! Wayland, no GPU). Each turn of the event loop takes the input that
-//! arrived, then renders one refinement step and shows it; input that
-//! arrives while a step renders starts the refinement over before the next.
+//! Wayland, no GPU). The refinement's steps render one at a time on a thread
+//! of their own ([`super::worker`]); the window shows each as it arrives and
+//! takes input meanwhile. Input that starts the refinement over gives up the
+//! step rendering (a quick frame excepted) before its next stage.
 
 use std::collections::VecDeque;
 use std::num::NonZeroU32;
 use std::path::{Path, PathBuf};
 use std::rc::Rc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use kage::Scene;
@@ -20,10 +23,11 @@ use winit::window::{Window, WindowId};
 
 use super::hud::Text;
 use super::orbit::Orbit;
-use super::refine::Refiner;
+use super::refine::{lock, Shown};
 use super::script::Action;
 use super::source::Source;
 use super::state::{Button, Display, Input, Key, Request, Smoothing, Step, Viewer, MAX_PASSES};
+use super::worker::{Done, Job, Outcome, Worker};
 
 /// The colour of a load error drawn over the image (0xRRGGBB).
 pub const ERROR_COLOUR: u32 = 0x00ff_4040;
@@ -33,6 +37,8 @@ pub const ERROR_COLOUR: u32 = 0x00ff_4040;
 pub enum Wake {
     /// A watched file changed.
     FileChanged,
+    /// The rendering thread finished with a step.
+    Rendered(Box<Done>),
 }
 
 /// How `kage view` starts.
@@ -75,6 +81,10 @@ struct Clock {
     first_image: Option<Duration>,
     /// Milliseconds of each quick frame (while the camera moves).
     quick_ms: Vec<f64>,
+    /// Milliseconds by stage (visibility, shadows, shading, traced, edges)
+    /// summed over the quick frames, and over the jittered passes, with how
+    /// many were summed.
+    stages: [(u32, [f64; 5]); 2],
     /// The last input that started the refinement over.
     last_input: Option<Instant>,
     /// From an input to the refinement's end, each time it ended.
@@ -83,6 +93,10 @@ struct Clock {
     unanswered: Option<Instant>,
     /// From an input to the first frame rendered after it.
     to_image: Vec<Duration>,
+    /// When the step rendering was asked to stop, if it was.
+    stop_raised: Option<Instant>,
+    /// From asking a step to stop to hearing it stopped, each time.
+    to_stop: Vec<Duration>,
 }
 
 impl Clock {
@@ -91,10 +105,13 @@ impl Clock {
             started: Instant::now(),
             first_image: None,
             quick_ms: Vec::new(),
+            stages: [(0, [0.0; 5]); 2],
             last_input: None,
             to_rest: Vec::new(),
             unanswered: None,
             to_image: Vec::new(),
+            stop_raised: None,
+            to_stop: Vec::new(),
         }
     }
 
@@ -110,13 +127,39 @@ impl Clock {
         let (quick, median_quick) = median(self.quick_ms.clone());
         let (rested, rest) = median(ms(&self.to_rest));
         let (answered, answer) = median(ms(&self.to_image));
+        let (stopped, stop) = median(ms(&self.to_stop));
+        let mean = |(n, sum): (u32, [f64; 5])| {
+            let s = sum.map(|t| t / f64::from(n.max(1)));
+            format!(
+                "visibility {:.1}, shadows {:.1}, shading {:.1}, traced {:.1}, edges {:.1}",
+                s[0], s[1], s[2], s[3], s[4]
+            )
+        };
         format!(
-            "first image {:.0} ms; {quick} quick frames, median {median_quick:.1} ms ({:.1} fps); refined {rested} \
+            "first image {:.0} ms; {quick} quick frames, median {median_quick:.1} ms ({:.1} fps; mean ms: {}); {} \
+             jittered passes, mean ms: {}; refined {rested} \
              times, median {rest:.0} ms after the input; new image {answered} times, median {answer:.0} ms after the \
-             input",
+             input; {stopped} steps given up, median {stop:.1} ms after the input",
             self.first_image.map_or(f64::NAN, |d| d.as_secs_f64() * 1e3),
             1e3 / median_quick,
+            mean(self.stages[0]),
+            self.stages[1].0,
+            mean(self.stages[1]),
         )
+    }
+}
+
+impl Clock {
+    /// Adds a quick frame's or a pass's stage timings to the sums.
+    fn count(&mut self, step: Step, st: &kage::FrameStats) {
+        let (n, sum) = match step {
+            Step::Quick => &mut self.stages[0],
+            Step::Pass(_) => &mut self.stages[1],
+            Step::Full => return,
+        };
+        *n += 1;
+        let stages = [st.visibility_ms, st.shadow_ms, st.shading_ms, st.traced_ms, st.edge_ms];
+        sum.iter_mut().zip(stages).for_each(|(s, t)| *s += t);
     }
 }
 
@@ -138,8 +181,12 @@ struct Surface {
 struct App {
     viewer: Viewer,
     source: Source,
-    scene: Option<Scene>,
-    refiner: Refiner,
+    scene: Option<Arc<Scene>>,
+    /// The rendering thread, and the stop flag of the step it renders.
+    worker: Worker,
+    stop: Arc<AtomicBool>,
+    /// What is on screen, written by the rendering thread.
+    shown: Arc<Mutex<Shown>>,
     text: Text,
     script: VecDeque<Action>,
     sleep_until: Option<Instant>,
@@ -161,20 +208,27 @@ impl App {
     fn new(start: Start, proxy: EventLoopProxy<Wake>) -> App {
         let loaded = start.source.load(&super::state::Toggles::default());
         let (scene, error) = match loaded {
-            Ok(s) => (Some(s), None),
+            Ok(s) => (Some(Arc::new(s)), None),
             Err(e) => (None, Some(e)),
         };
         let size = start.size.unwrap_or_else(|| match (&scene, start.source.path.as_deref()) {
             (Some(s), Some(p)) if p.extension().is_some_and(|e| e.eq_ignore_ascii_case("toml")) => (s.width, s.height),
             _ => super::source::DEFAULT_SIZE,
         });
-        let mut viewer = viewer_for(scene.as_ref(), size);
+        let mut viewer = viewer_for(scene.as_deref(), size);
         viewer.error = error;
+        let reporter = proxy.clone();
+        let shown = Arc::new(Mutex::new(Shown::default()));
+        let worker = Worker::spawn(start.threads, shown.clone(), move |done| {
+            reporter.send_event(Wake::Rendered(Box::new(done))).ok();
+        });
         let mut app = App {
             viewer,
             source: start.source,
             scene,
-            refiner: Refiner::new(start.threads),
+            worker,
+            stop: Arc::new(AtomicBool::new(false)),
+            shown,
             text: Text::new(),
             script: start.script.into(),
             sleep_until: None,
@@ -221,6 +275,9 @@ impl App {
             self.clock.last_input = Some(Instant::now());
             self.clock.unanswered = self.clock.unanswered.or(self.clock.last_input);
         }
+        if self.viewer.stale() && !self.stop.swap(true, Ordering::Relaxed) {
+            self.clock.stop_raised = Some(Instant::now());
+        }
         match request {
             Request::Nothing | Request::Render => {}
             Request::Redraw => self.request_redraw(),
@@ -253,7 +310,7 @@ impl App {
                 }
                 self.viewer.costly_scene = scene.lights.iter().any(super::refine::costly);
                 self.viewer.error = None;
-                self.scene = Some(scene);
+                self.scene = Some(Arc::new(scene));
             }
             Err(e) => {
                 eprintln!("{e}");
@@ -264,7 +321,7 @@ impl App {
     }
 
     fn screenshot(&mut self, path: &Path) {
-        let shown = &self.refiner.shown;
+        let shown = lock(&self.shown);
         match kage::output::write_image(&shown.image, path, shown.scale, shown.tone) {
             Ok(()) => println!("wrote {}", path.display()),
             Err(e) => eprintln!("screenshot {}: {e}", path.display()),
@@ -306,11 +363,14 @@ impl App {
             match action {
                 Action::Wait if !self.viewer.at_rest() => return,
                 Action::Wait => {}
+                Action::WaitPasses(n) if lock(&self.shown).passes < n && !self.viewer.at_rest() => return,
+                Action::WaitPasses(_) => {}
                 Action::Sleep(s) => {
                     self.script.pop_front();
                     self.sleep_until = Some(Instant::now() + Duration::from_secs_f32(s));
                     continue;
                 }
+                Action::Input(_) if self.answering_input() => return,
                 Action::Input(input) => {
                     // One input a frame, as a user's events arrive: the
                     // frame it asks for renders before the next.
@@ -332,36 +392,65 @@ impl App {
         }
     }
 
-    /// Renders the next refinement step, if any.
-    fn refine(&mut self) -> bool {
+    /// Whether the step rendering answers the last input: a quick frame,
+    /// or a step asked to stop (the quick frame follows it).
+    fn answering_input(&self) -> bool {
+        self.viewer.rendering() == Some(Step::Quick) || self.stop.load(Ordering::Relaxed)
+    }
+
+    /// Hands the next refinement step, if any, to the rendering thread.
+    fn dispatch(&mut self) {
         let Some(scene) = &self.scene else {
-            while self.viewer.step().is_some() {}
-            return false;
-        };
-        let Some(step) = self.viewer.step() else { return false };
-        let start = Instant::now();
-        if let Err(e) = self.refiner.render(scene, &self.viewer, step) {
-            self.viewer.error = Some(e.to_string());
-            while self.viewer.step().is_some() {}
-        }
-        let took = start.elapsed();
-        self.frame_times.push_back(took.as_secs_f64());
-        if step == Step::Quick {
-            self.clock.quick_ms.push(took.as_secs_f64() * 1e3);
-        }
-        if let Some(at) = self.clock.unanswered.take() {
-            self.clock.to_image.push(at.elapsed());
-        }
-        if self.viewer.at_rest() {
-            if let Some(at) = self.clock.last_input.take() {
-                self.clock.to_rest.push(at.elapsed());
+            while self.viewer.step().is_some() {
+                self.viewer.rendered();
             }
+            return;
+        };
+        let Some(step) = self.viewer.step() else { return };
+        self.stop = Arc::new(AtomicBool::new(false));
+        let job = Job { scene: scene.clone(), viewer: self.viewer.clone(), step, stop: self.stop.clone() };
+        self.worker.send(job);
+    }
+
+    /// Takes a finished step: shows it, unless it was given up.
+    fn finished(&mut self, done: Done) {
+        self.viewer.rendered();
+        match done.outcome {
+            Outcome::Stopped => {
+                if let Some(at) = self.clock.stop_raised.take() {
+                    self.clock.to_stop.push(done.at - at);
+                }
+                return;
+            }
+            Outcome::Failed(e) => {
+                self.viewer.error = Some(e);
+                while self.viewer.step().is_some() {
+                    self.viewer.rendered();
+                }
+            }
+            Outcome::Rendered(stats) => self.clock.count(done.step, &stats),
         }
+        // The next step renders while this one is shown.
+        self.dispatch();
+        self.frame_times.push_back(done.took.as_secs_f64());
         if self.frame_times.len() > 10 {
             self.frame_times.pop_front();
         }
-        self.step = Some(step);
-        true
+        if done.step == Step::Quick {
+            self.clock.quick_ms.push(done.took.as_secs_f64() * 1e3);
+        }
+        // An image answers the inputs that came before its step began.
+        if let Some(at) = self.clock.unanswered.filter(|&at| done.at - done.took >= at) {
+            self.clock.to_image.push(done.at - at);
+            self.clock.unanswered = None;
+        }
+        if self.viewer.at_rest() {
+            if let Some(at) = self.clock.last_input.take() {
+                self.clock.to_rest.push(done.at - at);
+            }
+        }
+        self.step = Some(done.step);
+        self.present();
     }
 
     /// Shows the image, the HUD, the keys and any error.
@@ -375,20 +464,17 @@ impl App {
         let Ok(mut buffer) = s.surface.buffer_mut() else { return };
         let (bw, bh) = (size.width as usize, size.height as usize);
         buffer.fill(0x0020_2020);
-        let shown = &self.refiner.shown;
+        let shown = lock(&self.shown);
         let (iw, ih) = (shown.image.width() as usize, shown.image.height() as usize);
-        if iw > 0 {
-            let rgb = shown.image.to_srgb8_toned(shown.scale, shown.tone);
-            for y in 0..ih.min(bh) {
-                for x in 0..iw.min(bw) {
-                    let p = &rgb[3 * (y * iw + x)..3 * (y * iw + x) + 3];
-                    buffer[y * bw + x] = u32::from(p[0]) << 16 | u32::from(p[1]) << 8 | u32::from(p[2]);
-                }
+        if iw > 0 && shown.screen.len() == iw * ih {
+            let (w, h) = (iw.min(bw), ih.min(bh));
+            for (out, row) in buffer.chunks_mut(bw).zip(shown.screen.chunks(iw)).take(h) {
+                out[..w].copy_from_slice(&row[..w]);
             }
         }
         let mut below_hud = 8;
         if self.viewer.hud {
-            let lines = hud_lines(&self.viewer, &self.refiner, self.step, &self.frame_times);
+            let lines = hud_lines(&self.viewer, &shown, self.step, &self.frame_times);
             self.text.draw(&mut buffer, (bw, bh), (8, 8), &lines, 0x00e0_e0e0);
             below_hud += self.text.size(&lines).1 + 8;
         }
@@ -428,8 +514,7 @@ fn viewer_for(scene: Option<&Scene>, size: (u32, u32)) -> Viewer {
     viewer
 }
 
-fn hud_lines(viewer: &Viewer, refiner: &Refiner, step: Option<Step>, times: &VecDeque<f64>) -> Vec<String> {
-    let shown = &refiner.shown;
+fn hud_lines(viewer: &Viewer, shown: &Shown, step: Option<Step>, times: &VecDeque<f64>) -> Vec<String> {
     let st = &shown.stats;
     let mean = times.iter().sum::<f64>() / times.len().max(1) as f64;
     let stage = match step {
@@ -513,6 +598,7 @@ impl ApplicationHandler<Wake> for App {
     fn user_event(&mut self, event_loop: &ActiveEventLoop, event: Wake) {
         match event {
             Wake::FileChanged => self.input(event_loop, Input::FileChanged),
+            Wake::Rendered(done) => self.finished(*done),
         }
     }
 
@@ -571,19 +657,28 @@ impl ApplicationHandler<Wake> for App {
         }
     }
 
+    fn exiting(&mut self, _event_loop: &ActiveEventLoop) {
+        // The rendering thread gives its step up; closing waits for it.
+        self.stop.store(true, Ordering::Relaxed);
+    }
+
     fn about_to_wait(&mut self, event_loop: &ActiveEventLoop) {
         if self.surface.is_none() {
             return;
         }
+        // The step first, then the script: a scripted input then arrives
+        // while a step renders, as a user's does.
+        self.dispatch();
         self.run_script(event_loop);
         if event_loop.exiting() {
             return;
         }
-        if self.refine() {
-            self.present();
-            event_loop.set_control_flow(ControlFlow::Poll);
-        } else if self.sleep_until.is_none() {
-            event_loop.set_control_flow(if self.script.is_empty() { ControlFlow::Wait } else { ControlFlow::Poll });
+        self.dispatch();
+        if self.sleep_until.is_none() {
+            // The rendering thread wakes the loop when a step is done; a
+            // script with nothing rendering goes on at once.
+            let idle = self.viewer.rendering().is_none() && !self.script.is_empty();
+            event_loop.set_control_flow(if idle { ControlFlow::Poll } else { ControlFlow::Wait });
         }
     }
 }
