@@ -162,8 +162,8 @@ impl Texture {
         let decoded =
             std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| ::image::DynamicImage::from_decoder(header)))
                 .map_err(|_| "the image decoder failed on this file (it is malformed, or the decoder has a bug)")?;
-        let img = decoded.map_err(|e| e.to_string())?.into_rgb32f();
-        let (width, height) = img.dimensions();
+        let decoded = decoded.map_err(|e| e.to_string())?;
+        let (width, height) = (decoded.width(), decoded.height());
         if width == 0 || height == 0 {
             return Err("the image has no pixels".into());
         }
@@ -176,7 +176,16 @@ impl Texture {
                 c
             }
         };
-        let texels = img.pixels().map(|p| Vec3::new(decode(p[0]), decode(p[1]), decode(p[2]))).collect();
+        let texels = if decoded.color().bytes_per_pixel() == decoded.color().channel_count() {
+            // Eight bits a channel (JPEG, most PNGs): 256 values, each decoded
+            // once rather than with a power per texel.
+            let table: Vec<f32> = (0..=255u8).map(|k| decode(f32::from(k) / 255.0)).collect();
+            let img = decoded.into_rgb8();
+            img.pixels().map(|p| Vec3::new(table[p[0] as usize], table[p[1] as usize], table[p[2] as usize])).collect()
+        } else {
+            let img = decoded.into_rgb32f();
+            img.pixels().map(|p| Vec3::new(decode(p[0]), decode(p[1]), decode(p[2]))).collect()
+        };
         Ok(Texture::from_texels(width, height, texels))
     }
 
@@ -231,6 +240,39 @@ impl Texture {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// An 8-bit image (decoded through a table of its 256 values) and the
+    /// same values in 16 bits (a power per texel) give the same texels: the
+    /// sRGB curve's, or the code over 255 for linear data.
+    #[test]
+    fn eight_and_sixteen_bit_images_decode_alike() {
+        let encode = |image: ::image::DynamicImage| {
+            let mut bytes = Vec::new();
+            image.write_to(&mut std::io::Cursor::new(&mut bytes), ::image::ImageFormat::Png).unwrap();
+            bytes
+        };
+        let codes: Vec<u8> = (0..=255u8).flat_map(|k| [k, k.wrapping_mul(7), 255 - k]).collect();
+        let eight = ::image::RgbImage::from_raw(16, 16, codes.clone()).unwrap();
+        let wide: Vec<u16> = codes.iter().map(|&k| u16::from(k) * 257).collect();
+        let sixteen = ::image::ImageBuffer::<::image::Rgb<u16>, _>::from_raw(16, 16, wide).unwrap();
+        let (eight, sixteen) = (encode(eight.into()), encode(sixteen.into()));
+        for srgb in [true, false] {
+            let a = Texture::decode(&eight, srgb, &Limits::default()).unwrap();
+            let b = Texture::decode(&sixteen, srgb, &Limits::default()).unwrap();
+            for ((ta, tb), k) in a.levels[0].texels.iter().zip(&b.levels[0].texels).zip(codes.chunks(3)) {
+                let want = Vec3::from_array([k[0], k[1], k[2]].map(|k| {
+                    let c = f32::from(k) / 255.0;
+                    if srgb {
+                        srgb_to_linear(c)
+                    } else {
+                        c
+                    }
+                }));
+                assert!((*ta - want).abs().max_element() < 1e-6, "8-bit {ta} vs {want}");
+                assert!((*tb - want).abs().max_element() < 1e-6, "16-bit {tb} vs {want}");
+            }
+        }
+    }
 
     #[test]
     fn bilinear_repeats_and_interpolates() {

@@ -330,7 +330,7 @@ impl App {
 
     /// Writes the window's contents as last presented to a PNG.
     fn capture(&mut self, path: &Path) {
-        self.present();
+        self.present(true);
         let (pixels, w, h) = &self.presented;
         let mut image = kage::image::LinearImage::new(*w as u32, *h as u32);
         for (out, &p) in image.pixels_mut().iter_mut().zip(pixels) {
@@ -450,11 +450,12 @@ impl App {
             }
         }
         self.step = Some(done.step);
-        self.present();
+        self.present(false);
     }
 
-    /// Shows the image, the HUD, the keys and any error.
-    fn present(&mut self) {
+    /// Shows the image, the HUD, the keys and any error; `keep`: also keeps
+    /// what is shown for a capture.
+    fn present(&mut self, keep: bool) {
         let Some(s) = &mut self.surface else { return };
         let size = s.window.inner_size();
         let (Some(w), Some(h)) = (NonZeroU32::new(size.width), NonZeroU32::new(size.height)) else { return };
@@ -464,17 +465,21 @@ impl App {
         let Ok(mut buffer) = s.surface.buffer_mut() else { return };
         let (bw, bh) = (size.width as usize, size.height as usize);
         buffer.fill(0x0020_2020);
-        let shown = lock(&self.shown);
-        let (iw, ih) = (shown.image.width() as usize, shown.image.height() as usize);
-        if iw > 0 && shown.screen.len() == iw * ih {
-            let (w, h) = (iw.min(bw), ih.min(bh));
-            for (out, row) in buffer.chunks_mut(bw).zip(shown.screen.chunks(iw)).take(h) {
-                out[..w].copy_from_slice(&row[..w]);
+        // The image copied out, the lock let go before the rest: the
+        // rendering thread waits for it to write the next.
+        let (iw, lines) = {
+            let shown = lock(&self.shown);
+            let (iw, ih) = (shown.image.width() as usize, shown.image.height() as usize);
+            if iw > 0 && shown.screen.len() == iw * ih {
+                let (w, h) = (iw.min(bw), ih.min(bh));
+                for (out, row) in buffer.chunks_mut(bw).zip(shown.screen.chunks(iw)).take(h) {
+                    out[..w].copy_from_slice(&row[..w]);
+                }
             }
-        }
+            (iw, hud_lines(&self.viewer, &shown, self.step, &self.frame_times))
+        };
         let mut below_hud = 8;
         if self.viewer.hud {
-            let lines = hud_lines(&self.viewer, &shown, self.step, &self.frame_times);
             self.text.draw(&mut buffer, (bw, bh), (8, 8), &lines, 0x00e0_e0e0);
             below_hud += self.text.size(&lines).1 + 8;
         }
@@ -488,7 +493,9 @@ impl App {
             let y = bh.saturating_sub(self.text.size(&lines).1 + 8);
             self.text.draw(&mut buffer, (bw, bh), (8, y), &lines, ERROR_COLOUR);
         }
-        self.presented = (buffer.to_vec(), bw, bh);
+        if keep {
+            self.presented = (buffer.to_vec(), bw, bh);
+        }
         if buffer.present().is_ok() && iw > 0 && self.clock.first_image.is_none() {
             self.clock.first_image = Some(self.clock.started.elapsed());
         }
@@ -606,7 +613,7 @@ impl ApplicationHandler<Wake> for App {
         match event {
             WindowEvent::CloseRequested => event_loop.exit(),
             WindowEvent::Resized(size) => self.input(event_loop, Input::Resize(size.width, size.height)),
-            WindowEvent::RedrawRequested => self.present(),
+            WindowEvent::RedrawRequested => self.present(false),
             WindowEvent::ModifiersChanged(m) => self.mouse.shift = m.state().shift_key(),
             WindowEvent::MouseInput { state, button, .. } => {
                 let down = state == ElementState::Pressed;
