@@ -1,6 +1,7 @@
 //! Scripted input for `kage view --script FILE`: the events a user would
-//! make, one per line, for tests and recordings; each input is followed by
-//! the frame it asks for (120 `drag` lines: a 120-frame orbit).
+//! make, one per line, for tests and recordings. Inputs arrive one a step
+//! rendered, while it renders, as a moving mouse's events do (120 `drag`
+//! lines: a 120-frame orbit).
 //!
 //! ```text
 //! # a comment

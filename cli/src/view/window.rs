@@ -190,6 +190,8 @@ struct App {
     text: Text,
     script: VecDeque<Action>,
     sleep_until: Option<Instant>,
+    /// Whether the script gave an input since the step rendering began.
+    fed: bool,
     surface: Option<Surface>,
     mouse: Mouse,
     proxy: EventLoopProxy<Wake>,
@@ -232,6 +234,7 @@ impl App {
             text: Text::new(),
             script: start.script.into(),
             sleep_until: None,
+            fed: false,
             surface: None,
             mouse: Mouse::default(),
             proxy,
@@ -370,11 +373,12 @@ impl App {
                     self.sleep_until = Some(Instant::now() + Duration::from_secs_f32(s));
                     continue;
                 }
-                Action::Input(_) if self.answering_input() => return,
+                Action::Input(_) if self.viewer.rendering().is_some() && self.fed => return,
                 Action::Input(input) => {
-                    // One input a frame, as a user's events arrive: the
-                    // frame it asks for renders before the next.
+                    // One input a step rendered, arriving while it renders,
+                    // as a moving mouse's events do.
                     self.script.pop_front();
+                    self.fed = true;
                     self.input(event_loop, input);
                     return;
                 }
@@ -392,12 +396,6 @@ impl App {
         }
     }
 
-    /// Whether the step rendering answers the last input: a quick frame,
-    /// or a step asked to stop (the quick frame follows it).
-    fn answering_input(&self) -> bool {
-        self.viewer.rendering() == Some(Step::Quick) || self.stop.load(Ordering::Relaxed)
-    }
-
     /// Hands the next refinement step, if any, to the rendering thread.
     fn dispatch(&mut self) {
         let Some(scene) = &self.scene else {
@@ -408,6 +406,7 @@ impl App {
         };
         let Some(step) = self.viewer.step() else { return };
         self.stop = Arc::new(AtomicBool::new(false));
+        self.fed = false;
         let job = Job { scene: scene.clone(), viewer: self.viewer.clone(), step, stop: self.stop.clone() };
         self.worker.send(job);
     }
