@@ -3,7 +3,9 @@
 //! Mesa's software OpenGL, offscreen through EGL).
 //!
 //! kage runs as a user runs it — `kage view FILE --script orbit --timings`
-//! under a virtual X server (Xvfb): 120 drags of 3° each, one frame each,
+//! under a virtual X server (Xvfb): 120 drags of 3° each, one a frame,
+//! each arriving while the frame before it renders (the rate is the time
+//! between two frames shown, presentation included),
 //! then rest; 16 passes into the refinement an input (a zoom of no steps)
 //! gives up the pass rendering, and the refinement starts over and runs to
 //! its 64-pass image. f3d 4.0 (`pip install f3d`;
@@ -42,7 +44,7 @@ pub struct ViewArgs {
 struct Run {
     /// Launch to the first image, ms.
     first_ms: f64,
-    /// Median ms per frame while orbiting.
+    /// Median ms between two frames shown while orbiting.
     frame_ms: f64,
     /// From the last input to the fully refined image, ms (kage only).
     refined_ms: Option<f64>,
@@ -115,7 +117,7 @@ fn kage_scripted(kage: &Path, file: &Path, c: &Common, text: &str) -> Result<Run
     let line = said.lines().find(|l| l.starts_with("first image")).ok_or_else(|| miette!("no timings: {said}"))?;
     Ok(Run {
         first_ms: number_after(line, "first image", "").unwrap_or(f64::NAN),
-        frame_ms: number_after(line, "quick frames", "median").unwrap_or(f64::NAN),
+        frame_ms: number_after(line, "quick frames", "shown every").unwrap_or(f64::NAN),
         refined_ms: number_after(line, "refined", "median"),
         new_image_ms: number_after(line, "new image", "median"),
         given_up_ms: number_after(line, "given up", "median"),
@@ -245,7 +247,8 @@ pub fn run(args: &ViewArgs) -> Result<()> {
         saved_scad(&kage, c)?;
     }
     println!(
-        "\n{0}×{1}, 2 threads. kage: `kage view FILE --script` under Xvfb, {2} drags of 3° (one frame each: a quick \
+        "\n{0}×{1}, 2 threads. kage: `kage view FILE --script` under Xvfb, {2} drags of 3° (one a frame, arriving while the \
+         frame before renders; ms per frame: median time between two frames shown, presenting included; a quick \
          frame — no edge pass, plain maps for costlier shadows), then left to rest; after 16 jittered passes an \
          input (a zoom of no steps) gives up the pass rendering, and the refinement runs again until 64 passes are \
          averaged; first image from the window's start (scene loaded, window open, first frame shown). f3d 4.0: \

@@ -97,6 +97,15 @@ struct Clock {
     stop_raised: Option<Instant>,
     /// From asking a step to stop to hearing it stopped, each time.
     to_stop: Vec<Duration>,
+    /// When the last quick frame was shown, while quick frames follow each
+    /// other.
+    last_quick: Option<Instant>,
+    /// Between one quick frame shown and the next: the rate a moving camera
+    /// sees.
+    quick_apart: Vec<Duration>,
+    /// Milliseconds of each presentation (the image copied, text drawn, the
+    /// buffer handed to the window system).
+    present_ms: Vec<f64>,
 }
 
 impl Clock {
@@ -112,12 +121,15 @@ impl Clock {
             to_image: Vec::new(),
             stop_raised: None,
             to_stop: Vec::new(),
+            last_quick: None,
+            quick_apart: Vec::new(),
+            present_ms: Vec::new(),
         }
     }
 
     /// A line of figures: time to the first image, quick frames (median ms
-    /// and frames per second), input to fully refined and input to the next
-    /// image (medians).
+    /// to render, median ms between two shown, frames per second), input to
+    /// fully refined and input to the next image (medians).
     fn summary(&self) -> String {
         let median = |mut v: Vec<f64>| {
             v.sort_by(f64::total_cmp);
@@ -128,6 +140,8 @@ impl Clock {
         let (rested, rest) = median(ms(&self.to_rest));
         let (answered, answer) = median(ms(&self.to_image));
         let (stopped, stop) = median(ms(&self.to_stop));
+        let (_, apart) = median(ms(&self.quick_apart));
+        let (_, present) = median(self.present_ms.clone());
         let mean = |(n, sum): (u32, [f64; 5])| {
             let s = sum.map(|t| t / f64::from(n.max(1)));
             format!(
@@ -136,12 +150,13 @@ impl Clock {
             )
         };
         format!(
-            "first image {:.0} ms; {quick} quick frames, median {median_quick:.1} ms ({:.1} fps; mean ms: {}); {} \
-             jittered passes, mean ms: {}; refined {rested} \
+            "first image {:.0} ms; {quick} quick frames, median {median_quick:.1} ms to render, one shown every \
+             {apart:.1} ms ({:.1} fps; mean ms: {}); presenting median {present:.1} ms; {} jittered passes, mean \
+             ms: {}; refined {rested} \
              times, median {rest:.0} ms after the input; new image {answered} times, median {answer:.0} ms after the \
              input; {stopped} steps given up, median {stop:.1} ms after the input",
             self.first_image.map_or(f64::NAN, |d| d.as_secs_f64() * 1e3),
-            1e3 / median_quick,
+            1e3 / apart,
             mean(self.stages[0]),
             self.stages[1].0,
             mean(self.stages[1]),
@@ -437,6 +452,11 @@ impl App {
         }
         if done.step == Step::Quick {
             self.clock.quick_ms.push(done.took.as_secs_f64() * 1e3);
+            if let Some(last) = self.clock.last_quick.replace(done.at) {
+                self.clock.quick_apart.push(done.at - last);
+            }
+        } else {
+            self.clock.last_quick = None;
         }
         // An image answers the inputs that came before its step began.
         if let Some(at) = self.clock.unanswered.filter(|&at| done.at - done.took >= at) {
@@ -455,6 +475,7 @@ impl App {
     /// Shows the image, the HUD, the keys and any error; `keep`: also keeps
     /// what is shown for a capture.
     fn present(&mut self, keep: bool) {
+        let start = Instant::now();
         let Some(s) = &mut self.surface else { return };
         let size = s.window.inner_size();
         let (Some(w), Some(h)) = (NonZeroU32::new(size.width), NonZeroU32::new(size.height)) else { return };
@@ -498,6 +519,7 @@ impl App {
         if buffer.present().is_ok() && iw > 0 && self.clock.first_image.is_none() {
             self.clock.first_image = Some(self.clock.started.elapsed());
         }
+        self.clock.present_ms.push(start.elapsed().as_secs_f64() * 1e3);
     }
 }
 
