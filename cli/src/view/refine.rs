@@ -114,22 +114,16 @@ impl Refiner {
         let frame = renderer.render_or_stop(&scene, stop)?;
         let stats = frame.stats;
         let display = viewer.display;
-        let stopped = || stop.load(Ordering::Relaxed);
         let Step::Pass(n) = step else {
-            let mut out = lock(shown);
-            if stopped() {
-                return Err(kage::Error::Stopped);
-            }
-            display_image(&scene, frame, display, &mut out.image);
-            self.look = if display == Display::Image {
-                (scene.exposure.scale(&out.image), scene.tone)
-            } else {
-                (1.0, ToneCurve::Clip)
-            };
-            (out.scale, out.tone, out.stats, out.passes) = (self.look.0, self.look.1, stats, 0);
-            let Shown { image, scale, tone, screen, .. } = &mut *out;
-            image.to_0rgb_toned_into(*scale, *tone, screen);
-            return Ok(stats);
+            return publish(shown, stop, stats, 0, |image| {
+                display_image(&scene, frame, display, image);
+                self.look = if display == Display::Image {
+                    (scene.exposure.scale(image), scene.tone)
+                } else {
+                    (1.0, ToneCurve::Clip)
+                };
+                self.look
+            });
         };
         let image = if display == Display::Image {
             &frame.image
@@ -146,18 +140,34 @@ impl Refiner {
         if self.passes < SHOWN_FROM_PASS {
             return Ok(stats);
         }
-        let mut out = lock(shown);
-        if stopped() {
-            return Err(kage::Error::Stopped);
-        }
-        let k = 1.0 / self.passes as f32;
-        out.image.resize(self.sum.width(), self.sum.height());
-        out.image.pixels_mut().par_iter_mut().zip(self.sum.pixels().par_iter()).for_each(|(o, s)| *o = *s * k);
-        (out.scale, out.tone, out.stats, out.passes) = (self.look.0, self.look.1, stats, self.passes);
-        let Shown { image, scale, tone, screen, .. } = &mut *out;
-        image.to_0rgb_toned_into(*scale, *tone, screen);
-        Ok(stats)
+        let (sum, look, k) = (&self.sum, self.look, 1.0 / self.passes as f32);
+        publish(shown, stop, stats, self.passes, |image| {
+            image.resize(sum.width(), sum.height());
+            image.pixels_mut().par_iter_mut().zip(sum.pixels().par_iter()).for_each(|(o, s)| *o = *s * k);
+            look
+        })
     }
+}
+
+/// Writes what is shown, unless `stop` is raised: `fill` writes the linear
+/// image and gives its exposure and tone curve; the screen's words, the
+/// frame's `stats` and the `passes` averaged follow. Returns `stats`.
+fn publish(
+    shown: &Mutex<Shown>,
+    stop: &AtomicBool,
+    stats: FrameStats,
+    passes: u32,
+    fill: impl FnOnce(&mut LinearImage) -> (f32, ToneCurve),
+) -> kage::error::Result<FrameStats> {
+    let mut out = lock(shown);
+    if stop.load(Ordering::Relaxed) {
+        return Err(kage::Error::Stopped);
+    }
+    let Shown { image, scale, tone, stats: shown_stats, passes: shown_passes, screen } = &mut *out;
+    (*scale, *tone) = fill(image);
+    (*shown_stats, *shown_passes) = (stats, passes);
+    image.to_0rgb_toned_into(*scale, *tone, screen);
+    Ok(stats)
 }
 
 /// `base` as `viewer` and `step` set it up: the orbit's camera at the

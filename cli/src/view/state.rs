@@ -383,6 +383,12 @@ impl Viewer {
         Some(now)
     }
 
+    /// Ends the refinement without rendering the rest of it (nothing to
+    /// render, or the scene cannot be rendered).
+    pub fn settle(&mut self) {
+        (self.next, self.rendering, self.stale) = (None, None, false);
+    }
+
     /// The step being rendered is done (or given up).
     pub fn rendered(&mut self) {
         (self.rendering, self.stale) = (None, false);

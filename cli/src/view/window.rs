@@ -414,9 +414,7 @@ impl App {
     /// Hands the next refinement step, if any, to the rendering thread.
     fn dispatch(&mut self) {
         let Some(scene) = &self.scene else {
-            while self.viewer.step().is_some() {
-                self.viewer.rendered();
-            }
+            self.viewer.settle();
             return;
         };
         let Some(step) = self.viewer.step() else { return };
@@ -438,9 +436,7 @@ impl App {
             }
             Outcome::Failed(e) => {
                 self.viewer.error = Some(e);
-                while self.viewer.step().is_some() {
-                    self.viewer.rendered();
-                }
+                self.viewer.settle();
             }
             Outcome::Rendered(stats) => self.clock.count(done.step, &stats),
         }
