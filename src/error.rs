@@ -169,6 +169,16 @@ pub enum Error {
         /// The file.
         path: PathBuf,
     },
+    /// A region of the frame to render that is empty or does not lie inside it.
+    #[error("the region {}..{} x {}..{} is not a part of the {width}x{height} image", region.x0, region.x1, region.y0, region.y1)]
+    Region {
+        /// The region asked for.
+        region: crate::image::PixelRect,
+        /// The frame's width.
+        width: u32,
+        /// The frame's height.
+        height: u32,
+    },
     /// A frame was given up because its caller raised the stop flag
     /// ([`crate::Renderer::render_or_stop`]).
     #[error("the frame was stopped before it was done")]

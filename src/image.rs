@@ -11,6 +11,104 @@ use rayon::prelude::*;
 
 pub use tone::ToneCurve;
 
+/// A rectangle of pixels, `x0..x1` × `y0..y1` (half-open), in the
+/// coordinates of a whole image: what a tile of a frame covers.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct PixelRect {
+    /// First column.
+    pub x0: u32,
+    /// First row.
+    pub y0: u32,
+    /// One past the last column.
+    pub x1: u32,
+    /// One past the last row.
+    pub y1: u32,
+}
+
+impl PixelRect {
+    /// The whole of a `width` × `height` image.
+    #[must_use]
+    pub fn full(width: u32, height: u32) -> PixelRect {
+        PixelRect { x0: 0, y0: 0, x1: width, y1: height }
+    }
+
+    /// Width in pixels (0 when empty).
+    #[must_use]
+    pub fn width(self) -> u32 {
+        self.x1.saturating_sub(self.x0)
+    }
+
+    /// Height in pixels (0 when empty).
+    #[must_use]
+    pub fn height(self) -> u32 {
+        self.y1.saturating_sub(self.y0)
+    }
+
+    /// Whether it holds no pixel.
+    #[must_use]
+    pub fn is_empty(self) -> bool {
+        self.width() == 0 || self.height() == 0
+    }
+
+    /// Whether it lies inside a `width` × `height` image.
+    #[must_use]
+    pub fn fits(self, width: u32, height: u32) -> bool {
+        self.x0 <= self.x1 && self.y0 <= self.y1 && self.x1 <= width && self.y1 <= height
+    }
+
+    /// Whether pixel (x, y) is in it.
+    #[must_use]
+    pub fn contains(self, x: u32, y: u32) -> bool {
+        (self.x0..self.x1).contains(&x) && (self.y0..self.y1).contains(&y)
+    }
+
+    /// Grown by `by` pixels on every side, kept inside a `width` × `height`
+    /// image.
+    #[must_use]
+    pub fn grown(self, by: u32, width: u32, height: u32) -> PixelRect {
+        PixelRect {
+            x0: self.x0.saturating_sub(by),
+            y0: self.y0.saturating_sub(by),
+            x1: self.x1.saturating_add(by).min(width),
+            y1: self.y1.saturating_add(by).min(height),
+        }
+    }
+
+    /// Tile `index` of `count` tiles cutting a `width` × `height` image into a
+    /// grid: `count` = columns × rows, the pair whose tiles are closest to
+    /// square; tiles numbered row by row from the top left, their edges at
+    /// `⌊k·width/columns⌋` and `⌊k·height/rows⌋`.
+    ///
+    /// # Panics
+    ///
+    /// If `index >= count`.
+    #[must_use]
+    pub fn tile(index: u32, count: u32, width: u32, height: u32) -> PixelRect {
+        assert!(index < count, "tile {index} of {count}");
+        let (columns, rows) = grid(count, width, height);
+        let (i, j) = (index % columns, index / columns);
+        let cut = |k: u32, n: u32, size: u32| (u64::from(k) * u64::from(size) / u64::from(n)) as u32;
+        PixelRect {
+            x0: cut(i, columns, width),
+            x1: cut(i + 1, columns, width),
+            y0: cut(j, rows, height),
+            y1: cut(j + 1, rows, height),
+        }
+    }
+}
+
+/// Columns × rows = `count`, the factor pair whose cells of a `width` ×
+/// `height` image are nearest to square.
+fn grid(count: u32, width: u32, height: u32) -> (u32, u32) {
+    let squareness = |c: u32| {
+        let (cw, ch) = (width as f64 / f64::from(c), height as f64 / f64::from(count / c));
+        (cw / ch).ln().abs()
+    };
+    let columns = (1..=count).filter(|c| count % c == 0).min_by(|a, b| squareness(*a).total_cmp(&squareness(*b)));
+    let columns = columns.unwrap_or(1);
+    (columns, count / columns)
+}
+
 /// A linear-light RGB image, rows top to bottom.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct LinearImage {
@@ -55,6 +153,37 @@ impl LinearImage {
     /// All pixels, row-major, for writing.
     pub fn pixels_mut(&mut self) -> &mut [Vec3] {
         &mut self.pixels
+    }
+
+    /// The pixels of `rect`, a new image of its size.
+    ///
+    /// # Panics
+    ///
+    /// If `rect` does not lie inside the image.
+    #[must_use]
+    pub fn crop(&self, rect: PixelRect) -> LinearImage {
+        assert!(rect.fits(self.width, self.height), "{rect:?} outside a {}x{} image", self.width, self.height);
+        let w = self.width as usize;
+        let pixels = (rect.y0..rect.y1)
+            .flat_map(|y| &self.pixels[y as usize * w + rect.x0 as usize..y as usize * w + rect.x1 as usize])
+            .copied()
+            .collect();
+        LinearImage { width: rect.width(), height: rect.height(), pixels }
+    }
+
+    /// Copies `part` into the image with its top left corner at (x, y).
+    ///
+    /// # Panics
+    ///
+    /// If `part` placed there does not lie inside the image.
+    pub fn paste(&mut self, part: &LinearImage, x: u32, y: u32) {
+        let rect = PixelRect { x0: x, y0: y, x1: x + part.width, y1: y + part.height };
+        assert!(rect.fits(self.width, self.height), "{rect:?} outside a {}x{} image", self.width, self.height);
+        let (w, pw) = (self.width as usize, part.width as usize);
+        for (r, row) in part.pixels.chunks(pw.max(1)).enumerate() {
+            let start = (y as usize + r) * w + x as usize;
+            self.pixels[start..start + pw].copy_from_slice(row);
+        }
     }
 
     /// Pixel (x, y).

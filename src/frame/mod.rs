@@ -22,12 +22,12 @@ use std::time::{Duration, Instant};
 use glam::{Vec2, Vec3};
 
 use crate::error::{Error, Result};
-use crate::image::LinearImage;
+use crate::image::{LinearImage, PixelRect};
 use crate::raytrace::traced::Refine;
 use crate::raytrace::{traced, TraceCache};
 use crate::resolve::edges::{EdgeOptions, EdgePass};
 use crate::resolve::jitter;
-use crate::scene::{Antialias, Scene};
+use crate::scene::{Antialias, Scene, ShadowMethod};
 use crate::shading::{self, fog, translucency, Component, ComponentSet, PassStats, SubpixelShading, Target};
 use crate::shadows::MapPool;
 use crate::visibility::{self, RasterStats, VisibilityBuffer};
@@ -57,6 +57,38 @@ pub struct RenderOptions {
     /// about a quarter of the traced term's rays, for the frames of a moving
     /// camera. Ignored by edge-antialiased frames, which refine instead.
     pub sparse_traced: bool,
+    /// Only these pixels of the frame need be right (`None`: all of them): a
+    /// tile of a larger render. Every pixel inside equals the whole frame's
+    /// bit for bit; the frame's images keep the scene's size, and hold
+    /// background or partial results outside ([`region_drawn`] says which
+    /// pixels are drawn for it).
+    pub region: Option<PixelRect>,
+}
+
+/// Pixels drawn around a [`RenderOptions::region`]: more than any stage that
+/// looks at neighbours reaches (the edge pass's blends and its outlines' ends,
+/// the traced term's refinement, the silhouette-line buffer's footprints reach
+/// a few pixels).
+pub const REGION_GUARD_PX: u32 = 16;
+
+/// The pixels a frame limited to `region` draws: the region grown by
+/// [`REGION_GUARD_PX`], its columns widened to the shading's segment borders
+/// ([`shading::SEGMENT`]); or the whole frame when a light's shadows come
+/// from two shadow maps ([`ShadowMethod::Soft`]), whose distance transform
+/// reaches across the image.
+#[must_use]
+pub fn region_drawn(scene: &Scene, region: PixelRect) -> PixelRect {
+    let (w, h) = (scene.width, scene.height);
+    if scene.lights.iter().any(|l| l.shadow.method == ShadowMethod::Soft) {
+        return PixelRect::full(w, h);
+    }
+    let grown = region.grown(REGION_GUARD_PX, w, h);
+    let segment = shading::SEGMENT as u32;
+    PixelRect {
+        x0: grown.x0 / segment * segment,
+        x1: grown.x1.div_ceil(segment).saturating_mul(segment).min(w),
+        ..grown
+    }
 }
 
 impl Default for RenderOptions {
@@ -68,6 +100,7 @@ impl Default for RenderOptions {
             keep_shadow_maps: true,
             shadow_images: false,
             sparse_traced: false,
+            region: None,
         }
     }
 }
@@ -277,6 +310,11 @@ impl Renderer {
     fn render_watched(&mut self, scene: &Scene, progress: &(dyn Fn(u32, u32) + Sync), stop: Stop) -> Result<&Frame> {
         scene.validate()?;
         budget::check(scene)?;
+        if let Some(region) = self.options.region {
+            if region.is_empty() || !region.fits(scene.width, scene.height) {
+                return Err(Error::Region { region, width: scene.width, height: scene.height });
+            }
+        }
         let (frame, scratch) = (&mut self.frame, &mut self.scratch);
         let options = &self.options;
         match &self.pool {
@@ -446,6 +484,7 @@ fn render_pass(
     let Frame { image, visibility, aovs, stats, .. } = frame;
     let Scratch { aovs: component_images, maps, trace, edges: edge_pass, subpixel, shadows, .. } = scratch;
     visibility.resize(scene.width, scene.height);
+    visibility.set_scissor(options.region.map(|r| region_drawn(scene, r)));
     stats.raster = stats.timed(Stage::Visibility, || visibility::rasterize(scene, visibility));
     stop.check()?;
     let vb = &*visibility;

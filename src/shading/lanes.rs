@@ -188,6 +188,7 @@ impl Block {
         let first = used.next();
         let whole = first.filter(|&n0| used.all(|n| n == n0)).and_then(whole_exponent);
         LaneInputs {
+            exponents: self.shininess.map(|n| whole_exponent(n).unwrap_or(0)),
             a: self.a.load(),
             e1: self.e1.load(),
             e2: self.e2.load(),
@@ -220,7 +221,8 @@ impl Block {
         if self.sample_textures(&inputs, &mut s, rays, x0, &coefficients_at) {
             let textured = self.inputs();
             (inputs.ka, inputs.kd, inputs.ks, inputs.ke) = (textured.ka, textured.kd, textured.ks, textured.ke);
-            (inputs.shininess, inputs.whole) = (textured.shininess, textured.whole);
+            (inputs.shininess, inputs.whole, inputs.exponents) =
+                (textured.shininess, textured.whole, textured.exponents);
         }
         let rgb = lighting.shade(&inputs, &s);
         for (i, px) in out.iter_mut().enumerate() {
@@ -308,6 +310,7 @@ pub fn shade_run(
         ke: V3::splat(ke),
         shininess: F::splat(n),
         whole: whole_exponent(n),
+        exponents: [whole_exponent(n).unwrap_or(0); LANES],
         object: [tri.item.object; LANES],
     };
     let row = TriangleRow::new(&g, &rays.line(x0));
@@ -335,6 +338,9 @@ struct LaneInputs {
     shininess: F,
     /// The exponent shared by all lanes when it is a whole number.
     whole: Option<u32>,
+    /// Each lane's exponent when it is a whole number, else 0: a lane's
+    /// power is the same whatever its neighbours' exponents.
+    exponents: [u32; LANES],
     /// The object each lane's surface belongs to (the shadow's receiver).
     object: [u32; LANES],
 }
@@ -557,7 +563,7 @@ impl<'a> Lighting<'a> {
             let radiance = if casts { radiance.scale(shadow(terms, s, cos_theta, &inp.receivers())) } else { radiance };
             let r = s.n.scale(cos_theta + cos_theta).sub(l);
             let cos_alpha = r.dot(s.v).max(F::ZERO);
-            let spec = power(cos_alpha, inp.shininess, inp.whole);
+            let spec = power(cos_alpha, inp.shininess, inp.whole, &inp.exponents);
             diffuse = diffuse.add(radiance.scale(lit.select(cos_theta, F::ZERO)));
             specular = specular.add(radiance.scale(lit.select(spec, F::ZERO)));
         }
@@ -578,11 +584,13 @@ fn shadow(terms: &[ShadowTerm], s: &LaneSurface, cos_theta: F, receivers: &Recei
     ShadowTerm::mean_lit_lanes(terms, [s.p.x, s.p.y, s.p.z], cos_theta, receivers)
 }
 
-/// `x^n` per lane for x ≥ 0: by repeated squaring when every lane has the same
-/// whole exponent `whole` (exact, and several times faster), else through
-/// exp/log.
+/// `x^n` per lane for x ≥ 0: by repeated squaring for the lanes whose
+/// exponent is a whole number (`whole` when every lane shares it, else each
+/// lane's `exponents`, 0 for none; exact, and several times faster), through
+/// exp/log for the others. A lane's result does not depend on the other
+/// lanes: the squaring takes the same steps for its exponent either way.
 #[inline(always)]
-fn power(x: F, n: F, whole: Option<u32>) -> F {
+fn power(x: F, n: F, whole: Option<u32>, exponents: &[u32; LANES]) -> F {
     match whole {
         Some(mut e) => {
             let (mut base, mut acc) = (x, F::ONE);
@@ -595,7 +603,25 @@ fn power(x: F, n: F, whole: Option<u32>) -> F {
             }
             acc
         }
-        None => x.simd_gt(F::ZERO).select(x.powf_simd(n), F::ZERO),
+        None => {
+            let general = || x.simd_gt(F::ZERO).select(x.powf_simd(n), F::ZERO);
+            let most = exponents.iter().copied().max().unwrap_or(0);
+            if most == 0 {
+                return general();
+            }
+            let (mut base, mut acc, mut bit) = (x, F::ONE, 1u32);
+            while bit <= most {
+                let take = F::new(exponents.map(|e| if e & bit != 0 { f32::from_bits(u32::MAX) } else { 0.0 }));
+                acc = take.select(acc * base, acc);
+                base *= base;
+                bit <<= 1;
+            }
+            if exponents.contains(&0) {
+                let squared = F::new(exponents.map(|e| if e != 0 { f32::from_bits(u32::MAX) } else { 0.0 }));
+                return squared.select(acc, general());
+            }
+            acc
+        }
     }
 }
 
@@ -750,5 +776,21 @@ mod tests {
         let rough = Material { shininess: 7.5, ..Material::default() };
         reused.set_coefficients(4, &Coefficients::constant(&rough).expect("no maps"));
         assert_eq!(reused.inputs().whole, None);
+    }
+
+    #[test]
+    fn a_lanes_power_does_not_depend_on_its_neighbours_exponents() {
+        let x = F::new([0.9, 0.5, 0.99, 0.7, 0.95, 0.3, 0.999, 0.0]);
+        for e in [1u32, 7, 32, 120, 200, 4096] {
+            let alone = power(x, F::splat(e as f32), Some(e), &[e; LANES]).to_array();
+            let mut exponents = [e, 3, 0, 17, e, 2000, 0, e];
+            exponents[0] = e;
+            let n = F::new(exponents.map(|k| if k == 0 { 7.5 } else { k as f32 }));
+            let mixed = power(x, n, None, &exponents).to_array();
+            for i in [0, 4, 7] {
+                assert_eq!(alone[i].to_bits(), mixed[i].to_bits(), "x^{e}, lane {i}");
+            }
+            assert!((mixed[2] - 0.99f32.powf(7.5)).abs() < 1e-5, "a lane with no whole exponent");
+        }
     }
 }

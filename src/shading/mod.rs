@@ -85,6 +85,11 @@ pub fn shade_pass(scene: &Scene, vb: &VisibilityBuffer, image: &mut LinearImage,
         let row = lanes::RowRays::new(&rays, y);
         let mut x = 0;
         while x < w {
+            // Runs stop at every SEGMENT-th column, so the pixels of a segment
+            // are shaded alike whatever lies outside it (a tile of the frame
+            // shades them as the whole frame does).
+            let segment_end = ((x / SEGMENT + 1) * SEGMENT).min(w);
+            let items = &items[..segment_end];
             let first = items[x];
             let run = run_end(items, x);
             if !pass.receives(first) {
@@ -124,7 +129,7 @@ pub fn shade_pass(scene: &Scene, vb: &VisibilityBuffer, image: &mut LinearImage,
                     continue;
                 }
             }
-            let end = (x + lanes::LANES).min(w);
+            let end = (x + lanes::LANES).min(segment_end);
             block.clear();
             for (i, (&item, px)) in items[x..end].iter().zip(out[x..end].iter_mut()).enumerate() {
                 if !pass.receives(item) {
@@ -150,6 +155,12 @@ pub fn shade_pass(scene: &Scene, vb: &VisibilityBuffer, image: &mut LinearImage,
         }
     });
 }
+
+/// Columns of a row shaded on their own: runs of one triangle and blocks of
+/// eight are cut at multiples of it, so a pixel's arithmetic depends only on
+/// the items of its own segment. A tile of a frame whose columns start and end
+/// on segment borders is shaded bit for bit as the whole frame is.
+pub const SEGMENT: usize = 64;
 
 /// End of the run of pixels from `x` that show the same item as pixel `x`.
 fn run_end(items: &[ItemId], x: usize) -> usize {

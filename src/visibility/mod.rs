@@ -16,6 +16,7 @@ pub mod solids;
 
 use glam::Vec3;
 
+use crate::image::PixelRect;
 use crate::scene::{Body, Scene};
 
 pub use clip::{ClipPlanes, MAX_CLIPPED};
@@ -99,6 +100,8 @@ pub struct VisibilityBuffer {
     /// False for a buffer whose solids' normals are not wanted (every shadow
     /// map, even one that keeps items).
     with_normals: bool,
+    /// The pixels drawing fills in (`None`: all); the rest stay empty.
+    scissor: Option<PixelRect>,
 }
 
 impl VisibilityBuffer {
@@ -115,6 +118,7 @@ impl VisibilityBuffer {
             normals: Vec::new(),
             with_items: true,
             with_normals: true,
+            scissor: None,
         }
     }
 
@@ -132,6 +136,7 @@ impl VisibilityBuffer {
             normals: Vec::new(),
             with_items: false,
             with_normals: false,
+            scissor: None,
         }
     }
 
@@ -189,6 +194,7 @@ impl VisibilityBuffer {
         let n = width as usize * height as usize;
         self.width = width;
         self.height = height;
+        self.scissor = self.scissor.filter(|r| r.fits(width, height));
         self.depth.resize(n, 0.0);
         if self.with_items {
             self.items.resize(n, ItemId::NONE);
@@ -208,6 +214,28 @@ impl VisibilityBuffer {
             self.items = Vec::new();
             self.normals = Vec::new();
         }
+    }
+
+    /// Limits what [`rasterize`] and [`fragments`] draw to `rect` (`None`:
+    /// the whole buffer): every pixel inside holds exactly what a whole
+    /// frame's would, every pixel outside is left empty. Coordinates stay
+    /// the whole image's, so a tile of a frame is computed by the same
+    /// arithmetic as the frame.
+    ///
+    /// # Panics
+    ///
+    /// If `rect` does not lie inside the buffer.
+    pub fn set_scissor(&mut self, rect: Option<PixelRect>) {
+        if let Some(r) = rect {
+            assert!(r.fits(self.width, self.height), "{r:?} outside a {}x{} buffer", self.width, self.height);
+        }
+        self.scissor = rect;
+    }
+
+    /// The pixels drawing fills in ([`VisibilityBuffer::set_scissor`]).
+    #[must_use]
+    pub fn scissor(&self) -> PixelRect {
+        self.scissor.unwrap_or(PixelRect::full(self.width, self.height))
     }
 
     /// Forgets everything drawn.

@@ -15,6 +15,7 @@ use super::clip::{ClipPlanes, MAX_CLIPPED};
 use super::scan::{column_range, row_range, scan_triangle, signed_area2, FixedPoint, SpanSink, ONE};
 use super::{ItemId, VisibilityBuffer};
 use crate::camera::Camera;
+use crate::image::PixelRect;
 use crate::scene::{Material, Scene};
 
 /// Rows per band: the unit of parallel work and of binning.
@@ -102,7 +103,9 @@ struct PolygonPass<'a> {
     planes: ClipPlanes,
     viewport: Viewport,
     width: i64,
-    height: i64,
+    /// The rows and columns drawn (the buffer's scissor).
+    rows: Range<i64>,
+    cols: Range<i64>,
     /// Rows per band: [`BAND_ROWS`], or the whole image on one worker.
     band_rows: usize,
     bands: usize,
@@ -137,7 +140,8 @@ pub enum Faces {
 /// ([`super::solids::draw_solids`]; solids are drawn opaque whatever their
 /// material). Translucent meshes are left to [`fragments`].
 pub fn rasterize(scene: &Scene, vb: &mut VisibilityBuffer) -> RasterStats {
-    let pass = PolygonPass::new(scene, &scene.camera, Faces::AsMaterials, Workers::All, vb.width(), vb.height());
+    let pass = PolygonPass::new(scene, &scene.camera, Faces::AsMaterials, Workers::All, vb.width(), vb.height())
+        .within(vb.scissor());
     let stats = pass.draw(&chunks(scene, |_, m| !m.translucent()), vb);
     RasterStats { solids: super::solids::draw_solids(scene, &scene.camera, |_| true, vb), ..stats }
 }
@@ -157,7 +161,7 @@ pub fn rasterize_casters(
     workers: Workers,
     vb: &mut VisibilityBuffer,
 ) -> RasterStats {
-    let pass = PolygonPass::new(scene, camera, Faces::All, workers, vb.width(), vb.height());
+    let pass = PolygonPass::new(scene, camera, Faces::All, workers, vb.width(), vb.height()).within(vb.scissor());
     let stats = pass.draw(&chunks(scene, |i, _| casters[i]), vb);
     RasterStats { solids: super::solids::draw_solids(scene, camera, |i| casters[i], vb), ..stats }
 }
@@ -184,7 +188,7 @@ pub fn fragments(scene: &Scene, opaque: &VisibilityBuffer) -> Vec<Fragment> {
         return Vec::new();
     }
     let (w, h) = (opaque.width(), opaque.height());
-    let pass = PolygonPass::new(scene, &scene.camera, Faces::AsMaterials, Workers::All, w, h);
+    let pass = PolygonPass::new(scene, &scene.camera, Faces::AsMaterials, Workers::All, w, h).within(opaque.scissor());
     let bins: Vec<ChunkBins> = chunks.par_iter().map(|c| pass.bin(c)).collect();
     let band_len = w as usize * pass.band_rows;
     let bands = opaque.depths().par_chunks(band_len).enumerate();
@@ -194,6 +198,7 @@ pub fn fragments(scene: &Scene, opaque: &VisibilityBuffer) -> Vec<Fragment> {
             let mut sink = FragmentSink {
                 opaque: depth,
                 width: pass.width,
+                cols: pass.cols.clone(),
                 row0,
                 plane: LazyPlane::default(),
                 item: ItemId::NONE,
@@ -228,11 +233,18 @@ impl<'a> PolygonPass<'a> {
             planes,
             viewport,
             width: w as i64,
-            height: h as i64,
+            rows: 0..h as i64,
+            cols: 0..w as i64,
             band_rows,
             bands: h.div_ceil(band_rows),
             workers,
         }
+    }
+
+    /// The pass drawing only the pixels of `rect`.
+    fn within(self, rect: PixelRect) -> Self {
+        let rows = i64::from(rect.y0)..i64::from(rect.y1);
+        PolygonPass { rows, cols: i64::from(rect.x0)..i64::from(rect.x1), ..self }
     }
 
     /// Bins `chunks` and draws them into `vb`, bands in parallel, each band
@@ -249,7 +261,8 @@ impl<'a> PolygonPass<'a> {
             depth.fill(0.0);
             items.fill(ItemId::NONE);
             let (plane, item) = (LazyPlane::default(), ItemId::NONE);
-            let mut sink = DepthSink { depth, items, width: w, row0: row0(band), plane, item };
+            let cols = self.cols.clone();
+            let mut sink = DepthSink { depth, items, width: w, cols, row0: row0(band), plane, item };
             self.draw_band(band, &mut sink, chunks, &bins);
         };
         if self.workers == Workers::One {
@@ -368,8 +381,8 @@ impl PolygonPass<'_> {
         if area == 0 || (cull_back && area > 0) {
             return None;
         }
-        let rows = clamp(row_range(&p), self.height);
-        let cols = clamp(column_range(&p), self.width);
+        let rows = clamp(row_range(&p), &self.rows);
+        let cols = clamp(column_range(&p), &self.cols);
         if rows.is_empty() || cols.is_empty() {
             return None;
         }
@@ -379,7 +392,10 @@ impl PolygonPass<'_> {
     /// Scan-converts the triangles binned into `band` into `sink`, in scene order.
     fn draw_band(&self, band: usize, sink: &mut impl BandSink, chunks: &[Chunk], bins: &[ChunkBins]) {
         let row0 = (band * self.band_rows) as i64;
-        let rows = row0..(row0 + self.band_rows as i64).min(self.height);
+        let rows = clamp(row0..row0 + self.band_rows as i64, &self.rows);
+        if rows.is_empty() {
+            return;
+        }
         for (chunk, bin) in chunks.iter().zip(bins) {
             let p = &self.projected[chunk.object];
             let tris = &self.scene.objects[chunk.object].triangles().expect("chunks hold meshes").triangles;
@@ -396,8 +412,8 @@ impl PolygonPass<'_> {
     }
 }
 
-fn clamp(r: Range<i64>, n: i64) -> Range<i64> {
-    r.start.max(0)..r.end.min(n)
+fn clamp(r: Range<i64>, to: &Range<i64>) -> Range<i64> {
+    r.start.max(to.start)..r.end.min(to.end)
 }
 
 /// Depth as a plane over the screen: `z(x, y) = c + dx·x + dy·y` at the centre of
@@ -463,6 +479,8 @@ impl BandSink for DepthSink<'_> {
 struct FragmentSink<'a> {
     opaque: &'a [f32],
     width: i64,
+    /// The columns drawn.
+    cols: Range<i64>,
     row0: i64,
     plane: LazyPlane,
     item: ItemId,
@@ -477,7 +495,7 @@ impl BandSink for FragmentSink<'_> {
 
 impl SpanSink for FragmentSink<'_> {
     fn span(&mut self, y: i64, x0: i64, x1: i64) {
-        let (x0, x1) = (x0.max(0), x1.min(self.width));
+        let (x0, x1) = (x0.max(self.cols.start), x1.min(self.cols.end));
         let plane = self.plane.get();
         let row_z = plane.c + plane.dy * y as f64;
         let base = (y - self.row0) * self.width;
@@ -497,6 +515,8 @@ struct DepthSink<'a> {
     depth: &'a mut [f32],
     items: &'a mut [ItemId],
     width: i64,
+    /// The columns drawn.
+    cols: Range<i64>,
     row0: i64,
     plane: LazyPlane,
     item: ItemId,
@@ -504,7 +524,7 @@ struct DepthSink<'a> {
 
 impl SpanSink for DepthSink<'_> {
     fn span(&mut self, y: i64, x0: i64, x1: i64) {
-        let (x0, x1) = (x0.max(0), x1.min(self.width));
+        let (x0, x1) = (x0.max(self.cols.start), x1.min(self.cols.end));
         if x0 >= x1 {
             return;
         }

@@ -66,6 +66,7 @@ mod zbuffer;
 pub use surface_frame::SurfaceFrame;
 
 use std::cell::{Cell, RefCell};
+use std::ops::Range;
 
 use glam::{Vec2, Vec3};
 use rayon::iter::IndexedParallelIterator;
@@ -204,7 +205,8 @@ impl PreparedSolid {
             return;
         }
         let bands = out.bands_mut(BAND_ROWS);
-        scan_bands(self, camera, (width, height), bands, |(pixels, written), dy, row| {
+        let rows = 0..height as usize;
+        scan_bands(self, camera, (width, height), rows, bands, |(pixels, written), dy, row| {
             let out = row_to_write(&mut pixels[dy * w..(dy + 1) * w], &mut written[dy], row.blocks());
             row.unit_crossings_into(out);
         });
@@ -290,6 +292,8 @@ pub fn draw_solids(
     let (width, height) = (vb.width(), vb.height());
     let w = width as usize;
     let far = camera.far_plane_factor();
+    let scissor = vb.scissor();
+    let (rows, cols) = (scissor.y0 as usize..scissor.y1 as usize, scissor.x0 as usize..scissor.x1 as usize);
     let mut drawn = 0;
     for (object, o) in scene.objects.iter().enumerate().filter(|(i, _)| include(*i)) {
         let Some(solid) = o.solid() else { continue };
@@ -305,8 +309,8 @@ pub fn draw_solids(
             .collect();
         let bands = bands.into_par_iter().enumerate();
         let prepared = PreparedSolid::new(&world, CsgMethod::Segments).expect("segments need no expansion");
-        scan_bands(&prepared, camera, (width, height), bands, |(_, (depth, items, normals)), dy, row| {
-            for (x, h) in row.hits() {
+        scan_bands(&prepared, camera, (width, height), rows.clone(), bands, |(_, (depth, items, normals)), dy, row| {
+            for (x, h) in row.hits().filter(|(x, _)| cols.contains(x)) {
                 // A hit's `t` along its row line is its distance along the view axis.
                 let z = camera.depth_at_view_distance(h.t);
                 let i = dy * w + x;
@@ -408,11 +412,13 @@ impl ScannedRow<'_> {
 
 /// The walk itself: for each band of [`BAND_ROWS`] rows (in parallel, `bands`
 /// gives each its output), `visit(band, row_in_band, row)` with the row's
-/// visible hits ([`ScannedRow`]).
+/// visible hits ([`ScannedRow`]), for the rows in `rows` (the others are
+/// skipped).
 fn scan_bands<B: Send>(
     prepared: &PreparedSolid,
     camera: &Camera,
     (width, height): (u32, u32),
+    rows: Range<usize>,
     bands: impl IndexedParallelIterator<Item = B>,
     visit: impl Fn(&mut B, usize, &ScannedRow) + Sync,
 ) {
@@ -437,6 +443,9 @@ fn scan_bands<B: Send>(
                 for dy in 0..BAND_ROWS.min(h - first) {
                     let y = first + dy;
                     let occupied = occupancy.advance(y as i64);
+                    if !rows.contains(&y) {
+                        continue;
+                    }
                     frame.walk_row(y, occupied, &mut lent.0, |row| visit(&mut out, dy, row));
                 }
             },

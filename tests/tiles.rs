@@ -1,0 +1,127 @@
+//! Tiles of a frame: a region rendered on its own equals the same pixels of
+//! the whole frame, bit for bit, with every technique on (edge antialiasing
+//! and jittered passes, every shadow method, a mirror, glass, translucent
+//! surfaces, fog, a CSG solid, a texture), for random tilings.
+
+use std::path::Path;
+
+use kage::image::{LinearImage, PixelRect};
+use kage::scene::file::load_scene;
+use kage::scene::{Antialias, Scene, ShadowMethod};
+use kage::{render, RenderOptions};
+use rand::rngs::StdRng;
+use rand::{Rng, SeedableRng};
+
+fn everything() -> Scene {
+    load_scene(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/tiles.toml").as_path()).expect("test scene")
+}
+
+/// `cuts` random positions strictly inside `0..n`, sorted, with 0 and `n`.
+fn cuts(rng: &mut StdRng, n: u32, count: usize) -> Vec<u32> {
+    let mut c: Vec<u32> = (0..count).map(|_| rng.gen_range(1..n)).collect();
+    c.extend([0, n]);
+    c.sort_unstable();
+    c.dedup();
+    c
+}
+
+/// A random grid of tiles covering a `w` × `h` image.
+fn random_tiling(rng: &mut StdRng, w: u32, h: u32) -> Vec<PixelRect> {
+    let (nx, ny) = (rng.gen_range(0..4), rng.gen_range(0..4));
+    let (xs, ys) = (cuts(rng, w, nx), cuts(rng, h, ny));
+    let mut tiles = Vec::new();
+    for y in ys.windows(2) {
+        for x in xs.windows(2) {
+            tiles.push(PixelRect { x0: x[0], y0: y[0], x1: x[1], y1: y[1] });
+        }
+    }
+    tiles
+}
+
+/// Renders `scene` whole, then tile by tile for `tilings` random tilings, and
+/// asserts every tile's pixels equal the whole frame's, bit for bit.
+fn tiles_equal_the_frame(scene: &Scene, what: &str, seed: u64, tilings: usize) {
+    let whole = render(scene, &RenderOptions::default()).expect("whole frame").image;
+    let mut rng = StdRng::seed_from_u64(seed);
+    for _ in 0..tilings {
+        let tiling = random_tiling(&mut rng, scene.width, scene.height);
+        let mut merged = LinearImage::new(scene.width, scene.height);
+        for &tile in &tiling {
+            let options = RenderOptions { region: Some(tile), ..RenderOptions::default() };
+            let part = render(scene, &options).expect("tile").image.crop(tile);
+            merged.paste(&part, tile.x0, tile.y0);
+        }
+        let differ = whole
+            .pixels()
+            .iter()
+            .zip(merged.pixels())
+            .position(|(a, b)| a.to_array().map(f32::to_bits) != b.to_array().map(f32::to_bits));
+        if let Some(i) = differ {
+            let (x, y) = (i as u32 % scene.width, i as u32 / scene.width);
+            let count = whole.pixels().iter().zip(merged.pixels()).filter(|(a, b)| a != b).count();
+            panic!(
+                "{what}: tiling {tiling:?}: pixel ({x}, {y}) is {} whole and {} tiled ({count} pixels differ)",
+                whole.get(x, y),
+                merged.get(x, y)
+            );
+        }
+    }
+}
+
+#[test]
+fn tiles_of_an_edge_antialiased_frame_equal_the_frame() {
+    tiles_equal_the_frame(&everything(), "edge", 1, 3);
+}
+
+#[test]
+fn tiles_of_a_jittered_frame_equal_the_frame() {
+    let scene = Scene { antialias: Antialias::Jitter(4), ..everything() };
+    tiles_equal_the_frame(&scene, "jitter:4", 2, 2);
+}
+
+/// Without two-map soft shadows a tile draws only itself and a guard band:
+/// the band must hold everything its pixels look at.
+#[test]
+fn tiles_drawn_with_a_guard_band_equal_the_frame() {
+    let mut scene = everything();
+    for light in &mut scene.lights {
+        if light.shadow.method == ShadowMethod::Soft {
+            light.shadow = light.shadow.with_method(ShadowMethod::Map);
+        }
+    }
+    let drawn = kage::frame::region_drawn(&scene, PixelRect { x0: 40, y0: 30, x1: 60, y1: 50 });
+    assert_eq!(drawn, PixelRect { x0: 0, y0: 14, x1: 128, y1: 66 }, "a region grown by the guard band");
+    let none = Scene { antialias: Antialias::None, ..scene.clone() };
+    tiles_equal_the_frame(&none, "no antialiasing, no soft light", 3, 4);
+    tiles_equal_the_frame(&scene, "edge, no soft light", 3, 4);
+    let scene = Scene { antialias: Antialias::Jitter(3), ..scene };
+    tiles_equal_the_frame(&scene, "jitter:3, no soft light", 4, 2);
+}
+
+#[test]
+fn a_region_outside_the_frame_is_refused() {
+    let scene = everything();
+    for region in [PixelRect { x0: 0, y0: 0, x1: 193, y1: 10 }, PixelRect { x0: 5, y0: 5, x1: 5, y1: 9 }] {
+        let options = RenderOptions { region: Some(region), ..RenderOptions::default() };
+        let e = render(&scene, &options).err().expect("refused");
+        assert!(matches!(e, kage::Error::Region { .. }), "{e}");
+    }
+}
+
+#[test]
+fn tiles_cover_the_image_once() {
+    for (count, w, h) in [(16, 7680, 4320), (7, 100, 50), (6, 50, 100), (1, 3, 3), (12, 1920, 1080)] {
+        let mut hits = vec![0u8; (w * h) as usize];
+        for i in 0..count {
+            let t = PixelRect::tile(i, count, w, h);
+            assert!(!t.is_empty() && t.fits(w, h), "{t:?}");
+            for y in t.y0..t.y1 {
+                for x in t.x0..t.x1 {
+                    hits[(y * w + x) as usize] += 1;
+                }
+            }
+        }
+        assert!(hits.iter().all(|&n| n == 1), "{count} tiles of {w}x{h}");
+    }
+    assert_eq!(PixelRect::tile(5, 16, 7680, 4320), PixelRect { x0: 1920, y0: 1080, x1: 3840, y1: 2160 });
+}
