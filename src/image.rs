@@ -104,7 +104,8 @@ fn grid(count: u32, width: u32, height: u32) -> (u32, u32) {
         let (cw, ch) = (width as f64 / f64::from(c), height as f64 / f64::from(count / c));
         (cw / ch).ln().abs()
     };
-    let columns = (1..=count).filter(|c| count % c == 0).min_by(|a, b| squareness(*a).total_cmp(&squareness(*b)));
+    let columns =
+        (1..=count).filter(|c| count.is_multiple_of(*c)).min_by(|a, b| squareness(*a).total_cmp(&squareness(*b)));
     let columns = columns.unwrap_or(1);
     (columns, count / columns)
 }

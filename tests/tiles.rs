@@ -103,7 +103,7 @@ fn a_region_outside_the_frame_is_refused() {
     let scene = everything();
     for region in [PixelRect { x0: 0, y0: 0, x1: 193, y1: 10 }, PixelRect { x0: 5, y0: 5, x1: 5, y1: 9 }] {
         let options = RenderOptions { region: Some(region), ..RenderOptions::default() };
-        let e = render(&scene, &options).err().expect("refused");
+        let Err(e) = render(&scene, &options) else { panic!("{region:?} rendered") };
         assert!(matches!(e, kage::Error::Region { .. }), "{e}");
     }
 }

@@ -56,6 +56,7 @@ fn mirror_scene() -> Scene {
         translucency: Default::default(),
         tone: Default::default(),
         limits: Default::default(),
+        camera_path: None,
         camera: Camera {
             eye: Vec3::new(0.0, 0.0, 5.0),
             target: Vec3::ZERO,

@@ -3,7 +3,10 @@
 //! Library errors arrive typed; this binary turns them into reports that point at
 //! the offending line of a scene file.
 
+mod batch;
 mod report;
+mod scad;
+mod tiles;
 mod view;
 
 use std::path::{Path, PathBuf};
@@ -11,7 +14,7 @@ use std::path::{Path, PathBuf};
 use clap::{Parser, Subcommand};
 use glam::Vec3;
 use kage::csg::openscad::{CsgOptions, Geometry};
-use kage::image::ToneCurve;
+use kage::image::{PixelRect, ToneCurve};
 use kage::limits::{LimitSetting, Limits};
 use kage::scene::framing::{CameraOverride, View};
 use kage::scene::model::{self, ModelOptions};
@@ -41,6 +44,26 @@ enum Command {
     /// Measure image A against reference B: RMSE, PSNR, max error, share over a
     /// threshold, mask disagreement; optionally write a false-colour difference.
     Compare(CompareArgs),
+    /// Put the .exr tiles of one image (`kage render --tile` or `--region`)
+    /// back together; refuses tiles from different images, overlapping
+    /// tiles and gaps.
+    Merge(MergeArgs),
+    /// Render every model in a folder (or listed in a text file, one path a
+    /// line) into a folder of images: keeps going past files that fail and
+    /// names them at the end (exit code 1), skips images newer than their
+    /// model (run it again to resume), and can take one share of the files.
+    Batch(batch::BatchArgs),
+}
+
+#[derive(clap::Args)]
+struct MergeArgs {
+    /// The tiles (.exr).
+    #[arg(required = true)]
+    tiles: Vec<PathBuf>,
+    /// The whole image: .exr or .pfm (linear), .png or .jpg (8-bit, with the
+    /// exposure and tone curve the tiles were rendered with).
+    #[arg(short, long)]
+    output: PathBuf,
 }
 
 #[derive(clap::Args)]
@@ -63,14 +86,36 @@ struct CompareArgs {
     diff_scale: f32,
 }
 
-#[derive(clap::Args)]
+#[derive(clap::Args, Clone)]
 struct RenderArgs {
-    /// Scene or model file (omit for the built-in demo).
+    /// Scene or model file (omit for the built-in demo): .toml, .obj, .stl,
+    /// .gltf, .glb, .csg, or .scad (through `openscad`, when installed).
     input: Option<PathBuf>,
     /// Output image: .png or .jpg (8-bit sRGB through the tone curve), .exr or
-    /// .pfm (linear float, as rendered).
+    /// .pfm (linear float, as rendered). For many frames, a run of #s in the
+    /// name is replaced by the frame number, zero-padded to its length
+    /// (spin.####.png: spin.0000.png, spin.0001.png, ...).
     #[arg(short, long, default_value = "kage.png")]
     output: PathBuf,
+    /// Render N frames of a turntable: the camera goes once round the
+    /// vertical through what it looks at (a model: its centre), frame i at
+    /// 360·i/N degrees. The output name needs #s for the frame number.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    turntable: Option<u32>,
+    /// Render only frame I (from 0) of the turntable or of the scene file's
+    /// camera path, exactly as the whole run renders it.
+    #[arg(long, value_name = "I")]
+    frame: Option<u32>,
+    /// Render only pixels X0..X1 (columns) by Y0..Y1 (rows) of the image,
+    /// exactly as the whole image has them. An .exr output records where
+    /// the tile goes, for `kage merge`; other formats hold just the crop.
+    #[arg(long, value_parser = tiles::parse_region, value_name = "X0,Y0,X1,Y1", conflicts_with = "tile")]
+    region: Option<PixelRect>,
+    /// Render only tile I (from 0) of N: the image cut into a grid of N
+    /// tiles as near square as N allows, numbered row by row from the top
+    /// left. As --region otherwise.
+    #[arg(long, value_parser = tiles::parse_share, value_name = "I/N")]
+    tile: Option<(u32, u32)>,
     /// Image width in pixels (default: the scene's, 960 for a model).
     #[arg(long)]
     width: Option<u32>,
@@ -353,8 +398,10 @@ fn main() -> miette::Result<()> {
     // Paths and locations stay on one line, so they can be copied and grepped.
     miette::set_hook(Box::new(|_| Box::new(miette::MietteHandlerOpts::new().wrap_lines(false).build())))?;
     match cli.command {
-        Command::Render(args) => render_command(&args).map_err(report::to_report),
+        Command::Render(args) => render_command(&args),
         Command::Compare(args) => compare_command(&args).map_err(report::to_report),
+        Command::Merge(args) => merge_command(&args),
+        Command::Batch(args) => batch::run(&args),
         Command::View(args) => view::run(&args).map_err(|e| miette::miette!("{e}")),
     }
 }
@@ -373,6 +420,14 @@ fn load(args: &RenderArgs) -> kage::error::Result<Scene> {
         let ext = p.extension().and_then(|e| e.to_str()).unwrap_or_default().to_ascii_lowercase();
         matches!(ext.as_str(), "obj" | "stl" | "gltf" | "glb" | "csg")
     };
+    if let Some(p) = args.input.as_deref().filter(|p| extension(p) == "scad") {
+        let csg = scad::to_csg(p).map_err(kage::Error::Scene)?;
+        let mut from_csg = args.clone();
+        from_csg.input = Some(csg.clone());
+        let scene = load(&from_csg);
+        std::fs::remove_file(&csg).ok();
+        return scene;
+    }
     let geometry = match args.geometry {
         GeometryArg::Exact => Geometry::Exact,
         GeometryArg::Faceted => Geometry::Faceted,
@@ -413,10 +468,98 @@ fn load(args: &RenderArgs) -> kage::error::Result<Scene> {
     Ok(scene)
 }
 
-fn render_command(args: &RenderArgs) -> kage::error::Result<()> {
+fn extension(p: &Path) -> String {
+    p.extension().and_then(|e| e.to_str()).unwrap_or_default().to_ascii_lowercase()
+}
+
+/// What a `kage render` asks for beyond one image: its frames and its part.
+struct Job {
+    /// Frames in the turntable or camera path (`None`: a still).
+    frames: Option<u32>,
+    /// The frames to render.
+    wanted: std::ops::Range<u32>,
+    /// The pixels to render (`None`: all).
+    part: Option<PixelRect>,
+}
+
+impl Job {
+    /// Checks the frame and part options against `scene` and the output name.
+    fn of(args: &RenderArgs, scene: &Scene) -> miette::Result<Job> {
+        let frames = args.turntable.or(scene.camera_path.as_ref().map(|p| p.frames));
+        let wanted = match (frames, args.frame) {
+            (None, Some(_)) => {
+                miette::bail!("--frame picks a frame of a --turntable or of a scene file's [path]: there is neither")
+            }
+            (Some(n), Some(i)) if i >= n => miette::bail!("--frame {i}: the frames are 0 to {}", n - 1),
+            (Some(_), Some(i)) => i..i + 1,
+            (Some(n), None) => {
+                if !has_frame_number(&args.output) {
+                    miette::bail!(
+                        "{}: {n} frames need a frame number in the output name: put #s where it goes (e.g. spin.####.png), or render one with --frame",
+                        args.output.display()
+                    );
+                }
+                0..n
+            }
+            (None, None) => 0..1,
+        };
+        let part = match (args.region, args.tile) {
+            (Some(r), _) => Some(r),
+            (None, Some((index, count))) => Some(PixelRect::tile(index, count, scene.width, scene.height)),
+            (None, None) => None,
+        };
+        if let Some(r) = part {
+            if !r.fits(scene.width, scene.height) {
+                miette::bail!(
+                    "--region {},{},{},{} is not inside the {}x{} image",
+                    r.x0,
+                    r.y0,
+                    r.x1,
+                    r.y1,
+                    scene.width,
+                    scene.height
+                );
+            }
+            let exposure = args.exposure.unwrap_or(scene.exposure);
+            if exposure == Exposure::Auto && !matches!(extension(&args.output).as_str(), "exr" | "pfm") {
+                miette::bail!(
+                    "auto exposure measures the whole image, which a tile does not have: give --exposure STOPS, or write .exr tiles (kage merge exposes the whole)"
+                );
+            }
+        }
+        Ok(Job { frames, wanted, part })
+    }
+}
+
+/// Whether `path`'s file name holds a run of #s (where a frame number goes).
+fn has_frame_number(path: &Path) -> bool {
+    path.file_name().and_then(|n| n.to_str()).is_some_and(|n| n.contains('#'))
+}
+
+/// `pattern` with its file name's last run of #s replaced by `frame`,
+/// zero-padded to the run's length (unchanged when it has none).
+fn frame_path(pattern: &Path, frame: u32) -> PathBuf {
+    let Some(name) = pattern.file_name().and_then(|n| n.to_str()) else { return pattern.to_path_buf() };
+    let Some(end) = name.rfind('#') else { return pattern.to_path_buf() };
+    let start = name[..end].rfind(|c| c != '#').map_or(0, |i| i + 1);
+    let digits = end + 1 - start;
+    pattern.with_file_name(format!("{}{frame:0digits$}{}", &name[..start], &name[end + 1..]))
+}
+
+/// The camera of frame `frame`: the turntable's (`--turntable`, about
+/// `base`), the scene's path's, or `base` itself.
+fn camera_of(args: &RenderArgs, scene: &Scene, base: &kage::camera::Camera, frame: u32) -> kage::camera::Camera {
+    match (args.turntable, &scene.camera_path) {
+        (Some(n), _) => kage::scene::camera_path::turntable(base, frame, n),
+        (None, Some(path)) => path.camera_at(frame, base),
+        (None, None) => *base,
+    }
+}
+
+fn render_command(args: &RenderArgs) -> miette::Result<()> {
     // Cheap checks first: a bad output path is found before the render.
-    kage::output::check_output(&args.output)?;
-    let mut scene = load(args)?;
+    kage::output::check_output(&args.output).map_err(report::to_report)?;
+    let mut scene = load(args).map_err(report::to_report)?;
     scene.antialias = args.antialias.unwrap_or(scene.antialias);
     scene.tone = args.tonemap.unwrap_or(scene.tone);
     if let Some(method) = args.shadows {
@@ -425,8 +568,12 @@ fn render_command(args: &RenderArgs) -> kage::error::Result<()> {
     for w in &scene.warnings {
         eprintln!("warning: {w}");
     }
+    let job = Job::of(args, &scene)?;
     if args.reference {
-        return reference_command(args, &scene);
+        if job.frames.is_some() || job.part.is_some() {
+            miette::bail!("--reference renders one whole image: no --turntable, --frame, --region or --tile");
+        }
+        return reference_command(args, &scene).map_err(report::to_report);
     }
     let wanted = args.aov.unwrap_or(Aovs { components: ComponentSet::EMPTY, shadow: false });
     let options = RenderOptions {
@@ -434,36 +581,89 @@ fn render_command(args: &RenderArgs) -> kage::error::Result<()> {
         ray_depth: args.ray_depth,
         aovs: wanted.components,
         shadow_images: wanted.shadow,
+        region: job.part,
         ..RenderOptions::default()
     };
-    let mut renderer = Renderer::new(&options)?;
-    let bar = Progress::new("passes");
-    renderer.render_reporting(&scene, &|done, total| bar.update(done as u64, total as u64))?;
+    let mut renderer = Renderer::new(&options).map_err(report::to_report)?;
+    let many = job.wanted.len() > 1;
+    let bar = Progress::new(if many { "frames" } else { "passes" });
+    let base = scene.camera;
+    for (done, frame) in job.wanted.clone().enumerate() {
+        scene.camera = camera_of(args, &scene, &base, frame);
+        let report = |d: u32, total: u32| {
+            if !many {
+                bar.update(u64::from(d), u64::from(total));
+            }
+        };
+        let frame_out = renderer.render_reporting(&scene, &report).map_err(report::to_report)?;
+        let path = frame_path(&args.output, frame);
+        write_frame(args, &scene, frame_out, &path, job.part).map_err(report::to_report)?;
+        if many {
+            bar.update(done as u64 + 1, job.wanted.len() as u64);
+        } else {
+            print_stats(&path, &scene, frame_out);
+        }
+    }
     bar.finish();
-    let frame = renderer.into_frame();
-    let exposure = args.exposure.unwrap_or(scene.exposure).scale(&frame.image);
-    kage::output::write_image(&frame.image, &args.output, exposure, scene.tone)?;
+    if many {
+        let first = frame_path(&args.output, job.wanted.start);
+        eprintln!(
+            "wrote {} frames, {} to {}",
+            job.wanted.len(),
+            first.display(),
+            frame_path(&args.output, job.wanted.end - 1).display()
+        );
+    }
+    Ok(())
+}
+
+/// Writes `frame`'s image (and its parts) to `path`: the pixels of `part`
+/// when it is given, as an .exr tile that records where it goes.
+fn write_frame(
+    args: &RenderArgs,
+    scene: &Scene,
+    frame: &kage::Frame,
+    path: &Path,
+    part: Option<PixelRect>,
+) -> kage::error::Result<()> {
+    let exposure = args.exposure.unwrap_or(scene.exposure);
+    let scale = exposure.scale(&frame.image);
+    let write = |image: &kage::image::LinearImage, path: &Path, scale: f32, tone: ToneCurve| match part {
+        None => kage::output::write_image(image, path, scale, tone),
+        Some(rect) if extension(path) == "exr" => {
+            let whole = (image.width(), image.height());
+            tiles::write_tile(&image.crop(rect), rect, whole, exposure, tone, path)
+                .map_err(|message| kage::Error::Output { path: path.to_path_buf(), message })
+        }
+        Some(rect) => kage::output::write_image(&image.crop(rect), path, scale, tone),
+    };
+    write(&frame.image, path, scale, scene.tone)?;
     for (c, image) in &frame.aovs {
         // The same exposure and curve as the final image. (The parts add up
         // before the curve; with a rolling curve their 8-bit images only
         // roughly add up to the final one: .exr output adds up exactly.)
-        let path = aov_path(&args.output, c.name());
-        kage::output::write_image(image, &path, exposure, scene.tone)?;
-        eprintln!("wrote {} ({} component)", path.display(), c.name());
+        let aov = aov_path(path, c.name());
+        write(image, &aov, scale, scene.tone)?;
+        eprintln!("wrote {} ({} component)", aov.display(), c.name());
     }
     for (i, image) in frame.shadows.iter().enumerate() {
         // Linear floats, unexposed: 1 is lit, 0 in shadow.
-        let path = aov_path(&args.output.with_extension("exr"), &format!("shadow.{i}"));
-        kage::output::write_image(image, &path, 1.0, ToneCurve::Clip)?;
-        eprintln!("wrote {} (light {i}'s shadow term)", path.display());
+        let shadow = aov_path(&path.with_extension("exr"), &format!("shadow.{i}"));
+        write(image, &shadow, 1.0, ToneCurve::Clip)?;
+        eprintln!("wrote {} (light {i}'s shadow term)", shadow.display());
     }
+    Ok(())
+}
+
+/// Says what was written and how long each stage took.
+fn print_stats(path: &Path, scene: &Scene, frame: &kage::Frame) {
     if frame.visibility.items().iter().all(|i| i.is_none()) {
         eprintln!("warning: no object is in view: the image shows only the background (check the camera)");
     }
     let s = frame.stats;
     eprintln!(
         "wrote {} ({}x{}, {} triangles, {} solids, {} pass{}): visibility {:.1} ms, shadow maps {:.1} ms, shading {:.1} ms, reflections and refraction {:.1} ms ({} pixels, {} refined)",
-        args.output.display(),
+        path.display(),
         scene.width,
         scene.height,
         s.raster.triangles,
@@ -480,6 +680,23 @@ fn render_command(args: &RenderArgs) -> kage::error::Result<()> {
     if let Antialias::Edge(_) = scene.antialias {
         eprintln!("antialiased edges: {:.1} ms, {} pixels blended", s.edge_ms, s.edge_blends);
     }
+}
+
+fn merge_command(args: &MergeArgs) -> miette::Result<()> {
+    kage::output::check_output(&args.output).map_err(report::to_report)?;
+    let tiles: Vec<tiles::Tile> =
+        args.tiles.iter().map(|p| tiles::read_tile(p)).collect::<Result<_, _>>().map_err(|e| miette::miette!("{e}"))?;
+    let whole = tiles::merge(&tiles).map_err(|e| miette::miette!("{e}"))?;
+    let (exposure, tone) = (tiles[0].exposure, tiles[0].tone);
+    if let Some(t) = tiles.iter().find(|t| t.exposure != exposure || t.tone != tone) {
+        miette::bail!(
+            "{} was rendered with another exposure or tone curve than {}",
+            t.path.display(),
+            tiles[0].path.display()
+        );
+    }
+    kage::output::write_image(&whole, &args.output, exposure.scale(&whole), tone).map_err(report::to_report)?;
+    eprintln!("wrote {} ({}x{}, from {} tiles)", args.output.display(), whole.width(), whole.height(), tiles.len());
     Ok(())
 }
 

@@ -45,6 +45,12 @@ impl ToneCurve {
         Self::NAMES.iter().find(|(n, _)| *n == name).map(|&(_, c)| c)
     }
 
+    /// The curve's name, as [`ToneCurve::from_name`] reads it.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        Self::NAMES.iter().find(|(_, c)| *c == self).map_or("neutral", |&(n, _)| n)
+    }
+
     /// Display-linear colour in [0, 1]³ for scene-linear `c` (already times
     /// the exposure); negative and NaN channels count as 0.
     #[must_use]

@@ -2,6 +2,7 @@
 //! from where it is seen. Scene files are parsed to plain records first
 //! ([`mod@file`]), then meshes and textures are loaded ([`load`]) into this form.
 
+pub mod camera_path;
 pub mod demo;
 pub mod environment;
 pub mod file;
@@ -202,6 +203,9 @@ pub struct Scene {
     pub translucency: TranslucencyOrder,
     /// The eye.
     pub camera: Camera,
+    /// The camera's path over the frames of an animation, if the scene
+    /// file gives one (`[path]`): [`camera_path::CameraPath::camera_at`].
+    pub camera_path: Option<camera_path::CameraPath>,
     /// Lights.
     pub lights: Vec<Light>,
     /// Materials, referenced by index from objects.
@@ -251,6 +255,7 @@ impl Scene {
             environment: None,
             translucency: TranslucencyOrder::default(),
             camera,
+            camera_path: None,
             lights: Vec::new(),
             materials: Vec::new(),
             objects: Vec::new(),

@@ -41,6 +41,7 @@ pub fn scene_with(mesh: Mesh, camera: Camera, width: u32, height: u32, two_sided
         translucency: Default::default(),
         tone: Default::default(),
         limits: Default::default(),
+        camera_path: None,
     }
 }
 

@@ -44,7 +44,7 @@ impl Source {
         match ext.as_str() {
             "toml" => file::load_scene(path).map_err(|e| e.to_string()),
             "scad" => {
-                let csg = openscad_to_csg(path)?;
+                let csg = crate::scad::to_csg(path)?;
                 let scene = model_scene(&csg, toggles);
                 std::fs::remove_file(&csg).ok();
                 scene
@@ -88,33 +88,6 @@ fn model_scene(path: &Path, toggles: &Toggles) -> Result<Scene, String> {
         limits: Limits::default(),
     };
     model::scene_for_model_with(path, DEFAULT_SIZE.0, DEFAULT_SIZE.1, &options).map_err(|e| e.to_string())
-}
-
-/// Runs `openscad -o <temporary>.csg scad`: the `.csg` written (outside the
-/// watched folder, so writing it reloads nothing).
-///
-/// # Errors
-///
-/// When `openscad` is not on the PATH, or what it says when it fails.
-fn openscad_to_csg(scad: &Path) -> Result<PathBuf, String> {
-    let stem = scad.file_stem().and_then(|s| s.to_str()).unwrap_or("model");
-    let csg = std::env::temp_dir().join(format!("kage-view-{}-{stem}.csg", std::process::id()));
-    let run = std::process::Command::new("openscad").arg("-o").arg(&csg).arg(scad).output();
-    match run {
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Err(format!(
-            "{}: showing a .scad file needs OpenSCAD: `openscad` is not on the PATH (install it, or open the .csg \
-             that `openscad -o model.csg model.scad` writes)",
-            scad.display()
-        )),
-        Err(e) => Err(format!("{}: openscad: {e}", scad.display())),
-        Ok(out) if !out.status.success() || !csg.exists() => {
-            let said = String::from_utf8_lossy(&out.stderr);
-            let errors: Vec<&str> = said.lines().filter(|l| l.contains("ERROR") || l.contains("WARNING")).collect();
-            let shown = if errors.is_empty() { said.trim().to_string() } else { errors.join("\n") };
-            Err(format!("{}: openscad failed:\n{shown}", scad.display()))
-        }
-        Ok(_) => Ok(csg),
-    }
 }
 
 fn extension(path: &Path) -> String {

@@ -26,6 +26,7 @@ use crate::csg::openscad::{CsgOptions, Geometry};
 use crate::error::{Error, Result, SourceLocation};
 use crate::image::ToneCurve;
 use crate::limits::{Limit, LimitSetting, Limits};
+use crate::scene::camera_path::{CameraPath, Interpolation, Key};
 use crate::scene::material::Filter;
 use crate::scene::settings::{
     Antialias, EdgeFilter, EdgeMode, EdgeSelection, Exposure, Fog, FogMode, TranslucencyOrder, MAX_JITTER_SAMPLES,
@@ -43,6 +44,7 @@ pub struct SceneFile {
     #[serde(default)]
     image: ImageRec,
     camera: Option<Spanned<CameraRec>>,
+    path: Option<Spanned<PathRec>>,
     #[serde(default, rename = "light")]
     lights: Vec<Spanned<LightRec>>,
     #[serde(default, rename = "material")]
@@ -236,6 +238,36 @@ struct CameraRec {
     #[serde(default)]
     projection: ProjectionRec,
     height: Option<f32>,
+}
+
+/// `[path]`: the camera over an animation's frames.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PathRec {
+    frames: Spanned<i64>,
+    #[serde(default)]
+    interpolation: InterpolationRec,
+    #[serde(rename = "key")]
+    keys: Vec<Spanned<KeyRec>>,
+}
+
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default)]
+#[serde(rename_all = "kebab-case")]
+enum InterpolationRec {
+    Linear,
+    #[default]
+    CatmullRom,
+}
+
+/// `[[path.key]]`: what a key leaves out it keeps from the key before (the
+/// first: from `[camera]`).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct KeyRec {
+    frame: i64,
+    eye: Option<V3>,
+    target: Option<V3>,
+    fov: Option<f32>,
 }
 
 fn up() -> V3 {
@@ -623,6 +655,7 @@ impl SceneFile {
             environment: self.environment(&from)?,
             translucency: self.image.translucency.into(),
             limits: from.limits,
+            camera_path: None,
         };
         let mut models = Vec::new();
         let mut produced = Vec::new();
@@ -641,8 +674,59 @@ impl SceneFile {
             return Err(self.invalid(0..0, "the scene has no [[object]]: there is nothing to draw"));
         }
         self.place_camera_and_lights(&mut scene, &models)?;
+        scene.camera_path = self.camera_path(&scene.camera)?;
         scene.validate()?;
         Ok(scene)
+    }
+
+    /// `[path]`, its keys checked (frames rising, inside the path, every
+    /// camera usable) and completed from the keys before them and `camera`.
+    fn camera_path(&self, camera: &Camera) -> Result<Option<CameraPath>> {
+        let Some(rec) = &self.path else { return Ok(None) };
+        let frames = *rec.get_ref().frames.get_ref();
+        if !(1..=1_000_000).contains(&frames) {
+            return Err(self.invalid(rec.get_ref().frames.span(), "a path has 1 to 1000000 frames"));
+        }
+        if rec.get_ref().keys.is_empty() {
+            return Err(self.invalid(rec.span(), "a path needs at least one [[path.key]]"));
+        }
+        let fov = match camera.projection {
+            Projection::Perspective { fov_y_deg } => fov_y_deg,
+            Projection::Orthographic { .. } => 0.0,
+        };
+        let mut last = Key { frame: 0, eye: camera.eye, target: camera.target, fov_deg: fov };
+        let mut keys: Vec<Key> = Vec::new();
+        for k in &rec.get_ref().keys {
+            let r = k.get_ref();
+            let after = keys.last().map_or(0, |l| i64::from(l.frame) + 1);
+            if r.frame < after || r.frame >= frames {
+                let msg = format!("key frames must rise, each from {after} to {} (the path's last frame)", frames - 1);
+                return Err(self.invalid(k.span(), msg));
+            }
+            let key = Key {
+                frame: r.frame as u32,
+                eye: r.eye.map_or(last.eye, Vec3::from),
+                target: r.target.map_or(last.target, Vec3::from),
+                fov_deg: r.fov.unwrap_or(last.fov_deg),
+            };
+            let cam = Camera {
+                eye: key.eye,
+                target: key.target,
+                projection: match camera.projection {
+                    Projection::Perspective { .. } => Projection::Perspective { fov_y_deg: key.fov_deg },
+                    p => p,
+                },
+                ..*camera
+            };
+            cam.validate().map_err(|m| self.invalid(k.span(), m))?;
+            keys.push(key);
+            last = key;
+        }
+        let interpolation = match rec.get_ref().interpolation {
+            InterpolationRec::Linear => Interpolation::Linear,
+            InterpolationRec::CatmullRom => Interpolation::CatmullRom,
+        };
+        Ok(Some(CameraPath { frames: frames as u32, keys, interpolation }))
     }
 
     fn place_camera_and_lights(&self, scene: &mut Scene, models: &[LoadedModel]) -> Result<()> {
