@@ -8,7 +8,7 @@ use std::path::Path;
 use kage::image::{LinearImage, PixelRect};
 use kage::scene::file::load_scene;
 use kage::scene::{Antialias, Scene, ShadowMethod};
-use kage::{render, RenderOptions};
+use kage::{render, RenderOptions, Renderer};
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 
@@ -46,9 +46,12 @@ fn tiles_equal_the_frame(scene: &Scene, what: &str, seed: u64, tilings: usize) {
     for _ in 0..tilings {
         let tiling = random_tiling(&mut rng, scene.width, scene.height);
         let mut merged = LinearImage::new(scene.width, scene.height);
+        // One renderer for every tile: what a tile leaves outside itself
+        // (the tile before's pixels) must not reach the next.
+        let mut renderer = Renderer::new(&RenderOptions::default()).expect("renderer");
         for &tile in &tiling {
-            let options = RenderOptions { region: Some(tile), ..RenderOptions::default() };
-            let part = render(scene, &options).expect("tile").image.crop(tile);
+            renderer.set_options(&RenderOptions { region: Some(tile), ..RenderOptions::default() }).expect("options");
+            let part = renderer.render(scene).expect("tile").image.crop(tile);
             merged.paste(&part, tile.x0, tile.y0);
         }
         let differ = whole

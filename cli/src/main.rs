@@ -104,8 +104,13 @@ struct RenderArgs {
     turntable: Option<u32>,
     /// Render only frame I (from 0) of the turntable or of the scene file's
     /// camera path, exactly as the whole run renders it.
-    #[arg(long, value_name = "I")]
+    #[arg(long, value_name = "I", conflicts_with = "shard")]
     frame: Option<u32>,
+    /// Render only share I (from 0) of N of the frames: frames I, I + N,
+    /// I + 2N, ... of the turntable or camera path, in one process (the
+    /// scene loaded once).
+    #[arg(long, value_parser = tiles::parse_share, value_name = "I/N")]
+    shard: Option<(u32, u32)>,
     /// Render only pixels X0..X1 (columns) by Y0..Y1 (rows) of the image,
     /// exactly as the whole image has them. An .exr output records where
     /// the tile goes, for `kage merge`; other formats hold just the crop.
@@ -476,8 +481,8 @@ fn extension(p: &Path) -> String {
 struct Job {
     /// Frames in the turntable or camera path (`None`: a still).
     frames: Option<u32>,
-    /// The frames to render.
-    wanted: std::ops::Range<u32>,
+    /// The frames to render, in order.
+    wanted: Vec<u32>,
     /// The pixels to render (`None`: all).
     part: Option<PixelRect>,
 }
@@ -486,22 +491,23 @@ impl Job {
     /// Checks the frame and part options against `scene` and the output name.
     fn of(args: &RenderArgs, scene: &Scene) -> miette::Result<Job> {
         let frames = args.turntable.or(scene.camera_path.as_ref().map(|p| p.frames));
-        let wanted = match (frames, args.frame) {
-            (None, Some(_)) => {
-                miette::bail!("--frame picks a frame of a --turntable or of a scene file's [path]: there is neither")
-            }
-            (Some(n), Some(i)) if i >= n => miette::bail!("--frame {i}: the frames are 0 to {}", n - 1),
-            (Some(_), Some(i)) => i..i + 1,
-            (Some(n), None) => {
+        let wanted: Vec<u32> = match (frames, args.frame, args.shard) {
+            (None, Some(_), _) | (None, _, Some(_)) => miette::bail!(
+                "--frame and --shard pick frames of a --turntable or of a scene file's [path]: there is neither"
+            ),
+            (Some(n), Some(i), _) if i >= n => miette::bail!("--frame {i}: the frames are 0 to {}", n - 1),
+            (Some(_), Some(i), _) => vec![i],
+            (Some(n), None, shard) => {
                 if !has_frame_number(&args.output) {
                     miette::bail!(
                         "{}: {n} frames need a frame number in the output name: put #s where it goes (e.g. spin.####.png), or render one with --frame",
                         args.output.display()
                     );
                 }
-                0..n
+                let (i, count) = shard.unwrap_or((0, 1));
+                (i..n).step_by(count as usize).collect()
             }
-            (None, None) => 0..1,
+            (None, None, None) => vec![0],
         };
         let part = match (args.region, args.tile) {
             (Some(r), _) => Some(r),
@@ -588,7 +594,7 @@ fn render_command(args: &RenderArgs) -> miette::Result<()> {
     let many = job.wanted.len() > 1;
     let bar = Progress::new(if many { "frames" } else { "passes" });
     let base = scene.camera;
-    for (done, frame) in job.wanted.clone().enumerate() {
+    for (done, &frame) in job.wanted.iter().enumerate() {
         scene.camera = camera_of(args, &scene, &base, frame);
         let report = |d: u32, total: u32| {
             if !many {
@@ -605,14 +611,9 @@ fn render_command(args: &RenderArgs) -> miette::Result<()> {
         }
     }
     bar.finish();
-    if many {
-        let first = frame_path(&args.output, job.wanted.start);
-        eprintln!(
-            "wrote {} frames, {} to {}",
-            job.wanted.len(),
-            first.display(),
-            frame_path(&args.output, job.wanted.end - 1).display()
-        );
+    if let (true, Some(first), Some(last)) = (many, job.wanted.first(), job.wanted.last()) {
+        let (first, last) = (frame_path(&args.output, *first), frame_path(&args.output, *last));
+        eprintln!("wrote {} frames, {} to {}", job.wanted.len(), first.display(), last.display());
     }
     Ok(())
 }

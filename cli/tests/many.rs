@@ -60,6 +60,18 @@ fn a_frame_rendered_alone_equals_the_same_frame_of_the_turntable() {
         kage(&[&args[..], &["--width", "96", "--height", "54", "-o", one.to_str().unwrap()]].concat());
         assert_eq!(bytes(&one), bytes(&dir.join(format!("spin.{i:03}.png"))), "frame {i}");
     }
+    // A share of the frames, in one process: frames 1 and 4 of 6.
+    let shard = dir.join("shard");
+    std::fs::create_dir_all(&shard).unwrap();
+    let shard_pattern = shard.join("s.###.png");
+    let args =
+        ["render", teapot.to_str().unwrap(), "--turntable", "6", "--shard", "1/3", "--width", "96", "--height", "54"];
+    kage(&[&args[..], &["-o", shard_pattern.to_str().unwrap()]].concat());
+    let mut written: Vec<String> =
+        std::fs::read_dir(&shard).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    written.sort();
+    assert_eq!(written, ["s.001.png", "s.004.png"]);
+    assert_eq!(bytes(&shard.join("s.004.png")), bytes(&dir.join("spin.004.png")));
     // The turn shows the model from another side: frames differ.
     assert_ne!(bytes(&dir.join("spin.000.png")), bytes(&dir.join("spin.003.png")));
     // Many frames and no place for the number in the name: refused.

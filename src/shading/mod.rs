@@ -63,7 +63,8 @@ impl ShadingPass<'_> {
 }
 
 /// Runs one pass over `vb` into `image`, rows in parallel, eight pixels at a
-/// time (`lanes.rs`).
+/// time (`lanes.rs`): the pixels of the buffer's scissor
+/// ([`VisibilityBuffer::scissor`]; the others are left as they are).
 ///
 /// # Panics
 ///
@@ -81,9 +82,15 @@ pub fn shade_pass(scene: &Scene, vb: &VisibilityBuffer, image: &mut LinearImage,
     let (background, black) = (vec![pass.background; w], vec![Vec3::ZERO; w]);
     let rows = image.pixels_mut().par_chunks_mut(w).zip(vb.items().par_chunks(w));
     let caches = || (TriangleCache::new(512), lanes::Block::default());
+    // Only the buffer's scissor is drawn: the rest is left as it is.
+    let scissor = vb.scissor();
+    let (columns, drawn_rows) = (scissor.x0 as usize..scissor.x1 as usize, scissor.y0 as usize..scissor.y1 as usize);
     rows.enumerate().for_each_init(caches, |(cache, block), (y, (out, items))| {
+        if !drawn_rows.contains(&y) {
+            return;
+        }
         let row = lanes::RowRays::new(&rays, y);
-        let mut x = 0;
+        let (mut x, w) = (columns.start, columns.end);
         while x < w {
             // Runs stop at every SEGMENT-th column, so the pixels of a segment
             // are shaded alike whatever lies outside it (a tile of the frame
