@@ -170,10 +170,11 @@ pub enum Error {
         path: PathBuf,
     },
     /// A region of the frame to render that is empty or does not lie inside it.
-    #[error("the region {}..{} x {}..{} is not a part of the {width}x{height} image", region.x0, region.x1, region.y0, region.y1)]
+    #[error("the region {}..{} x {}..{} is not a part of the {width}x{height} image", region.0, region.2, region.1, region.3)]
     Region {
-        /// The region asked for.
-        region: crate::image::PixelRect,
+        /// The region asked for: its first column and row, one past its
+        /// last column and row.
+        region: (u32, u32, u32, u32),
         /// The frame's width.
         width: u32,
         /// The frame's height.

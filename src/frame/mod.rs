@@ -312,6 +312,7 @@ impl Renderer {
         budget::check(scene)?;
         if let Some(region) = self.options.region {
             if region.is_empty() || !region.fits(scene.width, scene.height) {
+                let region = (region.x0, region.y0, region.x1, region.y1);
                 return Err(Error::Region { region, width: scene.width, height: scene.height });
             }
         }
