@@ -9,7 +9,7 @@
 # Options after the arguments go to every render: ... 120 --width 1920 --height 1080
 #
 #SBATCH --job-name=kage
-#SBATCH --cpus-per-task=8
+#SBATCH --cpus-per-task=4
 #SBATCH --output=kage-%A_%a.log
 set -euo pipefail
 kage=${KAGE:-kage}

@@ -59,7 +59,7 @@ pub fn write_tile(
     });
     let attributes = LayerAttributes { layer_position: Vec2(rect.x0 as i32, rect.y0 as i32), ..Default::default() };
     let size = (rect.width() as usize, rect.height() as usize);
-    let mut image = Image::from_layer(Layer::new(size, attributes, Encoding::SMALL_LOSSLESS, channels));
+    let mut image = Image::from_layer(Layer::new(size, attributes, Encoding::FAST_LOSSLESS, channels));
     image.attributes.display_window = IntegerBounds::new((0, 0), (width as usize, height as usize));
     let exposure = match exposure {
         Exposure::Auto => AttributeValue::Text(Text::from("auto")),

@@ -328,3 +328,24 @@ fn the_slurm_array_script_renders_its_tasks_frame() {
     ]);
     assert_eq!(bytes(&dir.join("spin.0003.png")), bytes(&alone));
 }
+
+/// The Slurm array script under a real single-node Slurm
+/// (`jobs/slurm-local-check.sh`: munged, slurmctld and slurmd on this
+/// machine). Needs root and Debian's `slurm-wlm`; skipped with a message
+/// without them (`.ci/run` does not install Slurm: its daemons want root).
+#[test]
+fn the_slurm_array_script_runs_under_sbatch() {
+    let root = Command::new("id").arg("-u").output().is_ok_and(|o| String::from_utf8_lossy(&o.stdout).trim() == "0");
+    let slurm = Command::new("sh").args(["-c", "command -v slurmctld && command -v munged"]).output();
+    if !root || !slurm.is_ok_and(|o| o.status.success()) {
+        eprintln!("skipped: a local Slurm needs root and slurm-wlm (apt-get install slurm-wlm)");
+        return;
+    }
+    let out = Command::new("bash")
+        .arg(repo("jobs/slurm-local-check.sh"))
+        .env("KAGE", env!("CARGO_BIN_EXE_kage"))
+        .output()
+        .unwrap();
+    let said = format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
+    assert!(out.status.success() && said.contains("6 turntable frames equal"), "{said}");
+}
