@@ -349,3 +349,34 @@ fn the_slurm_array_script_runs_under_sbatch() {
     let said = format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
     assert!(out.status.success() && said.contains("6 turntable frames equal"), "{said}");
 }
+
+/// The Kubernetes Indexed Job's container command, run here as a pod would
+/// run it: its folded `args` through `sh -c` with `JOB_COMPLETION_INDEX` set,
+/// the volume's paths pointed at a scratch folder. (No cluster: the
+/// manifest's Kubernetes fields are not checked.)
+#[test]
+fn the_kubernetes_jobs_command_renders_its_index_frame() {
+    let manifest = std::fs::read_to_string(repo("jobs/k8s-indexed-job.yaml")).unwrap();
+    assert!(manifest.contains("completionMode: Indexed"));
+    // The folded scalar after `- >-`: its more-indented lines, joined by spaces.
+    let mut lines = manifest.lines().skip_while(|l| l.trim() != "- >-");
+    let marker = lines.next().expect("a folded args entry");
+    let indent = marker.len() - marker.trim_start().len();
+    let command: Vec<&str> =
+        lines.take_while(|l| l.len() - l.trim_start().len() > indent && !l.trim().is_empty()).map(str::trim).collect();
+    let dir = scratch("k8s");
+    let teapot = repo("assets/teapot.obj");
+    let command = command
+        .join(" ")
+        .replace("/data/model.glb", teapot.to_str().unwrap())
+        .replace("/data/out", dir.join("out").to_str().unwrap())
+        .replace("--width 1920 --height 1080", "--width 80 --height 45")
+        .replace("kage render", &format!("{} render", env!("CARGO_BIN_EXE_kage")));
+    let out = Command::new("sh").args(["-c", &command]).env("JOB_COMPLETION_INDEX", "7").output().unwrap();
+    assert!(out.status.success(), "{command}: {}", String::from_utf8_lossy(&out.stderr));
+    let alone = dir.join("alone.png");
+    let args =
+        ["render", teapot.to_str().unwrap(), "--turntable", "120", "--frame", "7", "--width", "80", "--height", "45"];
+    kage(&[&args[..], &["-o", alone.to_str().unwrap()]].concat());
+    assert_eq!(bytes(&dir.join("out/spin.0007.png")), bytes(&alone));
+}
