@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 
 use clap::Parser;
 
-use super::{render_command, tiles, RenderArgs};
+use super::{extension, render_command, tiles, RenderArgs};
 
 /// `kage batch`.
 #[derive(clap::Args)]
@@ -188,10 +188,6 @@ fn walk(folder: &Path, files: &mut Vec<PathBuf>) -> std::io::Result<()> {
         }
     }
     Ok(())
-}
-
-fn extension(p: &Path) -> String {
-    super::extension(p)
 }
 
 #[cfg(test)]

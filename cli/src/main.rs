@@ -421,10 +421,7 @@ fn camera_override(args: &RenderArgs) -> CameraOverride {
 }
 
 fn load(args: &RenderArgs) -> kage::error::Result<Scene> {
-    let is_model = |p: &Path| {
-        let ext = p.extension().and_then(|e| e.to_str()).unwrap_or_default().to_ascii_lowercase();
-        matches!(ext.as_str(), "obj" | "stl" | "gltf" | "glb" | "csg")
-    };
+    let is_model = |p: &Path| matches!(extension(p).as_str(), "obj" | "stl" | "gltf" | "glb" | "csg");
     if let Some(p) = args.input.as_deref().filter(|p| extension(p) == "scad") {
         let csg = scad::to_csg(p).map_err(kage::Error::Scene)?;
         let mut from_csg = args.clone();
