@@ -35,7 +35,8 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Render a scene file (.toml) or a model (.obj, .stl, .gltf, .glb, or an
-    /// OpenSCAD .csg); with no input, the built-in demo scene.
+    /// OpenSCAD .csg or .scad); with no input, the built-in demo scene. Also
+    /// the frames of a turntable or camera path, and tiles of a frame.
     Render(RenderArgs),
     /// Open a window on a scene file or a model (the demo with none): orbit,
     /// pan and zoom, switch shadow methods and antialiasing, see each pass;
