@@ -10,7 +10,7 @@ use exr::prelude::{
     AttributeValue, Encoding, Image, IntegerBounds, Layer, LayerAttributes, SpecificChannels, Text, Vec2, WritableImage,
 };
 use kage::image::{LinearImage, PixelRect, ToneCurve};
-use kage::scene::Exposure;
+use kage::scene::{check_image_size, Exposure};
 
 /// Parses `X0,Y0,X1,Y1` (pixels, the first column and row and one past the
 /// last).
@@ -94,10 +94,17 @@ pub fn read_tile(path: &Path) -> Result<Tile, String> {
         .no_deep_data()
         .largest_resolution_level()
         .rgb_channels(
-            |size, _| LinearImage::new(size.0 as u32, size.1 as u32),
+            // A size kage would not render is not allocated: the image stays
+            // empty, and is refused below.
+            |size, _| match check_image_size(size.0 as u64, size.1 as u64) {
+                Ok(()) => LinearImage::new(size.0 as u32, size.1 as u32),
+                Err(_) => LinearImage::default(),
+            },
             |image: &mut LinearImage, p: Vec2<usize>, (r, g, b): (f32, f32, f32)| {
                 let w = image.width() as usize;
-                image.pixels_mut()[p.1 * w + p.0] = glam::Vec3::new(r, g, b);
+                if let Some(px) = image.pixels_mut().get_mut(p.1 * w + p.0) {
+                    *px = glam::Vec3::new(r, g, b);
+                }
             },
         )
         .first_valid_layer()
@@ -107,6 +114,11 @@ pub fn read_tile(path: &Path) -> Result<Tile, String> {
     let display = read.attributes.display_window;
     let at = read.layer_data.attributes.layer_position;
     let data = read.layer_data.channel_data.pixels;
+    let too_large = |what: &str, w: usize, h: usize| {
+        check_image_size(w as u64, h as u64).map_err(|e| format!("{}: its {what}: {e}", path.display()))
+    };
+    too_large("data window", read.layer_data.size.0, read.layer_data.size.1)?;
+    too_large("display window", display.size.0, display.size.1)?;
     let (dx, dy) = (display.position.0, display.position.1);
     if dx != 0 || dy != 0 {
         return Err(format!("{}: its display window starts at ({dx}, {dy}), not (0, 0)", path.display()));
@@ -117,13 +129,18 @@ pub fn read_tile(path: &Path) -> Result<Tile, String> {
     }
     let rect = PixelRect { x0: x0 as u32, y0: y0 as u32, x1: x0 as u32 + data.width(), y1: y0 as u32 + data.height() };
     let whole = (display.size.0 as u32, display.size.1 as u32);
-    let other = &read.attributes.other;
-    let exposure = match other.get(&Text::from(EXPOSURE_ATTRIBUTE)) {
+    // Written with the image's attributes; a reader may hand them back with
+    // the layer's (one header holds both).
+    let attribute = |name: &str| {
+        let name = Text::from(name);
+        read.attributes.other.get(&name).or_else(|| read.layer_data.attributes.other.get(&name))
+    };
+    let exposure = match attribute(EXPOSURE_ATTRIBUTE) {
         Some(AttributeValue::Text(t)) if t.eq("auto") => Exposure::Auto,
         Some(&AttributeValue::F32(s)) => Exposure::Stops(s),
         _ => Exposure::default(),
     };
-    let tone = match other.get(&Text::from(TONE_ATTRIBUTE)) {
+    let tone = match attribute(TONE_ATTRIBUTE) {
         Some(AttributeValue::Text(t)) => ToneCurve::from_name(&t.to_string()).unwrap_or_default(),
         _ => ToneCurve::default(),
     };
@@ -170,4 +187,33 @@ pub fn merge(tiles: &[Tile]) -> Result<LinearImage, String> {
         ));
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tile_file(name: &str, rect: PixelRect, whole: (u32, u32)) -> PathBuf {
+        let path = std::env::temp_dir().join(format!("kage-tile-{}-{name}.exr", std::process::id()));
+        let part = LinearImage::new(rect.width(), rect.height());
+        write_tile(&part, rect, whole, Exposure::Stops(1.5), ToneCurve::Agx, &path).unwrap();
+        path
+    }
+
+    #[test]
+    fn a_tile_reads_back_where_it_goes_and_how_it_is_exposed() {
+        let rect = PixelRect { x0: 3, y0: 5, x1: 10, y1: 9 };
+        let path = tile_file("back", rect, (20, 12));
+        let t = read_tile(&path).unwrap();
+        assert_eq!((t.rect, t.whole, t.exposure, t.tone), (rect, (20, 12), Exposure::Stops(1.5), ToneCurve::Agx));
+        std::fs::remove_file(path).ok();
+    }
+
+    #[test]
+    fn a_tile_of_an_image_too_large_to_render_is_refused_before_allocating() {
+        let path = tile_file("huge", PixelRect { x0: 0, y0: 0, x1: 2, y1: 2 }, (100_000, 100_000));
+        let e = read_tile(&path).err().unwrap_or_default();
+        assert!(e.contains("display window"), "{e}");
+        std::fs::remove_file(path).ok();
+    }
 }
