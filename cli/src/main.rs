@@ -471,6 +471,7 @@ fn load(args: &RenderArgs) -> kage::error::Result<Scene> {
     Ok(scene)
 }
 
+/// A path's extension, lower case ("" when it has none).
 fn extension(p: &Path) -> String {
     p.extension().and_then(|e| e.to_str()).unwrap_or_default().to_ascii_lowercase()
 }
@@ -685,8 +686,7 @@ fn merge_command(args: &MergeArgs) -> miette::Result<()> {
     kage::output::check_output(&args.output).map_err(report::to_report)?;
     let tiles: Vec<tiles::Tile> =
         args.tiles.iter().map(|p| tiles::read_tile(p)).collect::<Result<_, _>>().map_err(|e| miette::miette!("{e}"))?;
-    let whole = tiles::merge(&tiles).map_err(|e| miette::miette!("{e}"))?;
-    let (exposure, tone) = (tiles[0].exposure, tiles[0].tone);
+    let (exposure, tone) = tiles.first().map(|t| (t.exposure, t.tone)).unwrap_or_default();
     if let Some(t) = tiles.iter().find(|t| t.exposure != exposure || t.tone != tone) {
         miette::bail!(
             "{} was rendered with another exposure or tone curve than {}",
@@ -694,6 +694,7 @@ fn merge_command(args: &MergeArgs) -> miette::Result<()> {
             tiles[0].path.display()
         );
     }
+    let whole = tiles::merge(&tiles).map_err(|e| miette::miette!("{e}"))?;
     kage::output::write_image(&whole, &args.output, exposure.scale(&whole), tone).map_err(report::to_report)?;
     eprintln!("wrote {} ({}x{}, from {} tiles)", args.output.display(), whole.width(), whole.height(), tiles.len());
     Ok(())

@@ -14,6 +14,7 @@ use kage::scene::{file, Scene};
 use kage::Limits;
 
 use super::state::Toggles;
+use crate::extension;
 
 /// Window size when neither the command line nor the scene file gives one.
 pub const DEFAULT_SIZE: (u32, u32) = (1280, 720);
@@ -88,10 +89,6 @@ fn model_scene(path: &Path, toggles: &Toggles) -> Result<Scene, String> {
         limits: Limits::default(),
     };
     model::scene_for_model_with(path, DEFAULT_SIZE.0, DEFAULT_SIZE.1, &options).map_err(|e| e.to_string())
-}
-
-fn extension(path: &Path) -> String {
-    path.extension().and_then(|e| e.to_str()).unwrap_or_default().to_ascii_lowercase()
 }
 
 #[cfg(test)]
