@@ -151,3 +151,17 @@ fn an_impossible_thread_count_is_refused_as_such_not_as_a_bad_scene() {
         assert!(message.contains("threads requested") && !message.contains("invalid scene"), "{message}");
     }
 }
+
+#[test]
+fn a_scene_whose_only_object_is_empty_is_a_located_error_not_a_panic() {
+    let dir = scratch("empty-solid");
+    // A difference whose positive part has no volume: an empty solid.
+    write(
+        &dir,
+        "nothing.csg",
+        "difference() {\n\tcube(size = [0, 1, 1], center = false);\n\tcube(size = [1, 1, 1], center = false);\n}\n",
+    );
+    let scene = write(&dir, "scene.toml", "[image]\nwidth = 32\nheight = 32\n\n[[object]]\nmesh = \"nothing.csg\"\n");
+    let e = load_scene(&scene).unwrap_err().to_string();
+    assert!(e.contains("scene.toml:5:1") && e.contains("nothing to draw"), "{e}");
+}

@@ -25,6 +25,7 @@
 //! compared pixel for pixel with OpenSCAD's. A `$fn` of 8 or less is always
 //! faceted: hexagonal nut traps are meant to be hexagons.
 
+mod hull;
 pub mod syntax;
 
 use std::f32::consts::PI;
@@ -32,12 +33,13 @@ use std::ops::Range;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use glam::{Affine3A, DVec3, Mat4, Vec3, Vec4};
+use glam::{Affine3A, Mat4, Vec3, Vec4};
 
 use super::model::{ConvexPolyhedron, CsgSolid, CsgTree, Primitive, Shape};
 use crate::camera::{Camera, Projection};
 use crate::error::{Error, Result, SourceLocation};
 use crate::limits::{Limit, Limits};
+use hull::{bounds_size, convex_from_faces, convex_hull};
 use syntax::{parse_csg, CsgNode, CsgValue};
 
 /// How spheres and cylinders become primitives.
@@ -600,110 +602,6 @@ fn circle(n: usize, r: f32, z: f32) -> Vec<Vec3> {
         .collect()
 }
 
-/// The convex hull of `points` (quickhull, the `chull` crate) as planes: the
-/// hull's triangles in f64, largest first, each merged into a plane already found
-/// when its three corners lie on it (a flat face of many thin triangles is one
-/// plane); `None` if the points span no volume.
-///
-/// The crate walks hash sets, so the triangles it returns, and their order,
-/// change from run to run. Only the set of planes is kept from them: each
-/// plane is then recomputed from the corners lying on it ([`face_plane`]) and
-/// the planes are sorted, so the same points give the same polyhedron, bit
-/// for bit, in every run and in any order.
-fn convex_hull(points: &[Vec3]) -> Option<ConvexPolyhedron> {
-    let size = f64::from(bounds_size(points));
-    if points.len() < 4 || size.is_nan() || size <= 0.0 {
-        return None;
-    }
-    let coords: Vec<Vec<f64>> = points.iter().map(|p| p.to_array().map(f64::from).to_vec()).collect();
-    let hull = chull::ConvexHull::try_new(&coords, size * 1e-9, None).ok()?;
-    let (corners, indices) = hull.vertices_indices();
-    let triangles: Vec<[DVec3; 3]> =
-        indices.chunks_exact(3).map(|t| [t[0], t[1], t[2]].map(|i| DVec3::from_slice(&corners[i]))).collect();
-    let mut corners: Vec<DVec3> = corners.iter().map(|c| DVec3::from_slice(c)).collect();
-    corners.sort_by(|a, b| a.to_array().partial_cmp(&b.to_array()).unwrap_or(std::cmp::Ordering::Equal));
-    corners.dedup();
-    let centroid = corners.iter().copied().sum::<DVec3>() / corners.len() as f64;
-    let mut triangles: Vec<(f64, DVec3, [DVec3; 3])> = triangles
-        .into_iter()
-        .filter_map(|[a, b, c]| {
-            let cross = (b - a).cross(c - a);
-            let n = cross.try_normalize()?;
-            Some((cross.length(), if n.dot(a - centroid) < 0.0 { -n } else { n }, [a, b, c]))
-        })
-        .collect();
-    triangles.sort_by(|x, y| y.0.total_cmp(&x.0));
-    let eps = 1e-6 * size;
-    let mut found: Vec<(DVec3, f64)> = Vec::new();
-    for (_, n, tri) in triangles {
-        let on = |(m, d): &(DVec3, f64)| m.dot(n) > 0.99 && tri.iter().all(|v| (m.dot(*v) - d).abs() < eps);
-        if !found.iter().any(on) {
-            found.push((n, n.dot(tri[0])));
-        }
-    }
-    let mut planes: Vec<Vec4> = found
-        .iter()
-        .filter_map(|&(n, d)| {
-            let on: Vec<DVec3> = corners.iter().copied().filter(|v| (n.dot(*v) - d).abs() < eps).collect();
-            face_plane(&on, n, centroid)
-        })
-        .map(|(n, d)| n.as_vec3().extend(d as f32))
-        .collect();
-    planes.sort_by(|a, b| a.to_array().partial_cmp(&b.to_array()).unwrap_or(std::cmp::Ordering::Equal));
-    planes.dedup();
-    Some(ConvexPolyhedron { planes, vertices: corners.iter().map(|c| c.as_vec3()).collect() })
-}
-
-/// The plane of a convex face from its corners `on` (sorted, so the result
-/// depends on the set alone): the corners taken in order round their centre
-/// (seen along the face's rough normal `rough`), the normal by Newell's
-/// method, turned away from the solid's `centroid`, through their centre.
-fn face_plane(on: &[DVec3], rough: DVec3, centroid: DVec3) -> Option<(DVec3, f64)> {
-    let centre = on.iter().copied().sum::<DVec3>() / on.len() as f64;
-    let u = (*on.first()? - centre).try_normalize()?;
-    let v = rough.cross(u);
-    let mut ring: Vec<(f64, DVec3)> = on.iter().map(|&p| ((p - centre).dot(v).atan2((p - centre).dot(u)), p)).collect();
-    ring.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let normal: DVec3 = (0..ring.len())
-        .map(|k| {
-            let (a, b) = (ring[k].1, ring[(k + 1) % ring.len()].1);
-            DVec3::new((a.y - b.y) * (a.z + b.z), (a.z - b.z) * (a.x + b.x), (a.x - b.x) * (a.y + b.y))
-        })
-        .sum();
-    let n = normal.try_normalize()?;
-    let n = if n.dot(centre - centroid) < 0.0 { -n } else { n };
-    Some((n, n.dot(centre)))
-}
-
-/// The largest side of the points' bounding box.
-fn bounds_size(points: &[Vec3]) -> f32 {
-    let (lo, hi) = points.iter().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(a, b), &p| (a.min(p), b.max(p)));
-    (hi - lo).max_element()
-}
-
-/// The planes of `faces` (any winding; each turned to face away from the points'
-/// centroid, which lies inside a convex solid), normals by Newell's method.
-/// Faces of zero area are dropped.
-fn convex_from_faces(vertices: Vec<Vec3>, faces: &[Vec<usize>]) -> ConvexPolyhedron {
-    let centroid = vertices.iter().copied().sum::<Vec3>() / vertices.len().max(1) as f32;
-    let planes = faces
-        .iter()
-        .filter_map(|f| {
-            let normal: Vec3 = (0..f.len())
-                .map(|k| {
-                    let (a, b) = (vertices[f[k]], vertices[f[(k + 1) % f.len()]]);
-                    Vec3::new((a.y - b.y) * (a.z + b.z), (a.z - b.z) * (a.x + b.x), (a.x - b.x) * (a.y + b.y))
-                })
-                .sum();
-            let n = normal.try_normalize()?;
-            let centre = f.iter().map(|&i| vertices[i]).sum::<Vec3>() / f.len() as f32;
-            let n = if n.dot(centre - centroid) < 0.0 { -n } else { n };
-            Some(n.extend(n.dot(centre)))
-        })
-        .collect();
-    ConvexPolyhedron { planes, vertices }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -812,26 +710,6 @@ mod tests {
         let Shape::Polyhedron(p) = &s.primitives[0].shape else { panic!("a polyhedron") };
         // Coplanar triangles merged: the two flat caps are one plane each.
         assert_eq!(p.planes.iter().filter(|q| q.z.abs() > 0.999).count(), 2);
-    }
-
-    #[test]
-    fn a_hull_is_the_same_to_the_bit_whatever_the_order_of_its_points() {
-        // A cylinder's two rings (caps of 24 coplanar corners, which the hull
-        // crate splits into triangles differently from run to run) and a cube.
-        let mut points: Vec<Vec3> = circle(24, 3.0, 0.0).into_iter().chain(circle(24, 2.0, 5.0)).collect();
-        points.extend((0..8).map(|k| Vec3::new((k & 1) as f32, (k >> 1 & 1) as f32, (k >> 2) as f32) * 4.0 - 2.0));
-        let first = convex_hull(&points).expect("a solid");
-        for turn in 1..6 {
-            points.rotate_left(turn * 7);
-            if turn % 2 == 0 {
-                points.reverse();
-            }
-            let again = convex_hull(&points).expect("a solid");
-            assert_eq!(again.planes, first.planes, "after turn {turn}");
-        }
-        // The top cap is one plane.
-        let top: Vec<&Vec4> = first.planes.iter().filter(|p| p.z > 0.999).collect();
-        assert!(top.len() == 1 && (top[0].w - 5.0).abs() < 1e-5, "{top:?}");
     }
 
     #[test]

@@ -731,7 +731,13 @@ impl SceneFile {
 
     fn place_camera_and_lights(&self, scene: &mut Scene, models: &[LoadedModel]) -> Result<()> {
         let aspect = scene.width as f32 / scene.height as f32;
-        let bounds = scene.bounds().expect("objects exist");
+        let Some(bounds) = scene.bounds() else {
+            let span = self.objects.first().map_or(0..0, |o| o.span());
+            return Err(self.invalid(
+                span,
+                "every object of the scene is empty (no volume, no triangles): there is nothing to draw",
+            ));
+        };
         let (auto_cam, auto_lights) = framing(bounds, aspect);
         let model_cam = models.iter().find_map(|m| m.camera);
         scene.camera = match &self.camera {
