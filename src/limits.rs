@@ -32,6 +32,13 @@ pub enum Limit {
     Triangles,
     /// Convex primitives in one CSG solid.
     Primitives,
+    /// Points of one OpenSCAD `polygon()` or `polyhedron()`.
+    Points,
+    /// Slices of one extrusion (`linear_extrude`'s `slices`, `rotate_extrude`'s
+    /// segments).
+    Slices,
+    /// Characters of one OpenSCAD `text()`.
+    TextLength,
     /// Pixels of one decoded texture, checked from the image header.
     TexturePixels,
     /// Mebibytes of shadow maps one light holds (its jittered samples' maps together).
@@ -47,7 +54,7 @@ pub enum Limit {
 
 impl Limit {
     /// Every limit, in the order the docs list them.
-    pub const ALL: [Limit; 12] = [
+    pub const ALL: [Limit; 15] = [
         Limit::Nesting,
         Limit::GltfNodes,
         Limit::Instances,
@@ -55,6 +62,9 @@ impl Limit {
         Limit::Facets,
         Limit::Triangles,
         Limit::Primitives,
+        Limit::Points,
+        Limit::Slices,
+        Limit::TextLength,
         Limit::TexturePixels,
         Limit::LightShadowMb,
         Limit::FrameShadowMb,
@@ -73,6 +83,9 @@ impl Limit {
             Limit::Facets => "facets",
             Limit::Triangles => "triangles",
             Limit::Primitives => "primitives",
+            Limit::Points => "points",
+            Limit::Slices => "slices",
+            Limit::TextLength => "text_length",
             Limit::TexturePixels => "texture_pixels",
             Limit::LightShadowMb => "light_shadow_mb",
             Limit::FrameShadowMb => "frame_shadow_mb",
@@ -91,7 +104,10 @@ impl Limit {
             Limit::Segments => 2048,
             Limit::Facets => 20_000,
             Limit::Triangles => 20_000_000,
-            Limit::Primitives => 10_000,
+            Limit::Primitives => 100_000,
+            Limit::Points => 1_000_000,
+            Limit::Slices => 10_000,
+            Limit::TextLength => 10_000,
             Limit::TexturePixels => 8192 * 8192,
             Limit::LightShadowMb => 1024,
             Limit::FrameShadowMb => 2048,

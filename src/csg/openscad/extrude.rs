@@ -1,0 +1,146 @@
+//! `linear_extrude()` and `rotate_extrude()` as unions of convex polyhedra:
+//! each convex piece of the region ([`super::partition`]) becomes one
+//! primitive per slice (a straight extrusion has one slice) or per segment
+//! of the revolution.
+//!
+//! - A straight extrusion of a convex piece, scaled alike in x and y, is the
+//!   convex prism between the piece and its scaled copy: OpenSCAD's own mesh,
+//!   exactly (its side quads are planar).
+//! - A twisted extrusion, or one scaled differently in x and y, has side
+//!   quads that are not planar; OpenSCAD splits each into two triangles. Each
+//!   slice of each piece is taken as the convex hull of its two ends, which
+//!   lies outside OpenSCAD's mesh by at most the bulge of one quad (for a
+//!   piece of size s twisted by θ per slice, about s·θ²/8).
+//! - A revolution of a convex piece between two angles is convex (a point is
+//!   `α·u + β·v + z·ẑ` for the two ends' radial directions u and v, with
+//!   `(α + β, z)` in the piece and α, β ≥ 0: a linear image of a convex set),
+//!   and its corners are OpenSCAD's: each segment is exactly OpenSCAD's mesh.
+
+use glam::{DAffine2, DMat2, DVec2, Vec3};
+
+use super::hull::convex_from_faces;
+use crate::csg::ConvexPolyhedron;
+
+/// The convex polyhedron between a convex counter-clockwise `bottom` at
+/// height `z0` and `top` (the same corners moved by a map that keeps the piece
+/// convex, or all one point) at `z1`.
+#[must_use]
+pub(crate) fn slab(bottom: &[DVec2], top: &[DVec2], z0: f64, z1: f64) -> ConvexPolyhedron {
+    let n = bottom.len();
+    let lift = |p: DVec2, z: f64| Vec3::new(p.x as f32, p.y as f32, z as f32);
+    let vertices: Vec<Vec3> = bottom.iter().map(|&p| lift(p, z0)).chain(top.iter().map(|&p| lift(p, z1))).collect();
+    let mut faces: Vec<Vec<usize>> = vec![(0..n).rev().collect(), (n..2 * n).collect()];
+    faces.extend((0..n).map(|i| vec![i, (i + 1) % n, n + (i + 1) % n, n + i]));
+    // A top shrunk to a point (scale 0) leaves a face of no area: dropped.
+    convex_from_faces(vertices, &faces)
+}
+
+/// How a `linear_extrude()` places its layers: `slices` of height `h` from
+/// `z0`, layer k turned by `−twist·k/slices` degrees, then scaled by
+/// `1 + (scale − 1)·k/slices`, as OpenSCAD does.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Layers {
+    pub(crate) z0: f64,
+    pub(crate) height: f64,
+    pub(crate) twist_deg: f64,
+    pub(crate) slices: usize,
+    pub(crate) scale: DVec2,
+}
+
+impl Layers {
+    /// The map of layer `k` (0 the bottom, `slices` the top).
+    #[must_use]
+    pub(crate) fn map(&self, k: usize) -> DAffine2 {
+        let f = k as f64 / self.slices as f64;
+        let scale = DVec2::ONE + (self.scale - DVec2::ONE) * f;
+        DAffine2::from_mat2(DMat2::from_diagonal(scale) * DMat2::from_angle((-self.twist_deg * f).to_radians()))
+    }
+
+    /// The height of layer `k`.
+    #[must_use]
+    pub(crate) fn z(&self, k: usize) -> f64 {
+        self.z0 + self.height * k as f64 / self.slices as f64
+    }
+
+    /// The slices of one convex piece.
+    pub(crate) fn slabs<'a>(&'a self, piece: &'a [DVec2]) -> impl Iterator<Item = ConvexPolyhedron> + 'a {
+        (0..self.slices).map(move |k| {
+            let (a, b) = (self.map(k), self.map(k + 1));
+            let bottom: Vec<DVec2> = piece.iter().map(|p| a.transform_point2(*p)).collect();
+            let top: Vec<DVec2> = piece.iter().map(|p| b.transform_point2(*p)).collect();
+            slab(&bottom, &top, self.z(k), self.z(k + 1))
+        })
+    }
+}
+
+/// The segments of a convex `piece` (x ≥ 0) revolved about the z axis:
+/// `segments` of them from 0 to `angle_deg` degrees (the profile's x along
+/// the radial direction, its y up), each the convex solid between the piece
+/// at two neighbouring angles.
+pub(crate) fn revolved(
+    piece: &[DVec2],
+    angle_deg: f64,
+    segments: usize,
+) -> impl Iterator<Item = ConvexPolyhedron> + '_ {
+    let n = piece.len();
+    let at = move |k: usize| {
+        let a = (angle_deg * k as f64 / segments as f64).to_radians();
+        let (s, c) = a.sin_cos();
+        piece.iter().map(move |p| Vec3::new((p.x * c) as f32, (p.x * s) as f32, p.y as f32))
+    };
+    (0..segments).map(move |k| {
+        let vertices: Vec<Vec3> = at(k).chain(at(k + 1)).collect();
+        let mut faces: Vec<Vec<usize>> = vec![(0..n).collect(), (n..2 * n).collect()];
+        faces.extend((0..n).map(|i| vec![i, (i + 1) % n, n + (i + 1) % n, n + i]));
+        // Corners on the axis meet themselves: their faces lose a corner
+        // and keep their plane (Newell's method over repeated corners).
+        convex_from_faces(vertices, &faces)
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_prism_is_its_piece_between_two_heights() {
+        let tri = [DVec2::ZERO, DVec2::new(2.0, 0.0), DVec2::new(0.0, 2.0)];
+        let p = slab(&tri, &tri, -1.0, 3.0);
+        assert_eq!(p.planes.len(), 5);
+        assert!(p.contains(Vec3::new(0.5, 0.5, 2.9), 0.0) && !p.contains(Vec3::new(0.5, 0.5, 3.1), 0.0));
+        assert!(!p.contains(Vec3::new(1.1, 1.1, 0.0), 0.0));
+        // Scaled to a point: a pyramid.
+        let apex = [DVec2::ZERO; 3];
+        let q = slab(&tri, &apex, 0.0, 1.0);
+        assert_eq!(q.planes.len(), 4);
+        assert!(q.contains(Vec3::new(0.2, 0.2, 0.5), 1e-6) && !q.contains(Vec3::new(0.6, 0.6, 0.5), 1e-6));
+    }
+
+    #[test]
+    fn layers_turn_then_scale_as_openscad_does() {
+        // linear_extrude(height = 10, twist = 90, slices = 3, scale = [2, 1]):
+        // OpenSCAD puts the square's corner (2, 0) at (2.3094, -1) on layer 1
+        // and (0, -2) at (4, -2)... read off its STL.
+        let l = Layers { z0: 0.0, height: 10.0, twist_deg: 90.0, slices: 3, scale: DVec2::new(2.0, 1.0) };
+        let p = l.map(1).transform_point2(DVec2::new(2.0, 0.0));
+        assert!((p - DVec2::new(2.3094, -1.0)).length() < 1e-4, "{p}");
+        let q = l.map(3).transform_point2(DVec2::new(2.0, 2.0));
+        assert!((q - DVec2::new(4.0, -2.0)).length() < 1e-9, "{q}");
+    }
+
+    #[test]
+    fn a_revolved_square_segment_is_convex_and_holds_its_ring() {
+        // translate([5, 0]) square([1, 2]) revolved in 8 segments.
+        let sq = [DVec2::new(5.0, 0.0), DVec2::new(6.0, 0.0), DVec2::new(6.0, 2.0), DVec2::new(5.0, 2.0)];
+        let segs: Vec<ConvexPolyhedron> = revolved(&sq, 360.0, 8).collect();
+        assert_eq!(segs.len(), 8);
+        assert!(segs.iter().all(|s| s.planes.len() == 6));
+        let mid = Vec3::new(5.5 * (22.5f32).to_radians().cos(), 5.5 * (22.5f32).to_radians().sin(), 1.0);
+        assert!(segs[0].contains(mid, 1e-5) && !segs[1].contains(mid, 1e-5));
+        // A piece touching the axis makes a wedge of a cone.
+        let tri = [DVec2::ZERO, DVec2::new(3.0, 0.0), DVec2::new(0.0, 3.0)];
+        let cone: Vec<ConvexPolyhedron> = revolved(&tri, 90.0, 2).collect();
+        assert!(cone[0].contains(Vec3::new(1.0, 0.3, 1.0), 1e-5));
+        assert!(!cone[0].contains(Vec3::new(1.0, 0.3, 2.5), 1e-5));
+    }
+}
