@@ -6,10 +6,11 @@
 //! to that):
 //!
 //! ```text
-//! limits · error · sampling · image · camera · bvh   the ground floor: what one input
-//!                                                may ask for, typed errors, sample
+//! limits · error · sampling · image · camera ·       the ground floor: what one input
+//! triangle · bvh                                 may ask for, typed errors, sample
 //!                                                patterns, the linear float image and
-//!                                                sRGB, the view and its rays, the BVH
+//!                                                sRGB, the view and its rays, a ray
+//!                                                against a triangle, the BVH
 //!   ▼
 //! csg            CSG solids (seed 003): model, OpenSCAD reader, ray casting by intervals
 //!   ▼
@@ -61,6 +62,7 @@ pub mod sampling;
 pub mod scene;
 pub mod shading;
 pub mod shadows;
+pub mod triangle;
 pub mod visibility;
 
 pub use error::{Error, SourceLocation};

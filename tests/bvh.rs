@@ -5,8 +5,8 @@ mod common;
 
 use glam::Vec3;
 use kage::camera::Ray;
-use kage::raytrace::triangle::ShearedRay;
 use kage::raytrace::TraceScene;
+use kage::triangle::ShearedRay;
 use kage::visibility::ItemId;
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};

@@ -15,6 +15,7 @@ const FRAME_ORDER: &[&str] = &[
     "sampling",
     "image",
     "camera",
+    "triangle",
     "bvh",
     "csg",
     "scene",

@@ -258,7 +258,10 @@ impl CsgCaster {
             (Clipping::Lanes(_), Shape::Polyhedron(poly)) if row.active => {
                 lanes::planes(row.over(block).map(|f| (f, &poly.planes[f as usize])), &rays)
             }
-            _ => lanes::shape(shape, &rays),
+            _ => match lanes::shape(shape, &rays) {
+                Some(spans) => spans,
+                None => return self.spans_one_by_one(i, unit, block, out),
+            },
         };
         // Faces are small whole numbers: converted in lanes (one by one, the
         // saturating `as` was a quarter of the fill).
@@ -269,6 +272,21 @@ impl CsgCaster {
             hit: spans.hit.to_bitmask() as u8,
             primitive: i as u32,
         };
+    }
+
+    /// [`CsgCaster::spans_on_eight`] pixel by pixel ([`CsgCaster::span_on`]):
+    /// a mesh's layers, whose intervals come from its triangles.
+    fn spans_one_by_one(&self, i: usize, unit: &RowLine, block: usize, out: &mut IntervalLanes) {
+        *out = IntervalLanes { primitive: i as u32, ..IntervalLanes::default() };
+        for j in 0..8 {
+            if let Some(s) = self.span_on(i, unit, (block * 8 + j) as f32) {
+                out.t[0][j] = s.enter.t;
+                out.t[1][j] = s.exit.t;
+                out.face[0][j] = s.enter.face;
+                out.face[1][j] = s.exit.face;
+                out.hit |= 1 << j;
+            }
+        }
     }
 
     /// The crossing `hit` of `ray` with its unit outward normal (solid space).
@@ -312,7 +330,7 @@ impl CsgCaster {
         match &self.solid.primitives[hit.primitive as usize].shape {
             Shape::Sphere => false,
             Shape::Frustum { .. } => hit.face & !Hit::CUT != shapes::SIDE,
-            Shape::Polyhedron(_) => true,
+            Shape::Polyhedron(_) | Shape::Mesh { .. } => true,
         }
     }
 

@@ -60,13 +60,15 @@ fn dot(a: [f32x8; 3], b: [f32x8; 3]) -> f32x8 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
-/// The interval of a unit shape ([`super::shapes::unit_span`]) in eight lanes.
-pub(super) fn shape(shape: &Shape, r: &RayLanes) -> SpanLanes {
-    match shape {
+/// The interval of a convex unit shape ([`super::shapes::unit_span`]) in
+/// eight lanes; `None` for a mesh's layer, found ray by ray.
+pub(super) fn shape(shape: &Shape, r: &RayLanes) -> Option<SpanLanes> {
+    Some(match shape {
         Shape::Sphere => sphere(r),
         Shape::Frustum { bottom, top } => frustum(*bottom, *top, r),
         Shape::Polyhedron(poly) => polyhedron(poly, r),
-    }
+        Shape::Mesh { .. } => return None,
+    })
 }
 
 /// [`super::shapes::roots`] in lanes: the smaller and larger root, and where they are real.

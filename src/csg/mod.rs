@@ -27,6 +27,7 @@ mod caster;
 mod faces;
 mod hit;
 mod lanes;
+mod mesh;
 mod model;
 pub(crate) mod occupancy;
 pub mod openscad;
@@ -37,6 +38,7 @@ pub use booleans::{above, below, combine, Booleans, LeafSpans, Operation, Parts,
 pub use caster::{first_hit, primitive_span, spans, CsgCaster};
 pub use faces::{FacesOnScreen, RowFaces};
 pub use hit::{Crossing, Hit, Interval, IntervalLanes, Span};
+pub use mesh::{pick_layer, ClosedMesh, MeshInterval, FLIP as MESH_FLIP, MAX_TRIANGLES as MAX_MESH_TRIANGLES};
 #[cfg(test)]
 pub(crate) use model::random_tree;
 pub use model::{Bound, BoxBound, ConvexPolyhedron, CsgSolid, CsgTree, Primitive, Reach, Shape};

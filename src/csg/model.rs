@@ -13,8 +13,11 @@
 //! against.
 
 use std::ops::Range;
+use std::sync::Arc;
 
 use glam::{Affine3A, Vec3, Vec4};
+
+use super::mesh::ClosedMesh;
 
 /// A unit shape, before its primitive's transform.
 #[derive(Debug, Clone, PartialEq)]
@@ -32,6 +35,16 @@ pub enum Shape {
     },
     /// A convex polyhedron.
     Polyhedron(ConvexPolyhedron),
+    /// One layer of a closed mesh that need not be convex: the `layer`-th
+    /// interval of each ray inside it (the last layer: to the last exit). A
+    /// mesh stands in a tree as the union of its layers
+    /// ([`CsgTree::mesh_layers`]).
+    Mesh {
+        /// The mesh, in the unit shape's space.
+        mesh: Arc<ClosedMesh>,
+        /// Which interval along a ray.
+        layer: u32,
+    },
 }
 
 /// A convex polyhedron: the points `p` with `n·p ≤ d` for every plane `(n, d)`
@@ -98,6 +111,10 @@ impl Primitive {
             Shape::Sphere => unit_box(-1.0),
             Shape::Frustum { .. } => unit_box(0.0),
             Shape::Polyhedron(p) => p.vertices.clone(),
+            Shape::Mesh { mesh, .. } => {
+                let (lo, hi) = mesh.bounds();
+                (0..8).map(|i| Vec3::select(glam::BVec3::new(i & 1 != 0, i & 2 != 0, i & 4 != 0), hi, lo)).collect()
+            }
         }
     }
 
@@ -120,6 +137,7 @@ impl Primitive {
                 (-EPS..=1.0 + EPS).contains(&q.z) && q.truncate().length() <= r + EPS
             }
             Shape::Polyhedron(poly) => poly.contains(q, EPS),
+            Shape::Mesh { mesh, layer } => mesh.layer_of(q) == Some(*layer),
         }
     }
 }
@@ -138,6 +156,16 @@ pub enum CsgTree {
 }
 
 impl CsgTree {
+    /// The union of the layers of a mesh whose first layer is primitive
+    /// `first` (its `layers` primitives numbered on from there).
+    #[must_use]
+    pub fn mesh_layers(first: usize, layers: u32) -> CsgTree {
+        match layers {
+            0 | 1 => CsgTree::Leaf(first),
+            n => CsgTree::Union((first..first + n as usize).map(CsgTree::Leaf).collect()),
+        }
+    }
+
     /// The same solid with nested booleans of one kind merged: a union's
     /// union operands and an intersection's intersection operands are spliced
     /// into it, a difference's union cutters become its own cutters

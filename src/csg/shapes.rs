@@ -25,6 +25,7 @@ pub(super) fn unit_normal(shape: &Shape, face: u32, p: Vec3) -> Vec3 {
             }
         },
         Shape::Polyhedron(poly) => poly.planes[face as usize].truncate(),
+        Shape::Mesh { mesh, .. } => mesh.normal(face),
     }
 }
 
@@ -41,6 +42,7 @@ pub(super) fn unit_span(shape: &Shape, o: Vec3, d: Vec3) -> Option<UnitSpan> {
         Shape::Sphere => sphere(o, d),
         Shape::Frustum { bottom, top } => frustum(*bottom, *top, o, d),
         Shape::Polyhedron(poly) => polyhedron(poly, o, d),
+        Shape::Mesh { mesh, layer } => mesh.layer_interval(*layer, o, d),
     }
 }
 

@@ -16,7 +16,6 @@ pub mod reference;
 pub mod shadow_truth;
 pub mod traced;
 pub mod tracer;
-pub mod triangle;
 
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
@@ -27,8 +26,8 @@ use crate::csg::{CsgCaster, CsgSolid};
 
 use crate::bvh::{Aabb, Bvh};
 use crate::camera::Ray;
+use crate::triangle::ShearedRay;
 use crate::visibility::ItemId;
-use triangle::ShearedRay;
 
 pub use cache::TraceCache;
 

@@ -7,10 +7,11 @@
 //!   convex prism between the piece and its scaled copy: OpenSCAD's own mesh,
 //!   exactly (its side quads are planar).
 //! - A twisted extrusion, or one scaled differently in x and y, has side
-//!   quads that are not planar; OpenSCAD splits each into two triangles. Each
-//!   slice of each piece is taken as the convex hull of its two ends, which
-//!   lies outside OpenSCAD's mesh by at most the bulge of one quad (for a
-//!   piece of size s twisted by θ per slice, about s·θ²/8).
+//!   quads that are not planar; OpenSCAD splits each into two triangles,
+//!   the diagonal chosen by the twist's sense, and the solid is no union of
+//!   convex prisms (a twisted triangular prism is Schönhardt's polyhedron,
+//!   which no tetrahedra fill). It is OpenSCAD's own mesh, as a closed mesh
+//!   primitive ([`Layers::mesh`]).
 //! - A revolution of a convex piece between two angles is convex (a point is
 //!   `α·u + β·v + z·ẑ` for the two ends' radial directions u and v, with
 //!   `(α + β, z)` in the piece and α, β ≥ 0: a linear image of a convex set),
@@ -18,8 +19,12 @@
 
 use glam::{DAffine2, DMat2, DVec2, Vec3};
 
+use manifold_rust::linalg::Vec2 as MVec2;
+use manifold_rust::polygon::triangulate;
+
+use super::flat::{signed_area, Region};
 use super::hull::convex_from_faces;
-use crate::csg::ConvexPolyhedron;
+use crate::csg::{ClosedMesh, ConvexPolyhedron};
 
 /// The convex polyhedron between a convex counter-clockwise `bottom` at
 /// height `z0` and `top` (the same corners moved by a map that keeps the piece
@@ -60,6 +65,77 @@ impl Layers {
     #[must_use]
     pub(crate) fn z(&self, k: usize) -> f64 {
         self.z0 + self.height * k as f64 / self.slices as f64
+    }
+
+    /// Whether each slice of a convex piece is exactly OpenSCAD's mesh: no
+    /// twist and the same scale in x and y (planar side quads).
+    #[must_use]
+    pub(crate) fn prisms(&self) -> bool {
+        self.twist_deg == 0.0 && self.scale.x == self.scale.y
+    }
+
+    /// The whole extrusion of `region` as OpenSCAD meshes it: each layer's
+    /// contours, each side quad split along the diagonal OpenSCAD picks (by
+    /// the twist's sense, the other way round for holes; without a twist,
+    /// the shorter), the region's triangles as caps (none on top when it is
+    /// scaled to a point).
+    #[must_use]
+    pub(crate) fn mesh(&self, region: &Region) -> Option<ClosedMesh> {
+        let contours = region.contours();
+        let per_layer: usize = contours.iter().map(Vec::len).sum();
+        let mut positions = Vec::with_capacity(per_layer * (self.slices + 1));
+        for k in 0..=self.slices {
+            let (m, z) = (self.map(k), self.z(k) as f32);
+            positions.extend(contours.iter().flatten().map(|p| {
+                let q = m.transform_point2(*p);
+                Vec3::new(q.x as f32, q.y as f32, z)
+            }));
+        }
+        let index = |k: usize, at: usize| (k * per_layer + at) as u32;
+        let mut triangles = Vec::new();
+        let pointed = self.scale == DVec2::ZERO;
+        for k in 0..self.slices {
+            // Twisted: OpenSCAD's `sin(rot1 − rot2) ≥ 0` picks the diagonal
+            // (the other one for holes); stretched, the shorter one.
+            let f = |k: usize| -self.twist_deg * k as f64 / self.slices as f64;
+            let by_twist = (f(k) - f(k + 1)).to_radians().sin() >= 0.0;
+            let mut start = 0;
+            for c in contours {
+                let outer = signed_area(c) > 0.0;
+                for i in 0..c.len() {
+                    let (p, q) = (start + i, start + (i + 1) % c.len());
+                    let (p1, q1, p2, q2) = (index(k, p), index(k, q), index(k + 1, p), index(k + 1, q));
+                    let at = |v: u32| positions[v as usize];
+                    let p1_q2 = if self.twist_deg == 0.0 {
+                        at(p1).distance(at(q2)) <= at(p2).distance(at(q1))
+                    } else {
+                        by_twist == outer
+                    };
+                    let top_point = pointed && k + 1 == self.slices;
+                    if p1_q2 {
+                        triangles.push([p1, q2, q1]);
+                        if !top_point {
+                            triangles.push([q2, p1, p2]);
+                        }
+                    } else {
+                        triangles.push([p1, p2, q1]);
+                        if !top_point {
+                            triangles.push([p2, q2, q1]);
+                        }
+                    }
+                }
+                start += c.len();
+            }
+        }
+        let flat: Vec<Vec<MVec2>> = contours.iter().map(|c| c.iter().map(|p| MVec2::new(p.x, p.y)).collect()).collect();
+        for t in triangulate(&flat, -1.0, true) {
+            let t = [t.x, t.y, t.z].map(|i| i as usize);
+            triangles.push([index(0, t[0]), index(0, t[2]), index(0, t[1])]);
+            if !pointed {
+                triangles.push(t.map(|i| index(self.slices, i)));
+            }
+        }
+        ClosedMesh::new(positions, triangles)
     }
 
     /// The slices of one convex piece.

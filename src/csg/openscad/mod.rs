@@ -43,6 +43,7 @@ use std::sync::Arc;
 
 use glam::{Affine3A, Vec3, Vec4};
 
+use super::mesh::ClosedMesh;
 use super::model::{ConvexPolyhedron, CsgSolid, CsgTree, Primitive, Shape};
 use crate::camera::{Camera, Projection};
 use crate::error::{Error, Result, SourceLocation};
@@ -315,6 +316,17 @@ impl Builder {
         }
         self.solid.primitives.push(p);
         Ok(Built::Tree(CsgTree::Leaf(self.solid.primitives.len() - 1)))
+    }
+
+    /// A closed mesh placed by `m`, made by `node`: the union of its layers.
+    fn push_mesh(&mut self, node: &CsgNode, mesh: ClosedMesh, m: Affine3A, color: Option<Vec4>) -> Result<Built> {
+        let mesh = Arc::new(mesh);
+        let first = self.solid.primitives.len();
+        for layer in 0..mesh.layers() {
+            let shape = Shape::Mesh { mesh: Arc::clone(&mesh), layer };
+            self.push(Primitive { shape, transform: m, color, source: node.span.clone() })?;
+        }
+        Ok(Built::Tree(CsgTree::mesh_layers(first, mesh.layers())))
     }
 
     /// The union of convex `pieces` placed by `m`, made by `node`.

@@ -5,12 +5,56 @@ use std::f32::consts::PI;
 
 use glam::{Affine3A, Vec3, Vec4};
 
+use glam::DVec3;
+use manifold_rust::linalg::Vec2 as MVec2;
+use manifold_rust::polygon::triangulate;
+
 use super::hull::{bounds_size, convex_from_faces};
-use super::syntax::{CsgNode, CsgValue};
+use super::syntax::CsgNode;
 use super::{Builder, Geometry};
-use crate::csg::{ConvexPolyhedron, Primitive, Shape};
+use crate::csg::{ClosedMesh, ConvexPolyhedron, Primitive, Shape};
 use crate::error::Result;
 use crate::limits::Limit;
+
+/// What a primitive node makes.
+pub(super) enum Made {
+    /// A convex primitive.
+    Convex(Primitive),
+    /// A closed mesh (unplaced: its faces as written).
+    Mesh(ClosedMesh),
+}
+
+/// A `polyhedron()`, convex or not.
+pub(super) enum Polyhedron {
+    Convex(ConvexPolyhedron),
+    Mesh(ClosedMesh),
+}
+
+/// Faces (polygons of corner indices into `points`) cut into triangles,
+/// wound as each face is: a triangle as it stands, a larger face by
+/// Manifold's ear clipper in its own plane (it may be concave, and its
+/// corners need not lie quite in one plane).
+#[must_use]
+pub(super) fn triangulated(points: &[Vec3], faces: &[Vec<usize>]) -> Vec<[u32; 3]> {
+    let mut out = Vec::with_capacity(faces.len() * 2);
+    for f in faces.iter().filter(|f| f.len() >= 3) {
+        if f.len() == 3 {
+            out.push([f[0] as u32, f[1] as u32, f[2] as u32]);
+            continue;
+        }
+        let corners: Vec<DVec3> = f.iter().map(|&i| points[i].as_dvec3()).collect();
+        // Newell's normal: the face's winding, whatever its shape.
+        let normal: DVec3 = (0..corners.len()).map(|k| corners[k].cross(corners[(k + 1) % corners.len()])).sum();
+        let Some(n) = normal.try_normalize() else { continue };
+        let u = n.any_orthonormal_vector();
+        let v = n.cross(u);
+        let flat: Vec<MVec2> = corners.iter().map(|c| MVec2::new(c.dot(u), c.dot(v))).collect();
+        for t in triangulate(&vec![flat], -1.0, true) {
+            out.push([t.x, t.y, t.z].map(|k| f[k as usize] as u32));
+        }
+    }
+    out
+}
 
 /// `$fn` at or below which spheres and cylinders stay faceted in exact mode.
 const ALWAYS_FACETED_FN: f64 = 8.0;
@@ -22,15 +66,22 @@ impl Builder {
         Ok(self.options.geometry == Geometry::Faceted || (fine > 0.0 && fine <= ALWAYS_FACETED_FN))
     }
 
-    /// A primitive node as a primitive, or `None` if it has no volume.
-    pub(super) fn primitive(&mut self, node: &CsgNode, m: Affine3A, color: Option<Vec4>) -> Result<Option<Primitive>> {
+    /// A primitive node as a convex primitive or a closed mesh (a
+    /// polyhedron that is not convex), or `None` if it has no volume.
+    pub(super) fn primitive(&mut self, node: &CsgNode, m: Affine3A, color: Option<Vec4>) -> Result<Option<Made>> {
         let made = match node.name.as_str() {
             "cube" => self.cube(node)?,
             "sphere" => self.sphere(node)?,
             "cylinder" => self.cylinder(node)?,
-            _ => self.polyhedron(node)?.map(|p| (Shape::Polyhedron(p), Affine3A::IDENTITY)),
+            _ => match self.polyhedron(node)? {
+                None => None,
+                Some(Polyhedron::Convex(p)) => Some((Shape::Polyhedron(p), Affine3A::IDENTITY)),
+                Some(Polyhedron::Mesh(mesh)) => return Ok(Some(Made::Mesh(mesh))),
+            },
         };
-        Ok(made.map(|(shape, local)| Primitive { shape, transform: m * local, color, source: node.span.clone() }))
+        Ok(made.map(|(shape, local)| {
+            Made::Convex(Primitive { shape, transform: m * local, color, source: node.span.clone() })
+        }))
     }
 
     pub(super) fn cube(&self, node: &CsgNode) -> Result<Option<(Shape, Affine3A)>> {
@@ -111,41 +162,24 @@ impl Builder {
         Ok(Some((Shape::Polyhedron(convex_from_faces(points, &faces)), Affine3A::IDENTITY)))
     }
 
-    pub(super) fn polyhedron(&self, node: &CsgNode) -> Result<Option<ConvexPolyhedron>> {
-        let points: Vec<Vec3> =
-            self.list(node, "points")?.iter().map(|p| self.vec3(node, "points", p)).collect::<Result<_>>()?;
-        let faces: Vec<Vec<usize>> = self
-            .list(node, "faces")?
-            .iter()
-            .map(|f| {
-                let CsgValue::Vector(ix) = f else {
-                    return Err(
-                        self.invalid(&self.span_of(node, "faces"), "a face must be a list of point indices".into())
-                    );
-                };
-                ix.iter()
-                    .map(|i| match i {
-                        CsgValue::Number(k) if *k >= 0.0 && (*k as usize) < points.len() && k.fract() == 0.0 => {
-                            Ok(*k as usize)
-                        }
-                        _ => Err(self.invalid(
-                            &self.span_of(node, "faces"),
-                            format!("face index {i:?} is not one of the {} points", points.len()),
-                        )),
-                    })
-                    .collect()
-            })
-            .collect::<Result<_>>()?;
+    /// `polyhedron()`: convex (its planes), or a closed mesh of its faces,
+    /// each face cut into triangles.
+    pub(super) fn polyhedron(&self, node: &CsgNode) -> Result<Option<Polyhedron>> {
+        let points = self.list(node, "points")?;
+        self.check(node, Limit::Points, points.len() as u64, || "this polyhedron's points".into())?;
+        let points: Vec<Vec3> = points.iter().map(|p| self.vec3(node, "points", p)).collect::<Result<_>>()?;
+        let faces = self.index_lists(node, "faces", points.len())?;
         if points.len() < 4 || faces.len() < 4 {
             return Ok(None);
         }
         let poly = convex_from_faces(points, &faces);
         let size = bounds_size(&poly.vertices);
         let eps = 1e-4 * size.max(f32::MIN_POSITIVE);
-        if let Some(v) = poly.vertices.iter().find(|v| !poly.contains(**v, eps)) {
-            return Err(self.invalid(&node.span, format!("this polyhedron is not convex (its point {v} lies outside the plane of one of its faces); kage renders convex polyhedra only")));
+        if poly.vertices.iter().all(|v| poly.contains(*v, eps)) {
+            return Ok(Some(Polyhedron::Convex(poly)));
         }
-        Ok(Some(poly))
+        let triangles = triangulated(&poly.vertices, &faces);
+        Ok(ClosedMesh::new(poly.vertices, triangles).map(Polyhedron::Mesh))
     }
 }
 

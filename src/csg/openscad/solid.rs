@@ -10,6 +10,7 @@ use super::flat::Region;
 use super::hull::convex_hull;
 use super::meshed::{surface_bounds, surface_points, union_only};
 use super::partition::convex_pieces;
+use super::primitives::Made;
 use super::syntax::CsgNode;
 use super::{combine, is_flat, kind, Builder, Built, Kind};
 use crate::csg::{CsgTree, Primitive, Shape};
@@ -55,10 +56,11 @@ impl Builder {
             Kind::Hull => self.hull(node, m, color),
             Kind::Minkowski => self.minkowski(node, m, color),
             Kind::Resize => self.resize(node, m, color),
-            Kind::Primitive => {
-                let Some(p) = self.primitive(node, m, color)? else { return Ok(Built::Empty) };
-                self.push(p)
-            }
+            Kind::Primitive => match self.primitive(node, m, color)? {
+                None => Ok(Built::Empty),
+                Some(Made::Convex(p)) => self.push(p),
+                Some(Made::Mesh(mesh)) => self.push_mesh(node, mesh, m, color),
+            },
             Kind::LinearExtrude => self.linear_extrude(node, m, color),
             Kind::RotateExtrude => self.rotate_extrude(node, m, color),
             // Flat kinds were drawn as plates above.
@@ -214,19 +216,40 @@ impl Builder {
     }
 
     /// `linear_extrude()`: each convex piece of the children's region made a
-    /// prism per slice ([`Layers`]).
+    /// prism ([`Layers`]); twisted or stretched, OpenSCAD's mesh of it.
     fn linear_extrude(&mut self, node: &CsgNode, m: Affine3A, color: Option<Vec4>) -> Result<Built> {
         let height = self.number(node, "height")?;
         let twist_deg = self.number_or(node, "twist", 0.0)?;
-        let slices = if twist_deg == 0.0 { 1.0 } else { self.number_or(node, "slices", 1.0)?.max(1.0) };
         let scale = if node.arg("scale").is_some() { self.pair(node, "scale")?.max(DVec2::ZERO) } else { DVec2::ONE };
-        self.check(node, Limit::Slices, slices.min(1e18) as u64, || "this linear_extrude()'s slices".into())?;
         if !(height > 0.0 && height.is_finite()) {
             return Ok(Built::Empty);
         }
+        let region = self.flat_children(node)?;
+        let slices = if twist_deg != 0.0 {
+            self.number_or(node, "slices", 1.0)?.max(1.0)
+        } else if scale.x != scale.y {
+            // OpenSCAD's slices for a stretched extrusion: $fn, else one per
+            // $fs along the longest path a corner takes.
+            let fine = self.number_or(node, "$fn", 0.0)?;
+            let reach = region.points().map(|p| (p - p * scale).length_squared()).fold(0.0, f64::max);
+            let fs = self.number_or(node, "$fs", 2.0)?.max(1e-9);
+            if fine > 0.0 {
+                fine.floor().max(1.0)
+            } else {
+                ((reach + height * height).sqrt() / fs).max(1.0).ceil()
+            }
+        } else {
+            1.0
+        };
+        self.check(node, Limit::Slices, slices.min(1e18) as u64, || "this linear_extrude()'s slices".into())?;
         let z0 = if self.flag_or(node, "center", false)? { -height / 2.0 } else { 0.0 };
         let layers = Layers { z0, height, twist_deg, slices: slices as usize, scale };
-        let region = self.flat_children(node)?;
+        if !layers.prisms() {
+            return match layers.mesh(&region) {
+                Some(mesh) => self.push_mesh(node, mesh, m, color),
+                None => Ok(Built::Empty),
+            };
+        }
         let pieces = convex_pieces(&region);
         let slabs: Vec<_> = pieces.iter().flat_map(|p| layers.slabs(p)).collect();
         self.push_all(node, slabs, m, color)
