@@ -6,6 +6,10 @@
 # and, for text, the Liberation fonts (`fonts-liberation2`).
 set -euo pipefail
 cd "$(dirname "$0")/../tests/data/openscad"
+# Meshes the models import, first.
+for scad in parts/*.scad; do
+  openscad --export-format binstl -o "${scad%.scad}.stl" "$scad" 2>/dev/null
+done
 for scad in *.scad; do
   name="${scad%.scad}"
   openscad -o "$name.csg" "$scad" 2>/dev/null

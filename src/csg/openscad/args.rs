@@ -11,7 +11,7 @@ use super::Builder;
 use crate::error::Result;
 use crate::limits::Limit;
 
-impl Builder {
+impl Builder<'_> {
     /// The number `name`, or `default` when the node does not write it.
     pub(super) fn number_or(&self, node: &CsgNode, name: &str, default: f64) -> Result<f64> {
         if node.arg(name).is_none() {

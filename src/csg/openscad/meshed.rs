@@ -18,12 +18,12 @@ use super::{Builder, CsgOptions, Geometry};
 use crate::csg::{CsgSolid, CsgTree};
 use crate::error::Result;
 
-impl Builder {
+impl Builder<'_> {
     /// `kids` placed by `m`, built as a solid of their own with OpenSCAD's
     /// facets (what `hull()`, `minkowski()` and `projection()` see).
     pub(super) fn faceted_solid(&mut self, kids: &[CsgNode], m: Affine3A) -> Result<CsgSolid> {
         let options = CsgOptions { geometry: Geometry::Faceted, ..self.options };
-        let mut sub = Builder::new(&self.path, std::sync::Arc::clone(&self.text), options, self.limits);
+        let mut sub = Builder::new(&self.path, std::sync::Arc::clone(&self.text), options, self.limits, self.imports);
         sub.cutting = self.cutting;
         let tree = sub.union(kids, m, None)?.into_tree();
         self.warnings.append(&mut sub.warnings);

@@ -29,6 +29,7 @@ mod args;
 mod extrude;
 mod flat;
 mod hull;
+mod import;
 mod meshed;
 mod partition;
 mod planar;
@@ -136,8 +137,25 @@ pub fn default_view((lo, hi): (Vec3, Vec3)) -> Camera {
 /// (unless [`CsgOptions::skip_unsupported`]), a malformed argument, a
 /// polyhedron that is not convex, or a request over a limit.
 pub fn load_csg(path: &Path, text: Arc<str>, options: &CsgOptions, limits: &Limits) -> Result<LoadedCsg> {
+    load_csg_with(path, text, options, limits, &NoImports)
+}
+
+/// [`load_csg`] with the files `import()` and `surface()` name read by
+/// `imports` (relative to the `.csg` file's folder).
+///
+/// # Errors
+///
+/// As [`load_csg`]; an `import()` or `surface()` whose file cannot be read
+/// or drawn is a located [`Error::CsgInvalid`] naming the file.
+pub fn load_csg_with(
+    path: &Path,
+    text: Arc<str>,
+    options: &CsgOptions,
+    limits: &Limits,
+    imports: &dyn Imports,
+) -> Result<LoadedCsg> {
     let nodes = parse_csg(path, Arc::clone(&text), limits)?;
-    let mut b = Builder::new(path, text, *options, *limits);
+    let mut b = Builder::new(path, text, *options, *limits, imports);
     let tree = b.union(&nodes, Affine3A::IDENTITY, None)?;
     b.solid.tree = tree.into_tree().map(CsgTree::flattened);
     if let (count, Some(first)) = b.plates.clone() {
@@ -145,6 +163,36 @@ pub fn load_csg(path: &Path, text: Arc<str>, options: &CsgOptions, limits: &Limi
         b.warn(&first, message);
     }
     Ok(LoadedCsg { solid: b.solid, warnings: b.warnings })
+}
+
+/// Reads the files a `.csg` names (`import()`, `surface()`), each as
+/// written in the file (relative to the `.csg` file's folder).
+pub trait Imports {
+    /// The vertices and triangles of a mesh file (STL, OFF, OBJ).
+    ///
+    /// # Errors
+    ///
+    /// What went wrong, in a sentence naming the file.
+    fn mesh(&self, file: &str) -> std::result::Result<(Vec<Vec3>, Vec<[u32; 3]>), String>;
+    /// The bytes of a file (a heightmap).
+    ///
+    /// # Errors
+    ///
+    /// What went wrong, in a sentence naming the file.
+    fn bytes(&self, file: &str) -> std::result::Result<Vec<u8>, String>;
+}
+
+/// No files to read: an `import()` or `surface()` says so.
+pub struct NoImports;
+
+impl Imports for NoImports {
+    fn mesh(&self, file: &str) -> std::result::Result<(Vec<Vec3>, Vec<[u32; 3]>), String> {
+        Err(format!("{file}: the model was not read from a folder, so its imports cannot be found"))
+    }
+
+    fn bytes(&self, file: &str) -> std::result::Result<Vec<u8>, String> {
+        self.mesh(file).map(|_| Vec::new())
+    }
 }
 
 /// What a node makes.
@@ -197,6 +245,10 @@ enum Kind {
     Text,
     Offset,
     Projection,
+    /// `import()`: a mesh, or a 2-D drawing.
+    Import,
+    /// `surface()`: a heightmap.
+    Surface,
 }
 
 /// Whether a node's result is flat (2-D) or solid, or as its children's.
@@ -206,10 +258,12 @@ enum Dim {
     Solid,
     /// As the first child's that says.
     Children,
+    /// As the named file's kind (a 2-D drawing or a mesh).
+    File,
 }
 
 /// Every node kage reads: its name, what it does, its dimension.
-const NODES: [(&str, Kind, Dim); 22] = [
+const NODES: [(&str, Kind, Dim); 24] = [
     ("group", Kind::Union, Dim::Children),
     ("union", Kind::Union, Dim::Children),
     ("render", Kind::Union, Dim::Children),
@@ -232,6 +286,8 @@ const NODES: [(&str, Kind, Dim); 22] = [
     ("text", Kind::Text, Dim::Flat),
     ("offset", Kind::Offset, Dim::Flat),
     ("projection", Kind::Projection, Dim::Flat),
+    ("import", Kind::Import, Dim::File),
+    ("surface", Kind::Surface, Dim::Solid),
 ];
 
 /// What `node` does, `None` for a node kage does not know.
@@ -247,6 +303,7 @@ fn is_flat(node: &CsgNode) -> bool {
         let (_, _, d) = NODES.iter().find(|(name, ..)| *name == node.name)?;
         match d {
             Dim::Children => node.children.iter().filter(|c| !c.background).find_map(dim),
+            Dim::File => Some(if import::drawing(node) { Dim::Flat } else { Dim::Solid }),
             d => Some(*d),
         }
     }
@@ -254,7 +311,9 @@ fn is_flat(node: &CsgNode) -> bool {
 }
 
 /// Reads a `.csg` file's nodes into a solid.
-struct Builder {
+struct Builder<'a> {
+    /// Reads the files `import()` and `surface()` name.
+    imports: &'a dyn Imports,
     path: PathBuf,
     text: Arc<str>,
     options: CsgOptions,
@@ -268,10 +327,17 @@ struct Builder {
     plates: (usize, Option<Range<usize>>),
 }
 
-impl Builder {
-    /// A builder for the file `path` holding `text`.
-    fn new(path: &Path, text: Arc<str>, options: CsgOptions, limits: Limits) -> Builder {
+impl Builder<'_> {
+    /// A builder for the file `path` holding `text`, its imports read by `imports`.
+    fn new<'a>(
+        path: &Path,
+        text: Arc<str>,
+        options: CsgOptions,
+        limits: Limits,
+        imports: &'a dyn Imports,
+    ) -> Builder<'a> {
         Builder {
+            imports,
             path: path.to_path_buf(),
             text,
             options,
@@ -420,16 +486,14 @@ mod tests {
     #[test]
     fn what_cannot_be_rendered_is_named_with_its_place() {
         let concave = "group() {\n\tpolyhedron(points = [[0, 0, 0], [4, 0, 0], [4, 4, 0], [0, 4, 0], [2, 2, 1], [2, 2, -3]], faces = [[0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4], [1, 0, 5], [2, 1, 5], [3, 2, 5], [0, 3, 5]], convexity = 1);\n}\n";
-        // Convex as written (a double pyramid), so it loads; now dent its top in.
-        assert!(load(concave, Geometry::Exact).is_ok());
-        let dented = concave.replace("[2, 2, 1]", "[2, 2, -1]");
-        match load(&dented, Geometry::Exact) {
-            Err(Error::CsgInvalid { location, message }) => {
-                assert_eq!((location.line, location.column), (2, 2), "{message}");
-                assert!(message.contains("not convex"), "{message}");
-            }
-            other => panic!("expected an error, got {other:?}"),
-        }
+        // Convex as written (a double pyramid): one convex primitive.
+        let convex = load(concave, Geometry::Exact).unwrap().solid;
+        assert!(matches!(convex.primitives[..], [Primitive { shape: Shape::Polyhedron(_), .. }]));
+        // Its top dented in: a closed mesh, drawn by its layers.
+        let dented = load(&concave.replace("[2, 2, 1]", "[2, 2, -1]"), Geometry::Exact).unwrap().solid;
+        assert!(dented.primitives.iter().all(|p| matches!(p.shape, Shape::Mesh { .. })));
+        assert!(dented.contains(Vec3::new(0.15, 2.0, -0.1)) && dented.contains(Vec3::new(2.0, 2.0, -2.0)));
+        assert!(!dented.contains(Vec3::new(2.0, 2.0, -0.5)) && !dented.contains(Vec3::new(0.5, 2.0, -0.2)));
         // `roof()`, of OpenSCAD's later releases.
         let text = "group() {\n\troof(method = \"voronoi\", convexity = 1) {\n\t\tsquare(size = [1, 1], center = false);\n\t}\n\tcube(size = [1, 1, 1], center = false);\n}\n";
         match load(text, Geometry::Exact) {

@@ -11,7 +11,7 @@ use super::syntax::CsgNode;
 use super::{is_flat, kind, Builder, Kind};
 use crate::error::Result;
 
-impl Builder {
+impl Builder<'_> {
     /// The region `node` makes, in its own frame; empty for a `%` part, a
     /// solid among 2-D shapes (OpenSCAD ignores it too, with a warning), or
     /// a node skipped with a warning.
@@ -63,8 +63,13 @@ impl Builder {
                 let solid = self.faceted_solid(&node.children, Affine3A::IDENTITY)?;
                 projection(&solid, cut)
             }
+            Kind::Import => {
+                let file = self.text_or(node, "file", "")?;
+                self.unsupported(node, format!("{file}: an imported 2-D drawing (SVG, DXF) is not drawn yet"))?;
+                Region::default()
+            }
             // Solid kinds were turned away above.
-            Kind::Primitive | Kind::LinearExtrude | Kind::RotateExtrude => Region::default(),
+            Kind::Primitive | Kind::LinearExtrude | Kind::RotateExtrude | Kind::Surface => Region::default(),
         })
     }
 

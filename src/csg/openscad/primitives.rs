@@ -59,7 +59,7 @@ pub(super) fn triangulated(points: &[Vec3], faces: &[Vec<usize>]) -> Vec<[u32; 3
 /// `$fn` at or below which spheres and cylinders stay faceted in exact mode.
 const ALWAYS_FACETED_FN: f64 = 8.0;
 
-impl Builder {
+impl Builder<'_> {
     /// Whether a sphere or cylinder is made of facets.
     pub(super) fn faceted(&self, node: &CsgNode) -> Result<bool> {
         let fine = self.number(node, "$fn")?;

@@ -21,7 +21,7 @@ use crate::limits::Limit;
 /// z = −½ to ½, and a subtracted one a tenth thicker.
 const PLATE: (f64, f64) = (0.5, 0.55);
 
-impl Builder {
+impl Builder<'_> {
     /// What `node` makes, placed by `m`, coloured `color` unless it or a
     /// node below it says otherwise.
     pub(super) fn node(&mut self, node: &CsgNode, m: Affine3A, color: Option<Vec4>) -> Result<Built> {
@@ -63,6 +63,8 @@ impl Builder {
             },
             Kind::LinearExtrude => self.linear_extrude(node, m, color),
             Kind::RotateExtrude => self.rotate_extrude(node, m, color),
+            Kind::Import => self.import(node, m, color),
+            Kind::Surface => self.surface(node, m, color),
             // Flat kinds were drawn as plates above.
             Kind::Shape2d | Kind::Text | Kind::Offset | Kind::Projection => Ok(Built::Empty),
         }

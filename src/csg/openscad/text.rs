@@ -128,7 +128,7 @@ fn faces_in(path: &Path) -> Vec<(String, String, PathBuf, u32)> {
         .collect()
 }
 
-impl Builder {
+impl Builder<'_> {
     /// The font `font` names (beside the model, bundled, or on the system),
     /// or Liberation Sans with a warning.
     fn font(&mut self, node: &CsgNode, font: &str) -> Result<FontFile> {

@@ -1,4 +1,5 @@
-//! Mesh and texture files: Wavefront OBJ + MTL, STL (binary and ASCII), glTF 2.0;
+//! Mesh and texture files: Wavefront OBJ + MTL, STL (binary and ASCII), glTF 2.0,
+//! OFF (as OpenSCAD imports it);
 //! and OpenSCAD `.csg` files ([`crate::csg::openscad`] reads the solid).
 //!
 //! Each loader turns a file into a [`LoadedModel`]: parts (a mesh with an optional
@@ -10,6 +11,7 @@
 
 mod gltf;
 mod obj;
+mod off;
 mod openscad;
 mod stl;
 
@@ -291,7 +293,7 @@ pub fn model_with(path: &Path, assets: &dyn AssetSource, csg: &CsgOptions, limit
         "csg" => {
             let text = String::from_utf8(bytes).map_err(|_| fail("the file is not UTF-8 text".into()))?;
             let sidecar = read(&path.with_extension("camera.txt"), assets, limits).ok();
-            LoadedModel { up: Up::Z, ..openscad::model(&shown, text.into(), sidecar.as_deref(), csg, limits)? }
+            LoadedModel { up: Up::Z, ..openscad::model((path, &shown), text.into(), sidecar.as_deref(), csg, from)? }
         }
         _ => unreachable!("the extension was checked"),
     };

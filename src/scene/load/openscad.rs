@@ -2,34 +2,70 @@
 //! a material per distinct colour, and the camera of the file's sidecar or
 //! OpenSCAD's default view.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use glam::{Vec3, Vec4};
 
-use super::{LoadedModel, SolidPart};
-use crate::csg::openscad::{default_view, load_csg, sidecar_camera, CsgOptions};
+use super::{Files, LoadedModel, SolidPart};
+use crate::csg::openscad::{default_view, load_csg_with, sidecar_camera, CsgOptions, Imports};
 use crate::error::Result;
 use crate::image::srgb_to_linear;
-use crate::limits::Limits;
 use crate::scene::Material;
 
 /// OpenSCAD's colour of faces without a `color` (the default "Cornfield"
 /// scheme's #f9d72c), sRGB.
 const CORNFIELD_FACE: [u8; 3] = [249, 215, 44];
 
-/// A `.csg` file as a model: its solid, a material per distinct colour
+/// The files a `.csg` imports, read through the model's assets relative to
+/// the `.csg` file's folder.
+struct CsgImports<'a> {
+    files: Files<'a>,
+    folder: PathBuf,
+}
+
+impl Imports for CsgImports<'_> {
+    fn mesh(&self, file: &str) -> std::result::Result<(Vec<Vec3>, Vec<[u32; 3]>), String> {
+        let path = self.folder.join(file);
+        let bytes = self.bytes(file)?;
+        let ext = path.extension().and_then(|e| e.to_str()).unwrap_or_default().to_ascii_lowercase();
+        let shown = self.files.assets.display_path(&path);
+        let fail = |e: String| format!("{}: {e}", shown.display());
+        let model = match ext.as_str() {
+            "stl" => super::stl::load(&bytes, self.files.limits).map_err(fail)?,
+            "obj" => super::obj::load(&bytes, &path, self.files).map_err(fail)?,
+            "off" => super::off::load(&bytes, self.files.limits).map_err(fail)?,
+            _ => return Err(fail(format!("kage imports .stl, .obj and .off meshes, not '.{ext}'"))),
+        };
+        let (mut positions, mut triangles) = (Vec::new(), Vec::new());
+        for part in &model.parts {
+            let base = positions.len() as u32;
+            positions.extend(part.mesh.positions.iter().map(|p| part.transform.transform_point3(*p)));
+            triangles.extend(part.mesh.triangles.iter().map(|t| t.map(|i| base + i)));
+        }
+        Ok((positions, triangles))
+    }
+
+    fn bytes(&self, file: &str) -> std::result::Result<Vec<u8>, String> {
+        self.files.read(&self.folder.join(file)).map_err(|e| e.to_string())
+    }
+}
+
+/// A `.csg` file (`path`, read through `assets`; `shown` names it in
+/// messages) as a model: its solid, a material per distinct colour
 /// (uncoloured primitives get OpenSCAD's face colour), and the camera of its
 /// sidecar (the text of `NAME.camera.txt`, if there is one and it reads) or
-/// else OpenSCAD's default view.
+/// else OpenSCAD's default view. Its `import()` and `surface()` files are
+/// read through `assets`, relative to its folder.
 pub fn model(
-    path: &Path,
+    (path, shown): (&Path, &Path),
     text: Arc<str>,
     sidecar: Option<&[u8]>,
     options: &CsgOptions,
-    limits: &Limits,
+    files: Files,
 ) -> Result<LoadedModel> {
-    let loaded = load_csg(path, text, options, limits)?;
+    let imports = CsgImports { files, folder: path.parent().map(Path::to_path_buf).unwrap_or_default() };
+    let loaded = load_csg_with(shown, text, options, files.limits, &imports)?;
     let solid = loaded.solid;
     let camera = sidecar
         .and_then(|b| std::str::from_utf8(b).ok())
@@ -49,7 +85,7 @@ pub fn model(
             })
         })
         .collect();
-    let name = path.file_stem().map_or_else(|| "csg".to_string(), |s| s.to_string_lossy().into_owned());
+    let name = shown.file_stem().map_or_else(|| "csg".to_string(), |s| s.to_string_lossy().into_owned());
     let part =
         SolidPart { name, solid: Arc::new(solid), palette: palette.into_iter().map(|(_, m)| m).collect(), materials };
     Ok(LoadedModel { solids: vec![part], camera, warnings: loaded.warnings, ..Default::default() })
