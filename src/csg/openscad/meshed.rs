@@ -15,7 +15,7 @@ use manifold_rust::types::OpType;
 use super::flat::Region;
 use super::syntax::CsgNode;
 use super::{Builder, CsgOptions, Geometry};
-use crate::csg::{CsgSolid, CsgTree};
+use crate::csg::{ClosedMesh, CsgSolid, CsgTree};
 use crate::error::Result;
 
 impl Builder<'_> {
@@ -100,4 +100,26 @@ pub(super) fn projection(solid: &CsgSolid, cut: bool) -> Region {
     let contours: Vec<Vec<DVec2>> =
         section.to_polygons().into_iter().map(|c| c.into_iter().map(|p| DVec2::new(p.x, p.y)).collect()).collect();
     Region::non_zero(&contours)
+}
+
+/// The Minkowski sum of `solids` (each evaluated as a mesh), by Manifold,
+/// as a closed mesh; `None` when it is empty.
+#[must_use]
+pub(super) fn minkowski_of_meshes(solids: &[CsgSolid]) -> Option<ClosedMesh> {
+    let mut parts = solids.iter().map(to_manifold);
+    let first = parts.next()?;
+    let sum = parts.fold(first, |acc, part| acc.minkowski_sum(&part));
+    closed_mesh(&sum)
+}
+
+/// A Manifold mesh as a closed mesh primitive.
+#[must_use]
+pub(super) fn closed_mesh(m: &Manifold) -> Option<ClosedMesh> {
+    let mesh = m.get_mesh_gl64(0);
+    let stride = (mesh.num_prop as usize).max(3);
+    let positions: Vec<Vec3> =
+        mesh.vert_properties.chunks_exact(stride).map(|v| Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32)).collect();
+    let triangles: Vec<[u32; 3]> =
+        mesh.tri_verts.chunks_exact(3).map(|t| [t[0] as u32, t[1] as u32, t[2] as u32]).collect();
+    ClosedMesh::new(positions, triangles)
 }

@@ -8,7 +8,7 @@ use glam::{Affine3A, DVec2, Vec3, Vec4};
 use super::extrude::{revolved, slab, Layers};
 use super::flat::Region;
 use super::hull::convex_hull;
-use super::meshed::{surface_bounds, surface_points, union_only};
+use super::meshed::{minkowski_of_meshes, surface_bounds, surface_points, union_only};
 use super::partition::convex_pieces;
 use super::primitives::Made;
 use super::syntax::CsgNode;
@@ -159,22 +159,30 @@ impl Builder<'_> {
         self.push(Primitive { shape, transform: m, color, source: node.span.clone() })
     }
 
-    /// `minkowski()` of children that are each a union of convex parts: the
-    /// union, over every choice of one part per child, of the hull of the
-    /// sums of their corners (a Minkowski sum distributes over unions, and
-    /// that of convex parts is the hull of their corners' sums).
+    /// `minkowski()`: of children that are each a union of convex parts,
+    /// the union, over every choice of one part per child, of the hull of
+    /// the sums of their corners (a Minkowski sum distributes over unions,
+    /// and that of convex parts is the hull of their corners' sums); of
+    /// children cut or intersected, Manifold's sum of their meshes, as a
+    /// closed mesh.
     fn minkowski(&mut self, node: &CsgNode, m: Affine3A, color: Option<Vec4>) -> Result<Built> {
-        let mut factors: Vec<Vec<Vec<Vec3>>> = Vec::new();
+        let mut solids = Vec::new();
         for kid in node.children.iter().filter(|k| !k.background) {
             let solid = self.faceted_solid(std::slice::from_ref(kid), Affine3A::IDENTITY)?;
-            let Some(tree) = &solid.tree else { return Ok(Built::Empty) };
-            if !union_only(tree) {
-                let message = "`minkowski()` of a part that is cut or intersected is not drawn yet (only of unions of convex parts)".to_string();
-                self.unsupported(kid, message)?;
-                return Ok(Built::Skipped);
+            if solid.tree.is_none() {
+                return Ok(Built::Empty);
             }
-            factors.push(solid.primitives.iter().map(|p| p.corners()).collect());
+            solids.push(solid);
         }
+        if !solids.iter().all(|s| s.tree.as_ref().is_some_and(union_only)) {
+            let mesh = minkowski_of_meshes(&solids);
+            return match mesh {
+                Some(mesh) => self.push_mesh(node, mesh, m, color),
+                None => Ok(Built::Empty),
+            };
+        }
+        let factors: Vec<Vec<Vec<Vec3>>> =
+            solids.iter().map(|s| s.primitives.iter().map(|p| p.corners()).collect()).collect();
         let count: u64 = factors.iter().map(|f| f.len() as u64).product();
         self.check(node, Limit::Primitives, count, || "this minkowski()'s pieces (one per choice of parts)".into())?;
         let mut sums: Vec<Vec<Vec3>> = vec![vec![Vec3::ZERO]];
