@@ -423,14 +423,6 @@ fn camera_override(args: &RenderArgs) -> CameraOverride {
 
 fn load(args: &RenderArgs) -> kage::error::Result<Scene> {
     let is_model = |p: &Path| matches!(extension(p).as_str(), "obj" | "stl" | "gltf" | "glb" | "csg");
-    if let Some(p) = args.input.as_deref().filter(|p| extension(p) == "scad") {
-        let csg = scad::to_csg(p).map_err(kage::Error::Scene)?;
-        let mut from_csg = args.clone();
-        from_csg.input = Some(csg.clone());
-        let scene = load(&from_csg);
-        std::fs::remove_file(&csg).ok();
-        return scene;
-    }
     let geometry = match args.geometry {
         GeometryArg::Exact => Geometry::Exact,
         GeometryArg::Faceted => Geometry::Faceted,
@@ -450,6 +442,9 @@ fn load(args: &RenderArgs) -> kage::error::Result<Scene> {
     let mut scene = match args.input.as_deref() {
         Some(p) if is_model(p) => {
             return model::scene_for_model_with(p, width.unwrap_or(960), height.unwrap_or(540), &options);
+        }
+        Some(p) if extension(p) == "scad" => {
+            return scad::scene_for_scad(p, width.unwrap_or(960), height.unwrap_or(540), &options);
         }
         None => demo_scene()?,
         Some(p) if p.extension().is_some_and(|e| e.eq_ignore_ascii_case("toml")) => {

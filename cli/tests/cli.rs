@@ -229,14 +229,48 @@ fn the_cli_renders_openscad_files() {
         assert!(r > 120 && g > 100 && b < r / 2, "centre pixel {r},{g},{b} is not yellow");
     }
     let bad = dir.join("bad.csg");
-    std::fs::write(&bad, "group() {\n  cube(size = [1, 1, 1], center = false);\n  linear_extrude(height = 2, center = false) {\n    square(size = [1, 1], center = false);\n  }\n}\n").unwrap();
+    // `roof()`, of OpenSCAD's later releases.
+    std::fs::write(&bad, "group() {\n  cube(size = [1, 1, 1], center = false);\n  roof(method = \"voronoi\") {\n    square(size = [1, 1], center = false);\n  }\n}\n").unwrap();
     let o = run(&["render", bad.to_str().unwrap(), "-o", dir.join("bad.png").to_str().unwrap()]);
     let err = String::from_utf8_lossy(&o.stderr);
-    assert!(!o.status.success() && err.contains("linear_extrude") && err.contains("bad.csg:3:3"), "{err}");
+    assert!(!o.status.success() && err.contains("roof") && err.contains("bad.csg:3:3"), "{err}");
     let o = run(&["render", bad.to_str().unwrap(), "--skip-unsupported", "-o", dir.join("bad.png").to_str().unwrap()]);
     let err = String::from_utf8_lossy(&o.stderr);
-    assert!(o.status.success() && err.contains("warning") && err.contains("linear_extrude"), "{err}");
+    assert!(
+        o.status.success() && err.contains("warning") && err.contains("roof") && err.contains("bad.csg:3:3"),
+        "{err}"
+    );
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A `.scad` file is read as if OpenSCAD's `.csg` of it sat beside it: an
+/// `import()` relative to it is found, and kage's errors name the `.scad`,
+/// never the temporary `.csg`. Skips (and says so) without `openscad`.
+#[test]
+fn a_scad_file_finds_its_imports_and_its_errors_name_it() {
+    if Command::new("openscad").arg("--version").output().is_err() {
+        eprintln!("skipped: openscad is not on the PATH");
+        return;
+    }
+    let dir = scratch("scad-imports");
+    let parts = dir.join("parts");
+    std::fs::create_dir_all(&parts).unwrap();
+    let bracket = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/data/openscad/parts/bracket.stl");
+    std::fs::copy(&bracket, parts.join("bracket.stl")).unwrap();
+    let scad = write(
+        &dir,
+        "holder.scad",
+        "difference() {\n  import(\"parts/bracket.stl\");\n  translate([10, 2, 6]) sphere(r = 3);\n}\n",
+    );
+    let out = dir.join("holder.png");
+    let o = run(&["render", scad.to_str().unwrap(), "--width", "96", "--height", "64", "-o", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    // Over a limit: kage's own error, about the .scad.
+    let o = run(&["render", scad.to_str().unwrap(), "--limit", "triangles=10", "-o", out.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success() && err.contains("holder.scad") && err.contains("triangles"), "{err}");
+    // No temporary `.csg` named anywhere.
+    assert!(!err.contains(".csg"), "{err}");
 }
 
 /// The camera from the command line: a tall box seen from the front is

@@ -44,13 +44,7 @@ impl Source {
         let ext = extension(path);
         match ext.as_str() {
             "toml" => file::load_scene(path).map_err(|e| e.to_string()),
-            "scad" => {
-                let csg = crate::scad::to_csg(path)?;
-                let scene = model_scene(&csg, toggles);
-                std::fs::remove_file(&csg).ok();
-                scene
-            }
-            "obj" | "stl" | "gltf" | "glb" | "csg" => model_scene(path, toggles),
+            "obj" | "stl" | "gltf" | "glb" | "csg" | "scad" => model_scene(path, toggles),
             _ => Err(format!(
                 "{}: kage view opens scene files (.toml), models (.obj, .stl, .gltf, .glb, .csg) and OpenSCAD files \
                  (.scad)",
@@ -88,7 +82,13 @@ fn model_scene(path: &Path, toggles: &Toggles) -> Result<Scene, String> {
         camera: CameraOverride::default(),
         limits: Limits::default(),
     };
-    model::scene_for_model_with(path, DEFAULT_SIZE.0, DEFAULT_SIZE.1, &options).map_err(|e| e.to_string())
+    let (w, h) = DEFAULT_SIZE;
+    let scene = if extension(path) == "scad" {
+        crate::scad::scene_for_scad(path, w, h, &options)
+    } else {
+        model::scene_for_model_with(path, w, h, &options)
+    };
+    scene.map_err(|e| e.to_string())
 }
 
 #[cfg(test)]
