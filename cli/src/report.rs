@@ -65,6 +65,14 @@ fn excerpt(text: &str, span: std::ops::Range<usize>) -> (String, std::ops::Range
     (out, start..start + (span_end - from_in_line))
 }
 
+/// Characters on the line of `text` that holds byte `at`.
+fn line_length(text: &str, at: usize) -> usize {
+    let at = at.min(text.len());
+    let start = text[..at].rfind('\n').map_or(0, |i| i + 1);
+    let end = text[at..].find('\n').map_or(text.len(), |i| at + i);
+    text.get(start..end).map_or(0, |line| line.chars().count())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -83,12 +91,4 @@ mod tests {
         assert_eq!(&text[span], "x");
         assert!(text.chars().count() < 100 && text.starts_with("… ") && text.ends_with(" …"), "{text}");
     }
-}
-
-/// Characters on the line of `text` that holds byte `at`.
-fn line_length(text: &str, at: usize) -> usize {
-    let at = at.min(text.len());
-    let start = text[..at].rfind('\n').map_or(0, |i| i + 1);
-    let end = text[at..].find('\n').map_or(text.len(), |i| at + i);
-    text.get(start..end).map_or(0, |line| line.chars().count())
 }
