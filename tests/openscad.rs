@@ -283,3 +283,40 @@ fn every_construct_agrees_with_openscads_exact_mesh() {
     }
     assert!(failed.is_empty(), "coverage below 99.5%: {failed:#?}");
 }
+
+/// OpenSCAD's preview marks: a highlighted (`#`) cutter is drawn see-through
+/// pink where it cut the part away, and a background (`%`) part is drawn
+/// see-through grey but is no part of the model.
+#[test]
+fn a_highlighted_cutter_shows_where_it_cut_and_a_background_part_is_not_solid() {
+    let dir = std::env::temp_dir().join(format!("kage-ghosts-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let cutter = "cylinder($fn = 32, $fa = 12, $fs = 2, h = 30, r1 = 5, r2 = 5, center = true);";
+    let marked = format!("difference() {{\n\tcube(size = [20, 20, 20], center = true);\n#\t{cutter}\n}}\n%multmatrix([[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, -30], [0, 0, 0, 1]]) {{\n\tcube(size = [5, 5, 5], center = true);\n}}\n");
+    let plain = marked.replace("#\t", "\t");
+    let options = kage::scene::model::ModelOptions {
+        camera: kage::scene::framing::CameraOverride {
+            view: Some(kage::scene::framing::View::TOP),
+            ..Default::default()
+        },
+        ground: false,
+        ..Default::default()
+    };
+    let centre = |text: &str, name: &str| {
+        let path = dir.join(name);
+        std::fs::write(&path, text).unwrap();
+        let scene = kage::scene::model::scene_for_model_with(&path, 96, 96, &options).unwrap();
+        let frame = kage::render(&scene, &kage::RenderOptions::default()).unwrap();
+        let solid = scene.objects.iter().find_map(|o| o.solid()).unwrap().clone();
+        (frame.image.get(48, 48), scene.objects.len(), solid)
+    };
+    let (pink, objects, solid) = centre(&marked, "marked.csg");
+    let (through, plain_objects, _) = centre(&plain, "plain.csg");
+    // The model, a ghost per mark (the plain file: the `%` one only).
+    assert_eq!((objects, plain_objects), (3, 2));
+    // Down the hole: the cutter's ghost tints the view red over green.
+    assert!(pink.x > pink.y * 1.3, "no pink in the hole: {pink:?} (without the mark: {through:?})");
+    assert!(through.x < through.y * 1.2, "the hole is pink without a mark: {through:?}");
+    // The `%` cube (under the part) is drawn but not solid.
+    assert!(!solid.contains(glam::Vec3::new(0.0, 0.0, -30.0)) && solid.contains(glam::Vec3::new(8.0, 8.0, 0.0)));
+}

@@ -72,7 +72,7 @@ fn random_solid(rng: &mut StdRng, name: String) -> Object {
     let solid = Arc::new(CsgSolid { primitives, tree: Some(tree) });
     let at = Vec3::new(rng.gen_range(-2.5..2.5), rng.gen_range(0.3..2.0), rng.gen_range(-2.5..2.5));
     let body = Body::Solid { solid, materials: Arc::from([1, 1]) };
-    Object { name, body, transform: Affine3A::from_translation(at), material: 1, casts_shadows: true }
+    Object { name, body, transform: Affine3A::from_translation(at), material: 1, casts_shadows: true, ghost: false }
 }
 
 /// A floor, and 3–8 cubes, spheres and CSG solids above it at random, under

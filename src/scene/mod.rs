@@ -119,13 +119,17 @@ pub struct Object {
     /// no shadow onto anything; leaving it out lets a light's map fit the
     /// objects that do ([`Scene::caster_bounds`]) rather than the floor.
     pub casts_shadows: bool,
+    /// An OpenSCAD `#` (highlighted) or `%` (background) part, drawn
+    /// see-through over the model as OpenSCAD's preview draws it; a viewer
+    /// may hide such parts.
+    pub ghost: bool,
 }
 
 impl Object {
     /// A mesh object.
     #[must_use]
     pub fn mesh(name: impl Into<String>, mesh: Arc<Mesh>, transform: Affine3A, material: usize) -> Object {
-        Object { name: name.into(), body: Body::Mesh(mesh), transform, material, casts_shadows: true }
+        Object { name: name.into(), body: Body::Mesh(mesh), transform, material, casts_shadows: true, ghost: false }
     }
 
     /// The triangles, if the object is a mesh.

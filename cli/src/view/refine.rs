@@ -204,6 +204,9 @@ pub fn scene_for(base: &Scene, viewer: &Viewer, step: Step) -> Scene {
     if !t.fog {
         scene.fog = None;
     }
+    if !t.ghosts {
+        scene.objects.retain(|o| !o.ghost);
+    }
     scene.antialias = match step {
         Step::Full if t.smoothing != Smoothing::None => match base.antialias {
             edge @ Antialias::Edge(_) => edge,

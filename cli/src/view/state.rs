@@ -201,6 +201,8 @@ pub struct Toggles {
     /// A `.csg` model's spheres and cylinders as true quadrics (C; off:
     /// OpenSCAD's facets).
     pub exact_csg: bool,
+    /// OpenSCAD's `#` and `%` parts drawn see-through (M).
+    pub ghosts: bool,
 }
 
 impl Default for Toggles {
@@ -212,6 +214,7 @@ impl Default for Toggles {
             fog: true,
             ground: true,
             exact_csg: true,
+            ghosts: true,
         }
     }
 }
@@ -339,6 +342,7 @@ impl Viewer {
             }
             Key::Char('r') => t.traced = !t.traced,
             Key::Char('g') => t.fog = !t.fog,
+            Key::Char('m') => t.ghosts = !t.ghosts,
             Key::Char('p') => {
                 t.ground = !t.ground;
                 return Request::Reload;
@@ -597,6 +601,8 @@ mod tests {
         assert!(!v.toggles.exact_csg);
         v.apply(Input::Key(Key::Char('r')));
         v.apply(Input::Key(Key::Char('g')));
+        assert_eq!(v.apply(Input::Key(Key::Char('m'))), Request::Render);
+        assert!(!v.toggles.ghosts);
         assert!(!v.toggles.traced && !v.toggles.fog, "R and G turn them off");
         assert_eq!(v.apply(Input::Key(Key::Escape)), Request::Quit);
         assert_eq!(v.apply(Input::Key(Key::Char('q'))), Request::Quit);

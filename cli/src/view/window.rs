@@ -585,6 +585,7 @@ pub fn cheat_sheet() -> Vec<String> {
         "G           fog",
         "P           ground plane",
         "C           CSG exact/faceted",
+        "M           OpenSCAD # and % parts",
         "V           show: image, passes,",
         "            shadow, depth, normals, ids",
         "Z           HUD    H  this sheet",

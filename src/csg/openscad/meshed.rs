@@ -25,6 +25,7 @@ impl Builder<'_> {
         let options = CsgOptions { geometry: Geometry::Faceted, ..self.options };
         let mut sub = Builder::new(&self.path, std::sync::Arc::clone(&self.text), options, self.limits, self.imports);
         sub.cutting = self.cutting;
+        sub.ghostly = false;
         let tree = sub.union(kids, m, None)?.into_tree();
         self.warnings.append(&mut sub.warnings);
         Ok(CsgSolid { primitives: sub.solid.primitives, tree })
@@ -122,4 +123,16 @@ pub(super) fn closed_mesh(m: &Manifold) -> Option<ClosedMesh> {
     let triangles: Vec<[u32; 3]> =
         mesh.tri_verts.chunks_exact(3).map(|t| [t[0] as u32, t[1] as u32, t[2] as u32]).collect();
     ClosedMesh::new(positions, triangles)
+}
+
+/// The solid's surface as a triangle mesh (Manifold's booleans of its
+/// faceted primitives): vertices and triangles wound outwards.
+#[must_use]
+pub fn surface_mesh(solid: &CsgSolid) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+    let mesh = to_manifold(solid).get_mesh_gl64(0);
+    let stride = (mesh.num_prop as usize).max(3);
+    let positions =
+        mesh.vert_properties.chunks_exact(stride).map(|v| Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32)).collect();
+    let triangles = mesh.tri_verts.chunks_exact(3).map(|t| [t[0] as u32, t[1] as u32, t[2] as u32]).collect();
+    (positions, triangles)
 }

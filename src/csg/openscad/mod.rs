@@ -31,6 +31,7 @@ mod flat;
 mod hull;
 mod import;
 mod meshed;
+pub use meshed::surface_mesh;
 mod partition;
 mod planar;
 mod primitives;
@@ -75,8 +76,44 @@ pub struct CsgOptions {
 pub struct LoadedCsg {
     /// The solid.
     pub solid: CsgSolid,
+    /// The parts OpenSCAD's preview draws see-through over the model: each
+    /// `#` (highlighted) and `%` (background) subtree.
+    pub ghosts: Vec<Ghost>,
     /// What was skipped or changed, one line each, with its location.
     pub warnings: Vec<String>,
+}
+
+/// How OpenSCAD's preview marks a part drawn see-through.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum GhostKind {
+    /// `#`: part of the model, and drawn again in translucent pink on top,
+    /// even where it is subtracted (the cutting tool made visible).
+    Highlight,
+    /// `%`: not part of the model; drawn in translucent grey.
+    Background,
+}
+
+/// A `#` or `%` subtree as its own solid (with OpenSCAD's facets, in the
+/// file's space), to be drawn see-through.
+#[derive(Debug, Clone)]
+pub struct Ghost {
+    /// Which mark.
+    pub kind: GhostKind,
+    /// The subtree's solid.
+    pub solid: CsgSolid,
+    /// Bytes of the marked node.
+    pub source: Range<usize>,
+}
+
+impl GhostKind {
+    /// OpenSCAD's preview colour of the mark, sRGB with alpha.
+    #[must_use]
+    pub fn color(self) -> Vec4 {
+        match self {
+            GhostKind::Highlight => Vec4::new(1.0, 81.0 / 255.0, 81.0 / 255.0, 0.5),
+            GhostKind::Background => Vec4::new(180.0 / 255.0, 180.0 / 255.0, 180.0 / 255.0, 0.5),
+        }
+    }
 }
 
 /// The camera of an OpenSCAD camera sidecar (the corpus's `NAME.camera.txt`:
@@ -162,7 +199,7 @@ pub fn load_csg_with(
         let message = format!("{count} 2-D shape(s) outside an extrusion, drawn 1 unit thick as OpenSCAD's preview draws them (they are no part of an exported 3-D model)");
         b.warn(&first, message);
     }
-    Ok(LoadedCsg { solid: b.solid, warnings: b.warnings })
+    Ok(LoadedCsg { solid: b.solid, ghosts: b.ghosts, warnings: b.warnings })
 }
 
 /// Reads the files a `.csg` names (`import()`, `surface()`), each as
@@ -325,6 +362,10 @@ struct Builder<'a> {
     cutting: u32,
     /// 2-D shapes drawn as plates: how many, and the first one's place.
     plates: (usize, Option<Range<usize>>),
+    /// `#` and `%` subtrees (none gathered in a builder of a subtree's own).
+    ghosts: Vec<Ghost>,
+    /// Whether `#` and `%` marks make ghosts here.
+    ghostly: bool,
 }
 
 impl Builder<'_> {
@@ -346,6 +387,8 @@ impl Builder<'_> {
             warnings: Vec::new(),
             cutting: 0,
             plates: (0, None),
+            ghosts: Vec::new(),
+            ghostly: true,
         }
     }
 
@@ -382,6 +425,16 @@ impl Builder<'_> {
         }
         self.solid.primitives.push(p);
         Ok(Built::Tree(CsgTree::Leaf(self.solid.primitives.len() - 1)))
+    }
+
+    /// A `#` or `%` subtree as a ghost of its own (placed by `m`).
+    fn ghost(&mut self, node: &CsgNode, kind: GhostKind, m: Affine3A) -> Result<()> {
+        let plain = CsgNode { background: false, highlight: false, ..node.clone() };
+        let solid = self.faceted_solid(std::slice::from_ref(&plain), m)?;
+        if solid.tree.is_some() {
+            self.ghosts.push(Ghost { kind, solid, source: node.span.clone() });
+        }
+        Ok(())
     }
 
     /// A closed mesh placed by `m`, made by `node`: the union of its layers.

@@ -12,7 +12,7 @@ use super::meshed::{minkowski_of_meshes, surface_bounds, surface_points, union_o
 use super::partition::convex_pieces;
 use super::primitives::Made;
 use super::syntax::CsgNode;
-use super::{combine, is_flat, kind, Builder, Built, Kind};
+use super::{combine, is_flat, kind, Builder, Built, GhostKind, Kind};
 use crate::csg::{CsgTree, Primitive, Shape};
 use crate::error::Result;
 use crate::limits::Limit;
@@ -26,7 +26,13 @@ impl Builder<'_> {
     /// node below it says otherwise.
     pub(super) fn node(&mut self, node: &CsgNode, m: Affine3A, color: Option<Vec4>) -> Result<Built> {
         if node.background {
+            if self.ghostly {
+                self.ghost(node, GhostKind::Background, m)?;
+            }
             return Ok(Built::Skipped);
+        }
+        if node.highlight && self.ghostly {
+            self.ghost(node, GhostKind::Highlight, m)?;
         }
         let Some(kind) = kind(node) else {
             let message = format!("`{}()` is not a node kage knows", node.name);

@@ -892,7 +892,8 @@ pub fn add_model(scene: &mut Scene, model: &LoadedModel, label: &str, transform:
             scene.materials.len() - 1
         });
         let name = if model.parts.len() > 1 { format!("{label}/{}", part.name) } else { label.to_string() };
-        scene.objects.push(Object::mesh(name, part.mesh.clone(), transform * part.transform, material));
+        let object = Object::mesh(name, part.mesh.clone(), transform * part.transform, material);
+        scene.objects.push(Object { casts_shadows: !part.ghost, ghost: part.ghost, ..object });
     }
     for part in &model.solids {
         let materials: Arc<[usize]> = match material {
@@ -914,7 +915,7 @@ pub fn add_model(scene: &mut Scene, model: &LoadedModel, label: &str, transform:
             label.to_string()
         };
         let body = Body::Solid { solid: Arc::clone(&part.solid), materials };
-        scene.objects.push(Object { name, body, transform, material: own, casts_shadows: true });
+        scene.objects.push(Object { name, body, transform, material: own, casts_shadows: true, ghost: false });
     }
 }
 

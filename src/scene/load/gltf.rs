@@ -242,7 +242,7 @@ impl Context<'_> {
         let built = Mesh::new(positions, normals, uvs, triangles, NormalMode::Smooth);
         let mesh = checked(out, self.path, built, &format!("mesh '{name}'"))?;
         let material = prim.material().index().and_then(|i| materials.get(i).cloned());
-        out.parts.push(Part { name: name.to_string(), mesh: Arc::new(mesh), material, transform });
+        out.parts.push(Part { name: name.to_string(), mesh: Arc::new(mesh), material, transform, ghost: false });
         Ok(())
     }
 

@@ -192,6 +192,9 @@ pub struct Part {
     pub material: Option<Material>,
     /// Placement inside the model (glTF node transforms).
     pub transform: Affine3A,
+    /// An OpenSCAD `#` or `%` part drawn see-through over the model: it
+    /// casts no shadow, and a viewer may hide it ([`crate::scene::Object::ghost`]).
+    pub ghost: bool,
 }
 
 /// One CSG solid of a model (an OpenSCAD `.csg` file), with the materials its
@@ -230,7 +233,13 @@ impl LoadedModel {
     /// A model of one mesh without a material.
     #[must_use]
     pub fn single(mesh: Mesh) -> LoadedModel {
-        let part = Part { name: "mesh".into(), mesh: Arc::new(mesh), material: None, transform: Affine3A::IDENTITY };
+        let part = Part {
+            name: "mesh".into(),
+            mesh: Arc::new(mesh),
+            material: None,
+            transform: Affine3A::IDENTITY,
+            ghost: false,
+        };
         LoadedModel { parts: vec![part], ..Default::default() }
     }
 

@@ -55,7 +55,13 @@ pub(super) fn load(bytes: &[u8], path: &Path, from: Files) -> Result<LoadedModel
             }
         };
         let material = m.mesh.material_id.and_then(|i| materials.get(i).cloned());
-        out.parts.push(Part { name: m.name, mesh: Arc::new(mesh), material, transform: Affine3A::IDENTITY });
+        out.parts.push(Part {
+            name: m.name,
+            mesh: Arc::new(mesh),
+            material,
+            transform: Affine3A::IDENTITY,
+            ghost: false,
+        });
     }
     if out.parts.is_empty() {
         return Err(first_error.unwrap_or_else(|| "the file has no triangles".into()));

@@ -7,10 +7,13 @@ use std::sync::Arc;
 
 use glam::{Vec3, Vec4};
 
-use super::{Files, LoadedModel, SolidPart};
-use crate::csg::openscad::{default_view, load_csg_with, sidecar_camera, CsgOptions, Imports};
+use super::{Files, LoadedModel, Part, SolidPart};
+use crate::csg::openscad::{
+    default_view, load_csg_with, sidecar_camera, surface_mesh, CsgOptions, Ghost, GhostKind, Imports,
+};
 use crate::error::Result;
 use crate::image::srgb_to_linear;
+use crate::scene::mesh::{Mesh, NormalMode};
 use crate::scene::Material;
 
 /// OpenSCAD's colour of faces without a `color` (the default "Cornfield"
@@ -86,9 +89,31 @@ pub fn model(
         })
         .collect();
     let name = shown.file_stem().map_or_else(|| "csg".to_string(), |s| s.to_string_lossy().into_owned());
+    let parts = loaded.ghosts.iter().filter_map(|g| ghost_part(g, &name)).collect();
     let part =
         SolidPart { name, solid: Arc::new(solid), palette: palette.into_iter().map(|(_, m)| m).collect(), materials };
-    Ok(LoadedModel { solids: vec![part], camera, warnings: loaded.warnings, ..Default::default() })
+    Ok(LoadedModel { solids: vec![part], parts, camera, warnings: loaded.warnings, ..Default::default() })
+}
+
+/// A `#` or `%` subtree as a see-through mesh in OpenSCAD's preview colour
+/// that casts no shadow; `None` if it has no surface.
+fn ghost_part(ghost: &Ghost, model: &str) -> Option<Part> {
+    let (positions, triangles) = surface_mesh(&ghost.solid);
+    let mesh = Mesh::new(positions, Vec::new(), Vec::new(), triangles, NormalMode::Flat).ok()?.0;
+    let rgba = ghost.kind.color();
+    let mark = match ghost.kind {
+        GhostKind::Highlight => "#",
+        GhostKind::Background => "%",
+    };
+    let material =
+        Material { name: format!("OpenSCAD {mark}"), opacity: rgba.w, two_sided: true, ..colour_material(rgba, 0) };
+    Some(Part {
+        name: format!("{model} {mark} at bytes {}..{}", ghost.source.start, ghost.source.end),
+        mesh: Arc::new(mesh),
+        material: Some(material),
+        transform: glam::Affine3A::IDENTITY,
+        ghost: true,
+    })
 }
 
 /// A plastic-like material of an OpenSCAD colour (sRGB components in 0–1; the
