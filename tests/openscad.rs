@@ -320,3 +320,53 @@ fn a_highlighted_cutter_shows_where_it_cut_and_a_background_part_is_not_solid() 
     // The `%` cube (under the part) is drawn but not solid.
     assert!(!solid.contains(glam::Vec3::new(0.0, 0.0, -30.0)) && solid.contains(glam::Vec3::new(8.0, 8.0, 0.0)));
 }
+
+/// Every node OpenSCAD writes into a `.csg` (2021.01's, and later releases'
+/// `roof` and `fill`), alone in a file read with `--skip-unsupported`:
+/// it draws something, or a warning names it, or reading fails naming it.
+/// A node kind dropped without a word fails here.
+#[test]
+fn no_node_is_dropped_without_a_message() {
+    let samples = [
+        ("group", "group() {\n\tcube(size = [1, 1, 1], center = false);\n}\n"),
+        ("union", "union() {\n\tcube(size = [1, 1, 1], center = false);\n}\n"),
+        ("render", "render(convexity = 2) {\n\tcube(size = [1, 1, 1], center = false);\n}\n"),
+        ("difference", "difference() {\n\tcube(size = [2, 2, 2], center = false);\n\tcube(size = [1, 1, 1], center = false);\n}\n"),
+        ("intersection", "intersection() {\n\tcube(size = [2, 2, 2], center = false);\n\tsphere($fn = 0, $fa = 12, $fs = 2, r = 1);\n}\n"),
+        ("multmatrix", "multmatrix([[1, 0, 0, 5], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]) {\n\tcube(size = [1, 1, 1], center = false);\n}\n"),
+        ("color", "color([1, 0, 0, 0.5]) {\n\tcube(size = [1, 1, 1], center = false);\n}\n"),
+        ("hull", "hull() {\n\tcube(size = [1, 1, 1], center = false);\n\tsphere($fn = 0, $fa = 12, $fs = 2, r = 1);\n}\n"),
+        ("minkowski", "minkowski(convexity = 0) {\n\tcube(size = [1, 1, 1], center = false);\n\tsphere($fn = 0, $fa = 12, $fs = 2, r = 1);\n}\n"),
+        ("resize", "resize(newsize = [3,0,0], auto = [1,1,1], convexity = 0) {\n\tcube(size = [1, 1, 1], center = false);\n}\n"),
+        ("cube", "cube(size = [1, 1, 1], center = false);\n"),
+        ("sphere", "sphere($fn = 0, $fa = 12, $fs = 2, r = 1);\n"),
+        ("cylinder", "cylinder($fn = 0, $fa = 12, $fs = 2, h = 1, r1 = 1, r2 = 1, center = false);\n"),
+        ("polyhedron", "polyhedron(points = [[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], faces = [[0, 1, 2], [0, 3, 1], [0, 2, 3], [1, 3, 2]], convexity = 1);\n"),
+        ("square", "square(size = [1, 1], center = false);\n"),
+        ("circle", "circle($fn = 0, $fa = 12, $fs = 2, r = 1);\n"),
+        ("polygon", "polygon(points = [[0, 0], [1, 0], [0, 1]], paths = undef, convexity = 1);\n"),
+        ("text", "text(text = \"A\", size = 10, spacing = 1, font = \"\", direction = \"ltr\", language = \"en\", script = \"latin\", halign = \"left\", valign = \"baseline\", $fn = 0, $fa = 12, $fs = 2);\n"),
+        ("linear_extrude", "linear_extrude(height = 1, center = false, convexity = 1, scale = [1, 1], $fn = 0, $fa = 12, $fs = 2) {\n\tsquare(size = [1, 1], center = false);\n}\n"),
+        ("rotate_extrude", "rotate_extrude(angle = 360, convexity = 2, $fn = 0, $fa = 12, $fs = 2) {\n\tmultmatrix([[1, 0, 0, 2], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]) {\n\t\tsquare(size = [1, 1], center = false);\n\t}\n}\n"),
+        ("offset", "offset(r = 1, $fn = 0, $fa = 12, $fs = 2) {\n\tsquare(size = [1, 1], center = false);\n}\n"),
+        ("projection", "projection(cut = false, convexity = 0) {\n\tcube(size = [1, 1, 1], center = false);\n}\n"),
+        ("import", "import(file = \"part.stl\", layer = \"\", origin = [0, 0], scale = 1, convexity = 1, $fn = 0, $fa = 12, $fs = 2, timestamp = 0);\n"),
+        ("import", "import(file = \"plan.svg\", layer = \"\", origin = [0, 0], scale = 1, convexity = 1, $fn = 0, $fa = 12, $fs = 2, timestamp = 0);\n"),
+        ("surface", "surface(file = \"map.dat\", center = false, invert = false, timestamp = 0);\n"),
+        ("roof", "roof(method = \"voronoi\", convexity = 1) {\n\tsquare(size = [1, 1], center = false);\n}\n"),
+        ("fill", "fill() {\n\tsquare(size = [1, 1], center = false);\n}\n"),
+        // A node of a release yet to come.
+        ("measure_future", "measure_future(x = 1);\n"),
+    ];
+    let options = CsgOptions { geometry: Geometry::Exact, skip_unsupported: true };
+    for (name, text) in samples {
+        match load_csg(Path::new("t.csg"), Arc::from(text), &options, &Default::default()) {
+            Ok(loaded) => {
+                let drew = loaded.solid.tree.is_some();
+                let said = loaded.warnings.iter().any(|w| w.contains(name));
+                assert!(drew || said, "`{name}()` drew nothing and no warning names it: {:?}", loaded.warnings);
+            }
+            Err(e) => assert!(e.to_string().contains("t.csg:1:1"), "`{name}()`: {e}"),
+        }
+    }
+}

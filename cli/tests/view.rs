@@ -234,3 +234,35 @@ fn the_refined_demo_differs_from_64_jittered_passes_only_in_its_penumbrae() {
         eprintln!("wrote {}", docs.display());
     }
 }
+
+/// An OpenSCAD file with a node kage cannot draw opens with the node left
+/// out: the window says the image is incomplete, in amber over the image,
+/// and so does stderr, naming the node and its place.
+#[test]
+fn a_skipped_node_is_said_in_the_window_and_on_stderr() {
+    if !have_xvfb() {
+        return;
+    }
+    let dir = scratch("skipped");
+    let cube = "\tcube(size = [10, 10, 10], center = false);\n";
+    let roof = "\troof(method = \"voronoi\") {\n\t\tsquare(size = [5, 5], center = false);\n\t}\n";
+    std::fs::write(dir.join("part.csg"), format!("group() {{\n{cube}{roof}}}\n")).unwrap();
+    std::fs::write(dir.join("plain.csg"), format!("group() {{\n{cube}}}\n")).unwrap();
+    std::fs::write(dir.join("run.script"), "wait\ncapture window.png\nquit\n").unwrap();
+    let capture = |name: &str| {
+        let (ok, out) = view(&[dir.join(name).to_str().unwrap(), "--script", dir.join("run.script").to_str().unwrap()]);
+        assert!(ok, "{out}");
+        (out, read(&dir.join("window.png")))
+    };
+    let (out, with_skip) = capture("part.csg");
+    assert!(out.contains("part.csg:3:2") && out.contains("roof") && out.contains("skipped"), "{out}");
+    let (_, plain) = capture("plain.csg");
+    // The model is OpenSCAD's yellow: the text is what the plain file lacks.
+    let amber = |img: &RgbImage| img.pixels().filter(|p| p[0] > 200 && p[1] > 150 && p[1] < 220 && p[2] < 100).count();
+    assert!(
+        amber(&with_skip) > amber(&plain) + 100,
+        "amber warning text drawn: {} pixels against {}",
+        amber(&with_skip),
+        amber(&plain)
+    );
+}

@@ -253,6 +253,9 @@ pub struct Viewer {
     pub size: (u32, u32),
     /// The last load's error, shown over the last good scene.
     pub error: Option<String>,
+    /// What the loaded scene's files could not draw or drew otherwise
+    /// (OpenSCAD nodes skipped, meshes repaired), shown over the image.
+    pub warnings: Vec<String>,
     /// Whether the scene's own shadows cost more than plain maps (jittered
     /// maps, silhouette-line buffers, two-map soft shadows).
     pub costly_scene: bool,
@@ -280,6 +283,7 @@ impl Viewer {
             help: false,
             size,
             error: None,
+            warnings: Vec::new(),
             costly_scene: false,
             next: Some(Step::Quick),
             rendering: None,

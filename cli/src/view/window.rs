@@ -234,6 +234,7 @@ impl App {
         });
         let mut viewer = viewer_for(scene.as_deref(), size);
         viewer.error = error;
+        viewer.warnings = scene.as_deref().map(warned).unwrap_or_default();
         let reporter = proxy.clone();
         let shown = Arc::new(Mutex::new(Shown::default()));
         let worker = Worker::spawn(start.threads, shown.clone(), move |done| {
@@ -328,6 +329,7 @@ impl App {
                 }
                 self.viewer.costly_scene = scene.lights.iter().any(super::refine::costly);
                 self.viewer.error = None;
+                self.viewer.warnings = warned(&scene);
                 self.scene = Some(Arc::new(scene));
             }
             Err(e) => {
@@ -504,10 +506,16 @@ impl App {
             let x = bw.saturating_sub(self.text.size(&sheet).0 + 8);
             self.text.draw(&mut buffer, (bw, bh), (x, below_hud), &sheet, 0x00ff_ffff);
         }
+        let mut bottom = bh;
         if let Some(e) = &self.viewer.error {
             let lines: Vec<String> = e.lines().map(str::to_string).collect();
-            let y = bh.saturating_sub(self.text.size(&lines).1 + 8);
-            self.text.draw(&mut buffer, (bw, bh), (8, y), &lines, ERROR_COLOUR);
+            bottom = bottom.saturating_sub(self.text.size(&lines).1 + 8);
+            self.text.draw(&mut buffer, (bw, bh), (8, bottom), &lines, ERROR_COLOUR);
+        }
+        if !self.viewer.warnings.is_empty() {
+            let lines = warning_lines(&self.viewer.warnings);
+            bottom = bottom.saturating_sub(self.text.size(&lines).1 + 8);
+            self.text.draw(&mut buffer, (bw, bh), (8, bottom), &lines, WARNING_COLOUR);
         }
         if keep {
             self.presented = (buffer.to_vec(), bw, bh);
@@ -559,6 +567,10 @@ fn hud_lines(viewer: &Viewer, shown: &Shown, step: Option<Step>, times: &VecDequ
             st.visibility_ms, st.shadow_ms, st.shading_ms, st.traced_ms, st.edge_ms
         ),
         format!("{} triangles  {} solids  {} passes averaged", st.raster.triangles, st.raster.solids, shown.passes),
+        match skipped(&viewer.warnings) {
+            0 => format!("{} warnings", viewer.warnings.len()),
+            n => format!("INCOMPLETE: {n} part(s) not drawn"),
+        },
         format!(
             "shadows {}  smoothing {smoothing}  show {}{}",
             viewer.toggles.shadows.name(),
@@ -566,6 +578,40 @@ fn hud_lines(viewer: &Viewer, shown: &Shown, step: Option<Step>, times: &VecDequ
             if viewer.display == Display::Image { "" } else { " (V: next)" }
         ),
     ]
+}
+
+/// Warnings shown over the image.
+const WARNING_COLOUR: u32 = 0x00ff_c040;
+
+/// Most warnings drawn in the window (all go to stderr).
+const SHOWN_WARNINGS: usize = 6;
+
+/// The scene's warnings, each also written to stderr.
+fn warned(scene: &Scene) -> Vec<String> {
+    scene.warnings.iter().for_each(|w| eprintln!("warning: {w}"));
+    scene.warnings.clone()
+}
+
+/// How many parts the warnings say were left out of the image.
+#[must_use]
+pub fn skipped(warnings: &[String]) -> usize {
+    warnings.iter().filter(|w| w.contains("skipped")).count()
+}
+
+/// The warnings as the window draws them: a headline when parts are left
+/// out, then the first few, then how many more there are.
+#[must_use]
+pub fn warning_lines(warnings: &[String]) -> Vec<String> {
+    let mut lines = Vec::new();
+    match skipped(warnings) {
+        0 => {}
+        n => lines.push(format!("INCOMPLETE IMAGE: {n} part(s) of the file not drawn")),
+    }
+    lines.extend(warnings.iter().take(SHOWN_WARNINGS).map(|w| format!("warning: {w}")));
+    if warnings.len() > SHOWN_WARNINGS {
+        lines.push(format!("... and {} more warnings (on stderr)", warnings.len() - SHOWN_WARNINGS));
+    }
+    lines
 }
 
 /// The keys, as H shows them.

@@ -143,6 +143,13 @@ impl Region {
         from_paths(difference_d(&to_paths(&self.contours), &to_paths(&cuts), FillRule::NonZero, PRECISION))
     }
 
+    /// The region without its holes (`fill()`): its outer contours alone.
+    #[must_use]
+    pub(crate) fn filled(&self) -> Region {
+        let outer: Vec<Vec<DVec2>> = self.contours.iter().filter(|c| signed_area(c) > 0.0).cloned().collect();
+        Region::non_zero(&outer)
+    }
+
     /// The region moved by `m` (a mirror turns its contours back the right
     /// way round).
     #[must_use]
@@ -258,6 +265,8 @@ mod tests {
         let ring = Region::square(DVec2::splat(10.0), true).difference(&[b]);
         assert_eq!(ring.contours().len(), 2);
         assert!(near(ring.area(), 100.0 - 16.0));
+        // fill() closes the hole.
+        assert!(near(ring.filled().area(), 100.0));
     }
 
     #[test]

@@ -52,6 +52,10 @@ use crate::error::{Error, Result, SourceLocation};
 use crate::limits::{Limit, Limits};
 use syntax::{parse_csg, CsgNode};
 
+/// What a warning about a part left out of the model holds (after its
+/// place): the image lacks that part.
+pub const SKIPPED: &str = "skipped (not drawn): ";
+
 /// How spheres and cylinders become primitives.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub enum Geometry {
@@ -286,6 +290,8 @@ enum Kind {
     Import,
     /// `surface()`: a heightmap.
     Surface,
+    /// `fill()`: a 2-D shape without its holes.
+    Fill,
 }
 
 /// Whether a node's result is flat (2-D) or solid, or as its children's.
@@ -300,7 +306,7 @@ enum Dim {
 }
 
 /// Every node kage reads: its name, what it does, its dimension.
-const NODES: [(&str, Kind, Dim); 24] = [
+const NODES: [(&str, Kind, Dim); 25] = [
     ("group", Kind::Union, Dim::Children),
     ("union", Kind::Union, Dim::Children),
     ("render", Kind::Union, Dim::Children),
@@ -325,6 +331,7 @@ const NODES: [(&str, Kind, Dim); 24] = [
     ("projection", Kind::Projection, Dim::Flat),
     ("import", Kind::Import, Dim::File),
     ("surface", Kind::Surface, Dim::Solid),
+    ("fill", Kind::Fill, Dim::Flat),
 ];
 
 /// What `node` does, `None` for a node kage does not know.
@@ -407,10 +414,10 @@ impl Builder<'_> {
     }
 
     /// A node kage cannot draw: an error, or skipped with a warning
-    /// ([`CsgOptions::skip_unsupported`]).
+    /// ([`CsgOptions::skip_unsupported`]) that holds [`SKIPPED`].
     fn unsupported(&mut self, node: &CsgNode, message: String) -> Result<()> {
         if self.options.skip_unsupported {
-            self.warn(&node.span, format!("skipped: {message}"));
+            self.warn(&node.span, format!("{SKIPPED}{message}"));
             Ok(())
         } else {
             Err(self.invalid(&node.span, message))

@@ -63,6 +63,7 @@ impl Builder<'_> {
                 let solid = self.faceted_solid(&node.children, Affine3A::IDENTITY)?;
                 projection(&solid, cut)
             }
+            Kind::Fill => Region::union(&self.flat_kids(node)?).filled(),
             Kind::Import => {
                 let file = self.text_or(node, "file", "")?;
                 self.unsupported(node, format!("{file}: an imported 2-D drawing (SVG, DXF) is not drawn yet"))?;

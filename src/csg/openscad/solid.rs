@@ -72,7 +72,7 @@ impl Builder<'_> {
             Kind::Import => self.import(node, m, color),
             Kind::Surface => self.surface(node, m, color),
             // Flat kinds were drawn as plates above.
-            Kind::Shape2d | Kind::Text | Kind::Offset | Kind::Projection => Ok(Built::Empty),
+            Kind::Shape2d | Kind::Text | Kind::Offset | Kind::Projection | Kind::Fill => Ok(Built::Empty),
         }
     }
 
