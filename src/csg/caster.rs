@@ -277,16 +277,7 @@ impl CsgCaster {
     /// [`CsgCaster::spans_on_eight`] pixel by pixel ([`CsgCaster::span_on`]):
     /// a mesh's layers, whose intervals come from its triangles.
     fn spans_one_by_one(&self, i: usize, unit: &RowLine, block: usize, out: &mut IntervalLanes) {
-        *out = IntervalLanes { primitive: i as u32, ..IntervalLanes::default() };
-        for j in 0..8 {
-            if let Some(s) = self.span_on(i, unit, (block * 8 + j) as f32) {
-                out.t[0][j] = s.enter.t;
-                out.t[1][j] = s.exit.t;
-                out.face[0][j] = s.enter.face;
-                out.face[1][j] = s.exit.face;
-                out.hit |= 1 << j;
-            }
-        }
+        *out = IntervalLanes::from_fn(i, |j| self.span_on(i, unit, (block * 8 + j) as f32));
     }
 
     /// The crossing `hit` of `ray` with its unit outward normal (solid space).

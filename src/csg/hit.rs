@@ -109,6 +109,23 @@ pub struct IntervalLanes {
 }
 
 impl IntervalLanes {
+    /// Primitive `primitive`'s intervals at eight pixels, pixel `j`'s from
+    /// `at(j)` (a closed mesh's layer, found from its triangles).
+    #[must_use]
+    pub fn from_fn(primitive: usize, mut at: impl FnMut(usize) -> Option<Interval>) -> IntervalLanes {
+        let mut out = IntervalLanes { primitive: primitive as u32, ..IntervalLanes::default() };
+        for j in 0..8 {
+            if let Some(s) = at(j) {
+                out.t[0][j] = s.enter.t;
+                out.t[1][j] = s.exit.t;
+                out.face[0][j] = s.enter.face;
+                out.face[1][j] = s.exit.face;
+                out.hit |= 1 << j;
+            }
+        }
+        out
+    }
+
     /// The interval at pixel `j` (0–7) of the eight, if its ray meets the
     /// primitive.
     #[inline]

@@ -91,6 +91,7 @@ impl ClosedMesh {
     /// [`MAX_TRIANGLES`].
     #[must_use]
     pub fn new(positions: Vec<Vec3>, triangles: Vec<[u32; 3]>) -> Option<ClosedMesh> {
+        let (positions, triangles) = welded(positions, triangles);
         let corner = |t: &[u32; 3], k: usize| positions.get(t[k] as usize).copied();
         let mut kept = Vec::with_capacity(triangles.len());
         let mut normals = Vec::with_capacity(triangles.len());
@@ -147,6 +148,14 @@ impl ClosedMesh {
         } else {
             n
         }
+    }
+
+    /// Triangle `i`'s plane: its unit normal as wound, and the normal's dot
+    /// product with its points.
+    #[must_use]
+    pub fn plane(&self, i: usize) -> (Vec3, f32) {
+        let n = self.normals[i];
+        (n, n.dot(self.positions[self.triangles[i][0] as usize]))
     }
 
     /// The triangle `i`'s corners.
@@ -251,6 +260,34 @@ impl ClosedMesh {
         }
         most.max(1) as u32
     }
+}
+
+/// `triangles` over `positions` with the corners that lie at the same point
+/// made one (an STL repeats each corner per facet): neighbours then share the
+/// very corners, as a rasterizer's exact edge tests need. Indices past the
+/// positions are kept out.
+fn welded(positions: Vec<Vec3>, triangles: Vec<[u32; 3]>) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+    let mut first: std::collections::HashMap<[u32; 3], u32> = std::collections::HashMap::with_capacity(positions.len());
+    let mut kept = Vec::with_capacity(positions.len());
+    let index: Vec<u32> = positions
+        .iter()
+        .map(|p| {
+            // −0 and 0 are one point.
+            let key = (*p + Vec3::ZERO).to_array().map(f32::to_bits);
+            *first.entry(key).or_insert_with(|| {
+                kept.push(*p);
+                kept.len() as u32 - 1
+            })
+        })
+        .collect();
+    let triangles = triangles
+        .into_iter()
+        .filter_map(|t| {
+            let t = [index.get(t[0] as usize)?, index.get(t[1] as usize)?, index.get(t[2] as usize)?].map(|i| *i);
+            (t[0] != t[1] && t[1] != t[2] && t[0] != t[2]).then_some(t)
+        })
+        .collect();
+    (kept, triangles)
 }
 
 /// Layer `layer` of `layers` among a line's `intervals`.

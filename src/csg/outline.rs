@@ -50,6 +50,9 @@ pub(crate) struct Outline {
     /// The least distance along the view axis of those corners: no ray meets
     /// the primitive nearer (a row line's `t` counts that distance).
     pub(crate) nearest: f32,
+    /// The columns found where it shows, per row from the first one given
+    /// (a closed mesh's layer, rasterized), in place of the hull's.
+    table: Option<(i64, Vec<Option<(i64, i64)>>)>,
 }
 
 /// An ellipsoid `{M·q + c : |q| ≤ 1}` seen from an eye outside it, in the unit
@@ -106,12 +109,24 @@ impl Outline {
                 return None;
             }
         }
-        Some(Outline { rows, ellipsoid, hull, nearest })
+        Some(Outline { rows, ellipsoid, hull, nearest, table: None })
+    }
+
+    /// The outline where it shows on `rows`, row by row (`table`, from
+    /// `rows.y0`): a closed mesh's layer, as its rasterized pixels say.
+    #[must_use]
+    pub(crate) fn with_rows(self, rows: Extent, table: Vec<Option<(i64, i64)>>) -> Outline {
+        Outline { rows, ellipsoid: None, hull: Vec::new(), table: Some((rows.y0, table)), ..self }
     }
 
     /// The columns the primitive may cover on row `y`.
     pub(crate) fn columns(&self, y: i64) -> Option<(i64, i64)> {
         let (x0, x1) = (self.rows.x0, self.rows.x1);
+        if let Some((first, table)) = &self.table {
+            let (a, b) = (*table.get(usize::try_from(y - first).ok()?)?)?;
+            let (a, b) = (a.max(x0), b.min(x1));
+            return (a <= b).then_some((a, b));
+        }
         let Some(e) = &self.ellipsoid else {
             if self.hull.is_empty() {
                 return Some((x0, x1));

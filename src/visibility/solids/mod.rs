@@ -58,6 +58,7 @@ mod block;
 mod bounds;
 mod cut_region;
 mod horizon;
+mod layers;
 pub mod paper;
 mod spans;
 mod surface_frame;
@@ -82,6 +83,7 @@ use block::BlockOrder;
 use bounds::BoundingLeaves;
 use cut_region::CutRegions;
 use horizon::Horizon;
+use layers::MeshLayers;
 use paper::coherence::{self, PixelCoherence};
 use paper::pattern::{PatternMatrix, TooManySegments};
 use spans::{BlockSpans, PixelSpans, RowRun, RowSpans};
@@ -469,6 +471,8 @@ struct FrameWalk<'a> {
     /// Per primitive, where its faces show ([`CsgCaster::faces_on_screen`]:
     /// polyhedra of many planes).
     faces: Vec<Option<FacesOnScreen>>,
+    /// The closed meshes' layers at every pixel.
+    layers: MeshLayers,
     rays: PixelRays,
     /// Along a row line's direction (unit component along the view axis),
     /// the near plane lies at t = near, under either projection.
@@ -507,7 +511,11 @@ impl<'a> FrameWalk<'a> {
             }
         };
         // Many primitives: each primitive's outline and faces at once.
-        let (mut outlines, faces) = if many { rayon::join(outlines, faces) } else { (outlines(), faces()) };
+        let (outlines, faces) = if many { rayon::join(outlines, faces) } else { (outlines(), faces()) };
+        // A closed mesh's layers show where its rasterized pixels say.
+        let layers = MeshLayers::new(caster, vp, &rays, (width as usize, height as usize));
+        let mut outlines: Vec<Option<Outline>> =
+            outlines.into_iter().enumerate().map(|(i, o)| layers.narrow(i, o)).collect();
         if let Some(tree) = &solid.tree {
             let mut boxes: Vec<Option<Extent>> = outlines.iter().map(|o| o.as_ref().map(|o| o.rows)).collect();
             bounds::narrow(tree, &mut boxes);
@@ -531,6 +539,7 @@ impl<'a> FrameWalk<'a> {
             entry,
             caster,
             faces,
+            layers,
             rays,
             near: camera.near,
             width: width as usize,
@@ -603,7 +612,7 @@ impl<'a> FrameWalk<'a> {
         let line = self.rays.row_line(y);
         ends.iter().for_each(|&(i, _, _)| lines[i] = caster.unit_line(i, &line));
         blocks.begin_row(caster, ends.iter().map(|e| e.0), lines, &self.faces, y);
-        let spans = RowSpans { blocks, caster, lines };
+        let spans = RowSpans { blocks, caster, lines, layers: &self.layers, y };
         match self.walker {
             RowWalker::Segments(walk) => {
                 if !(walk.nearest_entries && self.nearest_entries(ends, &spans, row, by_depth, union)) {
@@ -611,7 +620,8 @@ impl<'a> FrameWalk<'a> {
                 }
             }
             RowWalker::Pattern(matrix) => {
-                matrix.walk_row(caster, ends, &|i, x| blocks.span(caster, i, &lines[i], x), self.near, row);
+                let source = spans.source();
+                matrix.walk_row(caster, ends, &|i, x| blocks.span(source, i, &lines[i], x), self.near, row);
             }
             RowWalker::Empty => {}
         }

@@ -10,6 +10,7 @@ use std::cell::{Cell, RefCell};
 
 use super::block::{BlockLanes, BlockOrder, BlockRun};
 use super::horizon::Horizon;
+use super::layers::MeshLayers;
 use crate::camera::RowLine;
 use crate::csg::{Booleans, CsgCaster, FacesOnScreen, Hit, Interval, IntervalLanes, LeafSpans, RowFaces, SpanScratch};
 
@@ -59,16 +60,16 @@ impl BlockSpans {
     /// Primitive `i`'s lanes for `block` of its row line `unit` into
     /// `lanes`, not kept (the union's z-buffer reads each block once).
     #[inline(always)]
-    pub(super) fn solve(&self, caster: &CsgCaster, i: usize, unit: &RowLine, block: usize, lanes: &mut IntervalLanes) {
-        Self::fill(caster, i, unit, block, &self.faces[i], lanes);
+    pub(super) fn solve(&self, source: Source, i: usize, unit: &RowLine, block: usize, lanes: &mut IntervalLanes) {
+        Self::fill(source, i, unit, block, &self.faces[i], lanes);
     }
 
     /// Primitive `i`'s interval at pixel `x` of its row line `unit`.
     #[inline(always)]
-    pub(super) fn span(&self, caster: &CsgCaster, i: usize, unit: &RowLine, x: usize) -> Option<Interval> {
+    pub(super) fn span(&self, source: Source, i: usize, unit: &RowLine, x: usize) -> Option<Interval> {
         let mut cached = self.cached.borrow_mut();
         let slot = &mut cached[i][x / 8 % 2];
-        self.fill_if_stale(slot, caster, i, unit, x / 8);
+        self.fill_if_stale(slot, source, i, unit, x / 8);
         slot.1.get(x % 8)
     }
 
@@ -77,23 +78,36 @@ impl BlockSpans {
     fn fill_if_stale(
         &self,
         (cached, lanes): &mut (usize, IntervalLanes),
-        caster: &CsgCaster,
+        source: Source,
         i: usize,
         unit: &RowLine,
         block: usize,
     ) {
         if *cached != block {
             *cached = block;
-            Self::fill(caster, i, unit, block, &self.faces[i], lanes);
+            Self::fill(source, i, unit, block, &self.faces[i], lanes);
         }
     }
 
     /// Primitive `i`'s lanes for `block`, into `lanes`: once per eight
-    /// pixels, not inlined.
+    /// pixels, not inlined. A closed mesh's layer comes from the frame's
+    /// rasterized layers where it has them.
     #[inline(never)]
-    fn fill(caster: &CsgCaster, i: usize, unit: &RowLine, block: usize, faces: &RowFaces, lanes: &mut IntervalLanes) {
-        caster.spans_on_eight(i, unit, block, faces, lanes);
+    fn fill(source: Source, i: usize, unit: &RowLine, block: usize, faces: &RowFaces, lanes: &mut IntervalLanes) {
+        let Source { caster, layers, y } = source;
+        if !layers.fill(i, y, block, lanes) {
+            caster.spans_on_eight(i, unit, block, faces, lanes);
+        }
     }
+}
+
+/// Where a scanline's lanes come from: the caster, or for a closed mesh's
+/// layers the frame's rasterized layers, on row `y`.
+#[derive(Clone, Copy)]
+pub(super) struct Source<'a> {
+    pub(super) caster: &'a CsgCaster,
+    pub(super) layers: &'a MeshLayers,
+    pub(super) y: usize,
 }
 
 /// A scanline's intervals as the booleans read them: each occupant's
@@ -102,13 +116,22 @@ pub(super) struct RowSpans<'a> {
     pub(super) blocks: &'a BlockSpans,
     pub(super) caster: &'a CsgCaster,
     pub(super) lines: &'a [RowLine],
+    /// The frame's rasterized mesh layers, and the row.
+    pub(super) layers: &'a MeshLayers,
+    pub(super) y: usize,
 }
 
 impl RowSpans<'_> {
     /// Primitive `i`'s interval at pixel `x`.
     #[inline(always)]
     pub(super) fn at(&self, i: usize, x: usize) -> Option<Interval> {
-        self.blocks.span(self.caster, i, &self.lines[i], x)
+        self.blocks.span(self.source(), i, &self.lines[i], x)
+    }
+
+    /// Where this row's lanes come from.
+    #[inline(always)]
+    pub(super) fn source(&self) -> Source<'_> {
+        Source { caster: self.caster, layers: self.layers, y: self.y }
     }
 
     /// The booleans' answer at pixel `x` over the tree `root` (beyond the
@@ -167,7 +190,7 @@ impl RowSpans<'_> {
         let mut cached = self.blocks.cached.borrow_mut();
         for &i in ids {
             let i = i as usize;
-            self.blocks.fill_if_stale(&mut cached[i][x / 8 % 2], self.caster, i, &self.lines[i], x / 8);
+            self.blocks.fill_if_stale(&mut cached[i][x / 8 % 2], self.source(), i, &self.lines[i], x / 8);
         }
         let (x0, slot) = (x / 8 * 8, x / 8 % 2);
         let end = (x0 + 8).min(row.len());
@@ -192,7 +215,7 @@ impl RowSpans<'_> {
         }
         for &i in ids {
             let i = i as usize;
-            self.blocks.fill_if_stale(&mut cached[i][block % 2], self.caster, i, &self.lines[i], block);
+            self.blocks.fill_if_stale(&mut cached[i][block % 2], self.source(), i, &self.lines[i], block);
         }
         let end = (x + 8).min(row.len());
         let lanes = BlockLanes {

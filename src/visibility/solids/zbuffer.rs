@@ -158,7 +158,7 @@ impl RowSpans<'_> {
                 1 => {
                     let (w, bits) = live.iter().enumerate().find(|(_, &l)| l != 0).unwrap_or((0, &0));
                     let o = &occupants[w * 64 + bits.trailing_zeros() as usize];
-                    self.blocks.solve(self.caster, o.primitive, &self.lines[o.primitive], block, &mut lanes);
+                    self.blocks.solve(self.source(), o.primitive, &self.lines[o.primitive], block, &mut lanes);
                     entries_ahead(&lanes, lanes.met() & o.pixels(x0), near, out)
                 }
                 _ => self.nearest_in_block(occupants, &live, (block, near), &mut lanes).map(|n| n.write(out)).is_some(),
@@ -209,7 +209,7 @@ impl RowSpans<'_> {
                     }
                 }
                 let i = o.primitive;
-                self.blocks.solve(self.caster, i, &self.lines[i], block, lanes);
+                self.blocks.solve(self.source(), i, &self.lines[i], block, lanes);
                 let met = lane_mask(lanes.met() & pixels);
                 let (enter, exit) = (f32x8::new(*lanes.ends(0)), f32x8::new(*lanes.ends(1)));
                 let ahead = enter.simd_gt(f32x8::splat(near));
