@@ -35,6 +35,9 @@ impl BoxBound for Extent {
     }
 }
 
+/// The columns a primitive covers, per row from the first one given.
+type ColumnTable = (i64, Vec<Option<(i64, i64)>>);
+
 /// Where a primitive shows on the screen: its scanlines (the y-entry table's
 /// key; procedure 1) and, per scanline, its left and right ends (procedure 2).
 #[derive(Debug, Clone)]
@@ -52,7 +55,7 @@ pub(crate) struct Outline {
     pub(crate) nearest: f32,
     /// The columns found where it shows, per row from the first one given
     /// (a closed mesh's layer, rasterized), in place of the hull's.
-    table: Option<(i64, Vec<Option<(i64, i64)>>)>,
+    table: Option<ColumnTable>,
 }
 
 /// An ellipsoid `{M·q + c : |q| ≤ 1}` seen from an eye outside it, in the unit

@@ -164,9 +164,8 @@ impl LayerView {
             if r0 > r1 {
                 continue;
             }
-            for band in (r0 as usize - y0) / BAND..=(r1 as usize - y0) / BAND {
-                binned[band].push(t as u32);
-            }
+            let bands = (r0 as usize - y0) / BAND..=(r1 as usize - y0) / BAND;
+            binned[bands].iter_mut().for_each(|b| b.push(t as u32));
         }
         let raster = Raster { caster, first, mesh, screen: &screen, rays, x0, w };
         let per_band: Vec<(Vec<u32>, Vec<MeshInterval>)> = binned
