@@ -9,7 +9,7 @@ seconds=${2:-3600}
 shift $(( $# < 2 ? $# : 2 ))
 dict=()
 case $target in
-    scene_tree|csg_tree|texture) ;;
+    scene_tree|csg_tree|texture|openscad_flat|font) ;;
     *) dict=("-dict=dict/$target.dict") ;;
 esac
 mkdir -p "corpus/$target" "artifacts/$target"

@@ -232,3 +232,31 @@ fn an_unknown_limit_or_a_negative_value_is_located() {
     let e = build_with(&format!("[limits]\ntriangles = -5\n{}", object("x.obj")), &[], &[]).err().unwrap().to_string();
     assert!(e.starts_with("s.toml:2:13") && e.contains("whole number"), "{e}");
 }
+
+#[test]
+fn slices_bound_an_extrusion_before_it_is_cut() {
+    let twisted = b"linear_extrude(height = 10, center = false, convexity = 1, twist = 90, slices = 40, scale = [1, 1]) {\n\tsquare(size = [1, 1], center = false);\n}\n";
+    let files = [("t.csg", twisted.to_vec())];
+    holds_at("slices", 40, |n| format!("[limits]\nslices = {n}\n{}", object("t.csg")), &files);
+    // A revolution's segments: $fn = 64 over half a turn is 32.
+    let revolved = b"rotate_extrude(angle = 180, convexity = 2, $fn = 64, $fa = 12, $fs = 2) {\n\tmultmatrix([[1, 0, 0, 2], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]) {\n\t\tsquare(size = [1, 1], center = false);\n\t}\n}\n";
+    let files = [("r.csg", revolved.to_vec())];
+    holds_at("slices", 32, |n| format!("[limits]\nslices = {n}\n{}", object("r.csg")), &files);
+}
+
+#[test]
+fn points_bound_a_polygon_and_a_polyhedron() {
+    let polygon = b"linear_extrude(height = 1, center = false, convexity = 1, scale = [1, 1]) {\n\tpolygon(points = [[0, 0], [2, 0], [2, 2], [1, 1], [0, 2]], paths = undef, convexity = 1);\n}\n";
+    let files = [("p.csg", polygon.to_vec())];
+    holds_at("points", 5, |n| format!("[limits]\npoints = {n}\n{}", object("p.csg")), &files);
+    let dented = b"polyhedron(points = [[0, 0, 0], [4, 0, 0], [4, 4, 0], [0, 4, 0], [2, 2, -1], [2, 2, -3]], faces = [[0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4], [1, 0, 5], [2, 1, 5], [3, 2, 5], [0, 3, 5]], convexity = 1);\n";
+    let files = [("d.csg", dented.to_vec())];
+    holds_at("points", 6, |n| format!("[limits]\npoints = {n}\n{}", object("d.csg")), &files);
+}
+
+#[test]
+fn text_length_bounds_a_label() {
+    let label = b"linear_extrude(height = 1, center = false, convexity = 1, scale = [1, 1]) {\n\ttext(text = \"kage!\", size = 10, spacing = 1, font = \"\", direction = \"ltr\", language = \"en\", script = \"latin\", halign = \"left\", valign = \"baseline\", $fn = 0, $fa = 12, $fs = 2);\n}\n";
+    let files = [("l.csg", label.to_vec())];
+    holds_at("text_length", 5, |n| format!("[limits]\ntext_length = {n}\n{}", object("l.csg")), &files);
+}

@@ -9,6 +9,7 @@
 
 mod aa;
 mod csg;
+mod openscad;
 mod raster;
 mod rays;
 mod share;
@@ -52,6 +53,10 @@ enum Command {
     /// The CSG paper's Tables 1 and 2 on random spheres, scanline beside naive
     /// ray casting.
     CsgRandom(csg::RandomArgs),
+    /// The OpenSCAD corpus (parts of public projects): drawn or not, agreement
+    /// with OpenSCAD's exact mesh, time to first image beside OpenSCAD's
+    /// preview and Manifold's booleans, peak memory.
+    Openscad(openscad::OpenscadArgs),
     /// Time to image of `kage render NAME.csg` beside OpenSCAD's preview, and
     /// frames per second when only the camera moves.
     CsgPreview(csg::PreviewArgs),
@@ -130,6 +135,7 @@ fn main() -> miette::Result<()> {
         Command::Csg(args) => csg::run(&args),
         Command::CsgRandom(args) => csg::run_random(&args),
         Command::CsgPreview(args) => csg::run_preview(&args),
+        Command::Openscad(args) => openscad::run(&args),
         Command::ShadowShare(args) => share::run(&args),
         Command::Slb(args) => slb::run(&args),
         Command::Soft(args) => soft::run(&args),

@@ -32,6 +32,7 @@ mod hull;
 mod import;
 mod meshed;
 pub use meshed::surface_mesh;
+pub use text::text_outlines;
 mod partition;
 mod planar;
 mod primitives;
@@ -339,19 +340,23 @@ fn kind(node: &CsgNode) -> Option<Kind> {
     NODES.iter().find(|(name, ..)| *name == node.name).map(|&(_, k, _)| k)
 }
 
-/// Whether `node` makes a 2-D shape: by its kind, or for booleans,
-/// transforms and the like by its first child that is not a `%` part and
-/// says (none: solid).
-fn is_flat(node: &CsgNode) -> bool {
-    fn dim(node: &CsgNode) -> Option<Dim> {
-        let (_, _, d) = NODES.iter().find(|(name, ..)| *name == node.name)?;
-        match d {
-            Dim::Children => node.children.iter().filter(|c| !c.background).find_map(dim),
-            Dim::File => Some(if import::drawing(node) { Dim::Flat } else { Dim::Solid }),
-            d => Some(*d),
-        }
+/// Whether `node` makes a 2-D shape (`Some(true)`) or a solid: by its kind,
+/// or for booleans, transforms and the like by its first child that is not
+/// a `%` part and says; `None` for a node with nothing below it that says
+/// (an empty group).
+fn flatness(node: &CsgNode) -> Option<bool> {
+    let (_, _, d) = NODES.iter().find(|(name, ..)| *name == node.name)?;
+    match d {
+        Dim::Children => node.children.iter().filter(|c| !c.background).find_map(flatness),
+        Dim::File => Some(import::drawing(node)),
+        Dim::Flat => Some(true),
+        Dim::Solid => Some(false),
     }
-    dim(node) == Some(Dim::Flat)
+}
+
+/// Whether `node` makes a 2-D shape ([`flatness`]; an empty group does not).
+fn is_flat(node: &CsgNode) -> bool {
+    flatness(node) == Some(true)
 }
 
 /// Reads a `.csg` file's nodes into a solid.

@@ -8,7 +8,7 @@ use glam::{Affine3A, DAffine2, DMat2, DVec2};
 use super::flat::{Join, Region};
 use super::meshed::projection;
 use super::syntax::CsgNode;
-use super::{is_flat, kind, Builder, Kind};
+use super::{flatness, kind, Builder, Kind};
 use crate::error::Result;
 
 impl Builder<'_> {
@@ -23,12 +23,15 @@ impl Builder<'_> {
             self.unsupported(node, format!("`{}()` is not a node kage knows", node.name))?;
             return Ok(Region::default());
         };
-        if !is_flat(node) && kind != Kind::Projection {
-            self.warn(
-                &node.span,
-                format!("a 3-D `{}()` among 2-D shapes is ignored, as OpenSCAD ignores it", node.name),
-            );
-            return Ok(Region::default());
+        match flatness(node) {
+            // Nothing below it: nothing to draw, nothing to say.
+            None => return Ok(Region::default()),
+            Some(false) if kind != Kind::Projection => {
+                let message = format!("a 3-D `{}()` among 2-D shapes is ignored, as OpenSCAD ignores it", node.name);
+                self.warn(&node.span, message);
+                return Ok(Region::default());
+            }
+            _ => {}
         }
         Ok(match kind {
             Kind::Union | Kind::Color => Region::union(&self.flat_kids(node)?),

@@ -190,6 +190,25 @@ impl Builder<'_> {
     }
 }
 
+/// The outlines `text(string, size)` makes in the font file `font` (its
+/// first face), as OpenSCAD lays them out: closed contours of straight
+/// pieces, outer ones counter-clockwise and holes clockwise. `None` when the
+/// bytes are not a TrueType or OpenType font.
+#[must_use]
+pub fn text_outlines(font: &[u8], string: &str, size: f64) -> Option<Vec<Vec<[f64; 2]>>> {
+    let face = Face::parse(font, 0).ok()?;
+    let layout = Layout {
+        size,
+        spacing: 1.0,
+        steps: 4,
+        halign: "left".into(),
+        valign: "baseline".into(),
+        direction: "ltr".into(),
+    };
+    let region = layout.region(&face, string);
+    Some(region.contours().iter().map(|c| c.iter().map(|p| [p.x, p.y]).collect()).collect())
+}
+
 /// How `text()` lays a string out.
 struct Layout {
     size: f64,

@@ -1,0 +1,62 @@
+#!/usr/bin/env bash
+# Rebuilds the OpenSCAD corpus from the public projects it is drawn from:
+# each NAME.scad here names one part of one project (SOURCES.md: which, at
+# which commit, under which licence). For each, OpenSCAD 2021.01 writes
+#   NAME.csg        the flattened tree kage reads (kept in the repository),
+#   stl/NAME.stl    the exact mesh of that tree, by OpenSCAD's own CGAL render (not kept:
+#                   rebuilt here; models whose render fails or passes the
+#                   time limit get none, and the benchmark says so).
+#
+# Usage: build.sh SOURCES [NAME...]
+#   SOURCES  a folder of clones named OWNER+REPO/repo (as the workplace's
+#            fetch tool leaves them) or OWNER+REPO (a plain `git clone`).
+#   NAME     only these models (default: every NAME.scad here).
+# Environment: STL_TIMEOUT (seconds, default 300) per exact render.
+set -euo pipefail
+here="$(cd "$(dirname "$0")" && pwd)"
+sources="$(cd "${1:?usage: build.sh SOURCES [NAME...]}" && pwd)"
+shift
+timeout_s="${STL_TIMEOUT:-300}"
+
+# The projects, pinned: folder name in OPENSCADPATH, OWNER+REPO, commit.
+projects=(
+  "Original-Prusa-i3 prusa3d+Original-Prusa-i3 529e5ad6892ce3b25015b7cca7f0481b8335a76c"
+  "threads-scad rcolyer+threads-scad 4ae9aeb3b136f9858200f77a304b909a000ce3b4"
+  "BOSL2 BelfrySCAD+BOSL2 df336a2c28f31ffc6554d331d8323f48cbe7a04b"
+  "NopSCADlib nophead+NopSCADlib cae9cdd778cd33329cf3b817505d7b58353f5fb0"
+  "MCAD openscad+MCAD 4b4caeb5dad3301139541d039f14eac654f90487"
+  "Round-Anything Irev-Dev+Round-Anything 061fef7c429628808e847696bb345a9b0ec6e279"
+  "LEGO.scad cfinke+LEGO.scad d717ca8e29dbb62f271bf351b35179060eaa744e"
+)
+
+lib="$(mktemp -d)"
+trap 'rm -rf "$lib"' EXIT
+for p in "${projects[@]}"; do
+  read -r folder repo commit <<<"$p"
+  git_dir="$sources/$repo/repo"
+  [ -d "$git_dir" ] || git_dir="$sources/$repo"
+  mkdir -p "$lib/$folder"
+  # Source files only (snapshots may lack large binary files).
+  git -C "$git_dir" ls-tree -r --name-only "$commit" | grep '\.scad$' |
+    xargs git -C "$git_dir" archive "$commit" -- | tar -x -C "$lib/$folder"
+done
+# Prusa's parts include their neighbours by plain names.
+export OPENSCADPATH="$lib"
+
+mkdir -p "$here/stl"
+cd "$here"
+names=("$@")
+[ ${#names[@]} -gt 0 ] || names=($(ls *.scad | sed 's/\.scad$//'))
+for name in "${names[@]}"; do
+  if ! openscad -o "$name.csg" "$name.scad" >"$lib/log" 2>&1; then
+    echo "$name: openscad could not export the tree:"; tail -3 "$lib/log"; continue
+  fi
+  # The exact mesh of the tree itself: a library that draws more in
+  # OpenSCAD's preview ($preview) baked that into the tree.
+  if timeout "$timeout_s" openscad --export-format binstl -o "stl/$name.stl" "$name.csg" >"$lib/log" 2>&1; then
+    echo "$name: $(wc -c <"$name.csg") bytes of tree, $(wc -c <"stl/$name.stl") bytes of mesh"
+  else
+    rm -f "stl/$name.stl"
+    echo "$name: $(wc -c <"$name.csg") bytes of tree, no exact mesh ($(tail -1 "$lib/log"))"
+  fi
+done

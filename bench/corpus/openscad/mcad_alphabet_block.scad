@@ -1,0 +1,2 @@
+// An alphabet block: MCAD bitmap/alphabet_block.
+include <MCAD/bitmap/alphabet_block.scad>

@@ -1,0 +1,2 @@
+// Letters for a necklace: MCAD bitmap/letter_necklace.
+include <MCAD/bitmap/letter_necklace.scad>

@@ -1,0 +1,2 @@
+// Original Prusa i3 MK3, Printed-Parts/SCAD/endstop-block.scad as it is.
+include <Original-Prusa-i3/Printed-Parts/SCAD/endstop-block.scad>

@@ -1,0 +1,3 @@
+// Round-Anything roundAnythingExamples.scad, beamChainExample().
+use <Round-Anything/roundAnythingExamples.scad>
+beamChainExample();

@@ -1,0 +1,3 @@
+// Round-Anything roundAnythingExamples.scad, conflicResolutionExample().
+use <Round-Anything/roundAnythingExamples.scad>
+conflicResolutionExample();

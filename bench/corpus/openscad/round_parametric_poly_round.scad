@@ -1,0 +1,3 @@
+// Round-Anything roundAnythingExamples.scad, parametricPolyRoundExample().
+use <Round-Anything/roundAnythingExamples.scad>
+parametricPolyRoundExample();

@@ -1,0 +1,3 @@
+// Round-Anything roundAnythingExamples.scad, polyRoundExtrudeExample().
+use <Round-Anything/roundAnythingExamples.scad>
+polyRoundExtrudeExample();

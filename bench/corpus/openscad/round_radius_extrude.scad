@@ -1,0 +1,3 @@
+// Round-Anything roundAnythingExamples.scad, radiusExtrudeExample().
+use <Round-Anything/roundAnythingExamples.scad>
+radiusExtrudeExample();
