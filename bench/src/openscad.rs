@@ -27,6 +27,13 @@ pub struct OpenscadArgs {
     /// The `kage` binary (default: the one beside kage-bench).
     #[arg(long)]
     pub kage: Option<PathBuf>,
+    /// Seconds Manifold may take on one model before it is stopped.
+    #[arg(long, default_value_t = 60)]
+    pub manifold_limit: u64,
+    /// Only time Manifold on this `.csg` and print the seconds (what the
+    /// table runs in a process of its own, to stop it at the limit).
+    #[arg(long, hide = true)]
+    pub manifold_only: Option<PathBuf>,
 }
 
 /// The corpus folder.
@@ -58,6 +65,11 @@ const CONSTRUCTS: [(&str, &str); 14] = [
 ///
 /// When the `kage` binary is not built or the corpus cannot be read.
 pub fn run(args: &OpenscadArgs) -> Result<()> {
+    if let Some(path) = &args.manifold_only {
+        let seconds = manifold_seconds(path, args.runs).ok_or_else(|| miette!("{}: does not read", path.display()))?;
+        println!("{seconds}");
+        return Ok(());
+    }
     let dir = corpus();
     let exe = match &args.kage {
         Some(exe) => exe.clone(),
@@ -93,8 +105,12 @@ pub fn run(args: &OpenscadArgs) -> Result<()> {
         }
         let theirs = display.as_ref().and_then(|d| openscad_preview(d, path, args.runs));
         faster += usize::from(theirs.is_some_and(|t| kage_s.is_some_and(|k| k < t)));
-        let manifold = manifold_seconds(path, args.runs);
+        let manifold = manifold_limited(path, args);
         if let (Some(m), Some(k)) = (manifold, kage_s) {
+            let m = match m {
+                Timed::Within(s) => s,
+                Timed::Over(limit) => limit as f64,
+            };
             if m >= 0.02 {
                 manifold_20ms += 1;
                 faster_than_manifold += usize::from(k < m);
@@ -108,7 +124,10 @@ pub fn run(args: &OpenscadArgs) -> Result<()> {
             show(kage_s, 2),
             show(peak_mb, 0),
             show(theirs, 2),
-            show(manifold, 3),
+            manifold.map_or("-".to_string(), |m| match m {
+                Timed::Within(s) => format!("{s:.3}"),
+                Timed::Over(limit) => format!("> {limit}"),
+            }),
         );
     }
     println!(
@@ -123,9 +142,10 @@ pub fn run(args: &OpenscadArgs) -> Result<()> {
          pixels where kage's scanline walk of the tree and kage's rasterizer of OpenSCAD's exact mesh (its CGAL \
          render to STL) both show the model or both miss it, from OpenSCAD's default view of the mesh. OpenSCAD \
          2021.01: `openscad --preview --imgsize=640,480 -o NAME.png NAME.csg` on one Xvfb server (Mesa llvmpipe), \
-         whole process. Manifold: the tree's primitives faceted as OpenSCAD facets them, each the hull of its \
-         corners, combined by Manifold's booleans (the manifold-rust port of Manifold 3.5, in this process).",
-        args.runs
+         whole process. Manifold: the same tree kage draws (its convex primitives faceted as OpenSCAD facets \
+         them, each the hull of its corners, and its closed meshes), combined by Manifold's booleans (the \
+         manifold-rust port of Manifold 3.5, one thread, in a process of its own stopped at {} s).",
+        args.runs, args.manifold_limit
     );
     Ok(())
 }
@@ -180,6 +200,42 @@ fn coverage(csg: &Path, stl: &Path) -> Result<f64> {
     kage::visibility::rasterize(&scene, &mut vb);
     let agree = scanned.iter().zip(vb.items()).filter(|(s, item)| s.is_some() == !item.is_none()).count();
     Ok(agree as f64 / scanned.len() as f64)
+}
+
+/// A time, or the limit it passed.
+#[derive(Debug, Clone, Copy)]
+enum Timed {
+    Within(f64),
+    Over(u64),
+}
+
+/// [`manifold_seconds`] in a process of its own, stopped at the limit.
+fn manifold_limited(path: &Path, args: &OpenscadArgs) -> Option<Timed> {
+    let exe = std::env::current_exe().ok()?;
+    let mut child = Command::new(exe)
+        .args(["openscad", "--runs", &args.runs.to_string(), "--manifold-only"])
+        .arg(path)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .ok()?;
+    let start = Instant::now();
+    loop {
+        if let Some(status) = child.try_wait().ok()? {
+            if !status.success() {
+                return None;
+            }
+            let mut out = String::new();
+            std::io::Read::read_to_string(&mut child.stdout.take()?, &mut out).ok()?;
+            return out.trim().parse().ok().map(Timed::Within);
+        }
+        if start.elapsed().as_secs() >= args.manifold_limit {
+            child.kill().ok();
+            child.wait().ok();
+            return Some(Timed::Over(args.manifold_limit));
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
 }
 
 /// Seconds Manifold takes to combine the tree's faceted primitives (median

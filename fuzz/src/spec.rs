@@ -292,7 +292,7 @@ impl SceneSpec {
             };
             scene.materials.push(material.material(k));
             let material = scene.materials.len() - 1;
-            scene.objects.push(Object { name: format!("o{k}"), body, transform, material, casts_shadows: true });
+            scene.objects.push(Object { name: format!("o{k}"), body, transform, material, casts_shadows: true, ghost: false });
         }
         scene.lights = self.lights.iter().take(MAX_LIGHTS).map(LightSpec::light).collect();
         (!scene.objects.is_empty()).then_some(scene)

@@ -38,7 +38,7 @@ for p in "${projects[@]}"; do
   mkdir -p "$lib/$folder"
   # Source files only (snapshots may lack large binary files).
   git -C "$git_dir" ls-tree -r --name-only "$commit" | grep '\.scad$' |
-    xargs git -C "$git_dir" archive "$commit" -- | tar -x -C "$lib/$folder"
+    xargs -d '\n' git -C "$git_dir" archive "$commit" -- | tar -x -C "$lib/$folder"
 done
 # Prusa's parts include their neighbours by plain names.
 export OPENSCADPATH="$lib"

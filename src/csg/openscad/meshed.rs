@@ -42,22 +42,36 @@ pub(super) fn union_only(tree: &CsgTree) -> bool {
     }
 }
 
-/// The solid as a Manifold mesh: each (faceted, convex) primitive the hull of
-/// its corners, combined along the tree.
+/// A primitive as a Manifold mesh: a convex one the hull of its corners
+/// (faceted: spheres and cylinders by their facets), a closed mesh's layer
+/// (the first; the others add nothing to the union of layers) its triangles.
+fn leaf(p: &crate::csg::Primitive) -> Manifold {
+    let point = |c: Vec3| MVec3::new(c.x.into(), c.y.into(), c.z.into());
+    match &p.shape {
+        crate::csg::Shape::Mesh { mesh, layer } => {
+            if *layer > 0 {
+                return Manifold::empty();
+            }
+            let mut gl = manifold_rust::types::MeshGL::default();
+            gl.num_prop = 3;
+            gl.vert_properties =
+                mesh.positions().iter().flat_map(|v| p.transform.transform_point3(*v).to_array()).collect();
+            gl.tri_verts = mesh.triangles().iter().flatten().copied().collect();
+            Manifold::from_mesh_gl(&gl)
+        }
+        _ => Manifold::hull(&p.corners().into_iter().map(point).collect::<Vec<_>>()),
+    }
+}
+
+/// The solid as a Manifold mesh: each primitive as [`leaf`] makes it,
+/// combined along the tree.
 #[must_use]
 pub(super) fn to_manifold(solid: &CsgSolid) -> Manifold {
     fn of(solid: &CsgSolid, tree: &CsgTree) -> Manifold {
         let batch =
             |kids: &[CsgTree], op| Manifold::batch_boolean(&kids.iter().map(|k| of(solid, k)).collect::<Vec<_>>(), op);
         match tree {
-            CsgTree::Leaf(i) => {
-                let corners: Vec<MVec3> = solid.primitives[*i]
-                    .corners()
-                    .into_iter()
-                    .map(|c| MVec3::new(c.x.into(), c.y.into(), c.z.into()))
-                    .collect();
-                Manifold::hull(&corners)
-            }
+            CsgTree::Leaf(i) => leaf(&solid.primitives[*i]),
             CsgTree::Union(kids) => batch(kids, OpType::Add),
             CsgTree::Intersection(kids) => batch(kids, OpType::Intersect),
             CsgTree::Difference(first, cutters) => {
@@ -69,13 +83,25 @@ pub(super) fn to_manifold(solid: &CsgSolid) -> Manifold {
     solid.tree.as_ref().map_or_else(Manifold::empty, |t| of(solid, t))
 }
 
+/// A primitive's corners: a convex one's, a closed mesh's vertices (its
+/// first layer's; the others repeat them).
+fn corners(p: &crate::csg::Primitive) -> Vec<Vec3> {
+    match &p.shape {
+        crate::csg::Shape::Mesh { mesh, layer: 0 } => {
+            mesh.positions().iter().map(|v| p.transform.transform_point3(*v)).collect()
+        }
+        crate::csg::Shape::Mesh { .. } => Vec::new(),
+        _ => p.corners(),
+    }
+}
+
 /// The corners of the solid's surface: its primitives' corners for a union
 /// of convex parts, the mesh's vertices otherwise.
 #[must_use]
 pub(super) fn surface_points(solid: &CsgSolid) -> Vec<Vec3> {
     let Some(tree) = &solid.tree else { return Vec::new() };
     if union_only(tree) {
-        return solid.primitives.iter().flat_map(|p| p.corners()).collect();
+        return solid.primitives.iter().flat_map(corners).collect();
     }
     let mesh = to_manifold(solid).get_mesh_gl64(0);
     let stride = (mesh.num_prop as usize).max(3);

@@ -13,7 +13,7 @@ use super::partition::convex_pieces;
 use super::primitives::Made;
 use super::syntax::CsgNode;
 use super::{combine, is_flat, kind, Builder, Built, GhostKind, Kind};
-use crate::csg::{CsgTree, Primitive, Shape};
+use crate::csg::{CsgSolid, CsgTree, Primitive, Shape};
 use crate::error::Result;
 use crate::limits::Limit;
 
@@ -180,7 +180,11 @@ impl Builder<'_> {
             }
             solids.push(solid);
         }
-        if !solids.iter().all(|s| s.tree.as_ref().is_some_and(union_only)) {
+        let convex = |s: &CsgSolid| {
+            s.tree.as_ref().is_some_and(union_only)
+                && !s.primitives.iter().any(|p| matches!(p.shape, Shape::Mesh { .. }))
+        };
+        if !solids.iter().all(convex) {
             let mesh = minkowski_of_meshes(&solids);
             return match mesh {
                 Some(mesh) => self.push_mesh(node, mesh, m, color),

@@ -8,3 +8,8 @@ translate([0, 25, 0]) minkowski() {
   linear_extrude(height = 2) polygon([[0, 0], [15, 0], [15, 3], [3, 3], [3, 12], [0, 12]]);
   cylinder(r = 1, h = 1, $fn = 12);
 }
+// The hull and the Minkowski sum of a star (a polyhedron that is not convex).
+module star() polyhedron(points = [for (z = [0, 3]) for (i = [0:9]) let(r = i % 2 ? 2 : 5) [r * cos(36 * i), r * sin(36 * i), z]],
+  faces = concat([[for (i = [9:-1:0]) i]], [[for (i = [0:9]) i + 10]], [for (i = [0:9]) [i, (i + 1) % 10, (i + 1) % 10 + 10, i + 10]]));
+translate([0, 45, 0]) hull() star();
+translate([20, 45, 0]) minkowski() { star(); sphere(r = 1, $fn = 8); }
