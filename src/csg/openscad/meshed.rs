@@ -52,11 +52,16 @@ fn leaf(p: &crate::csg::Primitive) -> Manifold {
             if *layer > 0 {
                 return Manifold::empty();
             }
-            let mut gl = manifold_rust::types::MeshGL::default();
-            gl.num_prop = 3;
-            gl.vert_properties =
-                mesh.positions().iter().flat_map(|v| p.transform.transform_point3(*v).to_array()).collect();
-            gl.tri_verts = mesh.triangles().iter().flatten().copied().collect();
+            let gl = manifold_rust::types::MeshGL {
+                num_prop: 3,
+                vert_properties: mesh
+                    .positions()
+                    .iter()
+                    .flat_map(|v| p.transform.transform_point3(*v).to_array())
+                    .collect(),
+                tri_verts: mesh.triangles().iter().flatten().copied().collect(),
+                ..Default::default()
+            };
             Manifold::from_mesh_gl(&gl)
         }
         _ => Manifold::hull(&p.corners().into_iter().map(point).collect::<Vec<_>>()),
