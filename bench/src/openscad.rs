@@ -198,7 +198,7 @@ fn coverage(csg: &Path, stl: &Path) -> Result<f64> {
     let scanned = kage::visibility::solids::scan_solid(&part.solid, &scene.camera, w, h);
     let mut vb = kage::visibility::VisibilityBuffer::new(w, h);
     kage::visibility::rasterize(&scene, &mut vb);
-    let agree = scanned.iter().zip(vb.items()).filter(|(s, item)| s.is_some() == !item.is_none()).count();
+    let agree = scanned.iter().zip(vb.items()).filter(|(s, item)| s.is_some() != item.is_none()).count();
     Ok(agree as f64 / scanned.len() as f64)
 }
 

@@ -39,6 +39,29 @@ fn solid_outline(a: ItemId, b: ItemId) -> bool {
     (a.primitive().is_some() || b.primitive().is_some()) && a != b
 }
 
+/// Two pieces of one solid's surface that meet without an edge that shows:
+/// neighbouring convex pieces of one flat face (an extruded shape's top, cut
+/// into convex prisms), or facets a few degrees apart (a revolution's
+/// segments): the same object, normals within [`SAME_SURFACE_COS`] and
+/// depths within [`SAME_SURFACE_DEPTH`] of each other. No outline runs
+/// between them.
+fn one_surface(vb: &VisibilityBuffer, a: ItemId, b: ItemId, (ax, ay): (u32, u32), (bx, by): (u32, u32)) -> bool {
+    if a.object != b.object || a.primitive().is_none() || b.primitive().is_none() {
+        return false;
+    }
+    let (da, db) = (vb.depth(ax, ay), vb.depth(bx, by));
+    vb.normal(ax, ay).dot(vb.normal(bx, by)) > SAME_SURFACE_COS
+        && (da - db).abs() <= SAME_SURFACE_DEPTH * da.abs().max(db.abs())
+}
+
+/// Cosine of the largest angle between two pieces' normals that still makes
+/// them one surface (10°).
+const SAME_SURFACE_COS: f32 = 0.985;
+
+/// The largest relative difference of two neighbouring pixels' depths on one
+/// surface.
+const SAME_SURFACE_DEPTH: f32 = 0.02;
+
 /// Finds the blends of every pixel on a solid's outline in `vb` (the frame of
 /// `scene` as the visibility pass left it), with `trace` the scene's rays.
 #[must_use]
@@ -54,7 +77,11 @@ pub fn find_outline_blends(scene: &Scene, vb: &VisibilityBuffer, trace: &TraceSc
                 let me = item(x, y);
                 let inside = |(nx, ny): (i64, i64)| (0..w).contains(&nx) && (0..h).contains(&ny);
                 let sides = [(x - 1, y), (x + 1, y), (x, y - 1), (x, y + 1)];
-                if !sides.into_iter().any(|n| inside(n) && solid_outline(me, item(n.0, n.1))) {
+                let outline = |(nx, ny): (i64, i64)| {
+                    let other = item(nx, ny);
+                    solid_outline(me, other) && !one_surface(vb, me, other, (x as u32, y as u32), (nx as u32, ny as u32))
+                };
+                if !sides.into_iter().any(|n| inside(n) && outline(n)) {
                     continue;
                 }
                 let near: Vec<(i64, i64)> = (-1..=1)
