@@ -79,7 +79,8 @@ pub fn find_outline_blends(scene: &Scene, vb: &VisibilityBuffer, trace: &TraceSc
                 let sides = [(x - 1, y), (x + 1, y), (x, y - 1), (x, y + 1)];
                 let outline = |(nx, ny): (i64, i64)| {
                     let other = item(nx, ny);
-                    solid_outline(me, other) && !one_surface(vb, me, other, (x as u32, y as u32), (nx as u32, ny as u32))
+                    solid_outline(me, other)
+                        && !one_surface(vb, me, other, (x as u32, y as u32), (nx as u32, ny as u32))
                 };
                 if !sides.into_iter().any(|n| inside(n) && outline(n)) {
                     continue;
