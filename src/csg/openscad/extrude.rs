@@ -16,6 +16,11 @@
 //!   `α·u + β·v + z·ẑ` for the two ends' radial directions u and v, with
 //!   `(α + β, z)` in the piece and α, β ≥ 0: a linear image of a convex set),
 //!   and its corners are OpenSCAD's: each segment is exactly OpenSCAD's mesh.
+//!   That is the faceted revolution. The exact one is smooth: a convex piece
+//!   revolved a whole turn is the inside of the cones its outer edges sweep
+//!   less the cones its inner edges sweep ([`revolution`]), a part turn that
+//!   cut by a wedge ([`wedge`]); a few quadrics per piece in place of a
+//!   polyhedron per piece and segment.
 
 use glam::{DAffine2, DMat2, DVec2, Vec3};
 
@@ -172,6 +177,111 @@ pub(crate) fn revolved(
         // and keep their plane (Newell's method over repeated corners).
         convex_from_faces(vertices, &faces)
     })
+}
+
+/// A solid frustum about the z axis: radius `r0` at height `z0`, `r1` at
+/// `z1` (`z0 < z1`; one radius may be 0).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Cone {
+    pub(crate) z0: f64,
+    pub(crate) z1: f64,
+    pub(crate) r0: f64,
+    pub(crate) r1: f64,
+}
+
+/// A convex profile piece revolved a whole turn, exactly: the points inside
+/// every cone of `within` and outside every cone of `without`.
+///
+/// The piece is the intersection of its edges' half-planes. An edge facing
+/// away from the axis bounds the radius from above by a line in z, which
+/// revolves into a solid cone over the piece's heights; an edge facing the
+/// axis bounds it from below, and its revolution is the outside of a cone;
+/// a level edge is the piece's top or bottom, which the first cones' heights
+/// already hold. A revolved rectangle is a tube: one cylinder less another.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Revolution {
+    pub(crate) within: Vec<Cone>,
+    pub(crate) without: Vec<Cone>,
+}
+
+/// The exact revolution of a convex counter-clockwise `piece` with x ≥ 0
+/// (x the radius, y the height), or `None` if it has no area.
+#[must_use]
+pub(crate) fn revolution(piece: &[DVec2]) -> Option<Revolution> {
+    let (z0, z1) = piece.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(p.y), hi.max(p.y)));
+    let reach = piece.iter().fold(0.0f64, |r, p| r.max(p.x));
+    let size = (z1 - z0).max(reach);
+    if !(z1 - z0 > 1e-9 * size && reach > 1e-9 * size) {
+        return None;
+    }
+    // Cutters reach a little past the piece's heights, so that no face of a
+    // cutter lies on a face of what it cuts.
+    let margin = 0.01 * (z1 - z0);
+    let mut out = Revolution { within: Vec::new(), without: Vec::new() };
+    for (i, &a) in piece.iter().enumerate() {
+        let b = piece[(i + 1) % piece.len()];
+        let d = b - a;
+        // The outward normal is (d.y, −d.x): its x says which way the edge faces.
+        if d.y.abs() <= 1e-9 * d.length().max(size * 1e-9) {
+            continue;
+        }
+        let radius = |z: f64| a.x + (z - a.y) * d.x / d.y;
+        if d.y > 0.0 {
+            let (r0, r1) = (radius(z0).max(0.0), radius(z1).max(0.0));
+            out.within.push(Cone { z0, z1, r0, r1 });
+        } else {
+            // The cone's part of positive radius, from z0 − margin to z1 + margin.
+            let (mut lo, mut hi) = (z0 - margin, z1 + margin);
+            let apex = a.y - a.x * d.y / d.x;
+            if d.x != 0.0 && apex > lo && apex < hi {
+                if radius(lo) > radius(hi) {
+                    hi = apex;
+                } else {
+                    lo = apex;
+                }
+            }
+            let (r0, r1) = (radius(lo).max(0.0), radius(hi).max(0.0));
+            if r0.max(r1) > 1e-9 * size {
+                out.without.push(Cone { z0: lo, z1: hi, r0, r1 });
+            }
+        }
+    }
+    (!out.within.is_empty()).then_some(out)
+}
+
+/// The wedge of space between the half-planes through the z axis at angles
+/// `from_deg` and `to_deg` (counter-clockwise, at most 180° apart), inside
+/// the box of half-width `reach` about the axis from `z0` to `z1`.
+#[must_use]
+pub(crate) fn wedge(from_deg: f64, to_deg: f64, reach: f64, z0: f64, z1: f64) -> ConvexPolyhedron {
+    let (u, v) = (DVec2::from_angle(from_deg.to_radians()), DVec2::from_angle(to_deg.to_radians()));
+    let mut square = vec![
+        DVec2::new(-reach, -reach),
+        DVec2::new(reach, -reach),
+        DVec2::new(reach, reach),
+        DVec2::new(-reach, reach),
+    ];
+    // Keep the side counter-clockwise of u, then the side clockwise of v.
+    square = clip(&square, |p| u.perp_dot(p));
+    square = clip(&square, |p| p.perp_dot(v));
+    slab(&square, &square, z0, z1)
+}
+
+/// The part of a convex polygon where `side` ≥ 0 (side linear).
+fn clip(polygon: &[DVec2], side: impl Fn(DVec2) -> f64) -> Vec<DVec2> {
+    let mut out = Vec::with_capacity(polygon.len() + 1);
+    for (i, &a) in polygon.iter().enumerate() {
+        let b = polygon[(i + 1) % polygon.len()];
+        let (sa, sb) = (side(a), side(b));
+        if sa >= 0.0 {
+            out.push(a);
+        }
+        if (sa >= 0.0) != (sb >= 0.0) {
+            out.push(a + (b - a) * (sa / (sa - sb)));
+        }
+    }
+    out.dedup_by(|p, q| p.distance(*q) < 1e-12);
+    out
 }
 
 #[cfg(test)]

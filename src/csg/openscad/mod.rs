@@ -508,6 +508,65 @@ mod tests {
         assert!(c.contains(Vec3::new(1.4, 0.0, 0.0)) && !c.contains(Vec3::new(0.0, 0.0, 2.1)));
     }
 
+    /// A small deterministic generator of points in a box.
+    fn points(n: usize, lo: Vec3, hi: Vec3) -> impl Iterator<Item = Vec3> {
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 40) as f32 / (1u64 << 24) as f32
+        };
+        (0..n).map(move |_| lo + (hi - lo) * Vec3::new(next(), next(), next()))
+    }
+
+    #[test]
+    fn an_exact_revolution_is_its_profile_turned() {
+        // An L-shaped profile (a rectangle with a step: non-convex, two or
+        // more pieces) left of the axis, turned 250° the negative way, and a
+        // triangle touching the axis turned whole (a cone less a cone).
+        let l_shape =
+            "polygon(points = [[-2, 0], [-6, 0], [-6, 1], [-3, 1], [-3, 4], [-2, 4]], paths = undef, convexity = 1);";
+        let cases = [
+            (format!("rotate_extrude(angle = -250, convexity = 2, $fn = 0, $fa = 12, $fs = 2) {{\n{l_shape}\n}}"), -250.0),
+            ("rotate_extrude(angle = 360, convexity = 2, $fn = 0, $fa = 12, $fs = 2) {\npolygon(points = [[0, 0], [3, 0], [1, 2]], paths = undef, convexity = 1);\n}".to_string(), 360.0),
+        ];
+        let in_l = |r: f32, z: f32| {
+            (2.0..6.0).contains(&r) && (0.0..1.0).contains(&z) || (2.0..3.0).contains(&r) && (0.0..4.0).contains(&z)
+        };
+        let in_tri = |r: f32, z: f32| z > 0.0 && r >= 0.0 && r < 3.0 - z && r > 0.5 * z;
+        for (k, (text, angle)) in cases.iter().enumerate() {
+            let s = solid(text);
+            let mut wrong = Vec::new();
+            for p in points(20_000, Vec3::new(-7.0, -7.0, -1.0), Vec3::new(7.0, 7.0, 5.0)) {
+                let (r, z) = (p.truncate().length(), p.z);
+                let truth = if k == 0 {
+                    // The shape's radius is −x: it sweeps from 180° (x < 0) by −250°.
+                    let a = (p.y.atan2(p.x).to_degrees() - 180.0).rem_euclid(360.0);
+                    in_l(r, z) && (a == 0.0 || a >= 360.0 + angle)
+                } else {
+                    in_tri(r, z)
+                };
+                // Points within a hair of a surface may go either way.
+                let near = |q: Vec3| s.contains(q) != truth;
+                if near(p) && [Vec3::X, Vec3::Y, Vec3::Z].iter().all(|&d| near(p + d * 1e-3) && near(p - d * 1e-3)) {
+                    wrong.push(p);
+                }
+            }
+            assert!(
+                wrong.is_empty(),
+                "case {k}: {} points wrong, e.g. {:?}",
+                wrong.len(),
+                &wrong[..wrong.len().min(5)]
+            );
+        }
+        // Exact: a whole turn is quadrics (and a part turn its wedges), not a polyhedron per segment.
+        let tube = solid("rotate_extrude($fn = 0, $fa = 12, $fs = 2) {\npolygon(points = [[5, 0], [6, 0], [6, 2], [5, 2]], paths = undef, convexity = 1);\n}\n");
+        assert_eq!(tube.primitives.len(), 2);
+        assert!(tube.primitives.iter().all(|p| matches!(p.shape, Shape::Frustum { .. })));
+        assert!(tube.contains(Vec3::new(0.0, 5.05, 1.0)) && !tube.contains(Vec3::new(0.0, 4.95, 1.0)));
+    }
+
     #[test]
     fn booleans_background_parts_and_empty_children_follow_openscad() {
         let cube = "cube(size = [2, 2, 2], center = true);";

@@ -5,7 +5,7 @@
 
 use glam::{Affine3A, DVec2, Vec3, Vec4};
 
-use super::extrude::{revolved, slab, Layers};
+use super::extrude::{revolution, revolved, slab, wedge, Cone, Layers};
 use super::flat::Region;
 use super::hull::convex_hull;
 use super::meshed::{minkowski_of_meshes, surface_bounds, surface_points, union_only};
@@ -13,7 +13,7 @@ use super::partition::convex_pieces;
 use super::primitives::Made;
 use super::syntax::CsgNode;
 use super::{combine, is_flat, kind, Builder, Built, GhostKind, Kind};
-use crate::csg::{CsgSolid, CsgTree, Primitive, Shape};
+use crate::csg::{ConvexPolyhedron, CsgSolid, CsgTree, Primitive, Shape};
 use crate::error::Result;
 use crate::limits::Limit;
 
@@ -293,12 +293,71 @@ impl Builder<'_> {
             return Ok(Built::Empty);
         }
         let reach = lo.x.abs().max(hi.x.abs());
+        if !self.faceted(node)? {
+            return self.revolve_exactly(node, &region, angle, (lo, hi), m, color);
+        }
         let full = self.fragments(node, reach as f32)? as f64;
-        let segments = (full * angle.abs() / 360.0).max(1.0).ceil();
+        // OpenSCAD 2021.01 truncates a part turn's share of the fragments.
+        let segments = (full * angle.abs() / 360.0).max(1.0).floor();
         self.check(node, Limit::Slices, segments as u64, || "this rotate_extrude()'s segments".into())?;
         let pieces = convex_pieces(&region);
         let parts: Vec<_> = pieces.iter().flat_map(|p| revolved(p, angle, segments as usize)).collect();
         self.push_all(node, parts, m, color)
+    }
+
+    /// `rotate_extrude()` of `region` (bounded by `lo`, `hi`) in exact
+    /// geometry: each convex piece its cones ([`revolution`]), a part turn cut
+    /// by one wedge or (past half a turn) the union of two.
+    fn revolve_exactly(
+        &mut self,
+        node: &CsgNode,
+        region: &Region,
+        angle: f64,
+        (lo, hi): (DVec2, DVec2),
+        m: Affine3A,
+        color: Option<Vec4>,
+    ) -> Result<Built> {
+        // A shape left of the axis sweeps the far side: radius −x, half a turn on.
+        let left = hi.x <= 0.0;
+        let turn = if left { 180.0 } else { 0.0 };
+        let (from, to) = if angle > 0.0 { (turn, turn + angle) } else { (turn + angle, turn) };
+        let reach = 1.01 * lo.x.abs().max(hi.x.abs()) + 1e-6;
+        let margin = 0.01 * (hi.y - lo.y) + 1e-6;
+        let (z0, z1) = (lo.y - margin, hi.y + margin);
+        let wedges: Vec<ConvexPolyhedron> = match to - from {
+            a if a >= 360.0 => Vec::new(),
+            a if a <= 180.0 => vec![wedge(from, to, reach, z0, z1)],
+            _ => vec![wedge(from, from + 180.0, reach, z0, z1), wedge(from + 180.0, to, reach, z0, z1)],
+        };
+        let mut parts = Vec::new();
+        for piece in convex_pieces(region) {
+            let piece: Vec<DVec2> =
+                if left { piece.iter().rev().map(|p| DVec2::new(-p.x, p.y)).collect() } else { piece };
+            let Some(rev) = revolution(&piece) else { continue };
+            let mut within = Vec::new();
+            for cone in &rev.within {
+                within.extend(self.push_cone(node, cone, m, color)?.into_tree());
+            }
+            if !wedges.is_empty() {
+                within.extend(self.push_all(node, wedges.iter().cloned(), m, color)?.into_tree());
+            }
+            let mut without = Vec::new();
+            for cone in &rev.without {
+                without.extend(self.push_cone(node, cone, m, color)?.into_tree());
+            }
+            let Built::Tree(body) = combine(within, CsgTree::Intersection) else { continue };
+            parts.push(if without.is_empty() { body } else { CsgTree::Difference(Box::new(body), without) });
+        }
+        Ok(combine(parts, CsgTree::Union))
+    }
+
+    /// A frustum about the z axis, placed by `m`, as a quadric primitive.
+    fn push_cone(&mut self, node: &CsgNode, cone: &Cone, m: Affine3A, color: Option<Vec4>) -> Result<Built> {
+        let big = cone.r0.max(cone.r1);
+        let size = Vec3::new(big as f32, big as f32, (cone.z1 - cone.z0) as f32);
+        let place = Affine3A::from_scale_rotation_translation(size, glam::Quat::IDENTITY, Vec3::Z * cone.z0 as f32);
+        let shape = Shape::Frustum { bottom: (cone.r0 / big) as f32, top: (cone.r1 / big) as f32 };
+        self.push(Primitive { shape, transform: m * place, color, source: node.span.clone() })
     }
 
     /// The union of a node's children as one 2-D region (an extrusion's
