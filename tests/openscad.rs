@@ -321,6 +321,62 @@ fn a_highlighted_cutter_shows_where_it_cut_and_a_background_part_is_not_solid() 
     assert!(!solid.contains(glam::Vec3::new(0.0, 0.0, -30.0)) && solid.contains(glam::Vec3::new(8.0, 8.0, 0.0)));
 }
 
+/// A `color()` with an alpha below 1 on a part of its own is drawn
+/// see-through (the ground shows through it, not through the same part
+/// opaque) and is no part of the solid; inside a difference it is drawn
+/// opaque with a warning.
+#[test]
+fn a_see_through_colour_shows_what_is_behind_it() {
+    let dir = std::env::temp_dir().join(format!("kage-alpha-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let part = |alpha: f32| {
+        // A red slab over a small cube, both centred on the z axis.
+        format!("cube(size = [2, 2, 2], center = true);\ncolor([1, 0, 0, {alpha}]) {{\n\tmultmatrix([[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 3], [0, 0, 0, 1]]) {{\n\t\tcube(size = [10, 10, 1], center = true);\n\t}}\n}}\n")
+    };
+    let options = kage::scene::model::ModelOptions {
+        camera: kage::scene::framing::CameraOverride {
+            view: Some(kage::scene::framing::View::TOP),
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    let shown = |text: &str, name: &str| {
+        let path = dir.join(name);
+        std::fs::write(&path, text).unwrap();
+        let scene = kage::scene::model::scene_for_model_with(&path, 160, 96, &options).unwrap();
+        let frame = kage::render(&scene, &kage::RenderOptions::default()).unwrap();
+        let solid = scene.objects.iter().find_map(|o| o.solid()).unwrap().clone();
+        (frame.image.get(80, 48), solid, scene.objects.len())
+    };
+    let (clear, solid, objects) = shown(&part(0.3), "clear.csg");
+    let (opaque, opaque_solid, opaque_objects) = shown(&part(1.0), "opaque.csg");
+    assert!(opaque.y < 0.1 * opaque.x, "the opaque slab is not red: {opaque:?}");
+    // Seen through the slab: the cube's yellow (red and green, no blue), in
+    // the slab's shadow (a see-through part casts a whole shadow).
+    assert!(
+        clear.y > 0.1 * clear.x && clear.x > 2.0 * clear.z,
+        "the cube does not show through: {clear:?} (opaque: {opaque:?})"
+    );
+    // The see-through part is a mesh of its own, not in the solid.
+    assert_eq!((objects, opaque_objects), (opaque_objects + 1, opaque_objects));
+    assert!(!solid.contains(glam::Vec3::new(4.0, 4.0, 3.0)) && opaque_solid.contains(glam::Vec3::new(4.0, 4.0, 3.0)));
+    // Inside a difference: opaque, said.
+    let cut = "difference() {\n\tcube(size = [4, 4, 4], center = false);\n\tcolor([0, 0, 1, 0.5]) {\n\t\tsphere(r = 2);\n\t}\n}\n";
+    let loaded = kage::csg::openscad::load_csg(
+        std::path::Path::new("cut.csg"),
+        std::sync::Arc::from(cut),
+        &kage::csg::openscad::CsgOptions::default(),
+        &kage::limits::Limits::default(),
+    )
+    .unwrap();
+    assert!(
+        loaded.see_through.is_empty()
+            && loaded.warnings.iter().any(|w| w.contains("cut.csg:3:2") && w.contains("alpha")),
+        "{:?}",
+        loaded.warnings
+    );
+}
+
 /// Every node OpenSCAD writes into a `.csg` (2021.01's, and later releases'
 /// `roof` and `fill`), alone in a file read with `--skip-unsupported`:
 /// it draws something, or a warning names it, or reading fails naming it.

@@ -87,8 +87,8 @@ pub fn run(args: &OpenscadArgs) -> Result<()> {
         .collect();
     models.sort();
     let display = Xvfb::start();
-    println!("| model | uses | kage | agrees with OpenSCAD's mesh | kage first image s | peak MB | OpenSCAD preview s | Manifold booleans s |");
-    println!("|---|---|---|---:|---:|---:|---:|---:|");
+    println!("| model | uses | kage | agrees with OpenSCAD's mesh | kage first image s | peak MB | OpenSCAD preview s | Manifold booleans s | Manifold peak MB |");
+    println!("|---|---|---|---:|---:|---:|---:|---:|---:|");
     let (mut drawn, mut agree_995, mut with_mesh, mut faster, mut faster_than_manifold, mut manifold_20ms) =
         (0, 0, 0, 0, 0, 0);
     for path in &models {
@@ -108,7 +108,7 @@ pub fn run(args: &OpenscadArgs) -> Result<()> {
         let manifold = manifold_limited(path, args);
         if let (Some(m), Some(k)) = (manifold, kage_s) {
             let m = match m {
-                Timed::Within(s) => s,
+                Timed::Within(s, _) => s,
                 Timed::Over(limit) => limit as f64,
             };
             if m >= 0.02 {
@@ -118,15 +118,19 @@ pub fn run(args: &OpenscadArgs) -> Result<()> {
         }
         let show = |v: Option<f64>, digits: usize| v.map_or("-".to_string(), |v| format!("{v:.digits$}"));
         println!(
-            "| {name} | {} | {status} | {} | {} | {} | {} | {} |",
+            "| {name} | {} | {status} | {} | {} | {} | {} | {} | {} |",
             uses.join(" "),
             agreement.map_or("no mesh".to_string(), |a| format!("{:.2}%", a * 100.0)),
             show(kage_s, 2),
             show(peak_mb, 0),
             show(theirs, 2),
             manifold.map_or("-".to_string(), |m| match m {
-                Timed::Within(s) => format!("{s:.3}"),
+                Timed::Within(s, _) => format!("{s:.3}"),
                 Timed::Over(limit) => format!("> {limit}"),
+            }),
+            manifold.map_or("-".to_string(), |m| match m {
+                Timed::Within(_, mb) => format!("{mb:.0}"),
+                Timed::Over(_) => "-".to_string(),
             }),
         );
     }
@@ -144,7 +148,8 @@ pub fn run(args: &OpenscadArgs) -> Result<()> {
          2021.01: `openscad --preview --imgsize=640,480 -o NAME.png NAME.csg` on one Xvfb server (Mesa llvmpipe), \
          whole process. Manifold: the same tree kage draws (its convex primitives faceted as OpenSCAD facets \
          them, each the hull of its corners, and its closed meshes), combined by Manifold's booleans (the \
-         manifold-rust port of Manifold 3.5, one thread, in a process of its own stopped at {} s).",
+         manifold-rust port of Manifold 3.5, one thread, in a process of its own stopped at {} s; its time is \
+         the booleans alone, before any image, and its peak memory the whole process's, reading the tree included).",
         args.runs, args.manifold_limit
     );
     Ok(())
@@ -202,21 +207,24 @@ fn coverage(csg: &Path, stl: &Path) -> Result<f64> {
     Ok(agree as f64 / scanned.len() as f64)
 }
 
-/// A time, or the limit it passed.
+/// A time (with the process's peak resident mebibytes), or the limit it
+/// passed.
 #[derive(Debug, Clone, Copy)]
 enum Timed {
-    Within(f64),
+    Within(f64, f64),
     Over(u64),
 }
 
 /// [`manifold_seconds`] in a process of its own, stopped at the limit.
 fn manifold_limited(path: &Path, args: &OpenscadArgs) -> Option<Timed> {
     let exe = std::env::current_exe().ok()?;
-    let mut child = Command::new(exe)
+    let mut child = Command::new("/usr/bin/time")
+        .args(["-f", "%M"])
+        .arg(exe)
         .args(["openscad", "--runs", &args.runs.to_string(), "--manifold-only"])
         .arg(path)
         .stdout(Stdio::piped())
-        .stderr(Stdio::null())
+        .stderr(Stdio::piped())
         .spawn()
         .ok()?;
     let start = Instant::now();
@@ -225,9 +233,11 @@ fn manifold_limited(path: &Path, args: &OpenscadArgs) -> Option<Timed> {
             if !status.success() {
                 return None;
             }
-            let mut out = String::new();
+            let (mut out, mut err) = (String::new(), String::new());
             std::io::Read::read_to_string(&mut child.stdout.take()?, &mut out).ok()?;
-            return out.trim().parse().ok().map(Timed::Within);
+            std::io::Read::read_to_string(&mut child.stderr.take()?, &mut err).ok()?;
+            let kb: f64 = err.lines().last().and_then(|l| l.trim().parse().ok()).unwrap_or(0.0);
+            return out.trim().parse().ok().map(|s| Timed::Within(s, kb / 1024.0));
         }
         if start.elapsed().as_secs() >= args.manifold_limit {
             child.kill().ok();

@@ -271,6 +271,21 @@ fn a_scad_file_finds_its_imports_and_its_errors_name_it() {
     assert!(!o.status.success() && err.contains("holder.scad") && err.contains("triangles"), "{err}");
     // No temporary `.csg` named anywhere.
     assert!(!err.contains(".csg"), "{err}");
+    // OpenSCAD's `!` (only this subtree) and `*` (disabled): the same image as
+    // the model written without what they leave out.
+    let image = |name: &str, text: &str| {
+        let scad = write(&dir, name, text);
+        let out = dir.join(format!("{name}.png"));
+        let o =
+            run(&["render", scad.to_str().unwrap(), "--width", "96", "--height", "64", "-o", out.to_str().unwrap()]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        image::open(&out).unwrap().to_rgb8().into_raw()
+    };
+    let ball = "translate([10, 0, 0]) sphere(r = 3);\n";
+    let only = image("only.scad", &format!("cube(8);\n!{ball}cylinder(r = 2, h = 9);\n"));
+    let off = image("off.scad", &format!("*cube(30);\n{ball}"));
+    let plain = image("plain.scad", ball);
+    assert!(only == plain && off == plain, "`!` or `*` changed what is drawn");
 }
 
 /// The camera from the command line: a tall box seen from the front is

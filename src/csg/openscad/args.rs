@@ -101,7 +101,9 @@ impl Builder<'_> {
     /// most [`Limit::Segments`]; `$fn`, `$fa` and `$fs` must be finite (and
     /// `$fa`, `$fs` positive when `$fn` does not decide).
     pub(super) fn fragments(&self, node: &CsgNode, r: f32) -> Result<usize> {
-        let (fine, fa, fs) = (self.number(node, "$fn")?, self.number(node, "$fa")?, self.number(node, "$fs")?);
+        // OpenSCAD's defaults where a hand-written file leaves them out.
+        let (fine, fa, fs) =
+            (self.number_or(node, "$fn", 0.0)?, self.number_or(node, "$fa", 12.0)?, self.number_or(node, "$fs", 2.0)?);
         for (name, v) in [("$fn", fine), ("$fa", fa), ("$fs", fs)] {
             if !v.is_finite() {
                 return Err(

@@ -84,8 +84,24 @@ pub struct LoadedCsg {
     /// The parts OpenSCAD's preview draws see-through over the model: each
     /// `#` (highlighted) and `%` (background) subtree.
     pub ghosts: Vec<Ghost>,
+    /// The `color()` subtrees with an alpha below 1 that stand alone in the
+    /// model (no boolean or other operation above them), drawn see-through
+    /// in their colour as OpenSCAD's preview draws them.
+    pub see_through: Vec<Tinted>,
     /// What was skipped or changed, one line each, with its location.
     pub warnings: Vec<String>,
+}
+
+/// A see-through `color()` subtree as its own solid (with OpenSCAD's
+/// facets, in the file's space).
+#[derive(Debug, Clone)]
+pub struct Tinted {
+    /// Its colour, sRGB, and alpha (below 1).
+    pub color: Vec4,
+    /// The subtree's solid.
+    pub solid: CsgSolid,
+    /// Bytes of the `color()` node.
+    pub source: Range<usize>,
 }
 
 /// How OpenSCAD's preview marks a part drawn see-through.
@@ -204,7 +220,7 @@ pub fn load_csg_with(
         let message = format!("{count} 2-D shape(s) outside an extrusion, drawn 1 unit thick as OpenSCAD's preview draws them (they are no part of an exported 3-D model)");
         b.warn(&first, message);
     }
-    Ok(LoadedCsg { solid: b.solid, ghosts: b.ghosts, warnings: b.warnings })
+    Ok(LoadedCsg { solid: b.solid, ghosts: b.ghosts, see_through: b.see_through, warnings: b.warnings })
 }
 
 /// Reads the files a `.csg` names (`import()`, `surface()`), each as
@@ -378,6 +394,11 @@ struct Builder<'a> {
     ghosts: Vec<Ghost>,
     /// Whether `#` and `%` marks make ghosts here.
     ghostly: bool,
+    /// Whether only groups, unions, transforms and colours lie above the node
+    /// at hand (a see-through colour there becomes a part of its own).
+    open: bool,
+    /// See-through `color()` subtrees.
+    see_through: Vec<Tinted>,
 }
 
 impl Builder<'_> {
@@ -401,6 +422,8 @@ impl Builder<'_> {
             plates: (0, None),
             ghosts: Vec::new(),
             ghostly: true,
+            open: true,
+            see_through: Vec::new(),
         }
     }
 
@@ -587,9 +610,9 @@ mod tests {
 
     #[test]
     fn the_outermost_colour_wins() {
-        let s = solid("color([1, 0, 0, 1]) {\n\tcolor([0, 1, 0, 1]) {\n\t\tcube(size = [1, 1, 1], center = false);\n\t}\n}\ncolor([-1, -1, -1, 1]) {\n\tcolor([0, 0, 1, 0.5]) {\n\t\tsphere($fn = 0, $fa = 12, $fs = 2, r = 1);\n\t}\n}\n");
+        let s = solid("color([1, 0, 0, 1]) {\n\tcolor([0, 1, 0, 1]) {\n\t\tcube(size = [1, 1, 1], center = false);\n\t}\n}\ncolor([-1, -1, -1, 1]) {\n\tcolor([0, 0, 1, 1]) {\n\t\tsphere($fn = 0, $fa = 12, $fs = 2, r = 1);\n\t}\n}\n");
         assert_eq!(s.primitives[0].color, Some(Vec4::new(1.0, 0.0, 0.0, 1.0)));
-        assert_eq!(s.primitives[1].color, Some(Vec4::new(0.0, 0.0, 1.0, 0.5)), "[-1, -1, -1, a] is no colour");
+        assert_eq!(s.primitives[1].color, Some(Vec4::new(0.0, 0.0, 1.0, 1.0)), "[-1, -1, -1, a] is no colour");
     }
 
     #[test]

@@ -62,7 +62,7 @@ const ALWAYS_FACETED_FN: f64 = 8.0;
 impl Builder<'_> {
     /// Whether a sphere or cylinder is made of facets.
     pub(super) fn faceted(&self, node: &CsgNode) -> Result<bool> {
-        let fine = self.number(node, "$fn")?;
+        let fine = self.number_or(node, "$fn", 0.0)?;
         Ok(self.options.geometry == Geometry::Faceted || (fine > 0.0 && fine <= ALWAYS_FACETED_FN))
     }
 

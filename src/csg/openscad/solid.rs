@@ -12,7 +12,7 @@ use super::meshed::{minkowski_of_meshes, surface_bounds, surface_points, union_o
 use super::partition::convex_pieces;
 use super::primitives::Made;
 use super::syntax::CsgNode;
-use super::{combine, is_flat, kind, Builder, Built, GhostKind, Kind};
+use super::{combine, is_flat, kind, Builder, Built, GhostKind, Kind, Tinted};
 use crate::csg::{ConvexPolyhedron, CsgSolid, CsgTree, Primitive, Shape};
 use crate::error::Result;
 use crate::limits::Limit;
@@ -42,6 +42,15 @@ impl Builder<'_> {
         if is_flat(node) {
             return self.plate(node, m, color);
         }
+        let open = self.open;
+        self.open &= matches!(kind, Kind::Union | Kind::Transform | Kind::Color);
+        let built = self.made(node, kind, m, color);
+        self.open = open;
+        built
+    }
+
+    /// What a node of 3-D `kind` makes, as [`Builder::node`].
+    fn made(&mut self, node: &CsgNode, kind: Kind, m: Affine3A, color: Option<Vec4>) -> Result<Built> {
         let kids = &node.children;
         match kind {
             Kind::Union => self.union(kids, m, color),
@@ -57,7 +66,10 @@ impl Builder<'_> {
             }
             Kind::Color => {
                 let own = self.color(node)?;
-                self.union(kids, m, color.or(own))
+                match own {
+                    Some(c) if c.w < 1.0 && color.is_none() && self.ghostly => self.see_through(node, c, m),
+                    _ => self.union(kids, m, color.or(own)),
+                }
             }
             Kind::Hull => self.hull(node, m, color),
             Kind::Minkowski => self.minkowski(node, m, color),
@@ -74,6 +86,26 @@ impl Builder<'_> {
             // Flat kinds were drawn as plates above.
             Kind::Shape2d | Kind::Text | Kind::Offset | Kind::Projection | Kind::Fill => Ok(Built::Empty),
         }
+    }
+
+    /// A `color()` with alpha below 1: a see-through part of its own where it
+    /// stands alone in the model; inside an operation, drawn opaque with a
+    /// warning.
+    fn see_through(&mut self, node: &CsgNode, color: Vec4, m: Affine3A) -> Result<Built> {
+        if !self.open {
+            let message = format!(
+                "this colour's alpha ({}) is drawn opaque: kage draws a see-through colour only on a part no operation combines",
+                color.w
+            );
+            self.warn(&node.span, message);
+            return self.union(&node.children, m, Some(color));
+        }
+        let solid = self.faceted_solid(&node.children, m)?;
+        if solid.tree.is_none() {
+            return Ok(Built::Empty);
+        }
+        self.see_through.push(Tinted { color, solid, source: node.span.clone() });
+        Ok(Built::Skipped)
     }
 
     /// `color()`'s own colour (`None` for OpenSCAD's "no colour").

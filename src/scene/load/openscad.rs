@@ -9,7 +9,7 @@ use glam::{Vec3, Vec4};
 
 use super::{Files, LoadedModel, Part, SolidPart};
 use crate::csg::openscad::{
-    default_view, load_csg_with, sidecar_camera, surface_mesh, CsgOptions, Ghost, GhostKind, Imports,
+    default_view, load_csg_with, sidecar_camera, surface_mesh, CsgOptions, Ghost, GhostKind, Imports, Tinted,
 };
 use crate::error::Result;
 use crate::image::srgb_to_linear;
@@ -89,7 +89,8 @@ pub fn model(
         })
         .collect();
     let name = shown.file_stem().map_or_else(|| "csg".to_string(), |s| s.to_string_lossy().into_owned());
-    let parts = loaded.ghosts.iter().filter_map(|g| ghost_part(g, &name)).collect();
+    let mut parts: Vec<Part> = loaded.see_through.iter().filter_map(|t| tinted_part(t, &name)).collect();
+    parts.extend(loaded.ghosts.iter().filter_map(|g| ghost_part(g, &name)));
     let part =
         SolidPart { name, solid: Arc::new(solid), palette: palette.into_iter().map(|(_, m)| m).collect(), materials };
     Ok(LoadedModel { solids: vec![part], parts, camera, warnings: loaded.warnings, ..Default::default() })
@@ -116,8 +117,24 @@ fn ghost_part(ghost: &Ghost, model: &str) -> Option<Part> {
     })
 }
 
+/// A `color()` subtree with an alpha below 1 as a see-through mesh in its
+/// colour; `None` if it has no surface.
+fn tinted_part(tinted: &Tinted, model: &str) -> Option<Part> {
+    let (positions, triangles) = surface_mesh(&tinted.solid);
+    let mesh = Mesh::new(positions, Vec::new(), Vec::new(), triangles, NormalMode::Flat).ok()?.0;
+    let material = Material { opacity: tinted.color.w, two_sided: true, ..colour_material(tinted.color, 0) };
+    Some(Part {
+        name: format!("{model} colour at bytes {}..{}", tinted.source.start, tinted.source.end),
+        mesh: Arc::new(mesh),
+        material: Some(Material { name: format!("OpenSCAD colour {}", tinted.color), ..material }),
+        transform: glam::Affine3A::IDENTITY,
+        ghost: false,
+    })
+}
+
 /// A plastic-like material of an OpenSCAD colour (sRGB components in 0–1; the
-/// alpha is not used: solids are drawn opaque).
+/// alpha is not used here: solids are drawn opaque, and a see-through colour
+/// is a part of its own).
 fn colour_material(rgba: Vec4, index: usize) -> Material {
     let linear = Vec3::new(srgb_to_linear(rgba.x), srgb_to_linear(rgba.y), srgb_to_linear(rgba.z));
     Material {
