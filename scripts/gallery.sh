@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Renders the README's gallery: models dropped in as they are — an STL, a
-# glTF, an OBJ and an OpenSCAD .csg from the shared corpus — each with plain
-# `kage render FILE` (no options but the size), into docs/gallery/.
+# glTF, an OBJ and an OpenSCAD .csg from the shared corpus, and two OpenSCAD
+# parts from this repository (a revolved knob, a printer part with its
+# label) — each with plain `kage render FILE` (no options but the size),
+# into docs/gallery/.
 #
 #   scripts/gallery.sh            # after a change that alters how models come out
 #
@@ -13,18 +15,21 @@ out=docs/gallery
 mkdir -p "$out"
 cargo build --release -q -p kage-cli
 kage=target/release/kage
+# From the shared corpus, then OpenSCAD parts kept in this repository.
 models=(
-  "csg/ex006_hull_dice.stl:stl.png"
-  "gltf/CesiumMilkTruck/CesiumMilkTruck.glb:gltf.png"
-  "meshes/utah-teapot/teapot.obj:obj.png"
-  "csg/ex_csg_modules.csg:csg.png"
+  "$assets/csg/ex006_hull_dice.stl:stl.png"
+  "$assets/gltf/CesiumMilkTruck/CesiumMilkTruck.glb:gltf.png"
+  "$assets/meshes/utah-teapot/teapot.obj:obj.png"
+  "$assets/csg/ex_csg_modules.csg:csg.png"
+  "examples/openscad/knob.csg:knob.png"
+  "bench/corpus/openscad/mk3_lcd_supports.csg:label.png"
 )
 for entry in "${models[@]}"; do
   model=${entry%%:*} name=${entry##*:}
-  if [ ! -f "$assets/$model" ]; then
-    echo "skipped $model: not in $assets" >&2
+  if [ ! -f "$model" ]; then
+    echo "skipped $model: not there" >&2
     continue
   fi
-  "$kage" render "$assets/$model" --width 480 --height 270 -o "$out/$name" 2>/dev/null
+  "$kage" render "$model" --width 480 --height 270 -o "$out/$name" 2>/dev/null
   echo "$out/$name  <-  kage render $model"
 done

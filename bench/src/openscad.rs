@@ -34,6 +34,9 @@ pub struct OpenscadArgs {
     /// table runs in a process of its own, to stop it at the limit).
     #[arg(long, hide = true)]
     pub manifold_only: Option<PathBuf>,
+    /// With `--manifold-only`: write Manifold's mesh here as binary STL.
+    #[arg(long, hide = true)]
+    pub manifold_stl: Option<PathBuf>,
 }
 
 /// The corpus folder.
@@ -66,7 +69,8 @@ const CONSTRUCTS: [(&str, &str); 14] = [
 /// When the `kage` binary is not built or the corpus cannot be read.
 pub fn run(args: &OpenscadArgs) -> Result<()> {
     if let Some(path) = &args.manifold_only {
-        let seconds = manifold_seconds(path, args.runs).ok_or_else(|| miette!("{}: does not read", path.display()))?;
+        let seconds = manifold_seconds(path, args.runs, args.manifold_stl.as_deref())
+            .ok_or_else(|| miette!("{}: does not read", path.display()))?;
         println!("{seconds}");
         return Ok(());
     }
@@ -87,10 +91,10 @@ pub fn run(args: &OpenscadArgs) -> Result<()> {
         .collect();
     models.sort();
     let display = Xvfb::start();
-    println!("| model | uses | kage | agrees with OpenSCAD's mesh | kage first image s | peak MB | OpenSCAD preview s | Manifold booleans s | Manifold peak MB |");
-    println!("|---|---|---|---:|---:|---:|---:|---:|---:|");
-    let (mut drawn, mut agree_995, mut with_mesh, mut faster, mut faster_than_manifold, mut manifold_20ms) =
-        (0, 0, 0, 0, 0, 0);
+    println!("| model | uses | kage | agrees with OpenSCAD's mesh | kage first image s | peak MB | OpenSCAD preview s | Manifold booleans s | Manifold way to image s | Manifold peak MB |");
+    println!("|---|---|---|---:|---:|---:|---:|---:|---:|---:|");
+    let (mut drawn, mut agree_995, mut with_mesh, mut faster) = (0, 0, 0, 0);
+    let (mut faster_than_manifold, mut faster_than_manifold_way, mut manifold_20ms) = (0, 0, 0);
     for path in &models {
         let name = path.file_stem().and_then(|s| s.to_str()).unwrap_or_default().to_string();
         let text = std::fs::read_to_string(path).map_err(|e| miette!("{}: {e}", path.display()))?;
@@ -105,7 +109,15 @@ pub fn run(args: &OpenscadArgs) -> Result<()> {
         }
         let theirs = display.as_ref().and_then(|d| openscad_preview(d, path, args.runs));
         faster += usize::from(theirs.is_some_and(|t| kage_s.is_some_and(|k| k < t)));
-        let manifold = manifold_limited(path, args);
+        let meshed = std::env::temp_dir().join(format!("kage-bench-manifold-{}.stl", std::process::id()));
+        let manifold = manifold_limited(path, &meshed, args);
+        // The Manifold way to a first image: its booleans, then kage's image
+        // of the mesh they make (the same size, lit and shadowed alike).
+        let manifold_way = match manifold {
+            Some(Timed::Within(s, _)) => kage_run(&exe, &meshed, args.runs).1.map(|image| s + image),
+            _ => None,
+        };
+        std::fs::remove_file(&meshed).ok();
         if let (Some(m), Some(k)) = (manifold, kage_s) {
             let m = match m {
                 Timed::Within(s, _) => s,
@@ -114,11 +126,12 @@ pub fn run(args: &OpenscadArgs) -> Result<()> {
             if m >= 0.02 {
                 manifold_20ms += 1;
                 faster_than_manifold += usize::from(k < m);
+                faster_than_manifold_way += usize::from(manifold_way.is_none_or(|w| k < w));
             }
         }
         let show = |v: Option<f64>, digits: usize| v.map_or("-".to_string(), |v| format!("{v:.digits$}"));
         println!(
-            "| {name} | {} | {status} | {} | {} | {} | {} | {} | {} |",
+            "| {name} | {} | {status} | {} | {} | {} | {} | {} | {} | {} |",
             uses.join(" "),
             agreement.map_or("no mesh".to_string(), |a| format!("{:.2}%", a * 100.0)),
             show(kage_s, 2),
@@ -128,6 +141,7 @@ pub fn run(args: &OpenscadArgs) -> Result<()> {
                 Timed::Within(s, _) => format!("{s:.3}"),
                 Timed::Over(limit) => format!("> {limit}"),
             }),
+            show(manifold_way, 2),
             manifold.map_or("-".to_string(), |m| match m {
                 Timed::Within(_, mb) => format!("{mb:.0}"),
                 Timed::Over(_) => "-".to_string(),
@@ -136,8 +150,9 @@ pub fn run(args: &OpenscadArgs) -> Result<()> {
     }
     println!(
         "\n{} models: {drawn} drawn; {agree_995} of the {with_mesh} with an exact mesh agree on ≥ 99.5% of pixels; \
-         kage's first image sooner than OpenSCAD's preview on {faster}; sooner than Manifold's booleans on \
-         {faster_than_manifold} of the {manifold_20ms} where those take ≥ 20 ms.",
+         kage's first image sooner than OpenSCAD's preview on {faster}; of the {manifold_20ms} where Manifold's \
+         booleans take ≥ 20 ms, sooner than the Manifold way to an image on {faster_than_manifold_way} and than \
+         its booleans alone on {faster_than_manifold}.",
         models.len()
     );
     println!(
@@ -148,8 +163,9 @@ pub fn run(args: &OpenscadArgs) -> Result<()> {
          2021.01: `openscad --preview --imgsize=640,480 -o NAME.png NAME.csg` on one Xvfb server (Mesa llvmpipe), \
          whole process. Manifold: the same tree kage draws (its convex primitives faceted as OpenSCAD facets \
          them, each the hull of its corners, and its closed meshes), combined by Manifold's booleans (the \
-         manifold-rust port of Manifold 3.5, one thread, in a process of its own stopped at {} s; its time is \
-         the booleans alone, before any image, and its peak memory the whole process's, reading the tree included).",
+         manifold-rust port of Manifold 3.5, one thread, in a process of its own stopped at {} s; its peak \
+         memory the whole process's, reading the tree included). The Manifold way to an image: those booleans, \
+         then `kage render` of the mesh they make at the same size (a median of as many runs), added.",
         args.runs, args.manifold_limit
     );
     Ok(())
@@ -216,12 +232,14 @@ enum Timed {
 }
 
 /// [`manifold_seconds`] in a process of its own, stopped at the limit.
-fn manifold_limited(path: &Path, args: &OpenscadArgs) -> Option<Timed> {
+fn manifold_limited(path: &Path, stl: &Path, args: &OpenscadArgs) -> Option<Timed> {
     let exe = std::env::current_exe().ok()?;
     let mut child = Command::new("/usr/bin/time")
         .args(["-f", "%M"])
         .arg(exe)
-        .args(["openscad", "--runs", &args.runs.to_string(), "--manifold-only"])
+        .args(["openscad", "--runs", &args.runs.to_string(), "--manifold-stl"])
+        .arg(stl)
+        .arg("--manifold-only")
         .arg(path)
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
@@ -250,7 +268,7 @@ fn manifold_limited(path: &Path, args: &OpenscadArgs) -> Option<Timed> {
 
 /// Seconds Manifold takes to combine the tree's faceted primitives (median
 /// of `runs`), or `None` when the file does not read.
-fn manifold_seconds(path: &Path, runs: usize) -> Option<f64> {
+fn manifold_seconds(path: &Path, runs: usize, stl: Option<&Path>) -> Option<f64> {
     let files = FileSystem { base: path.parent()?.to_path_buf() };
     let options = CsgOptions { geometry: Geometry::Faceted, skip_unsupported: true };
     let loaded =
@@ -263,7 +281,25 @@ fn manifold_seconds(path: &Path, runs: usize) -> Option<f64> {
             t.elapsed().as_secs_f64()
         })
         .collect();
+    if let Some(stl) = stl {
+        let (positions, triangles) = surface_mesh(&solid);
+        std::fs::write(stl, binary_stl(&positions, &triangles)).ok()?;
+    }
     Some(median(&mut times))
+}
+
+/// A mesh as binary STL (normals left zero: readers compute them).
+fn binary_stl(positions: &[glam::Vec3], triangles: &[[u32; 3]]) -> Vec<u8> {
+    let mut out = vec![0u8; 80];
+    out.extend((triangles.len() as u32).to_le_bytes());
+    for t in triangles {
+        out.extend([0u8; 12]);
+        for &i in t {
+            positions[i as usize].to_array().iter().for_each(|c| out.extend(c.to_le_bytes()));
+        }
+        out.extend([0u8; 2]);
+    }
+    out
 }
 
 /// A virtual X server for OpenSCAD's preview, stopped when dropped.

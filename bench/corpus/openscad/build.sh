@@ -11,12 +11,13 @@
 #   SOURCES  a folder of clones named OWNER+REPO/repo (as the workplace's
 #            fetch tool leaves them) or OWNER+REPO (a plain `git clone`).
 #   NAME     only these models (default: every NAME.scad here).
-# Environment: STL_TIMEOUT (seconds, default 300) per exact render.
+# Environment: STL_TIMEOUT (seconds, default 1800) per exact render (the slowest
+# corpus model takes about 12 minutes).
 set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
 sources="$(cd "${1:?usage: build.sh SOURCES [NAME...]}" && pwd)"
 shift
-timeout_s="${STL_TIMEOUT:-300}"
+timeout_s="${STL_TIMEOUT:-1800}"
 
 # The projects, pinned: folder name in OPENSCADPATH, OWNER+REPO, commit.
 projects=(

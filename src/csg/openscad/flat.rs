@@ -185,6 +185,15 @@ impl Region {
         from_paths(union_subjects_d(&paths, FillRule::NonZero, PRECISION))
     }
 
+    /// Open polylines drawn `width` wide: square ends, corners mitred up to
+    /// twice the half-width (Clipper's default), as OpenSCAD strokes an SVG
+    /// path that is not closed.
+    #[must_use]
+    pub(crate) fn stroked(lines: &[Vec<DVec2>], width: f64) -> Region {
+        let paths = inflate_paths_d(&to_paths(lines), width * 0.5, JoinType::Miter, EndType::Square, 2.0, PRECISION, 0.0);
+        from_paths(union_subjects_d(&paths, FillRule::NonZero, PRECISION))
+    }
+
     /// The Minkowski sum of `regions` in turn (each contour with each,
     /// unioned; a hole of either is filled as OpenSCAD's own 2-D sum does).
     #[must_use]

@@ -10,6 +10,8 @@
 
 use glam::{Affine3A, Vec3, Vec4};
 
+use super::drawing::svg_region;
+use super::flat::Region;
 use super::syntax::CsgNode;
 use super::{Builder, Built};
 use crate::csg::ClosedMesh;
@@ -44,6 +46,26 @@ impl Builder<'_> {
                 Ok(Built::Empty)
             }
         }
+    }
+
+    /// `import()` of a 2-D drawing: an SVG file's region ([`svg_region`]); a
+    /// DXF file is not read yet.
+    pub(super) fn drawing(&mut self, node: &CsgNode) -> Result<Region> {
+        let file = self.text_or(node, "file", "")?;
+        let svg = std::path::Path::new(&file).extension().is_some_and(|e| e.eq_ignore_ascii_case("svg"));
+        if !svg {
+            self.unsupported(node, format!("{file}: an imported DXF drawing is not drawn yet (SVG drawings are)"))?;
+            return Ok(Region::default());
+        }
+        let bytes = self.imports.bytes(&file).map_err(|e| self.invalid(&node.span, e))?;
+        let (dpi, center) = (self.number_or(node, "dpi", 72.0)?, self.flag_or(node, "center", false)?);
+        if !(dpi.is_finite() && dpi > 0.0) {
+            return Err(self.invalid(&self.span_of(node, "dpi"), format!("`dpi` must be a positive number, not {dpi}")));
+        }
+        let region = svg_region(&bytes, dpi, center).map_err(|e| self.invalid(&node.span, format!("{file}: {e}")))?;
+        let points = region.points().count() as u64;
+        self.check(node, Limit::Points, points, || format!("the points of {file}"))?;
+        Ok(region)
     }
 
     /// `surface()`: a heightmap's closed mesh.

@@ -26,6 +26,7 @@
 //! faceted: hexagonal nut traps are meant to be hexagons.
 
 mod args;
+mod drawing;
 mod extrude;
 mod flat;
 mod hull;
@@ -606,6 +607,17 @@ mod tests {
         assert!(solid(&format!("difference() {{\n{cube}\n\tcube(size = [0, 1, 1], center = false);\n}}"))
             .contains(Vec3::ZERO));
         assert_eq!(solid(&format!("intersection() {{\n{cube}\n\tcylinder($fn = 0, $fa = 12, $fs = 2, h = 1, r1 = 0, r2 = 0, center = false);\n}}")).tree, None);
+    }
+
+    #[test]
+    fn a_missing_font_is_said_and_helvetica_is_liberation_sans_as_fontconfig_has_it() {
+        let text = |font: &str| {
+            format!("linear_extrude(height = 1, center = false, convexity = 1, scale = [1, 1], $fn = 0, $fa = 12, $fs = 2) {{\n\ttext(text = \"Hi\", size = 10, spacing = 1, font = \"{font}\", direction = \"ltr\", language = \"en\", script = \"latin\", halign = \"left\", valign = \"baseline\", $fn = 0, $fa = 12, $fs = 2);\n}}\n")
+        };
+        let warnings = |font: &str| load(&text(font), Geometry::Exact).unwrap().warnings;
+        assert!(warnings("Helvetica:style=Bold").is_empty(), "{:?}", warnings("Helvetica:style=Bold"));
+        let missing = warnings("No Such Typeface:style=Bold");
+        assert!(missing.len() == 1 && missing[0].contains("No Such Typeface") && missing[0].contains("t.csg:2:2"), "{missing:?}");
     }
 
     #[test]

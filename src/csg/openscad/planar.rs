@@ -67,11 +67,7 @@ impl Builder<'_> {
                 projection(&solid, cut)
             }
             Kind::Fill => Region::union(&self.flat_kids(node)?).filled(),
-            Kind::Import => {
-                let file = self.text_or(node, "file", "")?;
-                self.unsupported(node, format!("{file}: an imported 2-D drawing (SVG, DXF) is not drawn yet"))?;
-                Region::default()
-            }
+            Kind::Import => self.drawing(node)?,
             // Solid kinds were turned away above.
             Kind::Primitive | Kind::LinearExtrude | Kind::RotateExtrude | Kind::Surface => Region::default(),
         })

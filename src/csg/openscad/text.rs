@@ -13,8 +13,10 @@
 //!
 //! Fonts: Liberation Sans (Regular and Bold, OpenSCAD's default font) is
 //! bundled; any other `font = "Family:style=Style"` is looked up among the
-//! fonts beside the model and the system's font folders, and falls back to
-//! Liberation Sans with a warning.
+//! fonts beside the model and the system's font folders, then as its
+//! metric-compatible stand-in (Helvetica and Arial: Liberation Sans, as
+//! fontconfig substitutes them), and falls back to Liberation Sans with a
+//! warning.
 
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, OnceLock};
@@ -32,6 +34,17 @@ use crate::limits::Limit;
 static BUNDLED: [(&str, &str, &[u8]); 2] = [
     ("Liberation Sans", "Regular", include_bytes!("../../../assets/fonts/LiberationSans-Regular.ttf")),
     ("Liberation Sans", "Bold", include_bytes!("../../../assets/fonts/LiberationSans-Bold.ttf")),
+];
+
+/// Families and the open fonts of the same metrics that fontconfig (and so
+/// OpenSCAD on Linux) draws in their place when they are not installed.
+const METRIC_ALIASES: [(&str, &str); 6] = [
+    ("Helvetica", "Liberation Sans"),
+    ("Arial", "Liberation Sans"),
+    ("Times", "Liberation Serif"),
+    ("Times New Roman", "Liberation Serif"),
+    ("Courier", "Liberation Mono"),
+    ("Courier New", "Liberation Mono"),
 ];
 
 /// A font file's bytes and the face's index in it.
@@ -130,9 +143,26 @@ fn faces_in(path: &Path) -> Vec<(String, String, PathBuf, u32)> {
 
 impl Builder<'_> {
     /// The font `font` names (beside the model, bundled, or on the system),
-    /// or Liberation Sans with a warning.
+    /// else its metric-compatible stand-in as fontconfig picks it (Helvetica
+    /// and Arial: Liberation Sans), or Liberation Sans with a warning.
     fn font(&mut self, node: &CsgNode, font: &str) -> Result<FontFile> {
         let (family, style) = family_and_style(font);
+        let same = |a: &str, b: &str| a.eq_ignore_ascii_case(b);
+        let alias = METRIC_ALIASES.iter().find(|(name, _)| same(name, &family)).map(|(_, stand_in)| *stand_in);
+        for name in std::iter::once(family.as_str()).chain(alias) {
+            if let Some(found) = self.font_named(node, name, &style)? {
+                return Ok(found);
+            }
+        }
+        let fallback = if same(&style, "Bold") { "Bold" } else { "Regular" };
+        self.warn(&node.span, format!("font \"{family}\" ({style}) not found: Liberation Sans {fallback} drawn instead"));
+        let (.., bytes) = BUNDLED.iter().find(|b| same(b.1, &style)).unwrap_or(&BUNDLED[0]);
+        Ok(FontFile { bytes: Arc::from(*bytes), index: 0 })
+    }
+
+    /// The face of `family` in `style` beside the model, bundled or on the
+    /// system, if there is one.
+    fn font_named(&self, node: &CsgNode, family: &str, style: &str) -> Result<Option<FontFile>> {
         let same = |a: &str, b: &str| a.eq_ignore_ascii_case(b);
         let beside: Vec<_> = {
             let mut files = Vec::new();
@@ -143,26 +173,18 @@ impl Builder<'_> {
         };
         let found = beside
             .iter()
-            .chain(if BUNDLED.iter().any(|b| same(b.0, &family)) { [].iter() } else { system_fonts().iter() })
-            .find(|(f, s, ..)| same(f, &family) && same(s, &style));
+            .chain(if BUNDLED.iter().any(|b| same(b.0, family)) { [].iter() } else { system_fonts().iter() })
+            .find(|(f, s, ..)| same(f, family) && same(s, style));
         if let Some((_, _, path, index)) = found {
             let size = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
             let what = || format!("the font file {}", path.display());
             self.limits.check_bytes(Limit::FileMb, size, what).map_err(|e| self.invalid(&node.span, e.to_string()))?;
             if let Ok(bytes) = std::fs::read(path) {
-                return Ok(FontFile { bytes: bytes.into(), index: *index });
+                return Ok(Some(FontFile { bytes: bytes.into(), index: *index }));
             }
         }
-        let bundled = BUNDLED.iter().find(|b| same(b.0, &family) && same(b.1, &style));
-        if bundled.is_none() {
-            let fallback = if same(&style, "Bold") { "Bold" } else { "Regular" };
-            self.warn(
-                &node.span,
-                format!("font \"{family}\" ({style}) not found: Liberation Sans {fallback} drawn instead"),
-            );
-        }
-        let (.., bytes) = bundled.or_else(|| BUNDLED.iter().find(|b| same(b.1, &style))).unwrap_or(&BUNDLED[0]);
-        Ok(FontFile { bytes: Arc::from(*bytes), index: 0 })
+        let bundled = BUNDLED.iter().find(|b| same(b.0, family) && same(b.1, style));
+        Ok(bundled.map(|(.., bytes)| FontFile { bytes: Arc::from(*bytes), index: 0 }))
     }
 
     /// `text()`'s region: the string's glyphs laid out by [`Layout`].
