@@ -228,11 +228,15 @@ mod tests {
     #[test]
     fn holes_go_by_the_even_odd_rule_and_curves_are_cut_alike() {
         // A square with a square hole drawn the same way round: still a hole.
-        let ring = region(r#"<svg xmlns="http://www.w3.org/2000/svg" width="100mm" height="100mm"><path d="M 0 0 L 40 0 L 40 40 L 0 40 Z M 10 10 L 30 10 L 30 30 L 10 30 Z"/></svg>"#);
+        let ring = region(
+            r#"<svg xmlns="http://www.w3.org/2000/svg" width="100mm" height="100mm"><path d="M 0 0 L 40 0 L 40 40 L 0 40 Z M 10 10 L 30 10 L 30 30 L 10 30 Z"/></svg>"#,
+        );
         assert!((ring.area() - 1200.0).abs() < 1e-6, "{}", ring.area());
         // A circle of radius 10: OpenSCAD's 40-gon holds 98.77% of the disc;
         // four cubics of 20 pieces each come as close.
-        let disc = region(r#"<svg xmlns="http://www.w3.org/2000/svg" width="100mm" height="100mm"><circle cx="50" cy="50" r="10"/></svg>"#);
+        let disc = region(
+            r#"<svg xmlns="http://www.w3.org/2000/svg" width="100mm" height="100mm"><circle cx="50" cy="50" r="10"/></svg>"#,
+        );
         let share = disc.area() / (std::f64::consts::PI * 100.0);
         assert!(share > 0.987 && share <= 1.0005, "{share}");
         // Centred: the bounding box about the origin.

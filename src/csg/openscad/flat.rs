@@ -190,7 +190,8 @@ impl Region {
     /// path that is not closed.
     #[must_use]
     pub(crate) fn stroked(lines: &[Vec<DVec2>], width: f64) -> Region {
-        let paths = inflate_paths_d(&to_paths(lines), width * 0.5, JoinType::Miter, EndType::Square, 2.0, PRECISION, 0.0);
+        let paths =
+            inflate_paths_d(&to_paths(lines), width * 0.5, JoinType::Miter, EndType::Square, 2.0, PRECISION, 0.0);
         from_paths(union_subjects_d(&paths, FillRule::NonZero, PRECISION))
     }
 

@@ -617,7 +617,10 @@ mod tests {
         let warnings = |font: &str| load(&text(font), Geometry::Exact).unwrap().warnings;
         assert!(warnings("Helvetica:style=Bold").is_empty(), "{:?}", warnings("Helvetica:style=Bold"));
         let missing = warnings("No Such Typeface:style=Bold");
-        assert!(missing.len() == 1 && missing[0].contains("No Such Typeface") && missing[0].contains("t.csg:2:2"), "{missing:?}");
+        assert!(
+            missing.len() == 1 && missing[0].contains("No Such Typeface") && missing[0].contains("t.csg:2:2"),
+            "{missing:?}"
+        );
     }
 
     #[test]

@@ -17,6 +17,12 @@ use crate::csg::{ConvexPolyhedron, CsgSolid, CsgTree, Primitive, Shape};
 use crate::error::Result;
 use crate::limits::Limit;
 
+/// Convex pieces past which a straight extrusion is drawn as one closed
+/// mesh (OpenSCAD's, as exact as its prisms) rather than a prism per piece:
+/// a shape with curved outlines cut into hundreds of pieces costs every ray
+/// and every scanline a box per piece, where the mesh costs its few layers.
+const MESHED_PIECES: usize = 24;
+
 /// Half the thickness of a plate: OpenSCAD's preview draws a 2-D shape from
 /// z = −½ to ½, and a subtracted one a tenth thicker.
 const PLATE: (f64, f64) = (0.5, 0.55);
@@ -296,13 +302,13 @@ impl Builder<'_> {
         self.check(node, Limit::Slices, slices.min(1e18) as u64, || "this linear_extrude()'s slices".into())?;
         let z0 = if self.flag_or(node, "center", false)? { -height / 2.0 } else { 0.0 };
         let layers = Layers { z0, height, twist_deg, slices: slices as usize, scale };
-        if !layers.prisms() {
+        let pieces = if layers.prisms() { convex_pieces(&region) } else { Vec::new() };
+        if pieces.is_empty() || pieces.len() > MESHED_PIECES {
             return match layers.mesh(&region) {
                 Some(mesh) => self.push_mesh(node, mesh, m, color),
                 None => Ok(Built::Empty),
             };
         }
-        let pieces = convex_pieces(&region);
         let slabs: Vec<_> = pieces.iter().flat_map(|p| layers.slabs(p)).collect();
         self.push_all(node, slabs, m, color)
     }

@@ -155,7 +155,10 @@ impl Builder<'_> {
             }
         }
         let fallback = if same(&style, "Bold") { "Bold" } else { "Regular" };
-        self.warn(&node.span, format!("font \"{family}\" ({style}) not found: Liberation Sans {fallback} drawn instead"));
+        self.warn(
+            &node.span,
+            format!("font \"{family}\" ({style}) not found: Liberation Sans {fallback} drawn instead"),
+        );
         let (.., bytes) = BUNDLED.iter().find(|b| same(b.1, &style)).unwrap_or(&BUNDLED[0]);
         Ok(FontFile { bytes: Arc::from(*bytes), index: 0 })
     }
