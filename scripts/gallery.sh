@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Renders the README's gallery: models dropped in as they are — an STL, a
 # glTF, an OBJ and an OpenSCAD .csg from the shared corpus, and two OpenSCAD
-# parts from this repository (a revolved knob, a printer part with its
-# label) — each with plain `kage render FILE` (no options but the size),
+# parts from this repository (a revolved knob, a label plate made with
+# BOSL2's text3d) — each with plain `kage render FILE` (no options but the size),
 # into docs/gallery/.
 #
 #   scripts/gallery.sh            # after a change that alters how models come out
@@ -22,7 +22,7 @@ models=(
   "$assets/meshes/utah-teapot/teapot.obj:obj.png"
   "$assets/csg/ex_csg_modules.csg:csg.png"
   "examples/openscad/knob.csg:knob.png"
-  "bench/corpus/openscad/mk3_lcd_supports.csg:label.png"
+  "bench/corpus/openscad/bosl2_text.csg:label.png"
 )
 for entry in "${models[@]}"; do
   model=${entry%%:*} name=${entry##*:}

@@ -3,7 +3,7 @@
 //! buffer).
 //!
 //! [`TraceScene`] puts a scene's triangles (in world space, with their item ids;
-//! [`triangle`] is the watertight ray/triangle test) and its CSG solids (cast by
+//! [`crate::triangle`] is the watertight ray/triangle test) and its CSG solids (cast by
 //! [`crate::csg::CsgCaster`]) behind one [`crate::bvh`], and answers `intersect`
 //! (nearest hit) and `occluded` (anything before a distance?); [`TraceCache`]
 //! keeps it while the geometry stays. [`tracer`] shades what a ray sees, bounces
