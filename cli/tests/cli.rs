@@ -150,12 +150,12 @@ fn aov_shadow_writes_each_lights_term() {
 #[test]
 fn a_csg_node_kage_cannot_render_is_reported_at_its_line() {
     let dir = scratch("csg-node");
-    let model =
-        write(&dir, "extrude.csg", "group() {\n\tlinear_extrude(height = 2) {\n\t\tsquare(size = 1);\n\t}\n}\n");
+    // `roof()`, of OpenSCAD's later releases.
+    let model = write(&dir, "roof.csg", "group() {\n\troof(method = \"voronoi\") {\n\t\tsquare(size = 1);\n\t}\n}\n");
     let (ok, err) = kage(&["render", model.to_str().unwrap(), "-o", dir.join("x.png").to_str().unwrap()]);
-    assert!(!ok && err.contains("extrude.csg:2:2") && err.contains("is not a node kage renders"), "{err}");
+    assert!(!ok && err.contains("roof.csg:2:2") && err.contains("is not a node kage knows"), "{err}");
     // The report shows the offending line of the file, the node marked.
-    assert!(err.contains("linear_extrude(height = 2)") && err.contains("here"), "{err}");
+    assert!(err.contains("roof(method = \"voronoi\")") && err.contains("here"), "{err}");
 }
 
 #[test]
