@@ -1,4 +1,4 @@
-//! CSG solids (issue 6): the ray caster's spans agree with point membership.
+//! CSG solids: the ray caster's spans agree with point membership.
 //!
 //! Random solids — spheres, cones, frustums, cylinders and convex polyhedra under
 //! random affine maps (rotation, shear, non-uniform scale), joined by random

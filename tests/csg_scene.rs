@@ -1,4 +1,4 @@
-//! CSG solids as part of the frame (issue 6): a `.csg` object in a scene file, next
+//! CSG solids as part of the frame: a `.csg` object in a scene file, next
 //! to meshes, drawn into the same visibility buffer by the scanline walk, shaded,
 //! shadowed and reflected like everything else. The oracle is the ray tracer: its
 //! BVH holds the same solids as leaves and casts their rays by interval

@@ -1,4 +1,4 @@
-//! OpenSCAD `.csg` input (issue 6): every file of the shared corpus parses and
+//! OpenSCAD `.csg` input: every file of the shared corpus parses and
 //! loads, its primitive counts match the corpus table, and in faceted mode the
 //! solid agrees with the mesh OpenSCAD's own CGAL render wrote (its STL), point by
 //! point. Everything here skips cleanly when `../shared/assets` is absent.
