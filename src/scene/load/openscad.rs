@@ -11,6 +11,7 @@ use super::{Files, LoadedModel, Part, SolidPart};
 use crate::csg::openscad::{
     default_view, load_csg_with, sidecar_camera, surface_mesh, CsgOptions, Ghost, GhostKind, Imports, Tinted,
 };
+use crate::csg::CsgSolid;
 use crate::error::Result;
 use crate::image::srgb_to_linear;
 use crate::scene::mesh::{Mesh, NormalMode};
@@ -99,37 +100,29 @@ pub fn model(
 /// A `#` or `%` subtree as a see-through mesh in OpenSCAD's preview colour
 /// that casts no shadow; `None` if it has no surface.
 fn ghost_part(ghost: &Ghost, model: &str) -> Option<Part> {
-    let (positions, triangles) = surface_mesh(&ghost.solid);
-    let mesh = Mesh::new(positions, Vec::new(), Vec::new(), triangles, NormalMode::Flat).ok()?.0;
-    let rgba = ghost.kind.color();
     let mark = match ghost.kind {
         GhostKind::Highlight => "#",
         GhostKind::Background => "%",
     };
-    let material =
-        Material { name: format!("OpenSCAD {mark}"), opacity: rgba.w, two_sided: true, ..colour_material(rgba, 0) };
-    Some(Part {
-        name: format!("{model} {mark} at bytes {}..{}", ghost.source.start, ghost.source.end),
-        mesh: Arc::new(mesh),
-        material: Some(material),
-        transform: glam::Affine3A::IDENTITY,
-        ghost: true,
-    })
+    let name = format!("{model} {mark} at bytes {}..{}", ghost.source.start, ghost.source.end);
+    see_through_part(&ghost.solid, ghost.kind.color(), format!("OpenSCAD {mark}"), name, true)
 }
 
 /// A `color()` subtree with an alpha below 1 as a see-through mesh in its
 /// colour; `None` if it has no surface.
 fn tinted_part(tinted: &Tinted, model: &str) -> Option<Part> {
-    let (positions, triangles) = surface_mesh(&tinted.solid);
+    let name = format!("{model} colour at bytes {}..{}", tinted.source.start, tinted.source.end);
+    see_through_part(&tinted.solid, tinted.color, format!("OpenSCAD colour {}", tinted.color), name, false)
+}
+
+/// `solid`'s surface as a two-sided mesh part of colour and opacity `rgba`
+/// (a ghost is left out of shadows and turned off by the viewer's key);
+/// `None` if it has no surface.
+fn see_through_part(solid: &CsgSolid, rgba: Vec4, material: String, name: String, ghost: bool) -> Option<Part> {
+    let (positions, triangles) = surface_mesh(solid);
     let mesh = Mesh::new(positions, Vec::new(), Vec::new(), triangles, NormalMode::Flat).ok()?.0;
-    let material = Material { opacity: tinted.color.w, two_sided: true, ..colour_material(tinted.color, 0) };
-    Some(Part {
-        name: format!("{model} colour at bytes {}..{}", tinted.source.start, tinted.source.end),
-        mesh: Arc::new(mesh),
-        material: Some(Material { name: format!("OpenSCAD colour {}", tinted.color), ..material }),
-        transform: glam::Affine3A::IDENTITY,
-        ghost: false,
-    })
+    let material = Material { name: material, opacity: rgba.w, two_sided: true, ..colour_material(rgba, 0) };
+    Some(Part { name, mesh: Arc::new(mesh), material: Some(material), transform: glam::Affine3A::IDENTITY, ghost })
 }
 
 /// A plastic-like material of an OpenSCAD colour (sRGB components in 0–1; the
