@@ -21,8 +21,9 @@ add obj $repo/tests/data/**/*.obj $repo/tests/regressions/obj/**/*.obj $findings
 add stl $repo/tests/data/**/*.stl $assets/csg/ex00*.stl $assets/meshes/**/*.stl
 add gltf $repo/tests/data/fuzz/*.gltf $repo/tests/data/fuzz/*.glb $repo/tests/regressions/gltf/* $findings/**/*.gltf $findings/**/*.glb $assets/gltf/**/*.gltf $assets/gltf/**/*.glb
 add csg $repo/tests/data/**/*.csg $repo/tests/regressions/csg/* $findings/**/*.csg $assets/csg/*.csg
+add drawing $repo/tests/data/**/*.dxf $repo/tests/data/**/*.svg $repo/tests/regressions/csg/**/*.dxf
 add texture $repo/examples/scenes/*.png $repo/tests/data/**/*.png $repo/tests/data/**/*.jpg $repo/tests/data/**/*.exr $assets/**/*.png
-for t in scene obj stl gltf csg texture csg_tree scene_tree; do
+for t in scene obj stl gltf csg drawing texture csg_tree scene_tree; do
     mkdir -p "corpus/$t"
     echo "$t: $(ls "corpus/$t" | wc -l) seed files"
 done

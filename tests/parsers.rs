@@ -208,6 +208,12 @@ fn csg(bytes: &[u8]) {
     model("m.csg", bytes);
 }
 
+fn drawing(bytes: &[u8], dxf: bool) {
+    for contour in kage::csg::openscad::drawing_outlines(bytes, dxf).into_iter().flatten() {
+        assert!(contour.iter().flatten().all(|v| v.is_finite()));
+    }
+}
+
 fn texture(bytes: &[u8]) {
     if let Ok(t) = Texture::decode(bytes, true, &limits()) {
         assert!(t.sample(glam::Vec2::new(0.4, 0.6)).is_finite());
@@ -246,6 +252,8 @@ never_panics!(stl, |b: &[u8]| model("m.stl", b), ["tests/data/fuzz", "tests/data
 never_panics!(gltf, |b: &[u8]| model("m.gltf", b), ["tests/data/fuzz", "tests/regressions/gltf"], "gltf");
 never_panics!(glb, |b: &[u8]| model("m.glb", b), ["tests/data/fuzz", "tests/regressions/gltf"], "glb");
 never_panics!(openscad, csg, ["tests/data", "tests/regressions/csg"], "csg");
+never_panics!(dxf, |b: &[u8]| drawing(b, true), ["tests/data/openscad", "tests/regressions/csg"], "dxf");
+never_panics!(svg, |b: &[u8]| drawing(b, false), ["tests/data/openscad", "tests/regressions/csg"], "svg");
 never_panics!(png, texture, ["tests/data", "tests/regressions/scene", "examples/scenes"], "png");
 
 /// The seeds of the fuzz targets load and render as they are: the mutations

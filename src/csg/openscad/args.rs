@@ -111,16 +111,11 @@ impl Builder<'_> {
                 );
             }
         }
-        let n = if f64::from(r) < 1e-10 {
-            3.0
-        } else if fine > 0.0 {
-            fine.floor().max(3.0)
-        } else if fa <= 0.0 || fs <= 0.0 {
+        if fine <= 0.0 && (fa <= 0.0 || fs <= 0.0) {
             let name = if fa <= 0.0 { "$fa" } else { "$fs" };
             return Err(self.invalid(&self.span_of(node, name), format!("`{name}` must be above 0 when `$fn` is 0")));
-        } else {
-            (360.0 / fa).min(2.0 * std::f64::consts::PI * f64::from(r) / fs).max(5.0).ceil()
-        };
+        }
+        let n = fragment_count([fine, fa, fs], f64::from(r));
         let what = || format!("`{}()`'s circle", node.name);
         if let Err(e) = self.limits.check(Limit::Segments, n.min(1e18) as u64, what) {
             let span = self.span_of(node, if fine > 0.0 { "$fn" } else { "$fs" });
@@ -223,5 +218,18 @@ impl Builder<'_> {
             return Err(bad());
         }
         Ok(Mat4::from_cols_array_2d(&m).transpose())
+    }
+}
+
+/// OpenSCAD's number of straight pieces round a circle of radius `r` for
+/// `[$fn, $fa, $fs]` (`$fa` and `$fs` above 0 where `$fn` is not).
+#[must_use]
+pub(super) fn fragment_count([fine, fa, fs]: [f64; 3], r: f64) -> f64 {
+    if r < 1e-10 {
+        3.0
+    } else if fine > 0.0 {
+        fine.floor().max(3.0)
+    } else {
+        (360.0 / fa).min(2.0 * std::f64::consts::PI * r / fs).max(5.0).ceil()
     }
 }

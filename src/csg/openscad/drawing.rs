@@ -49,7 +49,7 @@ pub(crate) fn svg_region(bytes: &[u8], dpi: f64, center: bool) -> Result<Region,
     let tree = usvg::Tree::from_str(text, &usvg::Options::default()).map_err(|e| format!("not an SVG drawing: {e}"))?;
     let to_mm = page.map(tree.size().width().into());
     let mut regions = Vec::new();
-    gather(tree.root(), &to_mm, &mut regions);
+    gather(tree.root(), &to_mm, &mut regions)?;
     let region = Region::union(&regions);
     Ok(match (center, region.bounds()) {
         (true, Some((lo, hi))) => region.transformed(&DAffine2::from_translation(-(lo + hi) * 0.5)),
@@ -71,6 +71,11 @@ struct Page {
 impl Page {
     fn read(text: &str, dpi: f64) -> Result<Page, String> {
         let doc = roxmltree::Document::parse(text).map_err(|e| format!("not an SVG drawing: {e}"))?;
+        if let Some(v) =
+            doc.descendants().flat_map(|n| geometry_numbers(&n)).find(|v| v.is_nan() || v.abs() > LARGEST_NUMBER)
+        {
+            return Err(format!("a shape's number {v:e} lies past {LARGEST_NUMBER:e} (the SVG reader's limit)"));
+        }
         let root = doc.root_element();
         let length = |name: &str| root.attribute(name).and_then(|v| millimetres(v, dpi));
         let view_box = root.attribute("viewBox").and_then(|v| {
@@ -96,6 +101,56 @@ impl Page {
     }
 }
 
+/// The largest number a shape's geometry may hold: curves past it would be
+/// cut into more pieces than memory holds.
+const LARGEST_NUMBER: f64 = 1e9;
+
+/// Attributes that place a shape's geometry.
+const GEOMETRY: [&str; 15] =
+    ["d", "points", "x", "y", "x1", "y1", "x2", "y2", "cx", "cy", "r", "rx", "ry", "width", "height"];
+
+/// Every number in an element's geometry attributes.
+fn geometry_numbers(node: &roxmltree::Node) -> Vec<f64> {
+    let mut out = Vec::new();
+    for value in GEOMETRY.iter().filter_map(|name| node.attribute(*name)) {
+        let bytes = value.as_bytes();
+        let mut i = 0;
+        while i < bytes.len() {
+            let start = i;
+            let digit = |i: usize| bytes.get(i).is_some_and(u8::is_ascii_digit);
+            if matches!(bytes[i], b'+' | b'-') {
+                i += 1;
+            }
+            while digit(i) {
+                i += 1;
+            }
+            if bytes.get(i) == Some(&b'.') {
+                i += 1;
+                while digit(i) {
+                    i += 1;
+                }
+            }
+            if i > start && matches!(bytes.get(i), Some(b'e' | b'E')) {
+                let mut j = i + 1;
+                if matches!(bytes.get(j), Some(b'+' | b'-')) {
+                    j += 1;
+                }
+                if digit(j) {
+                    i = j;
+                    while digit(i) {
+                        i += 1;
+                    }
+                }
+            }
+            match std::str::from_utf8(&bytes[start..i]).ok().and_then(|t| t.parse::<f64>().ok()).ok_or(()) {
+                Ok(v) => out.push(v),
+                Err(_) => i = start + 1,
+            }
+        }
+    }
+    out
+}
+
 /// An SVG length in millimetres, a bare number at `dpi` (`None` for a
 /// percentage or what does not parse).
 fn millimetres(value: &str, dpi: f64) -> Option<f64> {
@@ -116,28 +171,45 @@ fn millimetres(value: &str, dpi: f64) -> Option<f64> {
     Some(n * per)
 }
 
+/// The farthest a drawing's point may lie from the origin, in millimetres.
+const FARTHEST: f64 = 1e12;
+
 /// Each path under `group` as a region in millimetres (`to_mm` after the
 /// path's own transform).
-fn gather(group: &usvg::Group, to_mm: &DAffine2, out: &mut Vec<Region>) {
+///
+/// # Errors
+///
+/// A message when a point lies past [`FARTHEST`] (or is not finite).
+fn gather(group: &usvg::Group, to_mm: &DAffine2, out: &mut Vec<Region>) -> Result<(), String> {
     for node in group.children() {
         match node {
-            usvg::Node::Group(g) => gather(g, to_mm, out),
+            usvg::Node::Group(g) => gather(g, to_mm, out)?,
             usvg::Node::Path(path) => {
                 let t = path.abs_transform();
                 let own = DAffine2::from_cols_array(&[t.sx, t.ky, t.kx, t.sy, t.tx, t.ty].map(f64::from));
                 let m = *to_mm * own;
                 let (closed, open) = sub_paths(path.data(), &m);
+                let far =
+                    closed.iter().chain(&open).flatten().find(|p| !p.is_finite() || p.abs().max_element() > FARTHEST);
+                if let Some(p) = far {
+                    return Err(format!("a point at ({}, {}) mm lies beyond {FARTHEST:e} mm", p.x, p.y));
+                }
                 out.push(Region::even_odd(&closed));
                 if !open.is_empty() {
                     let width = path.stroke().map_or(1.0, |s| f64::from(s.width().get()));
                     // The width grows with the path's scale (the root of the
                     // map's area factor).
-                    out.push(Region::stroked(&open, width * m.matrix2.determinant().abs().sqrt()));
+                    let width = width * m.matrix2.determinant().abs().sqrt();
+                    if width.is_nan() || width > FARTHEST {
+                        return Err(format!("a stroke {width:e} mm wide is wider than {FARTHEST:e} mm"));
+                    }
+                    out.push(Region::stroked(&open, width));
                 }
             }
             usvg::Node::Image(_) | usvg::Node::Text(_) => {}
         }
     }
+    Ok(())
 }
 
 /// A path's closed and open sub-paths, placed by `m`, curves cut into

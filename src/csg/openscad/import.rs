@@ -3,20 +3,29 @@
 //! `.csg` file's folder), as closed meshes ([`crate::csg::ClosedMesh`]).
 //!
 //! A heightmap (`surface()`) is meshed as OpenSCAD meshes it: a `.dat` file's
-//! rows of numbers stand at y = 0, 1, 2, ... (columns at x = 0, 1, ...), each
-//! cell cut into four triangles about its centre (at the corners' mean
-//! height), walled down to a floor one unit below the lowest point; `center`
-//! moves the grid's middle to the origin.
+//! rows of numbers, or a PNG image's pixels (their luma, 0 to 100, the
+//! image's bottom row first), stand at y = 0, 1, 2, ... (columns at x = 0,
+//! 1, ...), each cell cut into four triangles about its centre (at the
+//! corners' mean height), walled down to a floor one unit below the lowest
+//! point (or at 0, when that is lower); `center` moves the grid's middle to
+//! the origin.
 
-use glam::{Affine3A, Vec3, Vec4};
+use glam::{Affine3A, DVec2, Vec3, Vec4};
 
+use super::args::fragment_count;
 use super::drawing::svg_region;
+use super::dxf::{dxf_region, DxfOptions};
 use super::flat::Region;
 use super::syntax::CsgNode;
 use super::{Builder, Built};
 use crate::csg::ClosedMesh;
 use crate::error::Result;
 use crate::limits::Limit;
+
+/// A file name's extension in lower case.
+fn extension(file: &str) -> String {
+    std::path::Path::new(file).extension().and_then(|e| e.to_str()).unwrap_or_default().to_ascii_lowercase()
+}
 
 /// File extensions `import()` reads as 2-D drawings.
 const DRAWINGS: [&str; 2] = ["svg", "dxf"];
@@ -25,10 +34,7 @@ const DRAWINGS: [&str; 2] = ["svg", "dxf"];
 #[must_use]
 pub(super) fn drawing(node: &CsgNode) -> bool {
     match node.arg("file").map(|a| &a.value) {
-        Some(super::syntax::CsgValue::Text(file)) => {
-            let ext = std::path::Path::new(file).extension().and_then(|e| e.to_str()).unwrap_or_default();
-            DRAWINGS.iter().any(|d| d.eq_ignore_ascii_case(ext))
-        }
+        Some(super::syntax::CsgValue::Text(file)) => DRAWINGS.contains(&extension(file).as_str()),
         _ => false,
     }
 }
@@ -48,14 +54,12 @@ impl Builder<'_> {
         }
     }
 
-    /// `import()` of a 2-D drawing: an SVG file's region ([`svg_region`]); a
-    /// DXF file is not read yet.
+    /// `import()` of a 2-D drawing: an SVG file's region ([`svg_region`]) or
+    /// a DXF file's ([`Builder::dxf`]).
     pub(super) fn drawing(&mut self, node: &CsgNode) -> Result<Region> {
         let file = self.text_or(node, "file", "")?;
-        let svg = std::path::Path::new(&file).extension().is_some_and(|e| e.eq_ignore_ascii_case("svg"));
-        if !svg {
-            self.unsupported(node, format!("{file}: an imported DXF drawing is not drawn yet (SVG drawings are)"))?;
-            return Ok(Region::default());
+        if extension(&file) == "dxf" {
+            return self.dxf(node, &file);
         }
         let bytes = self.imports.bytes(&file).map_err(|e| self.invalid(&node.span, e))?;
         let (dpi, center) = (self.number_or(node, "dpi", 72.0)?, self.flag_or(node, "center", false)?);
@@ -68,18 +72,58 @@ impl Builder<'_> {
         Ok(region)
     }
 
+    /// A DXF drawing's region ([`dxf_region`]): `import()`'s, or the profile
+    /// of an extrusion that names a `file` (its `scale`'s x scales the
+    /// drawing, as in OpenSCAD). Entities OpenSCAD does not draw either and
+    /// values that do not read are warnings.
+    pub(super) fn dxf(&mut self, node: &CsgNode, file: &str) -> Result<Region> {
+        let bytes = self.imports.bytes(file).map_err(|e| self.invalid(&node.span, e))?;
+        let layer = self.text_or(node, "layer", "")?;
+        let origin = if node.arg("origin").is_some() { self.pair(node, "origin")? } else { DVec2::ZERO };
+        let scale = match node.name.as_str() {
+            "linear_extrude" if node.arg("scale").is_some() => self.pair(node, "scale")?.x,
+            _ => self.number_or(node, "scale", 1.0)?,
+        };
+        if !scale.is_finite() {
+            return Err(
+                self.invalid(&self.span_of(node, "scale"), format!("`scale` must be a finite number, not {scale}"))
+            );
+        }
+        // Refuses a `$fn` (or `$fa`) past the limit for any radius.
+        self.fragments(node, f32::MAX)?;
+        let spec =
+            [self.number_or(node, "$fn", 0.0)?, self.number_or(node, "$fa", 12.0)?, self.number_or(node, "$fs", 2.0)?];
+        let fragments = |r: f64| fragment_count(spec, r) as usize;
+        let max_lines = self.limits.get(Limit::Points) as usize;
+        let options = DxfOptions { layer: &layer, origin, scale, fragments: &fragments, max_lines };
+        let drawing = dxf_region(&bytes, &options);
+        self.check(node, Limit::Points, drawing.lines as u64, || format!("the line pieces of {file}"))?;
+        for problem in &drawing.problems {
+            self.warn(&node.span, format!("{file}, {problem}"));
+        }
+        for (entity, count) in &drawing.unsupported {
+            let on = if layer.is_empty() { String::new() } else { format!(" on layer `{layer}`") };
+            let (noun, verb) = if *count == 1 { ("entity", "is") } else { ("entities", "are") };
+            let message = format!("{file}: {count} {entity} {noun}{on} {verb} not drawn (OpenSCAD draws none either)");
+            self.warn(&node.span, message);
+        }
+        Ok(drawing.region)
+    }
+
     /// `surface()`: a heightmap's closed mesh.
     pub(super) fn surface(&mut self, node: &CsgNode, m: Affine3A, color: Option<Vec4>) -> Result<Built> {
         let file = self.text_or(node, "file", "")?;
         let bytes = self.imports.bytes(&file).map_err(|e| self.invalid(&node.span, e))?;
-        let ext =
-            std::path::Path::new(&file).extension().and_then(|e| e.to_str()).unwrap_or_default().to_ascii_lowercase();
-        if ext == "png" {
-            let message = format!("{file}: a PNG heightmap is not drawn yet (a .dat file of numbers is)");
-            self.unsupported(node, message)?;
-            return Ok(Built::Skipped);
-        }
-        let rows = heights(&bytes).map_err(|e| self.invalid(&node.span, format!("{file}: {e}")))?;
+        let rows = if bytes.starts_with(PNG_SIGNATURE) {
+            let invert = self.flag_or(node, "invert", false)?;
+            let (w, h) = image::ImageReader::with_format(std::io::Cursor::new(&bytes), image::ImageFormat::Png)
+                .into_dimensions()
+                .map_err(|e| self.invalid(&node.span, format!("{file}: not a PNG image: {e}")))?;
+            self.check(node, Limit::Points, u64::from(w) * u64::from(h), || format!("the pixels of {file}"))?;
+            image_heights(&bytes, invert).map_err(|e| self.invalid(&node.span, format!("{file}: {e}")))?
+        } else {
+            heights(&bytes).map_err(|e| self.invalid(&node.span, format!("{file}: {e}")))?
+        };
         let cells = rows.len() as u64 * rows.first().map_or(0, Vec::len) as u64;
         self.check(node, Limit::Points, cells, || format!("the heights of {file}"))?;
         let center = self.flag_or(node, "center", false)?;
@@ -88,6 +132,43 @@ impl Builder<'_> {
             None => Ok(Built::Empty),
         }
     }
+}
+
+/// The outlines OpenSCAD 2021.01 draws of a 2-D drawing file's bytes (an
+/// SVG at 72 per inch when `dxf` is false, a DXF on every layer at the
+/// default `$fa` and `$fs` when true), each a closed contour, outer ones
+/// counter-clockwise. `None` when the bytes are no drawing.
+#[must_use]
+pub fn drawing_outlines(bytes: &[u8], dxf: bool) -> Option<Vec<Vec<[f64; 2]>>> {
+    let region = if dxf {
+        let fragments = |r: f64| fragment_count([0.0, 12.0, 2.0], r) as usize;
+        let options =
+            DxfOptions { layer: "", origin: DVec2::ZERO, scale: 1.0, fragments: &fragments, max_lines: 1_000_000 };
+        dxf_region(bytes, &options).region
+    } else {
+        svg_region(bytes, 72.0, false).ok()?
+    };
+    Some(region.contours().iter().map(|c| c.iter().map(|p| [p.x, p.y]).collect()).collect())
+}
+
+/// The eight bytes a PNG file starts with (OpenSCAD reads a heightmap as a
+/// PNG image when it starts with them, as numbers otherwise).
+const PNG_SIGNATURE: &[u8] = b"\x89PNG\r\n\x1a\n";
+
+/// A PNG heightmap's rows, bottom row of the image first: each pixel's
+/// luma (0.2126 R + 0.7152 G + 0.0722 B, alpha ignored) times 100 / 255;
+/// `invert` takes 1 − luma instead, as OpenSCAD 2021.01 does (a pixel's
+/// luma counts from 0 to 255 there, so an inverted map lies below 0).
+fn image_heights(bytes: &[u8], invert: bool) -> std::result::Result<Vec<Vec<f32>>, String> {
+    let image = image::load_from_memory_with_format(bytes, image::ImageFormat::Png)
+        .map_err(|e| format!("not a PNG image: {e}"))?
+        .to_rgba8();
+    let height = |p: &image::Rgba<u8>| {
+        let [r, g, b, _] = p.0.map(f64::from);
+        let luma = 0.2126 * r + 0.7152 * g + 0.0722 * b;
+        (100.0 / 255.0 * if invert { 1.0 - luma } else { luma }) as f32
+    };
+    Ok(image.rows().rev().map(|row| row.map(height).collect()).collect())
 }
 
 /// A `.dat` heightmap's rows of numbers (`#` starts a comment; every row as
@@ -121,7 +202,8 @@ fn heightmap(rows: &[Vec<f32>], center: bool) -> Option<ClosedMesh> {
     if nx < 2 || ny < 2 {
         return None;
     }
-    let floor = rows.iter().flatten().copied().fold(f32::INFINITY, f32::min) - 1.0;
+    // One below the lowest height, or 0 when that is higher (OpenSCAD's).
+    let floor = (rows.iter().flatten().copied().fold(f32::INFINITY, f32::min) - 1.0).min(0.0);
     let shift = if center { Vec3::new((nx - 1) as f32 / 2.0, (ny - 1) as f32 / 2.0, 0.0) } else { Vec3::ZERO };
     let mut positions = Vec::with_capacity(2 * nx * ny + (nx - 1) * (ny - 1));
     let at = |x: usize, y: usize| y * nx + x;
@@ -165,6 +247,28 @@ mod tests {
     use super::*;
 
     #[test]
+    fn a_png_heightmap_is_its_pixels_luma_bottom_row_first() {
+        // The construct model's image: OpenSCAD's STL of surface() of it
+        // (a tenth high) has its floor at 0 and its top at 9.0196 (the
+        // ring's grey 230); inverted, its top at -1.1373 (the ground's grey
+        // 30 at the corner).
+        let png = std::fs::read(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/openscad/parts/relief.png")).unwrap();
+        let rows = image_heights(&png, false).unwrap();
+        assert_eq!((rows.len(), rows[0].len()), (24, 32));
+        let top = rows.iter().flatten().copied().fold(f32::MIN, f32::max);
+        assert!((top - 90.196).abs() < 1e-3, "{top}");
+        // The image's top row (y = 0 in the file) is the map's last row: its
+        // pixel (0, 0) is (30, 30, 30), its bottom-left (30, 53, 30).
+        let luma = |r: f32, g: f32, b: f32| (0.2126 * r + 0.7152 * g + 0.0722 * b) * 100.0 / 255.0;
+        assert!(
+            (rows[23][0] - luma(30.0, 30.0, 30.0)).abs() < 1e-4 && (rows[0][0] - luma(30.0, 53.0, 30.0)).abs() < 1e-4
+        );
+        let inverted = image_heights(&png, true).unwrap();
+        assert!((inverted[23][0] - (100.0 / 255.0) * (1.0 - 30.0)).abs() < 1e-4);
+        assert!(image_heights(b"\x89PNG\r\n\x1a\nnope", false).is_err());
+    }
+
+    #[test]
     fn a_heightmap_is_openscads_closed_surface() {
         let rows = heights(b"# a tiny heightmap\n1 2 3\n4 5 6\n7 8 20\n").unwrap();
         let mesh = heightmap(&rows, false).unwrap();
@@ -173,6 +277,9 @@ mod tests {
         assert_eq!(mesh.bounds(), (Vec3::ZERO, Vec3::new(2.0, 2.0, 20.0)));
         assert!(mesh.contains(Vec3::new(0.5, 0.5, 2.9)) && !mesh.contains(Vec3::new(0.5, 0.5, 3.1)));
         assert!(mesh.contains(Vec3::new(1.5, 1.5, 9.7)) && !mesh.contains(Vec3::new(1.5, 1.5, 9.8)));
+        // Heights from 5 up: the floor stays at 0 (OpenSCAD's STL of it).
+        let high = heightmap(&heights(b"5 6\n7 9\n").unwrap(), false).unwrap();
+        assert_eq!(high.bounds(), (Vec3::ZERO, Vec3::new(1.0, 1.0, 9.0)));
         assert!(heights(b"1 2\n3\n").unwrap_err().contains("line 2"));
         assert!(heights(b"1 x\n").is_err());
     }

@@ -27,11 +27,13 @@
 
 mod args;
 mod drawing;
+mod dxf;
 mod extrude;
 mod flat;
 mod hull;
 mod import;
 mod meshed;
+pub use import::drawing_outlines;
 pub use meshed::surface_mesh;
 pub use text::text_outlines;
 mod partition;

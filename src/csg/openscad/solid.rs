@@ -11,7 +11,7 @@ use super::hull::convex_hull;
 use super::meshed::{minkowski_of_meshes, surface_bounds, surface_points, union_only};
 use super::partition::convex_pieces;
 use super::primitives::Made;
-use super::syntax::CsgNode;
+use super::syntax::{CsgNode, CsgValue};
 use super::{combine, is_flat, kind, Builder, Built, GhostKind, Kind, Tinted};
 use crate::csg::{ConvexPolyhedron, CsgSolid, CsgTree, Primitive, Shape};
 use crate::error::Result;
@@ -399,8 +399,14 @@ impl Builder<'_> {
     }
 
     /// The union of a node's children as one 2-D region (an extrusion's
-    /// shape).
+    /// shape), or the DXF drawing the extrusion names in `file`.
     fn flat_children(&mut self, node: &CsgNode) -> Result<Region> {
+        // The old way: a DXF drawing named by the extrusion itself.
+        if let Some(CsgValue::Text(file)) = node.arg("file").map(|a| &a.value) {
+            if !file.is_empty() {
+                return self.dxf(node, &file.clone());
+            }
+        }
         let mut regions = Vec::new();
         for kid in &node.children {
             regions.push(self.flat(kid)?);
