@@ -365,8 +365,10 @@ fn cutters_flush_with_their_part_are_left_out_only_where_they_cannot_meet_it() {
 }
 
 /// The BVH-culled ray caster (a primitive whose box the ray misses counts as
-/// missed) finds exactly what casting every primitive finds, on random solids
-/// large enough to get a BVH, for rays from inside and outside their reach.
+/// missed, a union's operands read nearest box first and left once one box
+/// lies past the nearest hit) finds exactly what casting every primitive
+/// finds, on random solids large enough to get a BVH, for rays from inside
+/// and outside their reach.
 #[test]
 fn culling_primitives_by_their_boxes_changes_no_hit() {
     use kage::csg::CsgCaster;
@@ -374,7 +376,9 @@ fn culling_primitives_by_their_boxes_changes_no_hit() {
     let (mut hits, mut rays) = (0, 0);
     for _ in 0..40 {
         let mut prims = Vec::new();
-        let kids = (0..6).map(|_| random_tree(&mut rng, &mut prims, 3)).collect();
+        // Six operands are read in turn; from eight, nearest box first.
+        let operands = rng.gen_range(6..14);
+        let kids = (0..operands).map(|_| random_tree(&mut rng, &mut prims, 3)).collect();
         let mut solid = CsgSolid { primitives: prims, tree: Some(CsgTree::Union(kids)) };
         // Spread the parts out, so boxes separate them.
         for p in &mut solid.primitives {

@@ -38,6 +38,15 @@ pub fn above(t: f32) -> f32 {
 pub trait LeafSpans {
     /// Primitive `i`'s interval, if the ray meets it.
     fn span(&self, i: usize) -> Option<Interval>;
+
+    /// A bound below which primitive `i`'s interval cannot start (where the
+    /// ray enters its box): a union's first hit reads its operands nearest
+    /// bound first and stops at one beyond the nearest hit found. Minus
+    /// infinity (the default) when not known.
+    #[inline(always)]
+    fn entry_bound(&self, _i: usize) -> f32 {
+        f32::NEG_INFINITY
+    }
 }
 
 impl<F: Fn(usize) -> Option<Interval>> LeafSpans for F {

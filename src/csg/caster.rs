@@ -136,6 +136,13 @@ impl CsgCaster {
     /// cutters, and on one whose rays meet a few of its thousand parts).
     const NODES_PER_COUNTED: usize = 4;
 
+    /// Operands from which a union's first hit visits them nearest box
+    /// first and stops past the nearest hit (fewer are read in turn: the
+    /// ordering costs more than it saves). On a union of 101 stacked closed
+    /// meshes (Round-Anything's radius extrusion, 960 × 540) it cut the edge
+    /// pass's rays from 1.99 s to 0.36 s, the image unchanged to the bit.
+    const PRUNED_UNION: usize = 8;
+
     /// The solid.
     #[must_use]
     pub fn solid(&self) -> &CsgSolid {
@@ -353,7 +360,8 @@ impl CsgCaster {
     /// buffers reused from pixel to pixel.
     #[must_use]
     pub fn first_hit_with(&self, tree: &CsgTree, ray: &Ray, t_min: f32, scratch: &mut SpanScratch) -> Option<Crossing> {
-        self.first_hit_in_by(tree, &|i| self.interval(i, ray), t_min, scratch).map(|h| self.crossing_on_ray(h, ray))
+        self.first_hit_in_by(tree, &RaySpans { caster: self, ray }, t_min, scratch)
+            .map(|h| self.crossing_on_ray(h, ray))
     }
 
     /// The first surface at `t > t_min` of the solid `tree` describes (seed
@@ -384,6 +392,23 @@ impl CsgCaster {
         let Parts { operation, others, .. } = tree.parts();
         if operation == Operation::Union {
             let mut nearest: Option<Hit> = None;
+            if others.clone().nth(Self::PRUNED_UNION - 1).is_some() {
+                // Many operands: nearest box first, none past the nearest hit.
+                let bound = |k: B| k.leaf().map_or(f32::NEG_INFINITY, |i| leaf.entry_bound(i));
+                let mut order: Vec<(f32, B)> = others.map(|k| (bound(k), k)).collect();
+                order.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
+                for (bound, k) in order {
+                    if nearest.is_some_and(|n| n.t < bound) {
+                        break;
+                    }
+                    match first_entry(k, leaf, t_min, scratch) {
+                        Ok(Some(h)) if nearest.is_none_or(|n| h.nearer_than(&n)) => nearest = Some(h),
+                        Ok(_) => {}
+                        Err(Inside) => return first_of_all(tree, leaf, t_min, scratch),
+                    }
+                }
+                return nearest;
+            }
             for k in others {
                 match first_entry(k, leaf, t_min, scratch) {
                     Ok(Some(h)) if nearest.is_none_or(|n| h.nearer_than(&n)) => nearest = Some(h),
@@ -476,7 +501,7 @@ impl CsgCaster {
                 counts.fit(shape);
                 met.iter().for_each(|&i| counts.set(shape, i as usize, true));
                 let root = counts.root(shape);
-                let hit = root.and_then(|root| self.first_hit_in_by(root, &|i| self.interval(i, ray), t_min, s));
+                let hit = root.and_then(|root| self.first_hit_in_by(root, &RaySpans { caster: self, ray }, t_min, s));
                 counts.clear(shape);
                 s.counts = counts;
                 hit
@@ -485,7 +510,8 @@ impl CsgCaster {
                 let mut crossed = std::mem::take(&mut s.crossed);
                 crossed.resize(self.frames.len(), false);
                 met.iter().for_each(|&i| crossed[i as usize] = true);
-                let leaf = |i: usize| if crossed[i] { self.interval(i, ray) } else { None };
+                let leaf = RaySpans { caster: self, ray };
+                let leaf = Crossed { crossed: &crossed, leaf };
                 let hit = self.first_hit_in_by(tree, &leaf, t_min, s);
                 met.iter().for_each(|&i| crossed[i as usize] = false);
                 s.crossed = crossed;
@@ -534,6 +560,60 @@ pub fn primitive_span(p: &Primitive, index: usize, ray: &Ray) -> Option<Span> {
         cut: false,
     };
     Some(Span { enter: crossing(t0, f0), exit: crossing(t1, f1) })
+}
+
+/// The spans of one ray, with where it enters each primitive's box.
+struct RaySpans<'a> {
+    caster: &'a CsgCaster,
+    ray: &'a Ray,
+}
+
+impl LeafSpans for RaySpans<'_> {
+    #[inline(always)]
+    fn span(&self, i: usize) -> Option<Interval> {
+        self.caster.interval(i, self.ray)
+    }
+
+    fn entry_bound(&self, i: usize) -> f32 {
+        let (o, d) = self.caster.unit_ray(i, self.ray);
+        let (lo, hi) = self.caster.unit_boxes[i];
+        let inv = Vec3A::ONE / Vec3A::from(d);
+        let (a, b) = ((lo - Vec3A::from(o)) * inv, (hi - Vec3A::from(o)) * inv);
+        let (near, far) = (a.min(b).max_element(), a.max(b).min_element());
+        if near.is_nan() || far.is_nan() {
+            return f32::NEG_INFINITY;
+        }
+        if near > far {
+            return f32::INFINITY;
+        }
+        // A little short of the box, for rounding in the primitive's own cut.
+        near - 1e-4 * near.abs().max(1.0)
+    }
+}
+
+/// [`RaySpans`] of the primitives a ray's boxes crossed only.
+struct Crossed<'a> {
+    crossed: &'a [bool],
+    leaf: RaySpans<'a>,
+}
+
+impl LeafSpans for Crossed<'_> {
+    #[inline(always)]
+    fn span(&self, i: usize) -> Option<Interval> {
+        if self.crossed[i] {
+            self.leaf.span(i)
+        } else {
+            None
+        }
+    }
+
+    fn entry_bound(&self, i: usize) -> f32 {
+        if self.crossed[i] {
+            self.leaf.entry_bound(i)
+        } else {
+            f32::INFINITY
+        }
+    }
 }
 
 #[cfg(test)]
