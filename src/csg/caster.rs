@@ -392,31 +392,38 @@ impl CsgCaster {
         let Parts { operation, others, .. } = tree.parts();
         if operation == Operation::Union {
             let mut nearest: Option<Hit> = None;
-            if others.clone().nth(Self::PRUNED_UNION - 1).is_some() {
+            // Each operand's first entry; `Err` when the ray starts inside one.
+            let mut read = |k: B, nearest: &mut Option<Hit>| {
+                if let Some(h) = first_entry(k, leaf, t_min, scratch)? {
+                    if nearest.is_none_or(|n| h.nearer_than(&n)) {
+                        *nearest = Some(h);
+                    }
+                }
+                Ok::<(), Inside>(())
+            };
+            let outside = if others.clone().nth(Self::PRUNED_UNION - 1).is_some() {
                 // Many operands: nearest box first, none past the nearest hit.
                 let bound = |k: B| k.leaf().map_or(f32::NEG_INFINITY, |i| leaf.entry_bound(i));
                 let mut order: Vec<(f32, B)> = others.map(|k| (bound(k), k)).collect();
                 order.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
+                let mut outside = Ok(());
                 for (bound, k) in order {
                     if nearest.is_some_and(|n| n.t < bound) {
                         break;
                     }
-                    match first_entry(k, leaf, t_min, scratch) {
-                        Ok(Some(h)) if nearest.is_none_or(|n| h.nearer_than(&n)) => nearest = Some(h),
-                        Ok(_) => {}
-                        Err(Inside) => return first_of_all(tree, leaf, t_min, scratch),
+                    outside = read(k, &mut nearest);
+                    if outside.is_err() {
+                        break;
                     }
                 }
-                return nearest;
-            }
-            for k in others {
-                match first_entry(k, leaf, t_min, scratch) {
-                    Ok(Some(h)) if nearest.is_none_or(|n| h.nearer_than(&n)) => nearest = Some(h),
-                    Ok(_) => {}
-                    Err(Inside) => return first_of_all(tree, leaf, t_min, scratch),
-                }
-            }
-            return nearest;
+                outside
+            } else {
+                others.into_iter().try_for_each(|k| read(k, &mut nearest))
+            };
+            return match outside {
+                Ok(()) => nearest,
+                Err(Inside) => first_of_all(tree, leaf, t_min, scratch),
+            };
         }
         first_of_all(tree, leaf, t_min, scratch)
     }

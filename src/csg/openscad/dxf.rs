@@ -477,7 +477,7 @@ mod tests {
     use super::*;
 
     fn read(text: &str, layer: &str) -> DxfDrawing {
-        let fragments = |r: f64| ((360.0_f64 / 12.0).min(r * std::f64::consts::TAU / 2.0).max(5.0)).ceil() as usize;
+        let fragments = |r: f64| super::super::args::fragment_count([0.0, 12.0, 2.0], r) as usize;
         let options = DxfOptions { layer, origin: DVec2::ZERO, scale: 1.0, fragments: &fragments, max_lines: 100_000 };
         dxf_region(text.as_bytes(), &options)
     }
