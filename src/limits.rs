@@ -32,7 +32,9 @@ pub enum Limit {
     Triangles,
     /// Convex primitives in one CSG solid.
     Primitives,
-    /// Points of one OpenSCAD `polygon()` or `polyhedron()`.
+    /// Points of one OpenSCAD `polygon()` or `polyhedron()`, of one imported
+    /// drawing (an SVG's points, a DXF's line pieces), and heights of one
+    /// height map (a `.dat` file's numbers, a PNG's pixels).
     Points,
     /// Slices of one extrusion (`linear_extrude`'s `slices`, `rotate_extrude`'s
     /// segments).
