@@ -98,10 +98,23 @@ impl Builder<'_> {
     }
 
     /// OpenSCAD's number of fragments around a circle of radius `r`, at
-    /// most [`Limit::Segments`]; `$fn`, `$fa` and `$fs` must be finite (and
-    /// `$fa`, `$fs` positive when `$fn` does not decide).
+    /// most [`Limit::Segments`] ([`Builder::fragment_spec`] checks the
+    /// numbers it comes from).
     pub(super) fn fragments(&self, node: &CsgNode, r: f32) -> Result<usize> {
-        // OpenSCAD's defaults where a hand-written file leaves them out.
+        let spec = self.fragment_spec(node)?;
+        let n = fragment_count(spec, f64::from(r));
+        let what = || format!("`{}()`'s circle", node.name);
+        if let Err(e) = self.limits.check(Limit::Segments, n.min(1e18) as u64, what) {
+            let span = self.span_of(node, if spec[0] > 0.0 { "$fn" } else { "$fs" });
+            return Err(self.invalid(&span, e.to_string()));
+        }
+        Ok(n as usize)
+    }
+
+    /// A node's `[$fn, $fa, $fs]` (OpenSCAD's defaults where a hand-written
+    /// file leaves them out): finite, and `$fa`, `$fs` positive when `$fn`
+    /// does not decide.
+    pub(super) fn fragment_spec(&self, node: &CsgNode) -> Result<[f64; 3]> {
         let (fine, fa, fs) =
             (self.number_or(node, "$fn", 0.0)?, self.number_or(node, "$fa", 12.0)?, self.number_or(node, "$fs", 2.0)?);
         for (name, v) in [("$fn", fine), ("$fa", fa), ("$fs", fs)] {
@@ -115,13 +128,7 @@ impl Builder<'_> {
             let name = if fa <= 0.0 { "$fa" } else { "$fs" };
             return Err(self.invalid(&self.span_of(node, name), format!("`{name}` must be above 0 when `$fn` is 0")));
         }
-        let n = fragment_count([fine, fa, fs], f64::from(r));
-        let what = || format!("`{}()`'s circle", node.name);
-        if let Err(e) = self.limits.check(Limit::Segments, n.min(1e18) as u64, what) {
-            let span = self.span_of(node, if fine > 0.0 { "$fn" } else { "$fs" });
-            return Err(self.invalid(&span, e.to_string()));
-        }
-        Ok(n as usize)
+        Ok([fine, fa, fs])
     }
 
     pub(super) fn arg<'n>(&self, node: &'n CsgNode, name: &str) -> Result<&'n CsgValue> {

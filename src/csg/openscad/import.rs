@@ -91,8 +91,7 @@ impl Builder<'_> {
         }
         // Refuses a `$fn` (or `$fa`) past the limit for any radius.
         self.fragments(node, f32::MAX)?;
-        let spec =
-            [self.number_or(node, "$fn", 0.0)?, self.number_or(node, "$fa", 12.0)?, self.number_or(node, "$fs", 2.0)?];
+        let spec = self.fragment_spec(node)?;
         let fragments = |r: f64| fragment_count(spec, r) as usize;
         let max_lines = self.limits.get(Limit::Points) as usize;
         let options = DxfOptions { layer: &layer, origin, scale, fragments: &fragments, max_lines };
