@@ -3,6 +3,8 @@
 # each NAME.scad here names one part of one project (SOURCES.md: which, at
 # which commit, under which licence). For each, OpenSCAD 2021.01 writes
 #   NAME.csg        the flattened tree kage reads (kept in the repository),
+#   files/*         the drawings and meshes a tree imports (kept: the tree
+#                   names them by paths relative to itself),
 #   stl/NAME.stl    the exact mesh of that tree, by OpenSCAD's own CGAL render (not kept:
 #                   rebuilt here; models whose render fails or passes the
 #                   time limit get none, and the benchmark says so).
@@ -28,18 +30,28 @@ projects=(
   "MCAD openscad+MCAD 4b4caeb5dad3301139541d039f14eac654f90487"
   "Round-Anything Irev-Dev+Round-Anything 061fef7c429628808e847696bb345a9b0ec6e279"
   "LEGO.scad cfinke+LEGO.scad d717ca8e29dbb62f271bf351b35179060eaa744e"
+  "openflexure_microscope rwb27+openflexure_microscope 0cedf45238bb1cf8185f4ad92d366eb36f44efc3"
 )
 
-lib="$(mktemp -d)"
+# The projects sit in a folder beside the trees while OpenSCAD runs, so that
+# the paths it writes for imported files are relative ones that can be moved.
+lib="$here/.lib"
+rm -rf "$lib"
+mkdir -p "$lib"
 trap 'rm -rf "$lib"' EXIT
 for p in "${projects[@]}"; do
   read -r folder repo commit <<<"$p"
   git_dir="$sources/$repo/repo"
   [ -d "$git_dir" ] || git_dir="$sources/$repo"
   mkdir -p "$lib/$folder"
-  # Source files only (snapshots may lack large binary files).
-  git -C "$git_dir" ls-tree -r --name-only "$commit" | grep '\.scad$' |
-    xargs -d '\n' git -C "$git_dir" archive "$commit" -- | tar -x -C "$lib/$folder"
+  # Source files and the drawings and meshes they import (snapshots may lack
+  # large binary files; the projects' documentation and examples are left out).
+  git -C "$git_dir" ls-tree -r "$commit" | grep -E '\.(scad|dxf|svg|stl|STL|dat)$' |
+    grep -v -P '\t(docs|examples)/' |
+    while IFS=$'\t' read -r meta path; do
+      if git -C "$git_dir" cat-file -e "${meta##* }" 2>/dev/null; then printf '%s\n' "$path"; fi
+    done |
+    xargs -d '\n' git -C "$git_dir" --literal-pathspecs archive "$commit" -- | tar -x -C "$lib/$folder"
 done
 # Prusa's parts include their neighbours by plain names.
 export OPENSCADPATH="$lib"
@@ -52,6 +64,16 @@ for name in "${names[@]}"; do
   if ! openscad -o "$name.csg" "$name.scad" >"$lib/log" 2>&1; then
     echo "$name: openscad could not export the tree:"; tail -3 "$lib/log"; continue
   fi
+  # Files imported from a project move to files/, and the tree names them there.
+  { grep -o 'file = "\.lib/[^"]*"' "$name.csg" || true; } | sed 's/^file = "//; s/"$//' | sort -u |
+    while read -r imported; do
+      mkdir -p files
+      cp "$imported" "files/$(basename "$imported")"
+      # A licence beside an imported file travels with it.
+      licence="$(dirname "$imported")/LICENSE.txt"
+      [ ! -f "$licence" ] || cp "$licence" "files/$(basename "$(dirname "$imported")")-LICENSE.txt"
+      sed -i "s|file = \"$imported\"|file = \"files/$(basename "$imported")\"|g" "$name.csg"
+    done
   # The exact mesh of the tree itself: a library that draws more in
   # OpenSCAD's preview ($preview) baked that into the tree.
   if timeout "$timeout_s" openscad --export-format binstl -o "stl/$name.stl" "$name.csg" >"$lib/log" 2>&1; then

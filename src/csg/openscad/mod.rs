@@ -33,6 +33,7 @@ mod flat;
 mod hull;
 mod import;
 mod meshed;
+mod pieces;
 pub use import::drawing_outlines;
 pub use meshed::surface_mesh;
 pub use text::text_outlines;

@@ -8,12 +8,13 @@ use glam::{Affine3A, DVec2, Vec3, Vec4};
 use super::extrude::{revolution, revolved, slab, wedge, Cone, Layers};
 use super::flat::Region;
 use super::hull::convex_hull;
-use super::meshed::{minkowski_of_meshes, surface_bounds, surface_points, union_only};
+use super::meshed::{minkowski_of_meshes, surface_bounds, surface_points};
 use super::partition::convex_pieces;
+use super::pieces::convex_summands;
 use super::primitives::Made;
 use super::syntax::{CsgNode, CsgValue};
 use super::{combine, is_flat, kind, Builder, Built, GhostKind, Kind, Tinted};
-use crate::csg::{ConvexPolyhedron, CsgSolid, CsgTree, Primitive, Shape};
+use crate::csg::{ConvexPolyhedron, CsgTree, Primitive, Shape};
 use crate::error::Result;
 use crate::limits::Limit;
 
@@ -22,6 +23,10 @@ use crate::limits::Limit;
 /// a shape with curved outlines cut into hundreds of pieces costs every ray
 /// and every scanline a box per piece, where the mesh costs its few layers.
 const MESHED_PIECES: usize = 24;
+
+/// The most convex pieces a cut or intersected child of a `minkowski()` is
+/// split into before it is summed by Manifold as a mesh instead.
+const MINKOWSKI_PIECES: usize = 512;
 
 /// Half the thickness of a plate: OpenSCAD's preview draws a 2-D shape from
 /// z = −½ to ½, and a subtracted one a tenth thicker.
@@ -203,12 +208,14 @@ impl Builder<'_> {
         self.push(Primitive { shape, transform: m, color, source: node.span.clone() })
     }
 
-    /// `minkowski()`: of children that are each a union of convex parts,
-    /// the union, over every choice of one part per child, of the hull of
-    /// the sums of their corners (a Minkowski sum distributes over unions,
-    /// and that of convex parts is the hull of their corners' sums); of
-    /// children cut or intersected, Manifold's sum of their meshes, as a
-    /// closed mesh.
+    /// `minkowski()`: each child as a union of convex pieces (its parts, or
+    /// for a child cut or intersected the pieces [`convex_summands`] splits it
+    /// into), then the union, over every choice of one piece per child, of
+    /// the hull of the sums of their corners (a Minkowski sum distributes
+    /// over unions, and that of convex pieces is the hull of their corners'
+    /// sums). Children holding meshes, or splitting into more than
+    /// [`MINKOWSKI_PIECES`] pieces, are summed by Manifold as meshes, into
+    /// one closed mesh.
     fn minkowski(&mut self, node: &CsgNode, m: Affine3A, color: Option<Vec4>) -> Result<Built> {
         let mut solids = Vec::new();
         for kid in node.children.iter().filter(|k| !k.background) {
@@ -218,19 +225,14 @@ impl Builder<'_> {
             }
             solids.push(solid);
         }
-        let convex = |s: &CsgSolid| {
-            s.tree.as_ref().is_some_and(union_only)
-                && !s.primitives.iter().any(|p| matches!(p.shape, Shape::Mesh { .. }))
-        };
-        if !solids.iter().all(convex) {
+        let pieces: Option<Vec<_>> = solids.iter().map(|s| convex_summands(s, MINKOWSKI_PIECES)).collect();
+        let Some(factors) = pieces else {
             let mesh = minkowski_of_meshes(&solids);
             return match mesh {
                 Some(mesh) => self.push_mesh(node, mesh, m, color),
                 None => Ok(Built::Empty),
             };
-        }
-        let factors: Vec<Vec<Vec<Vec3>>> =
-            solids.iter().map(|s| s.primitives.iter().map(|p| p.corners()).collect()).collect();
+        };
         let count: u64 = factors.iter().map(|f| f.len() as u64).product();
         self.check(node, Limit::Primitives, count, || "this minkowski()'s pieces (one per choice of parts)".into())?;
         let mut sums: Vec<Vec<Vec3>> = vec![vec![Vec3::ZERO]];

@@ -15,8 +15,10 @@
 //! bundled; any other `font = "Family:style=Style"` is looked up among the
 //! fonts beside the model and the system's font folders, then as its
 //! metric-compatible stand-in (Helvetica and Arial: Liberation Sans, as
-//! fontconfig substitutes them), and falls back to Liberation Sans with a
-//! warning.
+//! fontconfig substitutes them); a font not found is a warning, and the font
+//! drawn instead is the one fontconfig matches to the name (`fc-match`, what
+//! OpenSCAD draws on the same machine) or, without fontconfig, Liberation
+//! Sans.
 
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, OnceLock};
@@ -141,10 +143,30 @@ fn faces_in(path: &Path) -> Vec<(String, String, PathBuf, u32)> {
         .collect()
 }
 
+/// The font fontconfig matches to `family` in `style` (its best guess for a
+/// family it does not have, which is what OpenSCAD draws): its family and
+/// style for messages, and its file and face index. `None` where `fc-match`
+/// is not installed or answers nothing usable.
+fn fontconfig_match(family: &str, style: &str) -> Option<(String, (PathBuf, u32))> {
+    let pattern = format!("{}:style={}", family.replace(':', "\\:"), style.replace(':', "\\:"));
+    let out = std::process::Command::new("fc-match")
+        .args(["-f", "%{family[0]}\n%{style[0]}\n%{file}\n%{index}", &pattern])
+        .stderr(std::process::Stdio::null())
+        .output()
+        .ok()?;
+    let text = String::from_utf8(out.stdout).ok()?;
+    let mut lines = text.lines();
+    let (matched, matched_style, file) = (lines.next()?, lines.next()?, lines.next()?);
+    let index = lines.next().and_then(|i| i.trim().parse().ok()).unwrap_or(0);
+    let file = PathBuf::from(file);
+    (out.status.success() && file.is_file()).then(|| (format!("{matched} {matched_style}"), (file, index)))
+}
+
 impl Builder<'_> {
     /// The font `font` names (beside the model, bundled, or on the system),
     /// else its metric-compatible stand-in as fontconfig picks it (Helvetica
-    /// and Arial: Liberation Sans), or Liberation Sans with a warning.
+    /// and Arial: Liberation Sans), else with a warning the font fontconfig
+    /// matches (as OpenSCAD draws it) or, without fontconfig, Liberation Sans.
     fn font(&mut self, node: &CsgNode, font: &str) -> Result<FontFile> {
         let (family, style) = family_and_style(font);
         let same = |a: &str, b: &str| a.eq_ignore_ascii_case(b);
@@ -152,6 +174,18 @@ impl Builder<'_> {
         for name in std::iter::once(family.as_str()).chain(alias) {
             if let Some(found) = self.font_named(node, name, &style)? {
                 return Ok(found);
+            }
+        }
+        if let Some((matched, file)) = fontconfig_match(&family, &style) {
+            let size = std::fs::metadata(&file.0).map(|m| m.len()).unwrap_or(0);
+            let what = || format!("the font file {}", file.0.display());
+            self.limits.check_bytes(Limit::FileMb, size, what).map_err(|e| self.invalid(&node.span, e.to_string()))?;
+            if let Ok(bytes) = std::fs::read(&file.0) {
+                self.warn(
+                    &node.span,
+                    format!("font \"{family}\" ({style}) not found: {matched}, fontconfig's match (as OpenSCAD picks it), drawn instead"),
+                );
+                return Ok(FontFile { bytes: bytes.into(), index: file.1 });
             }
         }
         let fallback = if same(&style, "Bold") { "Bold" } else { "Regular" };

@@ -1,0 +1,3 @@
+// Original Prusa i3 MK3, Frame/MK3v8b.dxf: the frame drawing with its holes, extruded to
+// the frame's 6 mm (build.sh puts the projects in .lib/).
+linear_extrude(6) import(".lib/Original-Prusa-i3/Frame/MK3v8b.dxf");

@@ -1,0 +1,2 @@
+// OpenFlexure Microscope openscad/actuator_drilling_jig.scad as it is.
+include <openflexure_microscope/openscad/actuator_drilling_jig.scad>
