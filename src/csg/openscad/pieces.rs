@@ -222,8 +222,6 @@ mod tests {
     }
 
     fn volume(p: &Piece) -> f64 {
-        // The hull's volume by its planes: sum over faces of d * area / 3 is
-        // awkward here; the divergence over the triangulated hull instead.
         let input: Vec<MVec3> = p.corners.iter().map(|c| MVec3::new(c.x, c.y, c.z)).collect();
         Manifold::hull(&input).volume()
     }
@@ -260,6 +258,35 @@ mod tests {
             for q in &parts[i + 1..] {
                 assert!(p.intersect(q).map_or(0.0, |r| volume(&r)) < 1e-9, "pieces overlap");
             }
+        }
+    }
+
+    /// A random convex piece: the hull of 4 to 12 points in a box of side 2
+    /// about `centre`.
+    fn random_piece() -> impl proptest::strategy::Strategy<Value = Vec<DVec3>> {
+        use proptest::prelude::*;
+        (proptest::collection::vec((-1.0..1.0f64, -1.0..1.0f64, -1.0..1.0f64), 4..12), (-1.0..1.0f64, -1.0..1.0f64))
+            .prop_map(|(points, (cx, cy))| points.into_iter().map(|(x, y, z)| DVec3::new(x + cx, y + cy, z)).collect())
+    }
+
+    fn manifold_of(p: &Piece) -> Manifold {
+        Manifold::hull(&p.corners.iter().map(|c| MVec3::new(c.x, c.y, c.z)).collect::<Vec<_>>())
+    }
+
+    proptest::proptest! {
+        /// Against Manifold's booleans of the same hulls: the intersection
+        /// has the volume of Manifold's, and the pieces left by a cut are
+        /// disjoint and hold the volume of Manifold's difference.
+        #[test]
+        fn intersections_and_cuts_hold_the_volume_manifolds_booleans_find(a in random_piece(), b in random_piece()) {
+            let (Some(a), Some(b)) = (Piece::hull(&a), Piece::hull(&b)) else { return Ok(()) };
+            let both = manifold_of(&a).intersection(&manifold_of(&b)).volume();
+            let ours = a.intersect(&b).map_or(0.0, |p| volume(&p));
+            proptest::prop_assert!((ours - both).abs() < 1e-6, "intersection {} against {}", ours, both);
+            let rest = manifold_of(&a).difference(&manifold_of(&b)).volume();
+            let parts = outside(&a, &b);
+            let ours: f64 = parts.iter().map(volume).sum();
+            proptest::prop_assert!((ours - rest).abs() < 1e-6, "difference {} against {}", ours, rest);
         }
     }
 
