@@ -14,8 +14,9 @@
 //! Pieces that are flat (no volume) are dropped, as OpenSCAD's regularised
 //! booleans drop them. Cut solids can split into many pieces: past a budget
 //! the caller falls back to Manifold's sum of meshes. On the OpenFlexure
-//! microscope's body (six sums of a cylinder with an intersection of hulls)
-//! this is 3.4 s of Manifold's sums against a few milliseconds here.
+//! microscope's body (six sums of a cylinder with an intersection of hulls,
+//! 0.57 s each by Manifold) the whole `kage render` at 640 × 480 fell from
+//! 3.9 s to 0.64 s, the image the same.
 
 use glam::{DVec3, Vec3};
 use manifold_rust::linalg::Vec3 as MVec3;
