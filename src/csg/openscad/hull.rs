@@ -22,19 +22,11 @@ pub(crate) fn convex_hull(points: &[Vec3]) -> Option<ConvexPolyhedron> {
     if points.len() < 4 || size.is_nan() || size <= 0.0 {
         return None;
     }
-    let input: Vec<MVec3> = points.iter().map(|p| MVec3::new(p.x.into(), p.y.into(), p.z.into())).collect();
-    let mesh = Manifold::hull(&input).get_mesh_gl64(0);
-    let stride = mesh.num_prop as usize;
-    let corner = |k: u64| {
-        let at = k as usize * stride;
-        DVec3::from_slice(&mesh.vert_properties[at..at + 3])
-    };
-    let triangles: Vec<[DVec3; 3]> =
-        mesh.tri_verts.chunks_exact(3).map(|t| [corner(t[0]), corner(t[1]), corner(t[2])]).collect();
+    let (mut corners, triangles) = hull_mesh(points.iter().map(|p| p.as_dvec3()));
+    let triangles: Vec<[DVec3; 3]> = triangles.iter().map(|t| t.map(|k| corners[k])).collect();
     if triangles.len() < 4 {
         return None;
     }
-    let mut corners: Vec<DVec3> = (0..mesh.vert_properties.len() / stride.max(1)).map(|k| corner(k as u64)).collect();
     corners.sort_by(|a, b| a.to_array().partial_cmp(&b.to_array()).unwrap_or(std::cmp::Ordering::Equal));
     corners.dedup();
     let centroid = corners.iter().copied().sum::<DVec3>() / corners.len() as f64;
@@ -66,6 +58,18 @@ pub(crate) fn convex_hull(points: &[Vec3]) -> Option<ConvexPolyhedron> {
     planes.sort_by(|a, b| a.to_array().partial_cmp(&b.to_array()).unwrap_or(std::cmp::Ordering::Equal));
     planes.dedup();
     (planes.len() >= 4).then(|| ConvexPolyhedron { planes, vertices: corners.iter().map(|c| c.as_vec3()).collect() })
+}
+
+/// The hull of `points` as Manifold's quickhull makes it, in f64: its corners
+/// and its triangles (indices into the corners, wound outwards).
+#[must_use]
+pub(super) fn hull_mesh(points: impl Iterator<Item = DVec3>) -> (Vec<DVec3>, Vec<[usize; 3]>) {
+    let input: Vec<MVec3> = points.map(|p| MVec3::new(p.x, p.y, p.z)).collect();
+    let mesh = Manifold::hull(&input).get_mesh_gl64(0);
+    let stride = (mesh.num_prop as usize).max(3);
+    let corners = mesh.vert_properties.chunks_exact(stride).map(DVec3::from_slice).collect();
+    let triangles = mesh.tri_verts.chunks_exact(3).map(|t| [t[0], t[1], t[2]].map(|k| k as usize)).collect();
+    (corners, triangles)
 }
 
 /// The plane of a convex face from its corners `on` (sorted, so the result

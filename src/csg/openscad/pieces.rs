@@ -19,9 +19,8 @@
 //! 3.9 s to 0.64 s, the image the same.
 
 use glam::{DVec3, Vec3};
-use manifold_rust::linalg::Vec3 as MVec3;
-use manifold_rust::manifold::Manifold;
 
+use super::hull::hull_mesh;
 use super::meshed::union_only;
 use crate::csg::{CsgSolid, CsgTree, Shape};
 
@@ -46,16 +45,12 @@ impl Piece {
         if !(size > 0.0 && size.is_finite()) {
             return None;
         }
-        let input: Vec<MVec3> = points.iter().map(|p| MVec3::new(p.x, p.y, p.z)).collect();
-        let mesh = Manifold::hull(&input).get_mesh_gl64(0);
-        let stride = (mesh.num_prop as usize).max(3);
-        let corners: Vec<DVec3> = mesh.vert_properties.chunks_exact(stride).map(DVec3::from_slice).collect();
+        let (corners, triangles) = hull_mesh(points.iter().copied());
         let eps = 1e-9 * size;
         let mut planes: Vec<(DVec3, f64)> = Vec::new();
         let mut edges: Vec<[usize; 2]> = Vec::new();
         let mut volume = 0.0;
-        for t in mesh.tri_verts.chunks_exact(3) {
-            let [a, b, c] = [t[0], t[1], t[2]].map(|k| k as usize);
+        for [a, b, c] in triangles {
             let cross = (corners[b] - corners[a]).cross(corners[c] - corners[a]);
             volume += corners[a].dot(cross);
             let Some(n) = cross.try_normalize() else { continue };
@@ -205,6 +200,9 @@ fn outside(piece: &Piece, cut: &Piece) -> Vec<Piece> {
 
 #[cfg(test)]
 mod tests {
+    use manifold_rust::linalg::Vec3 as MVec3;
+    use manifold_rust::manifold::Manifold;
+
     use super::*;
 
     fn cube(lo: DVec3, hi: DVec3) -> Piece {
