@@ -31,6 +31,7 @@ projects=(
   "Round-Anything Irev-Dev+Round-Anything 061fef7c429628808e847696bb345a9b0ec6e279"
   "LEGO.scad cfinke+LEGO.scad d717ca8e29dbb62f271bf351b35179060eaa744e"
   "openflexure_microscope rwb27+openflexure_microscope 0cedf45238bb1cf8185f4ad92d366eb36f44efc3"
+  "YAPP_Box mrWheel+YAPP_Box f9400c419ef1dea7dc0b3607876989b4f3faa2b7"
 )
 
 # The projects sit in a folder beside the trees while OpenSCAD runs, so that
@@ -45,9 +46,8 @@ for p in "${projects[@]}"; do
   [ -d "$git_dir" ] || git_dir="$sources/$repo"
   mkdir -p "$lib/$folder"
   # Source files and the drawings and meshes they import (snapshots may lack
-  # large binary files; the projects' documentation and examples are left out).
+  # large binary files).
   git -C "$git_dir" ls-tree -r "$commit" | grep -E '\.(scad|dxf|svg|stl|STL|dat)$' |
-    grep -v -P '\t(docs|examples)/' |
     while IFS=$'\t' read -r meta path; do
       if git -C "$git_dir" cat-file -e "${meta##* }" 2>/dev/null; then printf '%s\n' "$path"; fi
     done |
