@@ -114,6 +114,20 @@ impl ClosedMesh {
         Some(mesh)
     }
 
+    /// How many edges are not shared by an even number of triangles: 0 for a
+    /// closed surface (its corners welded by position, as [`ClosedMesh::new`]
+    /// welds them).
+    #[must_use]
+    pub fn open_edges(&self) -> usize {
+        let mut count: std::collections::HashMap<(u32, u32), u32> = std::collections::HashMap::new();
+        for t in &self.triangles {
+            for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
+                *count.entry((a.min(b), a.max(b))).or_default() += 1;
+            }
+        }
+        count.values().filter(|&&n| n % 2 == 1).count()
+    }
+
     /// The vertices.
     #[must_use]
     pub fn positions(&self) -> &[Vec3] {
@@ -335,6 +349,20 @@ mod tests {
             }
         }
         ClosedMesh::new(positions, triangles).unwrap()
+    }
+
+    #[test]
+    fn closed_cubes_have_no_open_edge_and_a_cube_without_its_top_has_four() {
+        assert_eq!(two_cubes().open_edges(), 0);
+        // One cube as an STL has it (every triangle its own corners), less its top.
+        let cube = two_cubes();
+        let soup: Vec<Vec3> = cube.triangles[..12].iter().flatten().map(|&i| cube.positions[i as usize]).collect();
+        let triangles: Vec<[u32; 3]> = (0..12u32).map(|t| [3 * t, 3 * t + 1, 3 * t + 2]).collect();
+        assert_eq!(ClosedMesh::new(soup.clone(), triangles.clone()).unwrap().open_edges(), 0);
+        let top = |t: &[u32; 3]| t.iter().all(|&i| soup[i as usize].z == 1.0);
+        let open: Vec<[u32; 3]> = triangles.into_iter().filter(|t| !top(t)).collect();
+        assert_eq!(open.len(), 10);
+        assert_eq!(ClosedMesh::new(soup, open).unwrap().open_edges(), 4);
     }
 
     #[test]

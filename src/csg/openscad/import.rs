@@ -45,18 +45,21 @@ impl Builder<'_> {
         let file = self.text_or(node, "file", "")?;
         let (positions, triangles) = self.imports.mesh(&file).map_err(|e| self.invalid(&node.span, e))?;
         self.check(node, Limit::Triangles, triangles.len() as u64, || format!("the triangles of {file}"))?;
-        let open = open_edges(&positions, &triangles);
-        if open > 0 {
-            self.warn(
-                &node.span,
-                format!(
-                    "{file} is not closed ({open} edges bound one side only): its inside is taken from the parity \
-                     of its surfaces along each ray, which can be wrong near the gaps (OpenSCAD's render refuses it)"
-                ),
-            );
-        }
         match ClosedMesh::new(positions, triangles) {
-            Some(mesh) => self.push_mesh(node, mesh, m, color),
+            Some(mesh) => {
+                let open = mesh.open_edges();
+                if open > 0 {
+                    self.warn(
+                        &node.span,
+                        format!(
+                            "{file} is not closed ({open} edges bound one side only): its inside is taken from the \
+                             parity of its surfaces along each ray, which can be wrong near the gaps (OpenSCAD's \
+                             render refuses it)"
+                        ),
+                    );
+                }
+                self.push_mesh(node, mesh, m, color)
+            }
             None => {
                 self.warn(&node.span, format!("{file} holds no triangle with an area: nothing is drawn"));
                 Ok(Built::Empty)
@@ -205,31 +208,6 @@ fn heights(bytes: &[u8]) -> std::result::Result<Vec<Vec<f32>>, String> {
     Ok(rows)
 }
 
-/// How many edges of `triangles` are not shared by an even number of them
-/// (0 for a closed surface), corners at the same position being one corner
-/// (an STL repeats them).
-#[must_use]
-fn open_edges(positions: &[Vec3], triangles: &[[u32; 3]]) -> usize {
-    let mut ids: std::collections::HashMap<[u32; 3], u32> = std::collections::HashMap::new();
-    let id: Vec<u32> = positions
-        .iter()
-        .map(|p| {
-            let next = ids.len() as u32;
-            *ids.entry(p.to_array().map(|c| (c + 0.0).to_bits())).or_insert(next)
-        })
-        .collect();
-    let mut count: std::collections::HashMap<(u32, u32), u32> = std::collections::HashMap::new();
-    for t in triangles {
-        let t = t.map(|k| id.get(k as usize).copied().unwrap_or(k));
-        for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
-            if a != b {
-                *count.entry((a.min(b), a.max(b))).or_default() += 1;
-            }
-        }
-    }
-    count.values().filter(|&&n| n % 2 == 1).count()
-}
-
 /// The closed mesh of a heightmap (OpenSCAD's `surface()`).
 fn heightmap(rows: &[Vec<f32>], center: bool) -> Option<ClosedMesh> {
     let (ny, nx) = (rows.len(), rows.first()?.len());
@@ -300,18 +278,6 @@ mod tests {
         let inverted = image_heights(&png, true).unwrap();
         assert!((inverted[23][0] - (100.0 / 255.0) * (1.0 - 30.0)).abs() < 1e-4);
         assert!(image_heights(b"\x89PNG\r\n\x1a\nnope", false).is_err());
-    }
-
-    #[test]
-    fn a_lone_triangle_has_three_open_edges_and_a_tetrahedron_none() {
-        let corners = [Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z];
-        assert_eq!(open_edges(&corners, &[[0, 1, 2]]), 3);
-        assert_eq!(open_edges(&corners, &[[0, 2, 1], [0, 1, 3], [1, 2, 3], [2, 0, 3]]), 0);
-        // The same tetrahedron with every triangle's corners of its own, as an STL has them.
-        let soup: Vec<Vec3> =
-            [[0, 2, 1], [0, 1, 3], [1, 2, 3], [2, 0, 3]].iter().flatten().map(|&k| corners[k]).collect();
-        let triangles: Vec<[u32; 3]> = (0..4).map(|t| [3 * t, 3 * t + 1, 3 * t + 2]).collect();
-        assert_eq!(open_edges(&soup, &triangles), 0);
     }
 
     #[test]
