@@ -176,16 +176,13 @@ impl Builder<'_> {
                 return Ok(found);
             }
         }
-        if let Some((matched, file)) = fontconfig_match(&family, &style) {
-            let size = std::fs::metadata(&file.0).map(|m| m.len()).unwrap_or(0);
-            let what = || format!("the font file {}", file.0.display());
-            self.limits.check_bytes(Limit::FileMb, size, what).map_err(|e| self.invalid(&node.span, e.to_string()))?;
-            if let Ok(bytes) = std::fs::read(&file.0) {
+        if let Some((matched, (path, index))) = fontconfig_match(&family, &style) {
+            if let Some(found) = self.font_file(node, &path, index)? {
                 self.warn(
                     &node.span,
                     format!("font \"{family}\" ({style}) not found: {matched}, fontconfig's match (as OpenSCAD picks it), drawn instead"),
                 );
-                return Ok(FontFile { bytes: bytes.into(), index: file.1 });
+                return Ok(found);
             }
         }
         let fallback = if same(&style, "Bold") { "Bold" } else { "Regular" };
@@ -213,15 +210,21 @@ impl Builder<'_> {
             .chain(if BUNDLED.iter().any(|b| same(b.0, family)) { [].iter() } else { system_fonts().iter() })
             .find(|(f, s, ..)| same(f, family) && same(s, style));
         if let Some((_, _, path, index)) = found {
-            let size = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
-            let what = || format!("the font file {}", path.display());
-            self.limits.check_bytes(Limit::FileMb, size, what).map_err(|e| self.invalid(&node.span, e.to_string()))?;
-            if let Ok(bytes) = std::fs::read(path) {
-                return Ok(Some(FontFile { bytes: bytes.into(), index: *index }));
+            if let Some(file) = self.font_file(node, path, *index)? {
+                return Ok(Some(file));
             }
         }
         let bundled = BUNDLED.iter().find(|b| same(b.0, family) && same(b.1, style));
         Ok(bundled.map(|(.., bytes)| FontFile { bytes: Arc::from(*bytes), index: 0 }))
+    }
+
+    /// The font file at `path` (face `index`), refused past the file-size
+    /// limit; `None` if it cannot be read.
+    fn font_file(&self, node: &CsgNode, path: &Path, index: u32) -> Result<Option<FontFile>> {
+        let size = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
+        let what = || format!("the font file {}", path.display());
+        self.limits.check_bytes(Limit::FileMb, size, what).map_err(|e| self.invalid(&node.span, e.to_string()))?;
+        Ok(std::fs::read(path).ok().map(|bytes| FontFile { bytes: bytes.into(), index }))
     }
 
     /// `text()`'s region: the string's glyphs laid out by [`Layout`].
