@@ -7,10 +7,11 @@
 //!
 //! ```text
 //! limits · error · sampling · image · camera ·       the ground floor: what one input
-//! triangle · bvh                                 may ask for, typed errors, sample
+//! triangle · polygon · bvh                       may ask for, typed errors, sample
 //!                                                patterns, the linear float image and
 //!                                                sRGB, the view and its rays, a ray
-//!                                                against a triangle, the BVH
+//!                                                against a triangle, a polygon face
+//!                                                cut into triangles, the BVH
 //!   ▼
 //! csg            CSG solids (seed 003): model, OpenSCAD reader, ray casting by intervals
 //!   ▼
@@ -56,6 +57,7 @@ pub mod frame;
 pub mod image;
 pub mod limits;
 pub mod output;
+pub mod polygon;
 pub mod raytrace;
 pub mod resolve;
 pub mod sampling;

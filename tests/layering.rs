@@ -16,6 +16,7 @@ const FRAME_ORDER: &[&str] = &[
     "image",
     "camera",
     "triangle",
+    "polygon",
     "bvh",
     "csg",
     "scene",

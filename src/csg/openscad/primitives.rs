@@ -6,8 +6,6 @@ use std::f32::consts::PI;
 use glam::{Affine3A, Vec3, Vec4};
 
 use glam::DVec3;
-use manifold_rust::linalg::Vec2 as MVec2;
-use manifold_rust::polygon::triangulate;
 
 use super::hull::{bounds_size, convex_from_faces};
 use super::syntax::CsgNode;
@@ -15,6 +13,7 @@ use super::{Builder, Geometry};
 use crate::csg::{ClosedMesh, ConvexPolyhedron, Primitive, Shape};
 use crate::error::Result;
 use crate::limits::Limit;
+use crate::polygon::face_triangles;
 
 /// What a primitive node makes.
 pub(super) enum Made {
@@ -31,27 +30,14 @@ pub(super) enum Polyhedron {
 }
 
 /// Faces (polygons of corner indices into `points`) cut into triangles,
-/// wound as each face is: a triangle as it stands, a larger face by
-/// Manifold's ear clipper in its own plane (it may be concave, and its
-/// corners need not lie quite in one plane).
+/// wound as each face is (a face may be concave: see [`crate::polygon`]).
 #[must_use]
 pub(super) fn triangulated(points: &[Vec3], faces: &[Vec<usize>]) -> Vec<[u32; 3]> {
+    let points: Vec<DVec3> = points.iter().map(|p| p.as_dvec3()).collect();
     let mut out = Vec::with_capacity(faces.len() * 2);
-    for f in faces.iter().filter(|f| f.len() >= 3) {
-        if f.len() == 3 {
-            out.push([f[0] as u32, f[1] as u32, f[2] as u32]);
-            continue;
-        }
-        let corners: Vec<DVec3> = f.iter().map(|&i| points[i].as_dvec3()).collect();
-        // Newell's normal: the face's winding, whatever its shape.
-        let normal: DVec3 = (0..corners.len()).map(|k| corners[k].cross(corners[(k + 1) % corners.len()])).sum();
-        let Some(n) = normal.try_normalize() else { continue };
-        let u = n.any_orthonormal_vector();
-        let v = n.cross(u);
-        let flat: Vec<MVec2> = corners.iter().map(|c| MVec2::new(c.dot(u), c.dot(v))).collect();
-        for t in triangulate(&vec![flat], -1.0, true) {
-            out.push([t.x, t.y, t.z].map(|k| f[k as usize] as u32));
-        }
+    for f in faces {
+        let face: Vec<u32> = f.iter().map(|&i| i as u32).collect();
+        face_triangles(&points, &face, &mut out);
     }
     out
 }

@@ -1,6 +1,6 @@
 //! Wavefront OBJ with MTL materials, through `tobj`.
 //!
-//! Polygons are fan-triangulated; OBJ's texture v runs upwards, kage's downwards, so
+//! Polygons, concave or not, are cut into triangles by [`crate::polygon`]; OBJ's texture v runs upwards, kage's downwards, so
 //! v is flipped. A missing `.mtl` file is a warning (many OBJs name one they never
 //! shipped); a texture named by an `.mtl` is looked up in another letter case
 //! when the exact name is absent, and one not found at all is a warning and a
@@ -10,17 +10,18 @@ use std::io::Cursor;
 use std::path::Path;
 use std::sync::Arc;
 
-use glam::{Affine3A, Vec2, Vec3};
+use glam::{Affine3A, DVec3, Vec2, Vec3};
 
 use super::{checked, Files, LoadedModel, Part};
 use crate::error::Error;
+use crate::polygon::face_triangles;
 use crate::scene::mesh::{Mesh, NormalMode};
 use crate::scene::Material;
 
 /// Parses OBJ bytes; `path` locates the MTL files and textures it names.
 pub(super) fn load(bytes: &[u8], path: &Path, from: Files) -> Result<LoadedModel, String> {
     let dir = path.parent().unwrap_or(Path::new(""));
-    let options = tobj::LoadOptions { triangulate: true, single_index: true, ..Default::default() };
+    let options = tobj::LoadOptions { triangulate: false, single_index: true, ..Default::default() };
     let mtl_warnings = std::cell::RefCell::new(Vec::new());
     let parsed = super::contained("the OBJ reader (tobj)", || {
         tobj::load_obj_buf(&mut Cursor::new(bytes), &options, |mtl| {
@@ -106,8 +107,24 @@ fn normalised_mtl(text: &str, file: &Path, warnings: &mut Vec<String>) -> String
 fn mesh(m: &tobj::Mesh) -> Result<(Mesh, crate::scene::mesh::MeshRepairs), String> {
     let v3 = |a: &[f32]| a.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])).collect::<Vec<_>>();
     let uvs = m.texcoords.chunks_exact(2).map(|c| Vec2::new(c[0], 1.0 - c[1])).collect();
-    let triangles = m.indices.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
-    Mesh::new(v3(&m.positions), v3(&m.normals), uvs, triangles, NormalMode::Smooth)
+    let positions = v3(&m.positions);
+    let triangles = if m.face_arities.is_empty() {
+        m.indices.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect()
+    } else {
+        let points: Vec<DVec3> = positions.iter().map(|p| p.as_dvec3()).collect();
+        if m.indices.iter().any(|&i| i as usize >= points.len()) {
+            return Err("a face names a vertex the file does not have".into());
+        }
+        let mut triangles = Vec::with_capacity(m.indices.len());
+        let mut at = 0;
+        for &n in &m.face_arities {
+            let face = m.indices.get(at..at + n as usize).ok_or("a face lists more corners than the file has")?;
+            face_triangles(&points, face, &mut triangles);
+            at += n as usize;
+        }
+        triangles
+    };
+    Mesh::new(positions, v3(&m.normals), uvs, triangles, NormalMode::Smooth)
 }
 
 /// A `.mtl` material as kage's. The illumination model `illum` says which of
@@ -189,4 +206,33 @@ fn material(m: &tobj::Material, dir: &Path, from: Files, warnings: &mut Vec<Stri
         _ => out.opacity = if opacity > 0.0 { opacity } else { 1.0 },
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_concave_face_is_cut_inside_itself() {
+        // One L-shaped face (area 72) listed from its top corner, from where
+        // a fan sweeps across the notch: its triangles' areas would add up
+        // to more than the face's.
+        let l = [(0., 10.), (0., 0.), (12., 0.), (12., 4.), (4., 4.), (4., 10.)];
+        let obj = tobj::Mesh {
+            positions: l.iter().flat_map(|&(x, y)| [x, y, 0.0]).collect(),
+            indices: (0..6).collect(),
+            face_arities: vec![6],
+            ..Default::default()
+        };
+        let (mesh, _) = mesh(&obj).unwrap();
+        let area: f32 = mesh
+            .triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
+                (b - a).cross(c - a).length() / 2.0
+            })
+            .sum();
+        assert!((area - 72.0).abs() < 1e-3, "area {area}");
+    }
 }

@@ -1,12 +1,14 @@
 //! OFF (Object File Format), as OpenSCAD reads and writes it: `OFF`, the
 //! counts of vertices, faces and edges, the vertices (x y z), then each face
-//! as its corner count and corners (polygons are fanned into triangles; a
-//! colour after the corners is ignored). `#` starts a comment.
+//! as its corner count and corners (a polygon, concave or not, is cut into
+//! triangles by [`crate::polygon`]; a colour after the corners is ignored).
+//! `#` starts a comment.
 
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 
 use super::{checked, LoadedModel};
 use crate::limits::{Limit, Limits};
+use crate::polygon::face_triangles;
 use crate::scene::mesh::{Mesh, NormalMode};
 
 /// Parses OFF bytes.
@@ -39,11 +41,13 @@ pub fn load(bytes: &[u8], limits: &Limits) -> Result<LoadedModel, String> {
         }
         positions.push(p);
     }
+    let points: Vec<DVec3> = positions.iter().map(|p| p.as_dvec3()).collect();
     let mut triangles = Vec::with_capacity(faces);
     // Faces are read line by line (a colour may follow the corners), after
     // the header's and the vertices' words.
     let lines = text.lines().map(|l| l.split('#').next().unwrap_or("").trim()).filter(|l| !l.is_empty());
     let mut seen = 0usize;
+    let mut face = 0usize;
     let header_and_vertices = 4 + 3 * vertices;
     for line in lines {
         let ws: Vec<&str> = line.split_whitespace().collect();
@@ -54,16 +58,15 @@ pub fn load(bytes: &[u8], limits: &Limits) -> Result<LoadedModel, String> {
         let corners =
             count(ws[0].parse::<f64>().map_err(|_| format!("`{}` is not a corner count", ws[0]))?, "corners")?;
         if ws.len() < 1 + corners {
-            return Err(format!("face {} lists fewer than its {corners} corners", triangles.len()));
+            return Err(format!("face {face} lists fewer than its {corners} corners"));
         }
         let ix: Vec<u32> = ws[1..=corners]
             .iter()
             .map(|w| w.parse::<u32>().ok().filter(|&i| (i as usize) < vertices))
             .collect::<Option<_>>()
-            .ok_or_else(|| format!("a face names a vertex that is not one of the {vertices}"))?;
-        for k in 1..ix.len().saturating_sub(1) {
-            triangles.push([ix[0], ix[k], ix[k + 1]]);
-        }
+            .ok_or_else(|| format!("face {face} names a vertex that is not one of the {vertices}"))?;
+        face_triangles(&points, &ix, &mut triangles);
+        face += 1;
     }
     let mut model = LoadedModel::default();
     let built = Mesh::new(positions, Vec::new(), Vec::new(), triangles, NormalMode::Flat);
@@ -83,6 +86,26 @@ mod tests {
         assert!(load(b"OFF\n3 1 0\n0 0 0\n1 0 0\n", &Limits::default()).unwrap_err().contains("ends before"));
         assert!(load(b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n", &Limits::default())
             .unwrap_err()
-            .contains("not one of"));
+            .contains("face 0 names a vertex that is not one of"));
+    }
+
+    #[test]
+    fn a_concave_face_is_not_fanned() {
+        // An L-shaped prism whose ends are six-cornered concave faces: two
+        // ends of area 72 and sides of 44 × 8. A fan of an end covers the
+        // L's notch and part of the L twice over, so its triangles' areas
+        // add up to more than the surface's.
+        let off = include_str!("../../../tests/data/openscad/parts/step.off");
+        let m = load(off.as_bytes(), &Limits::default()).unwrap();
+        let mesh = &m.parts[0].mesh;
+        let area: f32 = mesh
+            .triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
+                (b - a).cross(c - a).length() / 2.0
+            })
+            .sum();
+        assert!((area - (2.0 * 72.0 + 44.0 * 8.0)).abs() < 1e-3, "area {area}");
     }
 }
