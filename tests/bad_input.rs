@@ -118,6 +118,12 @@ fn bad_meshes_are_errors_or_warned_repairs() {
     let some = write(&dir, "some.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 2 0 0\nf 1 2 3\nf 1 2 4\n");
     let scene = scene_for_model(&some, 64, 64).unwrap();
     assert!(scene.warnings.iter().any(|w| w.contains("dropped 1 zero-area")), "{:?}", scene.warnings);
+    // Three objects with a zero-area triangle each: one warning, counting 3.
+    let objects =
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 2 0 0\no a\nf 1 2 3\nf 1 2 4\no b\nf 1 2 3\nf 1 2 4\no c\nf 1 2 3\nf 1 2 4\n";
+    let scene = scene_for_model(&write(&dir, "objects.obj", objects), 64, 64).unwrap();
+    let dropped: Vec<&String> = scene.warnings.iter().filter(|w| w.contains("zero-area")).collect();
+    assert!(dropped.len() == 1 && dropped[0].contains("dropped 3 zero-area"), "{dropped:?}");
     let garbage = write(&dir, "garbage.glb", "not a gltf");
     let e = scene_for_model(&garbage, 64, 64).unwrap_err().to_string();
     assert!(e.contains("garbage.glb"), "{e}");

@@ -255,13 +255,21 @@ impl LoadedModel {
         meshes.chain(solids).fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), (a, b)| (lo.min(a), hi.max(b)))
     }
 
+    /// Notes a part's repairs: one warning per file, counting the
+    /// zero-area triangles of all its parts (a scene of many objects would
+    /// otherwise say it once per object).
     fn note_repairs(&mut self, path: &Path, repairs: MeshRepairs) {
-        if repairs.degenerate_triangles > 0 {
-            self.warnings.push(format!(
-                "{}: dropped {} zero-area triangle(s)",
-                path.display(),
-                repairs.degenerate_triangles
-            ));
+        if repairs.degenerate_triangles == 0 {
+            return;
+        }
+        let (head, tail) = (format!("{}: dropped ", path.display()), " zero-area triangle(s)");
+        let earlier = self.warnings.iter_mut().find_map(|w| {
+            let count = w.strip_prefix(head.as_str())?.strip_suffix(tail)?.parse::<usize>().ok()?;
+            Some((w, count))
+        });
+        match earlier {
+            Some((w, count)) => *w = format!("{head}{}{tail}", count + repairs.degenerate_triangles),
+            None => self.warnings.push(format!("{head}{}{tail}", repairs.degenerate_triangles)),
         }
     }
 }

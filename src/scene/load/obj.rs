@@ -73,24 +73,47 @@ pub(super) fn load(bytes: &[u8], path: &Path, from: Files) -> Result<LoadedModel
 /// Keys whose values tobj reads as exactly three numbers (and panics on fewer).
 const COLOUR_KEYS: [&str; 4] = ["Ka", "Kd", "Ks", "Ke"];
 
-/// `text` of MTL file `file` with every colour given by one number written
-/// out as three (the MTL format allows `Kd 0.5` for grey); a colour of two
-/// numbers, which the format does not allow, is taken as grey of the first
-/// with a warning naming the line.
+/// Keys whose first value tobj reads as one number (and `illum`, a whole
+/// number from 0 to 255).
+const NUMBER_KEYS: [&str; 4] = ["Ns", "Ni", "d", "illum"];
+
+/// Keys whose value tobj reads as a file name (and fails on none).
+const TEXTURE_KEYS: [&str; 8] = ["map_Ka", "map_Kd", "map_Ks", "map_Bump", "map_bump", "map_Ns", "bump", "map_d"];
+
+/// `text` of MTL file `file` as tobj can read it whole: every colour given by
+/// one number written out as three (the MTL format allows `Kd 0.5` for grey);
+/// a colour of two numbers, which the format does not allow, taken as grey
+/// of the first; a line tobj would refuse (a word that is not a number where
+/// one is read, a texture key without a file, a material without a name)
+/// left out. Each change but the first is a warning naming the line: one bad
+/// line no longer costs the file's other materials.
 fn normalised_mtl(text: &str, file: &Path, warnings: &mut Vec<String>) -> String {
     let mut out = String::with_capacity(text.len() + 64);
     for (n, line) in text.lines().enumerate() {
+        let at = || format!("{}:{}", file.display(), n + 1);
         let mut words = line.split_whitespace();
         let key = words.next().unwrap_or("");
         let values: Vec<&str> = words.collect();
-        if COLOUR_KEYS.contains(&key) && values.is_empty() {
-            warnings.push(format!("{}:{}: `{key}` has no numbers; ignored", file.display(), n + 1));
+        let bad = match key {
+            k if COLOUR_KEYS.contains(&k) => values.iter().take(3).find(|v| v.parse::<f32>().is_err()),
+            "illum" => values.first().filter(|v| v.parse::<u8>().is_err()),
+            k if NUMBER_KEYS.contains(&k) => values.first().filter(|v| v.parse::<f32>().is_err()),
+            _ => None,
+        };
+        if let Some(bad) = bad {
+            warnings.push(format!("{}: `{}`: `{bad}` is not a number; the line is ignored", at(), line.trim()));
+            continue;
+        }
+        let nameless = (TEXTURE_KEYS.contains(&key) || key == "newmtl") && values.is_empty();
+        if nameless || (NUMBER_KEYS.contains(&key) && values.is_empty()) {
+            warnings.push(format!("{}: `{key}` has no value; ignored", at()));
+        } else if COLOUR_KEYS.contains(&key) && values.is_empty() {
+            warnings.push(format!("{}: `{key}` has no numbers; ignored", at()));
         } else if COLOUR_KEYS.contains(&key) && values.len() < 3 {
             if values.len() == 2 {
                 warnings.push(format!(
-                    "{}:{}: `{key}` has two numbers (one or three expected); taken as grey {}",
-                    file.display(),
-                    n + 1,
+                    "{}: `{key}` has two numbers (one or three expected); taken as grey {}",
+                    at(),
                     values[0]
                 ));
             }
@@ -234,5 +257,20 @@ mod tests {
             })
             .sum();
         assert!((area - 72.0).abs() < 1e-3, "area {area}");
+    }
+
+    #[test]
+    fn a_bad_line_of_an_mtl_costs_only_that_line() {
+        let mtl =
+            "newmtl stone\nKa 0.0000 0.0000 0.0000c\nKd 0.5 0.4 0.3\nillum 2x\nmap_Kd\n\nnewmtl wood\nKd 0.6\nNs abc\n";
+        let mut warnings = Vec::new();
+        let text = normalised_mtl(mtl, Path::new("room.mtl"), &mut warnings);
+        let (materials, _) = tobj::load_mtl_buf(&mut Cursor::new(text.as_bytes())).expect("tobj reads what is left");
+        assert_eq!(materials.len(), 2);
+        assert_eq!(materials[0].diffuse, Some([0.5, 0.4, 0.3]));
+        assert_eq!(materials[1].diffuse, Some([0.6, 0.6, 0.6]));
+        let lines: Vec<&str> = warnings.iter().map(|w| w.split(": ").next().unwrap()).collect();
+        assert_eq!(lines, ["room.mtl:2", "room.mtl:4", "room.mtl:5", "room.mtl:9"], "{warnings:#?}");
+        assert!(warnings[0].contains("`0.0000c` is not a number"), "{}", warnings[0]);
     }
 }

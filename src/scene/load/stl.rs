@@ -10,7 +10,8 @@ use super::{checked, LoadedModel};
 use crate::limits::{Limit, Limits};
 use crate::scene::mesh::{Mesh, NormalMode};
 
-/// Parses STL bytes (binary when the size matches the triangle count, else ASCII).
+/// Parses STL bytes (binary when the size matches the triangle count, else ASCII
+/// if it begins with `solid`; keywords in any letter case).
 pub fn load(bytes: &[u8], limits: &Limits) -> Result<LoadedModel, String> {
     let positions = if is_binary(bytes) { binary(bytes, limits)? } else { ascii(bytes)? };
     let triangles = (0..positions.len() as u32 / 3).map(|t| [3 * t, 3 * t + 1, 3 * t + 2]).collect();
@@ -20,12 +21,18 @@ pub fn load(bytes: &[u8], limits: &Limits) -> Result<LoadedModel, String> {
     Ok(LoadedModel { warnings: model.warnings, ..LoadedModel::single(mesh) })
 }
 
+/// Binary when the size matches the header's triangle count (a binary
+/// header may begin with "solid" too), else ASCII when the text begins with
+/// `solid` in any letter case.
 fn is_binary(bytes: &[u8]) -> bool {
-    if bytes.len() < 84 {
-        return false;
+    if bytes.len() >= 84 {
+        let n = u32::from_le_bytes([bytes[80], bytes[81], bytes[82], bytes[83]]) as u64;
+        if 84 + 50 * n == bytes.len() as u64 {
+            return true;
+        }
     }
-    let n = u32::from_le_bytes([bytes[80], bytes[81], bytes[82], bytes[83]]) as u64;
-    84 + 50 * n == bytes.len() as u64 || !bytes.starts_with(b"solid")
+    let text = bytes.trim_ascii_start();
+    !(text.len() >= 5 && text[..5].eq_ignore_ascii_case(b"solid"))
 }
 
 fn binary(bytes: &[u8], limits: &Limits) -> Result<Vec<Vec3>, String> {
@@ -50,7 +57,7 @@ fn ascii(bytes: &[u8]) -> Result<Vec<Vec3>, String> {
     let mut out = Vec::new();
     for (n, line) in text.lines().enumerate() {
         let mut words = line.split_whitespace();
-        if words.next() != Some("vertex") {
+        if !words.next().is_some_and(|w| w.eq_ignore_ascii_case("vertex")) {
             continue;
         }
         let xyz: Vec<f32> =
@@ -93,5 +100,24 @@ mod tests {
         bin.extend(5u32.to_le_bytes());
         bin.extend([0u8; 60]);
         assert!(load(&bin, &Limits::default()).unwrap_err().contains("promises 5 triangles"));
+    }
+
+    #[test]
+    fn upper_case_ascii_is_ascii_and_a_solid_header_can_be_binary() {
+        // The words' spaces, read as a binary header's count, would promise
+        // 538,976,288 triangles.
+        let upper = ASCII.to_uppercase().replace("SOLID T", "  SOLID PART").replace("ENDSOLID T", "ENDSOLID PART");
+        assert!(upper.len() > 84);
+        let a = load(upper.as_bytes(), &Limits::default()).unwrap();
+        assert_eq!(a.parts[0].mesh.positions.len(), 3);
+        let mut bin = b"solid exported by a CAD tool".to_vec();
+        bin.resize(80, b' ');
+        bin.extend(1u32.to_le_bytes());
+        bin.extend([0u8; 12]);
+        for v in [[0f32, 0., 0.], [1., 0., 0.], [0., 1., 0.]] {
+            v.iter().for_each(|c| bin.extend(c.to_le_bytes()));
+        }
+        bin.extend([0u8; 2]);
+        assert_eq!(load(&bin, &Limits::default()).unwrap().parts[0].mesh.positions.len(), 3);
     }
 }
