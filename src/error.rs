@@ -161,13 +161,12 @@ pub enum Error {
         b: (u32, u32),
     },
     /// An input file of a kind kage does not read.
-    #[error(
-        "{}: not a file kage reads (a scene .toml, or a model: .obj, .stl, .gltf, .glb, .csg)",
-        path.display()
-    )]
+    #[error("{}: not a file kage reads; it reads {reads}", path.display())]
     UnknownInput {
         /// The file.
         path: PathBuf,
+        /// What it reads (`scene::load::InputFormat::described`).
+        reads: String,
     },
     /// A region of the frame to render that is empty or does not lie inside it.
     #[error("the region {}..{} x {}..{} is not a part of the {width}x{height} image", region.0, region.2, region.1, region.3)]

@@ -129,7 +129,11 @@ fn bad_meshes_are_errors_or_warned_repairs() {
     assert!(e.contains("garbage.glb"), "{e}");
     let unknown = write(&dir, "model.ply", "ply");
     let e = scene_for_model(&unknown, 64, 64).unwrap_err().to_string();
-    assert!(e.contains("unknown model format '.ply'"), "{e}");
+    assert!(e.contains("model.ply") && e.contains("not a model kage reads") && e.contains(".off"), "{e}");
+    // An OFF file, as OpenSCAD writes them, is a model of its own too.
+    let step = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/openscad/parts/step.off");
+    let scene = scene_for_model(&step, 64, 64).unwrap();
+    assert_eq!(scene.objects.len(), 2, "the step and the ground");
 }
 
 #[test]

@@ -8,6 +8,7 @@
 use std::path::{Path, PathBuf};
 
 use clap::Parser;
+use kage::scene::load::InputFormat;
 
 use super::{extension, render_command, tiles, RenderArgs};
 
@@ -38,9 +39,6 @@ pub struct BatchArgs {
     #[arg(last = true, value_name = "RENDER OPTIONS")]
     render: Vec<String>,
 }
-
-/// Model files a folder search takes.
-const MODELS: [&str; 6] = ["obj", "stl", "gltf", "glb", "csg", "scad"];
 
 /// `kage render`'s arguments alone, to read the options after `--`.
 #[derive(Parser)]
@@ -77,7 +75,7 @@ pub fn run(args: &BatchArgs) -> miette::Result<()> {
     }
     let has_openscad = std::process::Command::new("openscad").arg("--version").output().is_ok();
     let (scad, items): (Vec<Item>, Vec<Item>) =
-        items.into_iter().partition(|it| !has_openscad && extension(&it.input) == "scad");
+        items.into_iter().partition(|it| !has_openscad && InputFormat::from_path(&it.input) == Some(InputFormat::Scad));
     if !scad.is_empty() {
         eprintln!("warning: skipping {} .scad files: `openscad` is not on the PATH", scad.len());
     }
@@ -152,7 +150,7 @@ fn items(input: &Path, out: &Path, format: &str) -> miette::Result<Vec<Item>> {
     if input.is_dir() {
         let mut files = Vec::new();
         walk(input, &mut files).map_err(|e| miette::miette!("cannot read the folder {}: {e}", input.display()))?;
-        for f in files.into_iter().filter(|f| MODELS.contains(&extension(f).as_str())) {
+        for f in files.into_iter().filter(|f| InputFormat::from_path(f).is_some_and(InputFormat::is_model)) {
             let relative = f.strip_prefix(input).unwrap_or(&f).to_path_buf();
             items.push(Item { image: image(&relative), input: f });
         }

@@ -17,6 +17,7 @@ use kage::csg::openscad::{CsgOptions, Geometry};
 use kage::image::{PixelRect, ToneCurve};
 use kage::limits::{LimitSetting, Limits};
 use kage::scene::framing::{CameraOverride, View};
+use kage::scene::load::InputFormat;
 use kage::scene::model::{self, ModelOptions};
 use kage::scene::{
     demo::demo_scene, file, Antialias, EdgeFilter, EdgeMode, EdgeSelection, Exposure, Scene, ShadowMethod, Up,
@@ -422,7 +423,6 @@ fn camera_override(args: &RenderArgs) -> CameraOverride {
 }
 
 fn load(args: &RenderArgs) -> kage::error::Result<Scene> {
-    let is_model = |p: &Path| matches!(extension(p).as_str(), "obj" | "stl" | "gltf" | "glb" | "csg");
     let geometry = match args.geometry {
         GeometryArg::Exact => Geometry::Exact,
         GeometryArg::Faceted => Geometry::Faceted,
@@ -439,18 +439,15 @@ fn load(args: &RenderArgs) -> kage::error::Result<Scene> {
         limits: Limits::default().with_settings(&args.limits),
     };
     let (width, height) = (args.width, args.height);
-    let mut scene = match args.input.as_deref() {
-        Some(p) if is_model(p) => {
-            return model::scene_for_model_with(p, width.unwrap_or(960), height.unwrap_or(540), &options);
-        }
-        Some(p) if extension(p) == "scad" => {
-            return scad::scene_for_scad(p, width.unwrap_or(960), height.unwrap_or(540), &options);
-        }
+    let (w, h) = (width.unwrap_or(960), height.unwrap_or(540));
+    let mut scene = match args.input.as_deref().map(|p| (p, InputFormat::from_path(p))) {
         None => demo_scene()?,
-        Some(p) if p.extension().is_some_and(|e| e.eq_ignore_ascii_case("toml")) => {
-            file::load_scene_with(p, &args.limits)?
+        Some((p, Some(InputFormat::Scene))) => file::load_scene_with(p, &args.limits)?,
+        Some((p, Some(InputFormat::Scad))) => return scad::scene_for_scad(p, w, h, &options),
+        Some((p, Some(_))) => return model::scene_for_model_with(p, w, h, &options),
+        Some((p, None)) => {
+            return Err(kage::Error::UnknownInput { path: p.to_path_buf(), reads: InputFormat::described() })
         }
-        Some(p) => return Err(kage::Error::UnknownInput { path: p.to_path_buf() }),
     };
     if args.input.is_none() {
         scene.limits = scene.limits.with_settings(&args.limits);

@@ -9,6 +9,7 @@ use std::path::{Path, PathBuf};
 use kage::csg::openscad::{CsgOptions, Geometry};
 use kage::scene::demo::demo_scene;
 use kage::scene::framing::CameraOverride;
+use kage::scene::load::InputFormat;
 use kage::scene::model::{self, ModelOptions};
 use kage::scene::{file, Scene};
 use kage::Limits;
@@ -18,11 +19,6 @@ use crate::extension;
 
 /// Window size when neither the command line nor the scene file gives one.
 pub const DEFAULT_SIZE: (u32, u32) = (1280, 720);
-
-/// Extensions of files a change to which reloads the scene (the scene, its
-/// models, their materials and textures).
-const WATCHED: [&str; 13] =
-    ["toml", "obj", "mtl", "stl", "gltf", "glb", "bin", "csg", "scad", "png", "jpg", "jpeg", "exr"];
 
 /// A file to show, or the demo.
 #[derive(Debug, Clone, PartialEq)]
@@ -41,15 +37,10 @@ impl Source {
     /// `.csg` file) when the file cannot be read or understood.
     pub fn load(&self, toggles: &Toggles) -> Result<Scene, String> {
         let Some(path) = &self.path else { return demo_scene().map_err(|e| e.to_string()) };
-        let ext = extension(path);
-        match ext.as_str() {
-            "toml" => file::load_scene(path).map_err(|e| e.to_string()),
-            "obj" | "stl" | "gltf" | "glb" | "csg" | "scad" => model_scene(path, toggles),
-            _ => Err(format!(
-                "{}: kage view opens scene files (.toml), models (.obj, .stl, .gltf, .glb, .csg) and OpenSCAD files \
-                 (.scad)",
-                path.display()
-            )),
+        match InputFormat::from_path(path) {
+            Some(InputFormat::Scene) => file::load_scene(path).map_err(|e| e.to_string()),
+            Some(_) => model_scene(path, toggles),
+            None => Err(format!("{}: kage view opens {}", path.display(), InputFormat::described())),
         }
     }
 
@@ -64,7 +55,7 @@ impl Source {
     /// Whether a change to `path` should reload the scene.
     #[must_use]
     pub fn is_watched(path: &Path) -> bool {
-        WATCHED.contains(&extension(path).as_str())
+        InputFormat::watched_extensions().contains(&extension(path).as_str())
     }
 }
 
@@ -83,7 +74,7 @@ fn model_scene(path: &Path, toggles: &Toggles) -> Result<Scene, String> {
         limits: Limits::default(),
     };
     let (w, h) = DEFAULT_SIZE;
-    let scene = if extension(path) == "scad" {
+    let scene = if InputFormat::from_path(path) == Some(InputFormat::Scad) {
         crate::scad::scene_for_scad(path, w, h, &options)
     } else {
         model::scene_for_model_with(path, w, h, &options)

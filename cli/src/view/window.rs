@@ -12,6 +12,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
+use kage::scene::load::InputFormat;
 use kage::Scene;
 use notify::Watcher;
 use winit::application::ApplicationHandler;
@@ -229,7 +230,7 @@ impl App {
             Err(e) => (None, Some(e)),
         };
         let size = start.size.unwrap_or_else(|| match (&scene, start.source.path.as_deref()) {
-            (Some(s), Some(p)) if p.extension().is_some_and(|e| e.eq_ignore_ascii_case("toml")) => (s.width, s.height),
+            (Some(s), Some(p)) if InputFormat::from_path(p) == Some(InputFormat::Scene) => (s.width, s.height),
             _ => super::source::DEFAULT_SIZE,
         });
         let mut viewer = viewer_for(scene.as_deref(), size);

@@ -1,6 +1,7 @@
 //! Mesh and texture files: Wavefront OBJ + MTL, STL (binary and ASCII), glTF 2.0,
-//! OFF (as OpenSCAD imports it);
+//! OFF (as OpenSCAD writes it);
 //! and OpenSCAD `.csg` files ([`crate::csg::openscad`] reads the solid).
+//! [`InputFormat`] is the one table of which extension names which format.
 //!
 //! Each loader turns a file into a [`LoadedModel`]: parts (a mesh with an optional
 //! material of its own and a placement), solids (an OpenSCAD file's CSG solid
@@ -9,6 +10,7 @@
 //! Files are read through an [`AssetSource`], so the built-in demo scene can be
 //! served from bytes compiled into the binary.
 
+mod format;
 mod gltf;
 mod obj;
 mod off;
@@ -29,6 +31,8 @@ use crate::csg::openscad::CsgOptions;
 use crate::csg::CsgSolid;
 use crate::error::{Error, Result};
 use crate::limits::{Limit, Limits};
+
+pub use format::InputFormat;
 
 /// Where scene files find the files they name.
 pub trait AssetSource: Sync {
@@ -296,23 +300,22 @@ pub fn model(path: &Path, assets: &dyn AssetSource) -> Result<LoadedModel> {
 /// [`Error::Limit`] when the file is larger than [`Limit::FileMb`].
 pub fn model_with(path: &Path, assets: &dyn AssetSource, csg: &CsgOptions, limits: &Limits) -> Result<LoadedModel> {
     let shown = assets.display_path(path);
-    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or_default().to_ascii_lowercase();
     let from = Files { assets, limits };
     let fail = |message: String| Error::MeshLoad { path: shown.clone(), message };
-    if !matches!(ext.as_str(), "obj" | "stl" | "gltf" | "glb" | "csg") {
-        return Err(fail(format!("unknown model format '.{ext}' (kage reads .obj, .stl, .gltf, .glb and .csg)")));
-    }
-    let bytes = read(path, assets, limits)?;
-    let model = match ext.as_str() {
-        "obj" => obj::load(&bytes, path, from).map_err(fail)?,
-        "stl" => LoadedModel { up: Up::Z, ..stl::load(&bytes, limits).map_err(fail)? },
-        "gltf" | "glb" => gltf::load(&bytes, path, from).map_err(fail)?,
-        "csg" => {
-            let text = String::from_utf8(bytes).map_err(|_| fail("the file is not UTF-8 text".into()))?;
+    let bytes = || read(path, assets, limits);
+    let model = match InputFormat::from_path(path) {
+        Some(InputFormat::Obj) => obj::load(&bytes()?, path, from).map_err(fail)?,
+        Some(InputFormat::Stl) => LoadedModel { up: Up::Z, ..stl::load(&bytes()?, limits).map_err(fail)? },
+        Some(InputFormat::Off) => LoadedModel { up: Up::Z, ..off::load(&bytes()?, limits).map_err(fail)? },
+        Some(InputFormat::Gltf) => gltf::load(&bytes()?, path, from).map_err(fail)?,
+        Some(InputFormat::Csg) => {
+            let text = String::from_utf8(bytes()?).map_err(|_| fail("the file is not UTF-8 text".into()))?;
             let sidecar = read(&path.with_extension("camera.txt"), assets, limits).ok();
             LoadedModel { up: Up::Z, ..openscad::model((path, &shown), text.into(), sidecar.as_deref(), csg, from)? }
         }
-        _ => unreachable!("the extension was checked"),
+        Some(InputFormat::Scene | InputFormat::Scad) | None => {
+            return Err(fail(format!("not a model kage reads; it reads {}", InputFormat::described())));
+        }
     };
     Ok(model)
 }

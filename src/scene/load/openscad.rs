@@ -7,7 +7,7 @@ use std::sync::Arc;
 
 use glam::{Vec3, Vec4};
 
-use super::{Files, LoadedModel, Part, SolidPart};
+use super::{Files, InputFormat, LoadedModel, Part, SolidPart};
 use crate::csg::openscad::{
     default_view, load_csg_with, sidecar_camera, surface_mesh, CsgOptions, Ghost, GhostKind, Imports, Tinted,
 };
@@ -32,14 +32,13 @@ impl Imports for CsgImports<'_> {
     fn mesh(&self, file: &str) -> std::result::Result<(Vec<Vec3>, Vec<[u32; 3]>), String> {
         let path = self.folder.join(file);
         let bytes = self.bytes(file)?;
-        let ext = path.extension().and_then(|e| e.to_str()).unwrap_or_default().to_ascii_lowercase();
         let shown = self.files.assets.display_path(&path);
         let fail = |e: String| format!("{}: {e}", shown.display());
-        let model = match ext.as_str() {
-            "stl" => super::stl::load(&bytes, self.files.limits).map_err(fail)?,
-            "obj" => super::obj::load(&bytes, &path, self.files).map_err(fail)?,
-            "off" => super::off::load(&bytes, self.files.limits).map_err(fail)?,
-            _ => return Err(fail(format!("kage imports .stl, .obj and .off meshes, not '.{ext}'"))),
+        let model = match InputFormat::from_path(&path) {
+            Some(InputFormat::Stl) => super::stl::load(&bytes, self.files.limits).map_err(fail)?,
+            Some(InputFormat::Obj) => super::obj::load(&bytes, &path, self.files).map_err(fail)?,
+            Some(InputFormat::Off) => super::off::load(&bytes, self.files.limits).map_err(fail)?,
+            _ => return Err(fail("kage imports .stl, .obj and .off meshes (and .svg and .dxf drawings)".into())),
         };
         let (mut positions, mut triangles) = (Vec::new(), Vec::new());
         for part in &model.parts {
