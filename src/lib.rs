@@ -1,7 +1,7 @@
 //! # kage — a CPU renderer for design previews
 //!
-//! kage implements five rendering papers (kept in `../shared/seeds/`, restated in
-//! `SPEC.md`) as one frame pipeline. The module tree is the frame, ground floor
+//! kage implements five rendering papers (cited in `docs/papers.md`, called seeds
+//! 000 to 004 in the code) as one frame pipeline. The module tree is the frame, ground floor
 //! first; a module uses only the ones before it (`tests/layering.rs` holds it
 //! to that):
 //!
@@ -19,7 +19,8 @@
 //!   ▼
 //! visibility     the item buffer: polygons (seed 004 §3(1)) and solids' scanline walk
 //!   ▼
-//! shadows        the shadow term per light (shadow maps)
+//! shadows        the shadow term per light: maps, the SLB (seed 000), two-map soft
+//!                shadows (seed 001), PCSS
 //!   ▼
 //! shading        seed 002's passes: eq. 1 per light, summed; fog, translucency
 //!   ▼

@@ -1,4 +1,5 @@
-//! CSG solids made of convex primitives (seed 003 §5–6): the model, its
+//! CSG solids made of convex primitives (seed 003: Tokoi & Kitahashi 1988, §5–6;
+//! `docs/papers.md`): the model, its
 //! OpenSCAD reader, and ray casting by intervals — everything about a solid
 //! that does not depend on the scene it stands in or the screen it is drawn on.
 //!

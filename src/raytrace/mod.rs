@@ -1,5 +1,6 @@
 //! Ray tracing: the exact answers every raster technique approximates, and the
-//! secondary rays of seed 002 §4 (reflection and refraction traced from the item
+//! secondary rays of seed 002 §4 (Kawabata, Watanabe & Sakai: reflection and
+//! refraction traced from the item
 //! buffer).
 //!
 //! [`TraceScene`] puts a scene's triangles (in world space, with their item ids;

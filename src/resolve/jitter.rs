@@ -1,5 +1,5 @@
 //! Antialiasing by jittered sub-pixel passes: the accumulation buffer of seed
-//! 002 §4.
+//! 002 §4 (Kawabata, Watanabe & Sakai).
 //!
 //! The paper antialiases its traced reflections by rendering several item
 //! buffers, each with the image shifted by a fraction of a pixel, tracing each

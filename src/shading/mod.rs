@@ -1,4 +1,5 @@
-//! Shading passes over the visibility buffer (seed 002 §3): in each pass every
+//! Shading passes over the visibility buffer (seed 002: Kawabata, Watanabe &
+//! Sakai, Hitachi, §3; `docs/papers.md`): in each pass every
 //! visible pixel's surface is reconstructed from its item id and lit by eq. 1, and
 //! the passes are summed in a linear float accumulation buffer (eq. 4).
 //!

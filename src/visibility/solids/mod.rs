@@ -1,4 +1,4 @@
-//! Scanline visibility of CSG solids (seed 003 §5).
+//! Scanline visibility of CSG solids (seed 003: Tokoi & Kitahashi 1988, §5).
 //!
 //! The frame is walked the paper's way: primitives are bucket-sorted by their
 //! top scanline into the y-entry table; each scanline moves entering primitives
