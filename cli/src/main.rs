@@ -159,10 +159,11 @@ struct RenderArgs {
     antialias: Option<Antialias>,
     /// Also write these parts of the image, each on its own, next to the
     /// output as NAME.PART.EXT: a comma list of ambient, diffuse, specular,
-    /// emission (with the background), traced (reflections and refraction); or
-    /// `all` (these five, which add up to the image). `shadow` writes each
-    /// light's shadow term as NAME.shadow.N.exr (N: the light's number from
-    /// 0, in the scene's order; 1 lit, 0 in shadow).
+    /// reflection (the environment map), emission (with the background),
+    /// traced (ray-traced reflections and refraction), fog; or `all` (these
+    /// seven, which add up to the image). `shadow` writes each light's shadow
+    /// term as NAME.shadow.N.exr (N: the light's number from 0, in the
+    /// scene's order; 1 lit, 0 in shadow).
     #[arg(long, value_parser = parse_aovs)]
     aov: Option<Aovs>,
     /// Brightness of 8-bit output: stops (e.g. 1.5, -1) or `auto`.
@@ -175,9 +176,10 @@ struct RenderArgs {
     #[arg(long, value_parser = parse_tone)]
     tonemap: Option<ToneCurve>,
     /// Every light's shadows by this method instead of its own: `none`,
-    /// `map` (shadow maps) or `slb` (silhouette-line buffer: shadow maps
-    /// with exact edges inside each texel). Each light keeps its other
-    /// shadow settings.
+    /// `map` (shadow maps), `slb` (silhouette-line buffer: shadow maps with
+    /// exact edges inside each texel), `soft` (soft shadows from two shadow
+    /// maps) or `pcss` (percentage-closer soft shadows). Each light keeps its
+    /// other shadow settings.
     #[arg(long, value_parser = parse_shadow_method)]
     shadows: Option<ShadowMethod>,
     /// An OpenSCAD .csg model's spheres and cylinders: `exact` (true curved
@@ -781,4 +783,43 @@ fn reference_command(args: &RenderArgs, scene: &Scene) -> kage::error::Result<()
         std::process::exit(130); // interrupted, as shells report Ctrl-C
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use clap::CommandFactory;
+
+    use super::*;
+
+    /// The help text of `kage SUBCOMMAND --ARG`.
+    fn help(subcommand: &str, arg: &str) -> String {
+        let cli = Cli::command();
+        let sub = cli.find_subcommand(subcommand).unwrap_or_else(|| panic!("no `{subcommand}`"));
+        let found = sub.get_arguments().find(|a| a.get_id() == arg).unwrap_or_else(|| panic!("no --{arg}"));
+        found.get_help().map(ToString::to_string).unwrap_or_default()
+    }
+
+    /// Each option's help names every value the code accepts, so a method
+    /// or part added to the library cannot go unmentioned.
+    #[test]
+    fn help_texts_name_every_value_the_code_accepts() {
+        let shadows = help("render", "shadows");
+        for (name, _) in ShadowMethod::NAMES {
+            assert!(shadows.contains(&format!("`{name}`")), "--shadows does not name `{name}`: {shadows}");
+        }
+        let aov = help("render", "aov");
+        for component in Component::ALL {
+            assert!(aov.contains(component.name()), "--aov does not name {}: {aov}", component.name());
+        }
+        let count = ["one", "two", "three", "four", "five", "six", "seven", "eight", "nine"][Component::ALL.len() - 1];
+        assert!(aov.contains(&format!("these {count}")), "--aov all does not say {count}: {aov}");
+        let tonemap = help("render", "tonemap");
+        for (name, _) in ToneCurve::NAMES {
+            assert!(tonemap.contains(&format!("`{name}`")), "--tonemap does not name `{name}`: {tonemap}");
+        }
+        let script = help("view", "script");
+        for (_, usage) in view::script::ACTIONS {
+            assert!(script.contains(&format!("`{usage}")), "--script does not show `{usage}`: {script}");
+        }
+    }
 }

@@ -31,8 +31,9 @@ pub struct ViewArgs {
     #[arg(long)]
     pub height: Option<u32>,
     /// Input events read from a file, one per line (tests, recordings):
-    /// `drag left DX DY [shift]`, `wheel N`, `key K`, `wait`, `sleep S`,
-    /// `screenshot FILE`, `copy FROM TO`, `quit`.
+    /// `drag left DX DY [shift]`, `wheel N`, `key K`, `drop FILE`, `wait`,
+    /// `wait N` (N jittered passes), `sleep S`, `screenshot FILE` (the image),
+    /// `capture FILE` (the window, HUD and all), `copy FROM TO`, `quit`.
     #[arg(long)]
     pub script: Option<PathBuf>,
     /// Worker threads (default: one per core).

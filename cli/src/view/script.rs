@@ -46,6 +46,21 @@ pub enum Action {
     Quit,
 }
 
+/// Every action a script line may start with, and how it is written (the
+/// `--script` help names each of them: a test holds it to this list).
+pub const ACTIONS: [(&str, &str); 10] = [
+    ("drag", "drag left DX DY [shift]"),
+    ("wheel", "wheel N"),
+    ("key", "key K"),
+    ("drop", "drop FILE"),
+    ("wait", "wait N"),
+    ("sleep", "sleep S"),
+    ("screenshot", "screenshot FILE"),
+    ("capture", "capture FILE"),
+    ("copy", "copy FROM TO"),
+    ("quit", "quit"),
+];
+
 /// A script's actions.
 ///
 /// # Errors
@@ -103,9 +118,8 @@ fn action(words: &[&str], base: &Path) -> Result<Action, String> {
         "copy" => Action::Copy(path(words.get(1))?, path(words.get(2))?),
         "quit" => Action::Quit,
         other => {
-            return Err(format!(
-                "unknown action `{other}` (drag, wheel, key, wait, sleep, screenshot, capture, copy, drop, quit)"
-            ))
+            let known: Vec<&str> = ACTIONS.iter().map(|(word, _)| *word).collect();
+            return Err(format!("unknown action `{other}` ({})", known.join(", ")));
         }
     })
 }
