@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use clap::Parser;
 use kage::scene::load::InputFormat;
 
-use super::{extension, render_command, tiles, RenderArgs};
+use super::{render_command, tiles, RenderArgs};
 
 /// `kage batch`.
 #[derive(clap::Args)]
@@ -103,24 +103,28 @@ pub fn run(args: &BatchArgs) -> miette::Result<()> {
     for (path, e) in &failed {
         eprintln!("  {}: {}", path.display(), e.lines().next().unwrap_or_default());
     }
-    miette::bail!("{} of {} files failed", failed.len(), stale.len())
+    miette::bail!(
+        "{} of {} files failed ({rendered} rendered, {} up to date)",
+        failed.len(),
+        stale.len() + fresh.len(),
+        fresh.len()
+    )
 }
 
-/// Renders one file into a temporary image beside its own, then puts it in
-/// place: a batch stopped part way leaves no half-written image that looks
-/// up to date. A panic is caught and reported as the file's failure.
+/// Renders one file into a temporary folder beside its image, then moves
+/// what it wrote (the image, and its parts with `--aov`) into place: a batch
+/// stopped part way leaves no half-written image that looks up to date. A
+/// panic is caught and reported as the file's failure.
 fn render_one(it: &Item, options: &impl Fn(&Path, &Path) -> Result<RenderArgs, clap::Error>) -> Result<(), String> {
     let folder = it.image.parent().unwrap_or(Path::new("."));
-    std::fs::create_dir_all(folder).map_err(|e| format!("cannot make {}: {e}", folder.display()))?;
-    let name = it.image.file_name().and_then(|n| n.to_str()).unwrap_or("image");
-    let ext = extension(&it.image);
-    let partial = it.image.with_file_name(format!("{name}.partial.{ext}"));
-    let args = options(&it.input, &partial).map_err(|e| e.to_string())?;
+    let partial = folder.join(format!(".kage-partial-{}", std::process::id()));
+    std::fs::create_dir_all(&partial).map_err(|e| format!("cannot make {}: {e}", partial.display()))?;
+    let name = it.image.file_name().unwrap_or_default();
+    let mut args = options(&it.input, &partial.join(name)).map_err(|e| e.to_string())?;
+    args.quiet = true;
     let done = std::panic::catch_unwind(|| render_command(&args));
     let result = match done {
-        Ok(Ok(())) => {
-            std::fs::rename(&partial, &it.image).map_err(|e| format!("cannot write {}: {e}", it.image.display()))
-        }
+        Ok(Ok(())) => move_all(&partial, folder),
         Ok(Err(report)) => Err(format!("{report}")),
         Err(panic) => {
             let what =
@@ -128,10 +132,18 @@ fn render_one(it: &Item, options: &impl Fn(&Path, &Path) -> Result<RenderArgs, c
             Err(format!("kage crashed on it: {}", what.unwrap_or_default()))
         }
     };
-    if result.is_err() {
-        std::fs::remove_file(&partial).ok();
-    }
+    std::fs::remove_dir_all(&partial).ok();
     result
+}
+
+/// Moves every file of folder `from` into folder `to`.
+fn move_all(from: &Path, to: &Path) -> Result<(), String> {
+    let entries = std::fs::read_dir(from).map_err(|e| format!("cannot read {}: {e}", from.display()))?;
+    for entry in entries.flatten() {
+        let target = to.join(entry.file_name());
+        std::fs::rename(entry.path(), &target).map_err(|e| format!("cannot write {}: {e}", target.display()))?;
+    }
+    Ok(())
 }
 
 /// Whether `it`'s image is newer than its file.

@@ -91,8 +91,11 @@ struct CompareArgs {
 #[derive(clap::Args, Clone)]
 struct RenderArgs {
     /// Scene or model file (omit for the built-in demo): .toml, .obj, .stl,
-    /// .gltf, .glb, .csg, or .scad (through `openscad`, when installed).
+    /// .off, .gltf, .glb, .csg, or .scad (through `openscad`, when installed).
     input: Option<PathBuf>,
+    /// No "wrote" lines (a batch reports each file itself); warnings still.
+    #[arg(skip)]
+    quiet: bool,
     /// Output image: .png or .jpg (8-bit sRGB through the tone curve), .exr or
     /// .pfm (linear float, as rendered). For many frames, a run of #s in the
     /// name is replaced by the frame number, zero-padded to its length
@@ -600,11 +603,11 @@ fn render_command(args: &RenderArgs) -> miette::Result<()> {
         if many {
             bar.update(done as u64 + 1, job.wanted.len() as u64);
         } else {
-            print_stats(&path, &scene, frame_out);
+            print_stats(&path, &scene, frame_out, args.quiet);
         }
     }
     bar.finish();
-    if let (true, Some(first), Some(last)) = (many, job.wanted.first(), job.wanted.last()) {
+    if let (true, false, Some(first), Some(last)) = (many, args.quiet, job.wanted.first(), job.wanted.last()) {
         let (first, last) = (frame_path(&args.output, *first), frame_path(&args.output, *last));
         eprintln!("wrote {} frames, {} to {}", job.wanted.len(), first.display(), last.display());
     }
@@ -638,21 +641,29 @@ fn write_frame(
         // roughly add up to the final one: .exr output adds up exactly.)
         let aov = aov_path(path, c.name());
         write(image, &aov, scale, scene.tone)?;
-        eprintln!("wrote {} ({} component)", aov.display(), c.name());
+        if !args.quiet {
+            eprintln!("wrote {} ({} component)", aov.display(), c.name());
+        }
     }
     for (i, image) in frame.shadows.iter().enumerate() {
         // Linear floats, unexposed: 1 is lit, 0 in shadow.
         let shadow = aov_path(&path.with_extension("exr"), &format!("shadow.{i}"));
         write(image, &shadow, 1.0, ToneCurve::Clip)?;
-        eprintln!("wrote {} (light {i}'s shadow term)", shadow.display());
+        if !args.quiet {
+            eprintln!("wrote {} (light {i}'s shadow term)", shadow.display());
+        }
     }
     Ok(())
 }
 
-/// Says what was written and how long each stage took.
-fn print_stats(path: &Path, scene: &Scene, frame: &kage::Frame) {
+/// Says what was written and how long each stage took (`quiet`: only a
+/// warning, if any).
+fn print_stats(path: &Path, scene: &Scene, frame: &kage::Frame, quiet: bool) {
     if frame.visibility.items().iter().all(|i| i.is_none()) {
         eprintln!("warning: no object is in view: the image shows only the background (check the camera)");
+    }
+    if quiet {
+        return;
     }
     let s = frame.stats;
     eprintln!(

@@ -203,12 +203,19 @@ fn a_batch_keeps_going_past_a_bad_file_and_resumes() {
     let said = String::from_utf8_lossy(&first.stderr);
     assert!(!first.status.success(), "a failed file fails the batch: {said}");
     assert!(said.contains("broken.stl") && said.contains("2 rendered, 0 up to date, 1 failed"), "{said}");
+    // No temporary file named; nothing left of them.
+    assert!(!said.contains("partial") && !said.contains("wrote"), "{said}");
+    assert_eq!(
+        std::fs::read_dir(&out).unwrap().flatten().filter(|e| e.file_name().to_string_lossy().starts_with('.')).count(),
+        0
+    );
     let (teapot, part) = (out.join("teapot.obj.png"), out.join("sub/part.csg.png"));
     assert!(teapot.exists() && part.exists() && !out.join("broken.stl.png").exists());
     let made = std::fs::metadata(&teapot).unwrap().modified().unwrap();
     let again = batch(&[]);
     let said = String::from_utf8_lossy(&again.stderr);
     assert!(said.contains("0 rendered, 2 up to date, 1 failed"), "nothing new the second time: {said}");
+    assert!(said.contains("1 of 3 files failed (0 rendered, 2 up to date)"), "{said}");
     assert_eq!(std::fs::metadata(&teapot).unwrap().modified().unwrap(), made);
     // Shares split the files between them, each file once.
     std::fs::remove_file(models.join("broken.stl")).unwrap();
