@@ -70,7 +70,7 @@ pub fn composite(
         t.image.pixels_mut().par_iter_mut().zip(transmittance.par_iter()).for_each(|(p, &tr)| *p *= tr);
     }
     let mut layers = prepare(scene, &fragments, &weights, w, h);
-    let bounds = scene.bounds().unwrap_or_default();
+    let bounds = scene.caster_bounds().unwrap_or_default();
     for FrameLight { light, samples } in &frame_lights(scene) {
         let terms = pool.terms(scene, samples, bounds);
         layers.par_iter_mut().filter(|l| light.only.as_ref().is_none_or(|o| o.contains(&l.object))).for_each(|l| {
