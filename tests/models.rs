@@ -114,6 +114,27 @@ fn a_lone_model_stands_on_a_ground_that_catches_its_shadow() {
     assert!(bare.objects.iter().all(|o| o.name != "ground"));
 }
 
+/// A lone flat card (one quad) is framed face-on from the side its face
+/// faces, and a ground under it never takes its pixels.
+#[test]
+fn a_flat_card_is_seen_face_on_and_not_hidden_by_its_ground() {
+    let dir = scratch("card");
+    let quad = |a: Vec3, b: Vec3, c: Vec3, d: Vec3| vec![[a, b, c], [a, c, d]];
+    let (p, q) = (Vec3::new(-1.0, 0.0, -1.0), Vec3::new(1.0, 0.0, 1.0));
+    let up = quad(p, Vec3::new(p.x, 0.0, q.z), q, Vec3::new(q.x, 0.0, p.z));
+    let down: Vec<[Vec3; 3]> = up.iter().map(|t| [t[0], t[2], t[1]]).collect();
+    for (name, triangles) in [("up", up), ("down", down)] {
+        let obj = dir.join(format!("card-{name}.obj"));
+        write_obj(&obj, &triangles);
+        let scene = scene_for_model(&obj, 160, 120).unwrap();
+        let (w, h) = shown_size(&scene);
+        assert!(w > 60 && h > 60, "card facing {name}: {w}x{h} pixels of the card");
+        let toward = (scene.camera.eye - scene.camera.target).normalize();
+        let facing = (triangles[0][1] - triangles[0][0]).cross(triangles[0][2] - triangles[0][0]).normalize();
+        assert!(toward.dot(facing) > 0.99, "card facing {name} is seen from {toward}");
+    }
+}
+
 /// An open box (five walls facing inwards, no wall towards +x) with a glowing
 /// panel under its top, as a Cornell box is modelled: it is seen through its
 /// open side, with no ground, lit from the panel.

@@ -18,13 +18,16 @@ use crate::error::{Error, Result};
 use crate::limits::Limits;
 
 /// A matte ground under `bounds` (kage's y-up world), four times their size,
-/// unless the camera looks at it from below.
+/// unless the camera looks at it from below. It lies a thousandth of the
+/// model's size below the model's lowest point, so it never coincides with a
+/// face of the model (a card lying flat would fight it for every pixel).
 fn add_ground(scene: &mut Scene, (lo, hi): (Vec3, Vec3)) {
     if scene.camera.eye.y <= lo.y {
         return;
     }
-    let size = 4.0 * (hi - lo).max_element().max(1e-3);
-    let centre = Vec3::new((lo.x + hi.x) * 0.5, lo.y, (lo.z + hi.z) * 0.5);
+    let extent = (hi - lo).max_element().max(1e-3);
+    let size = 4.0 * extent;
+    let centre = Vec3::new((lo.x + hi.x) * 0.5, lo.y - GROUND_GAP * extent, (lo.z + hi.z) * 0.5);
     let placed = Affine3A::from_translation(centre) * Affine3A::from_scale(Vec3::splat(size));
     scene.materials.push(Material {
         name: "ground".into(),
@@ -37,6 +40,37 @@ fn add_ground(scene: &mut Scene, (lo, hi): (Vec3, Vec3)) {
     // It lies under the model: its shadows fall on nothing, and in the key
     // light's map it would widen the map fourfold around the model.
     scene.objects.push(Object { casts_shadows: false, ..ground });
+}
+
+/// How far below a model its ground lies, in parts of the model's size.
+const GROUND_GAP: f32 = 1e-3;
+
+/// The view that sees a flat model of `size` face-on: along the axis it is
+/// flat along (thinner than a thousandth of its size), from the side its
+/// faces face (`facing`, the sum of its triangles' area vectors); `None` for
+/// a model that is not flat.
+fn face_on(size: Vec3, facing: Vec3) -> Option<View> {
+    let flat = |extent: f32| extent <= 1e-3 * size.max_element();
+    let from = |toward: f32, front: View, back: View| if toward >= 0.0 { front } else { back };
+    let below = View { azimuth_deg: 0.0, elevation_deg: -90.0 };
+    let behind = View { azimuth_deg: 180.0, elevation_deg: 0.0 };
+    let left = View { azimuth_deg: -90.0, elevation_deg: 0.0 };
+    [
+        (size.y, from(facing.y, View::TOP, below)),
+        (size.z, from(facing.z, View::FRONT, behind)),
+        (size.x, from(facing.x, View::RIGHT, left)),
+    ]
+    .into_iter()
+    .find(|&(extent, _)| flat(extent))
+    .map(|(_, view)| view)
+}
+
+/// The sum of the area vectors of `scene`'s triangles (which way its faces
+/// face, on the whole).
+fn facing(scene: &Scene) -> Vec3 {
+    let mut sum = Vec3::ZERO;
+    for_each_triangle(scene, |[a, b, c]| sum += (b - a).cross(c - a));
+    sum
 }
 
 /// Largest extent of a model along an axis that a camera frames: beyond it
@@ -136,7 +170,10 @@ pub fn scene_for_loaded_model(
     let camera = match (model.camera.filter(|_| options.file_camera), &interior) {
         (Some(own), _) => own.transformed(&turn),
         (None, Some(inside)) => inside.camera(bounds, aspect),
-        (None, None) => framed_camera(bounds, aspect, View::DEFAULT, FRAMING_FOV_DEG),
+        (None, None) => {
+            let view = face_on(size, facing(&scene)).unwrap_or(View::DEFAULT);
+            framed_camera(bounds, aspect, view, FRAMING_FOV_DEG)
+        }
     };
     scene.camera = options.camera.apply(camera, bounds, aspect);
     let mut lights = light_rig(bounds, &scene.camera);

@@ -239,8 +239,12 @@ pub struct Viewer {
     pub orbit: Orbit,
     /// The camera the scene was opened with (Home).
     pub home: Orbit,
-    /// What the scene's objects span, for framing.
+    /// What the scene's objects span (the near and far planes keep all of it).
     pub bounds: (Vec3, Vec3),
+    /// What F and the number keys frame: the objects that cast shadows, not
+    /// the ground they stand on ([`kage::Scene::caster_bounds`]), as
+    /// `kage render --view` frames them.
+    pub framed: (Vec3, Vec3),
     /// The toggles.
     pub toggles: Toggles,
     /// What is shown.
@@ -277,6 +281,7 @@ impl Viewer {
             orbit,
             home: orbit,
             bounds,
+            framed: bounds,
             toggles: Toggles::default(),
             display: Display::Image,
             hud: true,
@@ -334,11 +339,11 @@ impl Viewer {
             Key::Escape | Key::Char('q') => return Request::Quit,
             Key::F12 => return Request::Screenshot,
             Key::Home => self.orbit = self.home,
-            Key::Char('f') => self.orbit.frame(self.bounds, aspect),
-            Key::Char('1') => self.orbit.look_from(View::FRONT, self.bounds, aspect),
-            Key::Char('3') => self.orbit.look_from(View::RIGHT, self.bounds, aspect),
-            Key::Char('7') => self.orbit.look_from(View::TOP, self.bounds, aspect),
-            Key::Char('9') => self.orbit.look_from(View::ISO, self.bounds, aspect),
+            Key::Char('f') => self.orbit.frame(self.framed, aspect),
+            Key::Char('1') => self.orbit.look_from(View::FRONT, self.framed, aspect),
+            Key::Char('3') => self.orbit.look_from(View::RIGHT, self.framed, aspect),
+            Key::Char('7') => self.orbit.look_from(View::TOP, self.framed, aspect),
+            Key::Char('9') => self.orbit.look_from(View::ISO, self.framed, aspect),
             Key::Char('5') => self.orbit.toggle_projection(),
             Key::Char('s') => t.shadows = next_of(&Shadows::CYCLE, t.shadows),
             Key::Char('a') => {
@@ -564,6 +569,18 @@ mod tests {
         assert_eq!(v.orbit, before);
         v.apply(Input::Key(Key::Home));
         assert_eq!(v.orbit, start);
+    }
+
+    /// F and the number keys frame the part, not the ground square under it.
+    #[test]
+    fn presets_frame_the_part_not_its_ground() {
+        let mut v = viewer();
+        v.bounds = (Vec3::new(-50.0, -50.0, -0.1), Vec3::new(50.0, 50.0, 2.0));
+        v.framed = UNIT;
+        for key in ['f', '1', '3', '7', '9'] {
+            v.apply(Input::Key(Key::Char(key)));
+            assert!(v.orbit.distance < 10.0, "key {key}: {} away, framing the ground", v.orbit.distance);
+        }
     }
 
     /// The number keys put the eye at the standard views; 5 switches the lens.

@@ -327,6 +327,7 @@ impl App {
                     (self.viewer.toggles, self.viewer.display, self.viewer.hud) = keep;
                 } else if let Some(bounds) = scene.bounds() {
                     self.viewer.bounds = bounds;
+                    self.viewer.framed = scene.caster_bounds().unwrap_or(bounds);
                 }
                 self.viewer.costly_scene = scene.lights.iter().any(super::refine::costly);
                 self.viewer.error = None;
@@ -543,6 +544,7 @@ fn viewer_for(scene: Option<&Scene>, size: (u32, u32)) -> Viewer {
         |s| Orbit::from_camera(&s.camera),
     );
     let mut viewer = Viewer::new(orbit, bounds, size);
+    viewer.framed = scene.and_then(Scene::caster_bounds).unwrap_or(bounds);
     viewer.costly_scene = costly;
     viewer
 }
