@@ -135,6 +135,38 @@ fn a_flat_card_is_seen_face_on_and_not_hidden_by_its_ground() {
     }
 }
 
+/// Round a turntable, a model's light rig turns with the camera: every
+/// frame shows the model lit alike (its mean brightness within 20%), where a
+/// rig fixed in the world would leave the frames behind it in shade.
+#[test]
+fn a_turntable_lights_every_side_of_a_model_alike() {
+    let dir = scratch("turntable");
+    let stl = dir.join("box.stl");
+    write_stl(&stl, &box_triangles(Vec3::ZERO, Vec3::new(2.0, 1.0, 1.0)));
+    let mut scene = scene_for_model(&stl, 96, 72).unwrap();
+    assert!(scene.lights_follow_camera);
+    let (camera, rig) = (scene.camera, scene.lights.clone());
+    let mut means = Vec::new();
+    for frame in 0..8 {
+        scene.camera = kage::scene::camera_path::turntable(&camera, frame, 8);
+        scene.lights = kage::scene::camera_path::turntable_lights(&rig, camera.target, frame, 8);
+        let out = render(&scene, &RenderOptions::default()).unwrap();
+        let (mut sum, mut n) = (0.0, 0);
+        for y in 0..scene.height {
+            for x in 0..scene.width {
+                let item = out.visibility.item(x, y);
+                if !item.is_none() && scene.objects[item.object as usize].name != "ground" {
+                    sum += out.image.get(x, y).dot(Vec3::splat(1.0 / 3.0));
+                    n += 1;
+                }
+            }
+        }
+        means.push(sum / n as f32);
+    }
+    let (lo, hi) = means.iter().fold((f32::MAX, 0.0f32), |(a, b), &m| (a.min(m), b.max(m)));
+    assert!(hi <= 1.2 * lo, "the frames' mean brightness: {means:?}");
+}
+
 /// An open box (five walls facing inwards, no wall towards +x) with a glowing
 /// panel under its top, as a Cornell box is modelled: it is seen through its
 /// open side, with no ground, lit from the panel.

@@ -57,6 +57,7 @@ fn mirror_scene() -> Scene {
         tone: Default::default(),
         limits: Default::default(),
         camera_path: None,
+        lights_follow_camera: false,
         camera: Camera {
             eye: Vec3::new(0.0, 0.0, 5.0),
             target: Vec3::ZERO,

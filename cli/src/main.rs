@@ -104,7 +104,9 @@ struct RenderArgs {
     output: PathBuf,
     /// Render N frames of a turntable: the camera goes once round the
     /// vertical through what it looks at (a model: its centre), frame i at
-    /// 360·i/N degrees. The output name needs #s for the frame number.
+    /// 360·i/N degrees. A model's own light rig turns with the camera, so
+    /// every side is lit alike; a scene file's (or a glTF file's) lights stay
+    /// put. The output name needs #s for the frame number.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
     turntable: Option<u32>,
     /// Render only frame I (from 0) of the turntable or of the scene file's
@@ -589,9 +591,12 @@ fn render_command(args: &RenderArgs) -> miette::Result<()> {
     let mut renderer = Renderer::new(&options).map_err(report::to_report)?;
     let many = job.wanted.len() > 1;
     let bar = Progress::new(if many { "frames" } else { "passes" });
-    let base = scene.camera;
+    let (base, rig) = (scene.camera, scene.lights.clone());
     for (done, &frame) in job.wanted.iter().enumerate() {
         scene.camera = camera_of(args, &scene, &base, frame);
+        if let (Some(n), true) = (args.turntable, scene.lights_follow_camera) {
+            scene.lights = kage::scene::camera_path::turntable_lights(&rig, base.target, frame, n);
+        }
         let report = |d: u32, total: u32| {
             if !many {
                 bar.update(u64::from(d), u64::from(total));

@@ -4,9 +4,10 @@
 //! pure function of `i`, so one frame rendered on its own equals the same
 //! frame of the whole run, bit for bit.
 
-use glam::Vec3;
+use glam::{Affine3A, Vec3};
 
 use crate::camera::{Camera, Projection};
+use crate::scene::light::Light;
 
 /// How a camera path joins its keyframes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -124,6 +125,19 @@ pub fn turntable(camera: &Camera, frame: u32, frames: u32) -> Camera {
     Camera { eye: camera.target + turned, ..*camera }
 }
 
+/// `lights` turned with the camera of turntable frame `frame` of `frames`:
+/// about the vertical axis through `target`, by the camera's angle, so a
+/// model lit by a rig placed from the camera is lit alike from every side.
+#[must_use]
+pub fn turntable_lights(lights: &[Light], target: Vec3, frame: u32, frames: u32) -> Vec<Light> {
+    assert!(frames > 0, "a turntable has at least one frame");
+    let angle = f64::from(frame % frames) / f64::from(frames) * std::f64::consts::TAU;
+    let turn = Affine3A::from_translation(target)
+        * Affine3A::from_rotation_y(angle as f32)
+        * Affine3A::from_translation(-target);
+    lights.iter().map(|l| Light { kind: l.kind.transformed(&turn), ..l.clone() }).collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -197,5 +211,21 @@ mod tests {
         let quarter = turntable(&c, 3, 12);
         assert!(quarter.eye.abs_diff_eq(Vec3::new(5.0, 1.0, 0.0), 1e-5), "{:?}", quarter.eye);
         assert_eq!(turntable(&c, 12, 12).eye, turntable(&c, 0, 12).eye);
+    }
+
+    /// A light turned with the turntable keeps its place as the camera sees
+    /// it: its position relative to the eye and target turns with them.
+    #[test]
+    fn turntable_lights_turn_with_the_camera() {
+        use crate::scene::light::LightKind;
+        let camera = base();
+        let light = Light { kind: LightKind::Point { position: Vec3::new(3.0, 4.0, 2.0) }, ..Light::default() };
+        for frame in 0..8 {
+            let eye = turntable(&camera, frame, 8).eye;
+            let turned = turntable_lights(std::slice::from_ref(&light), camera.target, frame, 8);
+            let LightKind::Point { position } = turned[0].kind else { panic!("a point light stays one") };
+            assert!((position.distance(eye) - Vec3::new(3.0, 4.0, 2.0).distance(camera.eye)).abs() < 1e-4);
+            assert!((position.length() - Vec3::new(3.0, 4.0, 2.0).length()).abs() < 1e-4);
+        }
     }
 }

@@ -212,6 +212,10 @@ pub struct Scene {
     pub camera_path: Option<camera_path::CameraPath>,
     /// Lights.
     pub lights: Vec<Light>,
+    /// Whether the lights are a rig placed from the camera (a lone model's,
+    /// [`model`]), which turns with it round a turntable
+    /// ([`camera_path::turntable_lights`]); a scene file's lights stay put.
+    pub lights_follow_camera: bool,
     /// Materials, referenced by index from objects.
     pub materials: Vec<Material>,
     /// Objects.
@@ -261,6 +265,7 @@ impl Scene {
             camera,
             camera_path: None,
             lights: Vec::new(),
+            lights_follow_camera: false,
             materials: Vec::new(),
             objects: Vec::new(),
             warnings: Vec::new(),

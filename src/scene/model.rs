@@ -195,6 +195,7 @@ pub fn scene_for_loaded_model(
     if options.ground && interior.is_none() {
         add_ground(&mut scene, bounds);
     }
+    scene.lights_follow_camera = model.lights.is_empty();
     scene.lights = if model.lights.is_empty() {
         lights
     } else {

@@ -31,6 +31,7 @@ pub fn scene_with(mesh: Mesh, camera: Camera, width: u32, height: u32, two_sided
             falloff: Falloff::None,
             ..Light::default()
         }],
+        lights_follow_camera: false,
         materials: vec![Material { two_sided, ..Material::default() }],
         objects: vec![Object::mesh("soup", Arc::new(mesh), Affine3A::IDENTITY, 0)],
         warnings: Vec::new(),

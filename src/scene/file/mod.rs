@@ -645,6 +645,7 @@ impl SceneFile {
             background: self.background()?,
             camera: framing((Vec3::ZERO, Vec3::ONE), 1.0).0,
             lights: self.lights.iter().map(|l| self.light(l)).collect::<Result<_>>()?,
+            lights_follow_camera: false,
             materials,
             objects: Vec::new(),
             warnings: Vec::new(),
