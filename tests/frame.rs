@@ -2,6 +2,8 @@
 //! model loaders on the shared real-world assets (skipped when absent).
 
 mod common;
+#[path = "common/skip.rs"]
+mod skip;
 
 use std::path::Path;
 
@@ -119,7 +121,7 @@ fn shared(rel: &str) -> Option<std::path::PathBuf> {
     if p.exists() {
         Some(p)
     } else {
-        eprintln!("skipped: {} not present", p.display());
+        skip::skipped(&format!("{} not present", p.display()));
         None
     }
 }

@@ -3,6 +3,8 @@
 //! embedded `data:` buffers and images, photometric lights through a tone
 //! curve without clipping.
 
+#[path = "common/skip.rs"]
+mod skip;
 use std::path::{Path, PathBuf};
 
 use base64::Engine as _;
@@ -15,7 +17,7 @@ fn asset(rel: &str) -> Option<PathBuf> {
     if p.exists() {
         Some(p)
     } else {
-        eprintln!("skipped: {} is absent", p.display());
+        skip::skipped(&format!("{} is absent", p.display()));
         None
     }
 }

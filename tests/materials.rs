@@ -2,6 +2,8 @@
 //! mirrors and glass, a texture named in another letter case is found, and a
 //! texture not found at all is a warning and a visible stand-in.
 
+#[path = "common/skip.rs"]
+mod skip;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -140,7 +142,7 @@ fn a_texture_in_another_case_is_found_and_a_missing_one_is_a_checker() {
 fn sponza_loads_with_its_textures() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/scenes/sponza-dabrovic/sponza.obj");
     if !path.exists() {
-        eprintln!("skipped: {} is absent", path.display());
+        skip::skipped(&format!("{} is absent", path.display()));
         return;
     }
     let scene = kage::scene::model::scene_for_model(&path, 160, 90).unwrap();

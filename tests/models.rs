@@ -2,6 +2,8 @@
 //! OpenSCAD z-up, OBJ and glTF y-up), on a ground that catches its shadow,
 //! seen by a camera that frames it.
 
+#[path = "common/skip.rs"]
+mod skip;
 use std::path::{Path, PathBuf};
 
 use glam::Vec3;
@@ -221,7 +223,7 @@ fn the_cornell_box_is_seen_through_its_open_front() {
     let path =
         Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/scenes/cornell-box/CornellBox-Original.obj");
     if !path.exists() {
-        eprintln!("skipped: {} is absent", path.display());
+        skip::skipped(&format!("{} is absent", path.display()));
         return;
     }
     let scene = scene_for_model(&path, 160, 120).unwrap();

@@ -7,6 +7,8 @@
 //! changes its image where its texture says.
 
 mod common;
+#[path = "common/skip.rs"]
+mod skip;
 
 use std::path::Path;
 use std::sync::Arc;
@@ -100,7 +102,7 @@ fn a_map_of_one_tilt_shades_as_the_tilted_square_would() {
 fn the_avocados_normal_map_moves_its_shading() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/gltf/Avocado/Avocado.gltf");
     if !path.exists() {
-        eprintln!("skipped: {} is absent", path.display());
+        skip::skipped(&format!("{} is absent", path.display()));
         return;
     }
     let scene = kage::scene::model::scene_for_model(&path, 240, 240).unwrap();

@@ -3,6 +3,8 @@
 //! solid agrees with the mesh OpenSCAD's own CGAL render wrote (its STL), point by
 //! point. Everything here skips cleanly when `../shared/assets` is absent.
 
+#[path = "common/skip.rs"]
+mod skip;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -14,7 +16,7 @@ use kage::scene::load::{model, FileSystem};
 fn corpus() -> Option<(PathBuf, Vec<PathBuf>)> {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/csg");
     let Ok(entries) = std::fs::read_dir(&dir) else {
-        eprintln!("skipped: {} not found", dir.display());
+        skip::skipped(&format!("{} not found", dir.display()));
         return None;
     };
     let mut files: Vec<_> =

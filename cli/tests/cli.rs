@@ -1,6 +1,8 @@
 //! The `kage` command: exit codes, located reports, warnings and what it
 //! writes, run as a user runs it.
 
+#[path = "../../tests/common/skip.rs"]
+mod skip;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -249,7 +251,7 @@ fn the_cli_renders_openscad_files() {
 #[test]
 fn a_scad_file_finds_its_imports_and_its_errors_name_it() {
     if Command::new("openscad").arg("--version").output().is_err() {
-        eprintln!("skipped: openscad is not on the PATH");
+        skip::skipped("openscad is not on the PATH");
         return;
     }
     let dir = scratch("scad-imports");

@@ -5,6 +5,8 @@
 //! OpenJD one under `openjd run`, skipped with a message when it is not
 //! installed; `.ci/run` installs it).
 
+#[path = "../../tests/common/skip.rs"]
+mod skip;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -255,7 +257,7 @@ fn openjd() -> Option<PathBuf> {
 #[test]
 fn the_openjd_template_renders_the_frames_from_their_tiles() {
     let Some(openjd) = openjd() else {
-        eprintln!("skipped: openjd is not installed (pip install openjd-cli; .ci/run does, into .ci/venv)");
+        skip::skipped("openjd is not installed (pip install openjd-cli; .ci/run does, into .ci/venv)");
         return;
     };
     let dir = scratch("openjd");
@@ -345,7 +347,7 @@ fn the_slurm_array_script_runs_under_sbatch() {
     let root = Command::new("id").arg("-u").output().is_ok_and(|o| String::from_utf8_lossy(&o.stdout).trim() == "0");
     let slurm = Command::new("sh").args(["-c", "command -v slurmctld && command -v munged"]).output();
     if !root || !slurm.is_ok_and(|o| o.status.success()) {
-        eprintln!("skipped: a local Slurm needs root and slurm-wlm (apt-get install slurm-wlm)");
+        skip::skipped("a local Slurm needs root and slurm-wlm (apt-get install slurm-wlm)");
         return;
     }
     let out = Command::new("bash")

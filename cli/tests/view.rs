@@ -3,6 +3,8 @@
 //! scripted input, screenshots against `kage render`, live reload, and a
 //! broken scene file that keeps the window alive with its error drawn.
 
+#[path = "../../tests/common/skip.rs"]
+mod skip;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -18,7 +20,7 @@ fn scratch(name: &str) -> PathBuf {
 fn have_xvfb() -> bool {
     let ok = Command::new("xvfb-run").arg("--help").output().is_ok();
     if !ok {
-        eprintln!("skipped: xvfb-run is not installed (apt-get install xvfb; .ci/run does)");
+        skip::skipped("xvfb-run is not installed (apt-get install xvfb; .ci/run does)");
     }
     ok
 }
