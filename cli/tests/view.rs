@@ -143,6 +143,7 @@ fn a_broken_scene_file_keeps_the_window_and_draws_the_error() {
     let (ok, out) = view(&[file.to_str().unwrap(), "--script", dir.join("run.script").to_str().unwrap()]);
     assert!(ok, "the viewer exits cleanly after the bad edit: {out}");
     assert!(out.contains("scene.toml:2:"), "the error names file and line: {out}");
+    assert_eq!(out.matches("scene.toml:2:").count(), 1, "the error is said once: {out}");
     let red = |img: &RgbImage| img.pixels().filter(|p| p[0] > 200 && p[1] < 120 && p[2] < 120).count();
     let (good, bad) = (read(&dir.join("good.png")), read(&dir.join("bad.png")));
     assert!(red(&bad) > red(&good) + 30, "red error text drawn: {} against {}", red(&bad), red(&good));
@@ -267,4 +268,18 @@ fn a_skipped_node_is_said_in_the_window_and_on_stderr() {
         amber(&with_skip),
         amber(&plain)
     );
+}
+
+/// Without a display the viewer says what to do, not where in winit it failed.
+#[test]
+fn without_a_display_the_viewer_says_what_to_do() {
+    let out = Command::new(env!("CARGO_BIN_EXE_kage"))
+        .args(["view", "--script", "/dev/null"])
+        .env_remove("DISPLAY")
+        .env_remove("WAYLAND_DISPLAY")
+        .output()
+        .unwrap();
+    let said = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{said}");
+    assert!(said.contains("no display") && said.contains("xvfb-run") && !said.contains(".cargo"), "{said}");
 }

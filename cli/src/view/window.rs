@@ -57,6 +57,9 @@ pub struct Start {
     pub timings: bool,
 }
 
+/// What the viewer says when it cannot open a window.
+const NO_DISPLAY: &str = "no display to open a window on: set DISPLAY (or WAYLAND_DISPLAY), or run under xvfb-run";
+
 /// Runs the viewer until its window closes.
 ///
 /// # Errors
@@ -64,7 +67,12 @@ pub struct Start {
 /// When no window can be opened (no display) or the event loop fails.
 pub fn run(start: Start) -> Result<(), String> {
     let started = Instant::now();
-    let event_loop = EventLoop::<Wake>::with_user_event().build().map_err(|e| format!("no window: {e}"))?;
+    let unix_desktop = cfg!(all(unix, not(target_os = "macos")));
+    if unix_desktop && std::env::var_os("DISPLAY").is_none() && std::env::var_os("WAYLAND_DISPLAY").is_none() {
+        return Err(NO_DISPLAY.into());
+    }
+    // winit's error names a source file of its own: say what to do instead.
+    let event_loop = EventLoop::<Wake>::with_user_event().build().map_err(|_| NO_DISPLAY.to_string())?;
     let timings = start.timings;
     let mut app = App::new(start, event_loop.create_proxy());
     app.clock.started = started;
@@ -134,8 +142,11 @@ impl Clock {
     fn summary(&self) -> String {
         let median = |mut v: Vec<f64>| {
             v.sort_by(f64::total_cmp);
-            (v.len(), v.get(v.len() / 2).copied().unwrap_or(f64::NAN))
+            (v.len(), v.get(v.len() / 2).copied())
         };
+        // A figure that was never measured (no quick frame, no input) is "-",
+        // not NaN.
+        let show = |v: Option<f64>, digits: usize| v.map_or_else(|| "-".to_string(), |x| format!("{x:.digits$}"));
         let ms = |d: &[Duration]| d.iter().map(|d| d.as_secs_f64() * 1e3).collect::<Vec<f64>>();
         let (quick, median_quick) = median(self.quick_ms.clone());
         let (rested, rest) = median(ms(&self.to_rest));
@@ -144,23 +155,31 @@ impl Clock {
         let (_, apart) = median(ms(&self.quick_apart));
         let (_, present) = median(self.present_ms.clone());
         let mean = |(n, sum): (u32, [f64; 5])| {
-            let s = sum.map(|t| t / f64::from(n.max(1)));
+            if n == 0 {
+                return "-".to_string();
+            }
+            let s = sum.map(|t| t / f64::from(n));
             format!(
                 "visibility {:.1}, shadows {:.1}, shading {:.1}, traced {:.1}, edges {:.1}",
                 s[0], s[1], s[2], s[3], s[4]
             )
         };
         format!(
-            "first image {:.0} ms; {quick} quick frames, median {median_quick:.1} ms to render, one shown every \
-             {apart:.1} ms ({:.1} fps; mean ms: {}); presenting median {present:.1} ms; {} jittered passes, mean \
-             ms: {}; refined {rested} \
-             times, median {rest:.0} ms after the input; new image {answered} times, median {answer:.0} ms after the \
-             input; {stopped} steps given up, median {stop:.1} ms after the input",
-            self.first_image.map_or(f64::NAN, |d| d.as_secs_f64() * 1e3),
-            1e3 / apart,
+            "first image {} ms; {quick} quick frames, median {} ms to render, one shown every {} ms ({} fps; mean \
+             ms: {}); presenting median {} ms; {} jittered passes, mean ms: {}; refined {rested} times, median {} ms \
+             after the input; new image {answered} times, median {} ms after the input; {stopped} steps given up, \
+             median {} ms after the input",
+            show(self.first_image.map(|d| d.as_secs_f64() * 1e3), 0),
+            show(median_quick, 1),
+            show(apart, 1),
+            show(apart.filter(|&a| a > 0.0).map(|a| 1e3 / a), 1),
             mean(self.stages[0]),
+            show(present, 1),
             self.stages[1].0,
             mean(self.stages[1]),
+            show(rest, 0),
+            show(answer, 0),
+            show(stop, 1),
         )
     }
 }
@@ -335,7 +354,11 @@ impl App {
                 self.scene = Some(Arc::new(scene));
             }
             Err(e) => {
-                eprintln!("{e}");
+                // A save often reaches the watcher as several events: the
+                // same error is said once.
+                if self.viewer.error.as_deref() != Some(e.as_str()) {
+                    eprintln!("{e}");
+                }
                 self.viewer.error = Some(e);
             }
         }
@@ -564,7 +587,12 @@ fn hud_lines(viewer: &Viewer, shown: &Shown, step: Option<Step>, times: &VecDequ
         Smoothing::Progressive => "progressive",
     };
     vec![
-        format!("{:.1} fps  {}x{}  {stage}", 1.0 / mean.max(1e-6), viewer.size.0, viewer.size.1),
+        if times.is_empty() || mean <= 0.0 {
+            // No frame rendered yet (or only an error shown): no rate to give.
+            format!("- fps  {}x{}  {stage}", viewer.size.0, viewer.size.1)
+        } else {
+            format!("{:.1} fps  {}x{}  {stage}", 1.0 / mean, viewer.size.0, viewer.size.1)
+        },
         format!(
             "ms: visibility {:.1}  shadows {:.1}  shading {:.1}  traced {:.1}  edges {:.1}",
             st.visibility_ms, st.shadow_ms, st.shading_ms, st.traced_ms, st.edge_ms
@@ -754,5 +782,19 @@ impl ApplicationHandler<Wake> for App {
             let idle = self.viewer.rendering().is_none() && !self.script.is_empty();
             event_loop.set_control_flow(if idle { ControlFlow::Poll } else { ControlFlow::Wait });
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A window closed before any frame or input: every figure is "-", none
+    /// NaN.
+    #[test]
+    fn timings_of_nothing_say_so_without_nan() {
+        let summary = Clock::new().summary();
+        assert!(!summary.contains("NaN") && !summary.contains("inf"), "{summary}");
+        assert!(summary.starts_with("first image - ms; 0 quick frames"), "{summary}");
     }
 }
