@@ -171,8 +171,14 @@ pub fn scene_for_loaded_model(
         (Some(own), _) => own.transformed(&turn),
         (None, Some(inside)) => inside.camera(bounds, aspect),
         (None, None) => {
-            let view = face_on(size, facing(&scene)).unwrap_or(View::DEFAULT);
-            framed_camera(bounds, aspect, view, FRAMING_FOV_DEG)
+            let framed = |view| framed_camera(bounds, aspect, view, FRAMING_FOV_DEG);
+            // Far from the origin a model may look flat only because its
+            // coordinates lost their fractions: if a camera along the thin
+            // axis is not usable there, the usual view.
+            face_on(size, facing(&scene))
+                .map(framed)
+                .filter(|c| c.validate().is_ok())
+                .unwrap_or_else(|| framed(View::DEFAULT))
         }
     };
     scene.camera = options.camera.apply(camera, bounds, aspect);
