@@ -119,6 +119,13 @@ impl Mesh {
             (lo.min(p), hi.max(p))
         })
     }
+
+    /// The area of all triangles together (where triangles overlap, counted
+    /// once per triangle).
+    #[must_use]
+    pub fn surface_area(&self) -> f32 {
+        self.triangles.iter().map(|&t| face_normal(&self.positions, t).length() / 2.0).sum()
+    }
 }
 
 /// Unnormalised face normal (cross product; length is twice the area).

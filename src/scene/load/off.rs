@@ -97,15 +97,7 @@ mod tests {
         // add up to more than the surface's.
         let off = include_str!("../../../tests/data/openscad/parts/step.off");
         let m = load(off.as_bytes(), &Limits::default()).unwrap();
-        let mesh = &m.parts[0].mesh;
-        let area: f32 = mesh
-            .triangles
-            .iter()
-            .map(|t| {
-                let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
-                (b - a).cross(c - a).length() / 2.0
-            })
-            .sum();
+        let area = m.parts[0].mesh.surface_area();
         assert!((area - (2.0 * 72.0 + 44.0 * 8.0)).abs() < 1e-3, "area {area}");
     }
 }
