@@ -204,16 +204,67 @@ fn an_open_box_is_seen_through_its_open_side_and_lit_from_within() {
     assert!(scene.objects.iter().all(|o| o.name != "ground"), "a box has its own floor");
     let inside = |p: Vec3| p.cmpge(Vec3::ZERO).all() && p.cmple(Vec3::ONE).all();
     let light = scene.lights.iter().find_map(|l| match l.kind {
-        kage::scene::LightKind::Point { position } if inside(position) => Some(position),
+        kage::scene::LightKind::Point { position } if inside(position) => Some((position, l.size)),
         _ => None,
     });
-    assert!(light.is_some_and(|p| p.y > 0.9), "a light at the panel: {light:?}");
+    // A sphere as wide as the panel (0.2 × 0.2 at y = 0.98), just under it.
+    let at_panel =
+        |(p, r): (Vec3, f32)| (p.y + r - 0.98).abs() < 0.01 && (r - 0.2 / std::f32::consts::PI.sqrt()).abs() < 1e-3;
+    assert!(light.is_some_and(at_panel), "a light at the panel: {light:?}");
     // The back wall (x = 0) shows through the opening, lit.
     let options = RenderOptions { aovs: ComponentSet::only(Component::Diffuse), ..RenderOptions::default() };
     let frame = render(&scene, &options).unwrap();
     let (x, y) = (scene.width / 2, scene.height / 2);
     assert!(!frame.visibility.item(x, y).is_none(), "the centre sees into the box");
     assert!(frame.aovs[0].1.get(x, y).max_element() > 0.1, "the back wall is lit: {}", frame.aovs[0].1.get(x, y));
+}
+
+/// An OBJ of inward-facing quads (counter-clockwise seen from inside) on the
+/// faces of the box `lo..hi` that `sides` picks (−x, +x, −y, +y, −z, +z).
+fn write_room(path: &Path, lo: Vec3, hi: Vec3, sides: [bool; 6]) {
+    let inside: Vec<[Vec3; 3]> = box_triangles(lo, hi).iter().map(|t| [t[0], t[2], t[1]]).collect();
+    // box_triangles lists −z, +z, −y, +y, −x, +x, two triangles each.
+    let order = [4, 5, 2, 3, 0, 1];
+    let kept: Vec<[Vec3; 3]> =
+        (0..6).filter(|&k| sides[order[k]]).flat_map(|k| [inside[2 * k], inside[2 * k + 1]]).collect();
+    write_obj(path, &kept);
+}
+
+/// A closed room (a courtyard building, a town under a sky dome) encloses
+/// the point the usual camera looks at: it is framed from inside, and kage
+/// says so; an open tray, which the usual camera sees into, is not.
+#[test]
+fn a_model_that_encloses_its_centre_is_framed_from_inside_and_says_so() {
+    let dir = scratch("enclosed");
+    let (lo, hi) = (Vec3::ZERO, Vec3::new(4.0, 2.0, 2.0));
+    write_room(&dir.join("room.obj"), lo, hi, [true; 6]);
+    let scene = scene_for_model(&dir.join("room.obj"), 160, 90).unwrap();
+    let eye = scene.camera.eye;
+    assert!(eye.cmpgt(lo).all() && eye.cmplt(hi).all(), "the eye is inside the room: {eye}");
+    assert!(
+        scene.warnings.iter().any(|w| w.contains("framed from inside")),
+        "kage says where it put the camera: {:?}",
+        scene.warnings
+    );
+    assert!(scene.objects.iter().all(|o| o.name != "ground"), "a room has its own floor");
+    let options = RenderOptions { aovs: ComponentSet::only(Component::Diffuse), ..RenderOptions::default() };
+    let frame = render(&scene, &options).unwrap();
+    let (x, y) = (scene.width / 2, scene.height / 2);
+    assert!(frame.aovs[0].1.get(x, y).max_element() > 0.1, "the far wall is lit: {}", frame.aovs[0].1.get(x, y));
+
+    // A tray (no top) is seen into from above, as any part.
+    write_room(&dir.join("tray.obj"), Vec3::ZERO, Vec3::new(1.0, 0.3, 1.0), [true, true, true, false, true, true]);
+    let scene = scene_for_model(&dir.join("tray.obj"), 160, 90).unwrap();
+    assert!(scene.camera.eye.y > 0.3 && scene.warnings.is_empty(), "{} {:?}", scene.camera.eye, scene.warnings);
+    // A closed part holds its centre in its material: seen from outside.
+    write_obj(&dir.join("part.obj"), &box_triangles(lo, hi));
+    let scene = scene_for_model(&dir.join("part.obj"), 160, 90).unwrap();
+    assert!(
+        !scene.camera.eye.cmplt(hi).all() && scene.warnings.is_empty(),
+        "{} {:?}",
+        scene.camera.eye,
+        scene.warnings
+    );
 }
 
 /// The Cornell box of the shared corpus, dropped in: seen through its open
@@ -230,8 +281,12 @@ fn the_cornell_box_is_seen_through_its_open_front() {
     let (lo, hi) = scene.bounds().unwrap();
     let cam = scene.camera;
     assert!(cam.eye.z > hi.z && (cam.eye.x - (lo.x + hi.x) * 0.5).abs() < 0.05 * (hi.x - lo.x), "eye {}", cam.eye);
+    // The light's sphere lies just under the ceiling's lamp.
     let lit_from_ceiling = scene.lights.iter().any(|l| match l.kind {
-        kage::scene::LightKind::Point { position } => position.y > lo.y + 0.9 * (hi.y - lo.y) && position.y < hi.y,
+        kage::scene::LightKind::Point { position } => {
+            let top = position.y + l.size;
+            top > lo.y + 0.95 * (hi.y - lo.y) && top < hi.y
+        }
         _ => false,
     });
     assert!(

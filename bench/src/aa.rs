@@ -11,7 +11,7 @@ use std::path::Path;
 use glam::Vec2;
 use kage::image::LinearImage;
 use kage::raytrace::shadow_truth;
-use kage::scene::{Antialias, EdgeFilter, EdgeMode, EdgeSelection, ShadowMethod, ShadowSettings};
+use kage::scene::{Antialias, EdgeFilter, EdgeMode, EdgeSelection, ShadowSettings};
 use kage::visibility::VisibilityBuffer;
 use kage::{RenderOptions, Renderer, Scene};
 use miette::{miette, Result};
@@ -127,7 +127,7 @@ fn with_slb(scene: &Scene, antialias: bool) -> Scene {
     let mut s = scene.clone();
     s.lights.iter_mut().for_each(|l| l.size = 0.0);
     let slb = ShadowSettings { antialias, ..ShadowSettings::SLB };
-    s.lights.iter_mut().filter(|l| l.shadow.method != ShadowMethod::None).for_each(|l| l.shadow = slb);
+    s.lights.iter_mut().filter(|l| l.casts_shadows()).for_each(|l| l.shadow = slb);
     s
 }
 

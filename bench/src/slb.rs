@@ -12,7 +12,7 @@ use glam::{Affine3A, Vec2, Vec3};
 use kage::camera::{Camera, Projection};
 use kage::raytrace::shadow_truth::{self, ShadowRays};
 use kage::scene::mesh::shapes;
-use kage::scene::{Light, LightKind, Material, Object, ShadowMethod, ShadowSettings};
+use kage::scene::{Light, LightKind, Material, Object, ShadowSettings};
 use kage::shadows::ShadowTerm;
 use kage::{RenderOptions, Renderer, Scene};
 use miette::{miette, Result};
@@ -145,7 +145,7 @@ fn with(scene: &Scene, settings: &ShadowSettings, (w, h): (u32, u32)) -> Scene {
     let mut s = scene.clone();
     (s.width, s.height) = (w, h);
     s.lights.iter_mut().for_each(|l| l.size = 0.0);
-    s.lights.iter_mut().filter(|l| l.shadow.method != ShadowMethod::None).for_each(|l| l.shadow = *settings);
+    s.lights.iter_mut().filter(|l| l.casts_shadows()).for_each(|l| l.shadow = *settings);
     s
 }
 
@@ -199,7 +199,7 @@ fn errors(scene: &Scene, truth: &Truth) -> Result<(f64, f64)> {
         terms[light].casts().then(|| terms[light].lit(q.surface.position, q.cos_theta, &receiver))
     });
     let (mut sum, mut n) = (0.0, 0);
-    let shadowed = scene.lights.iter().map(|l| l.shadow.method != ShadowMethod::None);
+    let shadowed = scene.lights.iter().map(kage::scene::Light::casts_shadows);
     let measured = frame.shadows.iter().zip(&truth.boundaries).zip(shadowed).filter(|(_, s)| *s);
     for ((image, boundary), _) in measured {
         let (rmse, k) = shadow_truth::rmse_at(image.pixels(), scene.width, &boundary.pixels, &boundary.covered);

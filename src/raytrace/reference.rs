@@ -7,6 +7,13 @@
 //! facing the point). Textures are read at their finest level: the reference
 //! filters them by supersampling.
 //!
+//! It reads the scene exactly as the raster pipeline does, or it would not be
+//! an oracle: a light whose shadow method is `none` is shadowed by neither
+//! ([`crate::scene::Light::casts_shadows`]); a single-sided back face, which
+//! the eye's pass culls, lets rays through; fog is laid on by the distance to
+//! the first surface a ray meets, as the fog pass does. A test holds every
+//! example scene, the demo and kage-framed models to their reference.
+//!
 //! With n = m = 1, shadows off and no area lights, every pixel whose primary hit
 //! agrees with the visibility buffer gets the rasterizer's colour (a test holds it).
 
@@ -59,7 +66,7 @@ pub fn render_reference_until(
 ) -> (LinearImage, u32) {
     let trace = TraceScene::new(scene);
     let frames = ObjectFrames::new(scene);
-    let run = Run { scene, opts, progress, stop };
+    let run = Run { scene, trace: &trace, opts, progress, stop };
     if opts.shadows {
         run.with(Tracer::new(scene, &trace, &frames, AreaLights { per_axis: opts.light_samples.max(1) }))
     } else {
@@ -70,6 +77,7 @@ pub fn render_reference_until(
 /// One reference render's settings, before its tracer is chosen.
 struct Run<'a> {
     scene: &'a Scene,
+    trace: &'a TraceScene,
     opts: &'a ReferenceOptions,
     progress: &'a (dyn Fn(u32) + Sync),
     stop: &'a AtomicBool,
@@ -87,23 +95,33 @@ impl Run<'_> {
                 return;
             }
             for (x, px) in row.iter_mut().enumerate() {
-                *px = pixel(&tracer, &rays, (x as u32, y as u32), self.opts);
+                *px = self.pixel(&tracer, &rays, (x as u32, y as u32));
             }
             (self.progress)(done.fetch_add(1, Ordering::Relaxed) + 1);
         });
         (image, done.into_inner())
     }
-}
 
-/// Pixel (x, y): the mean of n × n stratified, jittered rays through it.
-fn pixel<L: LightRays>(tracer: &Tracer<L>, rays: &PixelRays, (x, y): (u32, u32), opts: &ReferenceOptions) -> Vec3 {
-    let n = opts.pixel_samples.max(1);
-    let mut sum = Vec3::ZERO;
-    for k in 0..n * n {
-        let offset = stratified(k, n, hash3(x, y, k));
-        sum += tracer.radiance(&rays.ray(Vec2::new(x as f32, y as f32) + offset), opts.max_depth);
+    /// Pixel (x, y): the mean of n × n stratified, jittered rays through it,
+    /// each fogged by the distance to the first surface it meets (seed 002
+    /// §3.5's `lerp(colour, fog, f(d))`, as the raster's fog pass; a ray that
+    /// meets nothing keeps the background).
+    fn pixel<L: LightRays>(&self, tracer: &Tracer<L>, rays: &PixelRays, (x, y): (u32, u32)) -> Vec3 {
+        let n = self.opts.pixel_samples.max(1);
+        let mut sum = Vec3::ZERO;
+        for k in 0..n * n {
+            let ray = rays.ray(Vec2::new(x as f32, y as f32) + stratified(k, n, hash3(x, y, k)));
+            let seen = tracer.radiance(&ray, self.opts.max_depth);
+            sum += match (
+                &self.scene.fog,
+                self.scene.fog.as_ref().and_then(|_| self.trace.intersect(&ray, f32::INFINITY)),
+            ) {
+                (Some(fog), Some(hit)) => seen.lerp(fog.color, fog.amount_at(&self.scene.camera, ray.at(hit.t))),
+                _ => seen,
+            };
+        }
+        sum / (n * n) as f32
     }
-    sum / (n * n) as f32
 }
 
 /// Area lights seen by m × m stratified shadow rays over each sized light's

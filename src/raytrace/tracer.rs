@@ -118,8 +118,8 @@ impl<'a, L: LightRays> Tracer<'a, L> {
                 self.scene.background_along(ray.dir)
             }
         };
-        if material.translucent() && !material.two_sided && !s.front {
-            return behind(); // a culled back face, as the polygon pass draws it
+        if !material.two_sided && !s.front {
+            return behind(); // a culled back face, as the eye's pass draws it
         }
         let mut acc = Components { emission: k.parts().3, ..Default::default() };
         for (i, light) in self.scene.lights.iter().enumerate() {
@@ -127,7 +127,11 @@ impl<'a, L: LightRays> Tracer<'a, L> {
                 continue; // selective lighting (seed 002 §3.3)
             }
             let origin = s.position + s.normal * self.epsilon;
-            let shadow = self.lights.lit(self.trace, light, origin, s.position, i as u32);
+            let shadow = if light.casts_shadows() {
+                self.lights.lit(self.trace, light, origin, s.position, i as u32)
+            } else {
+                1.0
+            };
             phong::add_light(&mut acc, light, &k, &s, shadow);
         }
         let own = acc.total() + reflection_map(self.scene, &s) + self.bounces_within(ray, &s, depth, rays);

@@ -77,6 +77,16 @@ pub struct Light {
     pub only: Option<Vec<usize>>,
 }
 
+impl Light {
+    /// Whether anything shadows this light: the one rule the raster pipeline's
+    /// shadow stage and every ray tracer (the traced term, the reference) both
+    /// follow, so the oracle renders the scene the product renders.
+    #[must_use]
+    pub fn casts_shadows(&self) -> bool {
+        self.shadow.method != ShadowMethod::None
+    }
+}
+
 impl Default for Light {
     /// A white point light of intensity 1 at the origin, no ambient, shadow-mapped.
     fn default() -> Self {

@@ -12,10 +12,12 @@ use super::framing::{fit_depth, framed_camera, key_light, light_rig, CameraOverr
 use super::load;
 use super::mesh::shapes;
 use super::{Environment, Exposure, Light, Material, Object, Scene, ShadowSettings, Up};
-use crate::camera::{Camera, Projection};
+use crate::bvh::{Aabb, Bvh};
+use crate::camera::{Camera, Projection, Ray};
 use crate::csg::openscad::CsgOptions;
 use crate::error::{Error, Result};
 use crate::limits::Limits;
+use crate::triangle::ShearedRay;
 
 /// A matte ground under `bounds` (kage's y-up world), four times their size,
 /// unless the camera looks at it from below. It lies a thousandth of the
@@ -182,6 +184,11 @@ pub fn scene_for_loaded_model(
         }
     };
     scene.camera = options.camera.apply(camera, bounds, aspect);
+    let own_camera = model.camera.is_some() && options.file_camera;
+    if let Some(note) = interior.as_ref().filter(|_| !own_camera && options.camera.is_empty()).and_then(Interior::note)
+    {
+        scene.warnings.push(format!("{}: {note}", path.display()));
+    }
     let mut lights = light_rig(bounds, &scene.camera);
     if let Some(inside) = &interior {
         // Lit from within: by its glowing surfaces, else from under its top;
@@ -219,12 +226,23 @@ pub fn scene_for_loaded_model(
     Ok(scene)
 }
 
-/// A model that is a room or an open box (a Cornell box): most of its surface
-/// faces inwards, and one side has no wall. It is seen through that side,
-/// level, needs no ground (it has its floor), and is lit from inside.
+/// A model that is a room: most of its surface faces inwards, and either one
+/// side has no wall (a Cornell box, seen through that side, level) or it
+/// encloses its own centre (a courtyard building, a town under a sky dome:
+/// seen from inside, along its longer floor axis). Either needs no ground (it
+/// has its floor) and is lit from inside.
 struct Interior {
-    /// The open side: the outward direction of the bounds' face with no wall.
-    open: Vec3,
+    /// Where the room is seen from.
+    view: RoomView,
+}
+
+/// How a room is looked into.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum RoomView {
+    /// Through the side with no wall (its outward direction).
+    OpenSide(Vec3),
+    /// From inside: from `eye` towards the bounds' centre.
+    Enclosed { eye: Vec3 },
 }
 
 impl Interior {
@@ -253,26 +271,46 @@ impl Interior {
         });
         let most = walls.iter().copied().fold(0.0, f32::max);
         let (open, least) = walls.iter().copied().enumerate().min_by(|a, b| a.1.total_cmp(&b.1))?;
-        let is_interior = total > 0.0 && inward > Self::INWARD_SHARE * total && least < 0.1 * most;
-        is_interior.then_some(Interior { open: sides[open] })
+        if total > 0.0 && inward > Self::INWARD_SHARE * total && least < 0.1 * most {
+            return Some(Interior { view: RoomView::OpenSide(sides[open]) });
+        }
+        let eye = Enclosure::around(scene, centre)?.eye(bounds)?;
+        Some(Interior { view: RoomView::Enclosed { eye } })
+    }
+
+    /// What to say about the camera kage chose, when it is not the usual one.
+    fn note(&self) -> Option<String> {
+        match self.view {
+            RoomView::OpenSide(_) => None,
+            RoomView::Enclosed { .. } => Some(
+                "the model encloses its centre (a room): framed from inside; --view or --eye to see it from outside"
+                    .into(),
+            ),
+        }
     }
 
     /// A level camera outside the open side, looking at the centre, as far
-    /// out as the opening needs to fill the view.
+    /// out as the opening needs to fill the view; or, enclosed, one inside
+    /// looking level at the centre, with a wide lens.
     fn camera(&self, (lo, hi): (Vec3, Vec3), aspect: f32) -> Camera {
         let (centre, size) = ((lo + hi) * 0.5, hi - lo);
-        let across = if self.open.x != 0.0 { size.z } else { size.x };
-        let half = (FRAMING_FOV_DEG.to_radians() * 0.5).tan();
-        let back = 1.05 * (size.y * 0.5 / half).max(across * 0.5 / (half * aspect));
-        let depth = size.dot(self.open.abs());
-        let eye = centre + self.open * (depth * 0.5 + back);
+        let (eye, fov_y_deg) = match self.view {
+            RoomView::OpenSide(open) => {
+                let across = if open.x != 0.0 { size.z } else { size.x };
+                let half = (FRAMING_FOV_DEG.to_radians() * 0.5).tan();
+                let back = 1.05 * (size.y * 0.5 / half).max(across * 0.5 / (half * aspect));
+                let depth = size.dot(open.abs());
+                (centre + open * (depth * 0.5 + back), FRAMING_FOV_DEG)
+            }
+            RoomView::Enclosed { eye } => (eye, Enclosure::FOV_DEG),
+        };
         let camera = Camera {
             eye,
-            target: centre,
+            target: Vec3::new(centre.x, eye.y, centre.z),
             up: Vec3::Y,
             near: 1.0,
             far: 2.0,
-            projection: Projection::Perspective { fov_y_deg: FRAMING_FOV_DEG },
+            projection: Projection::Perspective { fov_y_deg },
             shift: glam::Vec2::ZERO,
         };
         fit_depth(camera, (lo, hi))
@@ -300,10 +338,14 @@ impl Interior {
                 continue;
             }
             scene.objects[o].casts_shadows = false;
-            let normal = normal.normalize_or(Vec3::NEG_Y);
+            // A sphere as wide as the surface, just clear of it: every point
+            // of the light lies inside the room, so the shadow rays the
+            // reference casts at it and the maps the raster renders from it
+            // see the same light.
+            let (normal, radius) = (normal.normalize_or(Vec3::NEG_Y), (area / std::f32::consts::PI).sqrt());
             lights.push(Light {
                 color: ke / ke.max_element(),
-                ..Self::key(centre / area + normal * 1e-3 * extent, (area / std::f32::consts::PI).sqrt())
+                ..Self::key(centre / area + normal * (radius + 1e-3 * extent), radius)
             });
         }
         if lights.is_empty() {
@@ -320,6 +362,84 @@ impl Interior {
     fn key(position: Vec3, size: f32) -> Light {
         Light { intensity: 0.9, ..key_light(position, size) }
     }
+}
+
+/// The model's triangles behind a BVH, asked whether they surround a point.
+struct Enclosure {
+    triangles: Vec<[Vec3; 3]>,
+    bvh: Bvh,
+    centre: Vec3,
+}
+
+impl Enclosure {
+    /// Directions around the level that must meet an inward face: 16
+    /// azimuths at 0° and ±25° of elevation.
+    const AZIMUTHS: u32 = 16;
+    const ELEVATIONS_DEG: [f32; 3] = [-25.0, 0.0, 25.0];
+    /// Share of those directions that must meet the model from its inside
+    /// (a face turned towards the centre): a courtyard's arcades let a few
+    /// through between columns.
+    const ENCLOSED_SHARE: f32 = 0.9;
+    /// The lens inside a room: wide, as a visitor sees it.
+    const FOV_DEG: f32 = 60.0;
+
+    /// `Some` when `scene`'s mesh objects surround `centre`: the usual
+    /// camera's line to it meets a face turned towards it (a wall seen from
+    /// inside — not the outside of a solid part round it, nor nothing, as
+    /// for anything the usual camera sees into), and so does nearly every
+    /// direction round it.
+    fn around(scene: &Scene, centre: Vec3) -> Option<Enclosure> {
+        let mut triangles = Vec::new();
+        for_each_triangle(scene, |t| triangles.push(t));
+        // One ray first, against every triangle: most models stop here.
+        let towards_camera = Ray { origin: centre, dir: View::DEFAULT.direction() };
+        let sheared = ShearedRay::new(&towards_camera);
+        let first = triangles
+            .iter()
+            .filter_map(|t| Some((sheared.intersect(t, 0.0, f32::INFINITY)?.0, t)))
+            .min_by(|a, b| a.0.total_cmp(&b.0))?;
+        if !faces(first.1, towards_camera.dir) {
+            return None;
+        }
+        let boxes: Vec<Aabb> = triangles.iter().map(|t| Aabb::around(t)).collect();
+        let enclosure = Enclosure { bvh: Bvh::build(&boxes), triangles, centre };
+        let directions = Self::ELEVATIONS_DEG.iter().flat_map(|&up| {
+            (0..Self::AZIMUTHS)
+                .map(move |k| View { azimuth_deg: k as f32 * 360.0 / Self::AZIMUTHS as f32, elevation_deg: up })
+        });
+        let (mut inward, mut all) = (0u32, 0u32);
+        for view in directions {
+            all += 1;
+            inward += u32::from(enclosure.inward_hit(view.direction()).is_some());
+        }
+        (inward as f32 >= Self::ENCLOSED_SHARE * all as f32).then_some(enclosure)
+    }
+
+    /// Distance from the centre along unit `dir` to the first face, if that
+    /// face is turned towards the centre.
+    fn inward_hit(&self, dir: Vec3) -> Option<f32> {
+        let ray = Ray { origin: self.centre, dir };
+        let sheared = ShearedRay::new(&ray);
+        let (i, t) = self.bvh.intersect(&ray, f32::INFINITY, |i, t_max| {
+            sheared.intersect(&self.triangles[i as usize], 0.0, t_max).map(|h| h.0)
+        })?;
+        faces(&self.triangles[i as usize], dir).then_some(t)
+    }
+
+    /// An eye inside: back from the centre along the longer floor axis, most
+    /// of the way to the wall there, at the centre's height.
+    fn eye(&self, (lo, hi): (Vec3, Vec3)) -> Option<Vec3> {
+        let size = hi - lo;
+        let back = if size.x >= size.z { Vec3::NEG_X } else { Vec3::NEG_Z };
+        let wall = self.inward_hit(back)?;
+        Some(self.centre + back * 0.75 * wall)
+    }
+}
+
+/// Whether triangle `[a, b, c]` turns its front (counter-clockwise) side
+/// towards a ray along `dir`.
+fn faces([a, b, c]: &[Vec3; 3], dir: Vec3) -> bool {
+    (*b - *a).cross(*c - *a).dot(dir) < 0.0
 }
 
 /// Calls `f` with every triangle of `scene`'s mesh objects, in world space.

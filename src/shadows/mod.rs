@@ -331,7 +331,7 @@ enum Placement {
 /// through one cone just holding that sphere (the peers' placement), and needs a
 /// cube only when it is among the objects.
 fn placement(light: &Light, bounds: (Vec3, Vec3)) -> Placement {
-    if light.shadow.method == ShadowMethod::None {
+    if !light.casts_shadows() {
         return Placement::None;
     }
     let (centre, radius) = ((bounds.0 + bounds.1) * 0.5, (bounds.1 - bounds.0).length() * 0.5);

@@ -254,7 +254,7 @@ fn display_image(scene: &Scene, frame: &kage::Frame, display: Display, out: &mut
             None => out.pixels_mut().fill(Vec3::ZERO),
         },
         Display::Shadow => {
-            let first = scene.lights.iter().position(|l| l.shadow.method != ShadowMethod::None);
+            let first = scene.lights.iter().position(kage::scene::Light::casts_shadows);
             match first.and_then(|i| frame.shadows.get(i)) {
                 Some(image) => copy(out, image),
                 None => out.pixels_mut().fill(Vec3::ONE),
