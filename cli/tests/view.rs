@@ -199,6 +199,29 @@ fn a_dropped_file_opens() {
     assert!(e < 1e-3, "RMSE {e} against kage render of the dropped file");
 }
 
+/// `wait N` right after an input waits for N passes of the new view, not
+/// the passes already shown of the old one.
+#[test]
+fn wait_for_passes_after_a_drop_waits_for_the_dropped_file() {
+    if !have_xvfb() {
+        return;
+    }
+    let dir = scratch("wait-passes");
+    let (first, other) = (dir.join("first.toml"), dir.join("other.toml"));
+    std::fs::write(&first, scene("sphere", "[0.8, 0.3, 0.2]")).unwrap();
+    std::fs::write(&other, scene("cube", "[0.2, 0.3, 0.8]")).unwrap();
+    let script = "wait\ndrop other.toml\nwait 8\nscreenshot shot.png\nquit\n";
+    std::fs::write(dir.join("run.script"), script).unwrap();
+    let (ok, out) = view(&[first.to_str().unwrap(), "--script", dir.join("run.script").to_str().unwrap()]);
+    assert!(ok, "{out}");
+    let (was, now) = (dir.join("first.png"), dir.join("other.png"));
+    kage(&["render", first.to_str().unwrap(), "-o", was.to_str().unwrap()]);
+    kage(&["render", other.to_str().unwrap(), "-o", now.to_str().unwrap()]);
+    let shot = read(&dir.join("shot.png"));
+    let (to_other, to_first) = (rmse(&shot, &read(&now)), rmse(&shot, &read(&was)));
+    assert!(to_other < 0.03 && to_first > 0.05, "RMSE {to_other} to the dropped file, {to_first} to the first");
+}
+
 /// The demo's lights have a size: its refined passes shadow each from a
 /// point of the disc of its own (64 in all), where `jitter:64` repeats the
 /// light's 8 in every pass — the same image but for the penumbrae' finer

@@ -37,6 +37,32 @@ impl Text {
         (cols * self.advance + 8, lines.len() * self.line + 6)
     }
 
+    /// `lines` broken so that their box is at most `width` pixels wide: a
+    /// line too long is cut at its last space that fits (mid-word when a
+    /// word alone is too long: a file path), the rest indented on the next.
+    #[must_use]
+    pub fn wrapped(&self, lines: &[String], width: usize) -> Vec<String> {
+        let cols = (width.saturating_sub(8) / self.advance).max(8);
+        let mut out = Vec::new();
+        for line in lines {
+            let mut rest: Vec<char> = line.chars().collect();
+            let mut indent = 0;
+            while indent + rest.len() > cols {
+                let room = cols - indent;
+                let cut = rest[..=room].iter().rposition(|&c| c == ' ').filter(|&k| k > room / 2).unwrap_or(room);
+                let head: String = rest[..cut].iter().collect();
+                out.push(format!("{:indent$}{}", "", head.trim_end()));
+                rest.drain(..cut);
+                while rest.first() == Some(&' ') {
+                    rest.remove(0);
+                }
+                indent = 2;
+            }
+            out.push(format!("{:indent$}{}", "", rest.iter().collect::<String>()));
+        }
+        out
+    }
+
     /// Draws `lines` in `colour` (0xRRGGBB) with their top-left corner at
     /// `(x, y)` on a darkened box, into `buffer` (`width` × `height`, 0RGB
     /// row by row); what falls outside is clipped.
@@ -111,5 +137,24 @@ mod tests {
         let mut corner = vec![0u32; w * h];
         text.draw(&mut corner, (w, h), (190, 30), &["clipped at the edge".to_string()], 0x00ff_0000);
         assert!(corner.iter().any(|&p| p != 0));
+    }
+
+    /// A long error fits the window once wrapped, every word kept, short
+    /// lines untouched.
+    #[test]
+    fn long_lines_wrap_within_the_width() {
+        let text = Text::new();
+        let long = "error: /home/user/projects/enclosure/parts/lid_with_hinge.scad:117: unknown module \
+                    'rounded_cube_with_fillets' (is it in a library not on OPENSCADPATH?)"
+            .to_string();
+        let lines = vec!["short".to_string(), long.clone()];
+        for width in [200, 400, 1280] {
+            let wrapped = text.wrapped(&lines, width);
+            assert!(text.size(&wrapped).0 <= width, "{width}: {wrapped:?}");
+            assert_eq!(wrapped[0], "short");
+            let words = |s: &str| s.split_whitespace().collect::<String>();
+            assert_eq!(words(&wrapped[1..].concat()), words(&long), "{width}: {wrapped:?}");
+        }
+        assert_eq!(text.wrapped(&lines, 2000).len(), 2, "a line that fits stays one");
     }
 }

@@ -310,12 +310,19 @@ impl App {
 
     fn input(&mut self, event_loop: &ActiveEventLoop, input: Input) {
         let request = self.viewer.apply(input);
-        if matches!(request, Request::Render | Request::Reload | Request::Open(_)) {
+        let changes = matches!(request, Request::Render | Request::Reload | Request::Open(_));
+        if changes {
             self.clock.last_input = Some(Instant::now());
             self.clock.unanswered = self.clock.unanswered.or(self.clock.last_input);
         }
         if self.viewer.stale() && !self.stop.swap(true, Ordering::Relaxed) {
             self.clock.stop_raised = Some(Instant::now());
+        }
+        if changes {
+            // What is on screen shows the view before this input: none of
+            // its passes count towards a script's `wait N` (the rendering
+            // thread, stopped, publishes no more of them).
+            lock(&self.shown).passes = 0;
         }
         match request {
             Request::Nothing | Request::Render => {}
@@ -534,11 +541,12 @@ impl App {
         let mut bottom = bh;
         if let Some(e) = &self.viewer.error {
             let lines: Vec<String> = e.lines().map(str::to_string).collect();
+            let lines = self.text.wrapped(&lines, bw.saturating_sub(16));
             bottom = bottom.saturating_sub(self.text.size(&lines).1 + 8);
             self.text.draw(&mut buffer, (bw, bh), (8, bottom), &lines, ERROR_COLOUR);
         }
         if !self.viewer.warnings.is_empty() {
-            let lines = warning_lines(&self.viewer.warnings);
+            let lines = self.text.wrapped(&warning_lines(&self.viewer.warnings), bw.saturating_sub(16));
             bottom = bottom.saturating_sub(self.text.size(&lines).1 + 8);
             self.text.draw(&mut buffer, (bw, bh), (8, bottom), &lines, WARNING_COLOUR);
         }
