@@ -362,3 +362,47 @@ fn shadow_images_show_each_lights_term_as_shadow_rays_say() {
         assert!(away > 100 && background > 100, "{away} pixels facing away, {background} background");
     }
 }
+
+/// The memory budget of a light's maps comes from what its method builds:
+/// on every example scene with shadows, for plain maps, silhouette-line
+/// buffers, two-map soft shadows (two points and the ring's four, with plain
+/// and silhouette-line hard shadows) and PCSS, the maps built hold no more
+/// than [`ShadowTerm::bytes_needed`] said, and not less than a third of it.
+#[test]
+fn every_methods_maps_fit_the_memory_it_budgets() {
+    use kage::scene::{HardShadows, PenumbraPoints, ShadowMethod};
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenes");
+    let mut scenes = common::shadow_example_scenes();
+    for name in ["soft-shadows", "csg", "atrium"] {
+        let mut scene = kage::scene::file::load_scene(&dir.join(format!("{name}.toml"))).unwrap();
+        (scene.width, scene.height) = (320, 200);
+        scenes.push((name, scene));
+    }
+    let base = ShadowSettings { resolution: 1024, by_need: false, samples: 1, ..ShadowSettings::default() };
+    let methods = [
+        ("map", ShadowSettings { method: ShadowMethod::Map, ..base }),
+        ("slb", ShadowSettings { method: ShadowMethod::Slb, ..base }),
+        ("soft", ShadowSettings { method: ShadowMethod::Soft, ..base }),
+        (
+            "soft ring slb",
+            ShadowSettings { method: ShadowMethod::Soft, points: PenumbraPoints::Ring, hard: HardShadows::Slb, ..base },
+        ),
+        ("pcss", ShadowSettings { method: ShadowMethod::Pcss, ..base }),
+    ];
+    let mut failed = Vec::new();
+    for (name, scene) in &scenes {
+        let Some(bounds) = scene.caster_bounds() else { continue };
+        for (method, settings) in &methods {
+            for (i, light) in scene.lights.iter().enumerate().filter(|(_, l)| l.casts_shadows()) {
+                let light = Light { shadow: *settings, size: light.size.max(0.05), ..light.clone() };
+                let built = ShadowTerm::build(scene, &light).memory_bytes();
+                let budget = ShadowTerm::bytes_needed(&light, bounds);
+                println!("{name:<12} light {i} {method:<14} built {built:>10} budget {budget:>10}");
+                if built > budget || 3 * built < budget {
+                    failed.push(format!("{name} light {i} {method}: built {built} bytes, budget {budget}"));
+                }
+            }
+        }
+    }
+    assert!(failed.is_empty(), "{failed:#?}");
+}

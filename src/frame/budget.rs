@@ -5,9 +5,10 @@
 //! The memory is an estimate from sizes known before the render: per triangle
 //! drawn, its mesh, its ray-tracing copy and their bounding-volume
 //! hierarchies ([`BYTES_PER_TRIANGLE`]); per texture, its texels and mip
-//! chain (16 bytes a texel); the shadow maps' depths at their configured
-//! resolution; per pixel, the item buffer, the component images and the edge
-//! pass's records ([`BYTES_PER_PIXEL`]).
+//! chain (16 bytes a texel); the shadow maps at their configured resolution,
+//! counted from what each light's method builds
+//! ([`ShadowTerm::bytes_needed`]); per pixel, the item buffer, the component
+//! images and the edge pass's records ([`BYTES_PER_PIXEL`]).
 
 use std::collections::HashSet;
 use std::sync::Arc;

@@ -142,11 +142,7 @@ impl ShadowTerm {
     /// [`ShadowSettings::hard`]) from the two points of seed 001, or its
     /// hard shadow alone where it has no size.
     fn build_soft(scene: &Scene, light: &Light, bounds: (Vec3, Vec3), pool: &mut MapPool) -> ShadowTerm {
-        let method = match light.shadow.hard {
-            HardShadows::Map => ShadowMethod::Map,
-            HardShadows::Slb => ShadowMethod::Slb,
-        };
-        let hard = ShadowSettings { samples: 1, ..light.shadow.with_method(method) };
+        let hard = soft_hard_settings(&light.shadow);
         let mut build = |l: &Light| ShadowTerm::build_within(scene, &Light { shadow: hard, ..l.clone() }, bounds, pool);
         match TwoMaps::build(light, bounds, &mut build) {
             Some(two) => ShadowTerm::Soft(Box::new(two)),
@@ -157,7 +153,7 @@ impl ShadowTerm {
     /// The PCSS term of `light`: a hard map (or cube) from its centre, read
     /// by [`pcss::lit`].
     fn build_pcss(scene: &Scene, light: &Light, bounds: (Vec3, Vec3), pool: &mut MapPool) -> ShadowTerm {
-        let hard = ShadowSettings { samples: 1, pcf: 1, ..light.shadow.with_method(ShadowMethod::Map) };
+        let hard = pcss_hard_settings(&light.shadow);
         let term = ShadowTerm::build_within(scene, &Light { shadow: hard, ..light.clone() }, bounds, pool);
         let (size, at) = match light.kind {
             LightKind::Point { position } | LightKind::Spot { position, .. } => (light.size.max(0.0), position),
@@ -172,21 +168,36 @@ impl ShadowTerm {
     }
 
     /// Bytes the maps of `light` hold at most (before they are rendered) in a
-    /// scene with these bounds: at the full configured resolution (a soft
-    /// term's two maps; its per-pixel term is the frame's and not counted).
+    /// scene with these bounds, counted from the maps its method builds: at
+    /// the full configured resolution, a cube's six faces at half of it, a
+    /// two-map soft term's hard shadows from each of its points (two, or the
+    /// ring's four), a silhouette-line buffer's lines on top of its map
+    /// ([`slb_bytes`]), PCSS's one map. A per-pixel term's screen images are
+    /// the frame's and not counted.
     #[must_use]
     pub fn bytes_needed(light: &Light, bounds: (Vec3, Vec3)) -> usize {
-        let res = light.shadow.resolution.max(1) as usize;
-        let texel = std::mem::size_of::<f32>();
-        let one = match placement(light, bounds) {
-            Placement::None => 0,
-            Placement::Cone { .. } | Placement::Parallel { .. } => res * res * texel,
-            Placement::Cube { .. } => 6 * (res / 2).max(16).pow(2) * texel,
-        };
-        if light.shadow.method == ShadowMethod::Soft {
-            2 * one
-        } else {
-            one
+        let with = |l: &Light, shadow: ShadowSettings| Self::bytes_needed(&Light { shadow, ..l.clone() }, bounds);
+        match light.shadow.method {
+            ShadowMethod::Soft => {
+                let hard = soft_hard_settings(&light.shadow);
+                match TwoMaps::hard_lights(light, bounds) {
+                    Some(lights) => lights.iter().map(|l| with(l, hard)).sum(),
+                    None => with(light, hard),
+                }
+            }
+            ShadowMethod::Pcss => with(light, pcss_hard_settings(&light.shadow)),
+            ShadowMethod::None | ShadowMethod::Map | ShadowMethod::Slb => {
+                let res = light.shadow.resolution.max(1) as usize;
+                let map = |res: usize| {
+                    let depth = res * res * std::mem::size_of::<f32>();
+                    depth + if light.shadow.method == ShadowMethod::Slb { slb_bytes(res) } else { 0 }
+                };
+                match placement(light, bounds) {
+                    Placement::None => 0,
+                    Placement::Cone { .. } | Placement::Parallel { .. } => map(res),
+                    Placement::Cube { .. } => 6 * map((res / 2).max(16)),
+                }
+            }
         }
     }
 
@@ -312,6 +323,41 @@ impl ShadowTerm {
             ShadowTerm::Pcss(hard, _) => hard.memory_bytes(),
         }
     }
+}
+
+/// The settings of a two-map soft term's hard shadows: its `hard` method,
+/// one map each.
+fn soft_hard_settings(soft: &ShadowSettings) -> ShadowSettings {
+    let method = match soft.hard {
+        HardShadows::Map => ShadowMethod::Map,
+        HardShadows::Slb => ShadowMethod::Slb,
+    };
+    ShadowSettings { samples: 1, ..soft.with_method(method) }
+}
+
+/// The settings of PCSS's one hard map: no filter of its own.
+fn pcss_hard_settings(pcss: &ShadowSettings) -> ShadowSettings {
+    ShadowSettings { samples: 1, pcf: 1, ..pcss.with_method(ShadowMethod::Map) }
+}
+
+/// Silhouette lines each texel of a silhouette-line buffer is budgeted,
+/// on average over the map (the edge texels' share times their lines): the
+/// example scenes' 1024² maps hold 0.013 (the demo) to 0.058 (the atrium's
+/// arcades), measured by `every_methods_maps_fit_the_memory_it_budgets` in
+/// `tests/shadows.rs`, which holds the budget to what the maps take.
+const SLB_LINES_PER_TEXEL: f64 = 0.08;
+
+/// Bytes a silhouette-line buffer adds to a map of `res` × `res` texels:
+/// the map's item per texel (which object is nearest the light), its edge
+/// bits, ranks and solids' step bits (1.5 + 1 bits a texel), and per budgeted
+/// line its record, its texel's start indices and a surface over the
+/// texel's centre.
+#[must_use]
+pub fn slb_bytes(res: usize) -> usize {
+    let texels = res * res;
+    let per_line = std::mem::size_of::<slb::line::SilhouetteLine>() + std::mem::size_of::<slb::line::Layer>() + 8;
+    let per_texel = std::mem::size_of::<crate::visibility::ItemId>() * 16 + 5;
+    texels * per_texel / 16 + (texels as f64 * SLB_LINES_PER_TEXEL) as usize * per_line
 }
 
 /// How a light's shadow maps are placed.

@@ -98,6 +98,22 @@ impl TwoMaps {
     /// the two lights moved to L1 and L2), with the casters within `bounds`;
     /// `None` when the light has no size or no position (directional).
     pub fn build(light: &Light, bounds: (Vec3, Vec3), mut hard: impl FnMut(&Light) -> ShadowTerm) -> Option<TwoMaps> {
+        let (centre, points) = Self::placed(light, bounds)?;
+        let hard = points.iter().map(|&p| hard(&Self::moved(light, p))).collect();
+        Some(TwoMaps { hard, points, centre, settings: light.shadow, screen: None })
+    }
+
+    /// The lights the hard shadows of `light` are cast from, as
+    /// [`TwoMaps::build`] casts them: `light` moved to each point (L1 and
+    /// L2, or the ring's four); `None` where [`TwoMaps::build`] gives none.
+    #[must_use]
+    pub fn hard_lights(light: &Light, bounds: (Vec3, Vec3)) -> Option<Vec<Light>> {
+        let (_, points) = Self::placed(light, bounds)?;
+        Some(points.iter().map(|&p| Self::moved(light, p)).collect())
+    }
+
+    /// The light's centre and the points its hard shadows are cast from.
+    fn placed(light: &Light, bounds: (Vec3, Vec3)) -> Option<(Vec3, Vec<Vec3>)> {
         let centre = match light.kind {
             LightKind::Point { position } | LightKind::Spot { position, .. } => position,
             LightKind::Directional { .. } => return None,
@@ -107,17 +123,18 @@ impl TwoMaps {
             PenumbraPoints::Ring => ring_points(centre, light.size, focus)?.to_vec(),
             placing => two_points(centre, light.size, focus, bounds, placing)?.to_vec(),
         };
-        let moved = |to: Vec3| {
-            let kind = match light.kind {
-                LightKind::Spot { direction, inner, outer, .. } => {
-                    LightKind::Spot { position: to, direction, inner, outer }
-                }
-                _ => LightKind::Point { position: to },
-            };
-            Light { kind, ..light.clone() }
+        Some((centre, points))
+    }
+
+    /// `light` moved to `to`, its kind and everything else kept.
+    fn moved(light: &Light, to: Vec3) -> Light {
+        let kind = match light.kind {
+            LightKind::Spot { direction, inner, outer, .. } => {
+                LightKind::Spot { position: to, direction, inner, outer }
+            }
+            _ => LightKind::Point { position: to },
         };
-        let hard = points.iter().map(|&p| hard(&moved(p))).collect();
-        Some(TwoMaps { hard, points, centre, settings: light.shadow, screen: None })
+        Light { kind, ..light.clone() }
     }
 
     /// The points the hard shadows are cast from: L1 and L2, or the ring's.
