@@ -53,6 +53,16 @@ pub struct Ray {
 }
 
 impl Camera {
+    /// This camera with its image shifted by `offset` pixels (y down) on a
+    /// `width` × `height` frame: a pass whose pixel centres sample the points
+    /// `offset` from the unshifted pixels' centres (a jittered pass).
+    #[must_use]
+    pub fn shifted(&self, offset: Vec2, (width, height): (u32, u32)) -> Camera {
+        let pixel = 2.0 / Vec2::new(width as f32, height as f32);
+        // Pixel offsets (y down) to NDC (y up).
+        Camera { shift: self.shift + Vec2::new(offset.x, -offset.y) * pixel, ..*self }
+    }
+
     /// The same camera with its eye, target and up moved by `m` (a rigid
     /// motion: a model's frame carried into the world's).
     #[must_use]

@@ -33,8 +33,15 @@
 //! output · compare                               images written and read; measured
 //! ```
 //!
-//! [`frame::render`] runs the whole chain; each stage is usable on its own, so tests
+//! [`render`] runs the whole chain; each stage is usable on its own, so tests
 //! can check coverage without shading and shading without files.
+//!
+//! The front door — what the `kage` command, its viewer and the benchmarks use —
+//! is re-exported here: [`render`] and [`Renderer`] with [`RenderOptions`], the
+//! [`Frame`] they give with its [`FrameStats`], the ray-traced oracle
+//! [`render_reference`] with [`ReferenceOptions`], the shading components
+//! ([`Component`], [`ComponentSet`]), [`thread_pool`], and [`Scene`] (built by
+//! [`scene::file`], [`scene::model`] or [`scene::demo`]).
 //!
 //! ```
 //! // Render the built-in demo scene and look at what the centre pixel sees.
@@ -69,6 +76,8 @@ pub mod triangle;
 pub mod visibility;
 
 pub use error::{Error, SourceLocation};
-pub use frame::{render, Frame, FrameStats, RenderOptions, Renderer};
+pub use frame::{render, thread_pool, Frame, FrameStats, RenderOptions, Renderer};
 pub use limits::{Limit, Limits};
+pub use raytrace::reference::{render_reference, render_reference_until, ReferenceOptions};
 pub use scene::Scene;
+pub use shading::{Component, ComponentSet};

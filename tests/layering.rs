@@ -128,10 +128,9 @@ fn without_comments(text: &str) -> String {
 /// The paths a `use` tree names (`a::{b, c::{d, self}}` → `a::b`, `a::c::d`,
 /// `a::c`), as lists of segments.
 fn expand_use_tree(tree: &str) -> Vec<Vec<String>> {
-    let tree: String = tree.chars().filter(|c| !c.is_whitespace()).collect();
+    let tree: String = without_renames(tree).chars().filter(|c| !c.is_whitespace()).collect();
     let Some(open) = tree.find('{') else {
-        let path = tree.split("as").next().unwrap_or_default();
-        return vec![path.split("::").filter(|s| !s.is_empty()).map(str::to_string).collect()];
+        return vec![tree.split("::").filter(|s| !s.is_empty()).map(str::to_string).collect()];
     };
     let prefix: Vec<String> = tree[..open].split("::").filter(|s| !s.is_empty()).map(str::to_string).collect();
     let close = tree.rfind('}').filter(|&c| c > open).unwrap_or(tree.len());
@@ -157,6 +156,22 @@ fn expand_use_tree(tree: &str) -> Vec<Vec<String>> {
             out.push(path);
         }
     }
+    out
+}
+
+/// `tree` without its renames (`a::b as c` → `a::b`): the word `as` and the
+/// name after it, whatever the spacing; names that merely hold the letters
+/// "as" (`passes`, `aa`) stay whole.
+fn without_renames(tree: &str) -> String {
+    let is_name = |c: char| c.is_alphanumeric() || c == '_';
+    let mut out = String::with_capacity(tree.len());
+    let mut rest = tree;
+    while let Some(at) = find_word(rest, "as") {
+        out.push_str(&rest[..at]);
+        let after = rest[at + 2..].trim_start();
+        rest = after.trim_start_matches(is_name);
+    }
+    out.push_str(rest);
     out
 }
 
@@ -228,12 +243,55 @@ fn target(tree: &BTreeMap<ModPath, String>, module: &ModPath, path: &[String]) -
     (0..=base.len()).rev().map(|k| base[..k].to_vec()).find(|m| tree.contains_key(m))
 }
 
+/// The items the crate root re-exports (`pub use frame::render;` at the
+/// root), by name → the module they come from.
+fn root_exports(tree: &BTreeMap<ModPath, String>) -> BTreeMap<String, ModPath> {
+    let Some(root) = tree.get(&Vec::new()) else { return BTreeMap::new() };
+    let mut out = BTreeMap::new();
+    let mut rest = root.as_str();
+    while let Some(at) = find_word(rest, "pub") {
+        let tail = rest[at + 3..].trim_start();
+        let end = tail.find(';').unwrap_or(tail.len());
+        if let Some(tree_text) = tail.strip_prefix("use").filter(|t| t.starts_with(char::is_whitespace)) {
+            for path in expand_use_tree(&tree_text[..end - 3]) {
+                let (Some(name), Some(from)) = (path.last(), target(tree, &Vec::new(), &path)) else { continue };
+                if !from.is_empty() {
+                    out.insert(name.clone(), from);
+                }
+            }
+        }
+        rest = &tail[end.min(tail.len())..];
+    }
+    out
+}
+
+/// The module a path written in `module` leads to, a crate-root re-export
+/// followed to the module it comes from.
+fn resolved(
+    tree: &BTreeMap<ModPath, String>,
+    exports: &BTreeMap<String, ModPath>,
+    module: &ModPath,
+    path: &[String],
+) -> Option<ModPath> {
+    let found = target(tree, module, path)?;
+    if !found.is_empty() {
+        return Some(found);
+    }
+    // At the root: the segment after the modules walked is an item there.
+    let item = path.iter().find(|s| !matches!(s.as_str(), "crate" | "super" | "self"))?;
+    Some(exports.get(item).cloned().unwrap_or(found))
+}
+
 /// Every module → the modules it uses.
 fn uses(tree: &BTreeMap<ModPath, String>) -> BTreeMap<ModPath, BTreeSet<ModPath>> {
+    let exports = root_exports(tree);
     tree.iter()
         .map(|(module, source)| {
-            let targets =
-                named_paths(source).iter().filter_map(|p| target(tree, module, p)).filter(|t| t != module).collect();
+            let targets = named_paths(source)
+                .iter()
+                .filter_map(|p| resolved(tree, &exports, module, p))
+                .filter(|t| t != module)
+                .collect();
             (module.clone(), targets)
         })
         .collect()
@@ -324,6 +382,82 @@ fn library() -> BTreeMap<ModPath, String> {
     read_tree(&Path::new(env!("CARGO_MANIFEST_DIR")).join("src"))
 }
 
+/// The library's front door for the command line and the viewer: the items
+/// the crate root re-exports (render, the reference, frame statistics, the
+/// component list, ...) and these modules, which describe a scene and its
+/// images. The stages (visibility, shadows, shading, ray tracing, resolve,
+/// the frame's internals) stay behind it.
+const FRONT_DOOR_MODULES: &[&[&str]] =
+    &[&["scene"], &["camera"], &["image"], &["output"], &["compare"], &["error"], &["limits"], &["csg", "openscad"]];
+
+/// Every `kage::` path `source` names: in its `use` trees and in its code.
+fn kage_paths(source: &str) -> Vec<Vec<String>> {
+    let mut paths: Vec<Vec<String>> =
+        named_paths(source).into_iter().filter(|p| p.first().is_some_and(|s| s == "kage")).collect();
+    let mut rest = source;
+    while let Some(at) = find_word(rest, "kage") {
+        let tail = &rest[at..];
+        let len = tail.find(|c: char| !(c.is_alphanumeric() || c == '_' || c == ':')).unwrap_or(tail.len());
+        let path: Vec<String> = tail[..len].split("::").filter(|s| !s.is_empty()).map(str::to_string).collect();
+        if path.len() > 1 && tail[..len].contains("::") {
+            paths.push(path);
+        }
+        rest = &tail[len.max(1)..];
+    }
+    paths
+}
+
+/// Where the crate in `tree` (a binary using the library) goes round the
+/// front door: an item the crate root re-exports from a stage named by its
+/// module path, and (unless `stages` is set) any path into a module that is
+/// not in [`FRONT_DOOR_MODULES`]. A module of the binary that uses an item of the
+/// binary's root (`main.rs`) is reported too: the root dispatches, the
+/// modules do the work.
+fn front_door_breaches(tree: &BTreeMap<ModPath, String>, lib: &BTreeMap<ModPath, String>, stages: bool) -> Vec<String> {
+    let exports = root_exports(lib);
+    let mut out = BTreeSet::new();
+    for (module, source) in tree {
+        let at = if module.is_empty() { "main".to_string() } else { module.join("::") };
+        for path in kage_paths(source) {
+            let rest = &path[1..];
+            let Some(m) = target(lib, &Vec::new(), rest).filter(|m| !m.is_empty()) else { continue };
+            let written = path.join("::");
+            let front = FRONT_DOOR_MODULES.iter().any(|f| m.len() >= f.len() && m[..f.len()] == **f);
+            if let Some(item) = rest.get(m.len()).filter(|i| !front && exports.get(*i) == Some(&m)) {
+                out.insert(format!("{at} names {written}: use kage::{item}"));
+            } else if !stages && !front {
+                out.insert(format!("{at} reaches into kage::{} (a stage behind the front door)", m.join("::")));
+            }
+        }
+        if module.is_empty() {
+            continue;
+        }
+        for path in named_paths(source) {
+            let Some(t) = target(tree, module, &path) else { continue };
+            if t.is_empty() && path.iter().any(|s| !matches!(s.as_str(), "crate" | "super" | "self")) {
+                out.insert(format!("{at} uses {} from the binary's root", path.join("::")));
+            }
+        }
+    }
+    out.into_iter().collect()
+}
+
+#[test]
+fn the_command_line_and_the_viewer_use_the_library_through_its_front_door() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let found = front_door_breaches(&read_tree(&root.join("cli/src")), &library(), false);
+    assert!(found.is_empty(), "round the front door:\n{}", found.join("\n"));
+}
+
+/// The benchmarks measure stages one by one, so they may reach them; what
+/// the front door offers they take from it.
+#[test]
+fn the_benchmarks_take_what_the_front_door_offers_from_it() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let found = front_door_breaches(&read_tree(&root.join("bench/src")), &library(), true);
+    assert!(found.is_empty(), "round the front door:\n{}", found.join("\n"));
+}
+
 #[test]
 fn every_top_level_module_has_its_place_in_the_frame() {
     let tree = library();
@@ -366,4 +500,42 @@ fn the_checks_catch_an_upward_import_and_a_circle() {
     assert_eq!(sibling_circles(&uses), vec!["in resolve: edges, parts use each other".to_string()]);
     let clean = BTreeMap::from([(vec!["scene".to_string()], String::new())]);
     assert!(upward(&crate::uses(&clean), &order).is_empty());
+    // A rename is not part of the path; a name holding "as" is whole.
+    assert_eq!(expand_use_tree("super::passes::x as y"), vec![vec!["super", "passes", "x"]]);
+    assert_eq!(expand_use_tree("a::{b as c, aas}"), vec![vec!["a", "b"], vec!["a", "aas"]]);
+    // Through a crate-root re-export, a scene reading shading is still seen.
+    let tree: BTreeMap<ModPath, String> = [
+        file(&[], "mod scene; mod shading; pub use shading::Fog;"),
+        file(&["scene"], "fn f(_: crate::Fog) {}"),
+        file(&["shading"], ""),
+    ]
+    .into_iter()
+    .collect();
+    assert_eq!(upward(&crate::uses(&tree), &order), vec!["scene uses shading".to_string()]);
+    // A binary naming a stage, or a re-exported item by its module, and a
+    // module of it calling into its root, are reported.
+    let lib: BTreeMap<ModPath, String> = [
+        file(&[], "mod scene; mod shading; pub use shading::Component;"),
+        file(&["scene"], ""),
+        file(&["shading"], "pub fn screen_surfaces() {}"),
+    ]
+    .into_iter()
+    .collect();
+    let bin: BTreeMap<ModPath, String> = [
+        file(&[], "mod batch; fn render_command() {} use kage::scene::Scene;"),
+        file(
+            &["batch"],
+            "use super::render_command; fn f() { kage::shading::screen_surfaces(); }\nuse kage::shading::Component;",
+        ),
+    ]
+    .into_iter()
+    .collect();
+    assert_eq!(
+        front_door_breaches(&bin, &lib, false),
+        vec![
+            "batch names kage::shading::Component: use kage::Component".to_string(),
+            "batch reaches into kage::shading (a stage behind the front door)".to_string(),
+            "batch uses super::render_command from the binary's root".to_string(),
+        ]
+    );
 }

@@ -10,7 +10,8 @@ use std::path::{Path, PathBuf};
 use clap::Parser;
 use kage::scene::load::InputFormat;
 
-use super::{render_command, tiles, RenderArgs};
+use crate::render::{render_command, RenderArgs};
+use crate::tiles;
 
 /// `kage batch`.
 #[derive(clap::Args)]

@@ -208,6 +208,17 @@ pub struct Frame {
     pub stats: FrameStats,
 }
 
+impl Frame {
+    /// Each pixel's shading normal (world space, unit; zero where no object
+    /// is seen), at the pixel's centre, from the visibility buffer of the
+    /// frame's last pass — `scene` is the scene it was rendered from.
+    #[must_use]
+    pub fn normals(&self, scene: &Scene) -> Vec<Vec3> {
+        let surfaces = crate::shading::screen_surfaces(scene, &self.visibility);
+        surfaces.surfaces.iter().map(|s| s.map_or(Vec3::ZERO, |s| s.normal)).collect()
+    }
+}
+
 /// Renders frames, reusing its buffers from one frame to the next.
 #[derive(Debug)]
 pub struct Renderer {
@@ -452,7 +463,7 @@ fn render_jittered(
     let mut pass = scene.clone();
     let mut passes = || {
         for (done, &offset) in (1..).zip(offsets) {
-            pass.camera = jitter::shifted(&scene.camera, offset, (scene.width, scene.height));
+            pass.camera = scene.camera.shifted(offset, (scene.width, scene.height));
             render_pass(&pass, frame, scratch, options, None, stop)?;
             jitter::accumulate(&mut scratch.accum, &frame.image, weight);
             frame.aovs.iter_mut().zip(&scratch.aovs).for_each(|((_, a), s)| jitter::accumulate(a, s, weight));

@@ -10,21 +10,9 @@
 //! everything at once. The offsets are the scene's
 //! ([`crate::scene::Antialias::offsets`]).
 
-use glam::Vec2;
 use rayon::prelude::*;
 
-use crate::camera::Camera;
 use crate::image::LinearImage;
-
-/// `camera` with its image shifted by `offset` pixels (y down) on a `width` ×
-/// `height` frame: a pass whose pixel centres sample the points `offset` from
-/// the unshifted pixels' centres.
-#[must_use]
-pub fn shifted(camera: &Camera, offset: Vec2, (width, height): (u32, u32)) -> Camera {
-    let pixel = 2.0 / Vec2::new(width as f32, height as f32);
-    // Pixel offsets (y down) to NDC (y up).
-    Camera { shift: camera.shift + Vec2::new(offset.x, -offset.y) * pixel, ..*camera }
-}
 
 /// `sum += weight · image` (same sizes).
 pub fn accumulate(sum: &mut LinearImage, image: &LinearImage, weight: f32) {

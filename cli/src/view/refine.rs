@@ -9,7 +9,7 @@ use std::sync::{Mutex, MutexGuard, PoisonError};
 use glam::Vec3;
 use kage::image::{LinearImage, ToneCurve};
 use kage::scene::{Antialias, Light, Scene, ShadowMethod, ShadowSettings};
-use kage::shading::ComponentSet;
+use kage::ComponentSet;
 use kage::{FrameStats, RenderOptions, Renderer};
 use rayon::prelude::*;
 
@@ -217,7 +217,7 @@ pub fn scene_for(base: &Scene, viewer: &Viewer, step: Step) -> Scene {
     if let Step::Pass(n) = step {
         let n = n.clamp(1, MAX_PASSES);
         let offset = Antialias::Jitter(MAX_PASSES).offsets()[(n - 1) as usize];
-        scene.camera = kage::resolve::jitter::shifted(&scene.camera, offset, viewer.size);
+        scene.camera = scene.camera.shifted(offset, viewer.size);
         // A jittered light is shadowed from one point of its disc a pass, a
         // new one each pass: 64 passes average 64 points, for the cost of one
         // map a pass instead of all of them.
@@ -269,9 +269,8 @@ fn display_image(scene: &Scene, frame: &kage::Frame, display: Display, out: &mut
             }
         }
         Display::Normals => {
-            let surfaces = kage::shading::screen_surfaces(scene, vb);
-            for (p, s) in out.pixels_mut().iter_mut().zip(&surfaces.surfaces) {
-                *p = s.map_or(Vec3::ZERO, |s| s.normal * 0.5 + 0.5);
+            for (p, n) in out.pixels_mut().iter_mut().zip(frame.normals(scene)) {
+                *p = if n == Vec3::ZERO { Vec3::ZERO } else { n * 0.5 + 0.5 };
             }
         }
         Display::Items => {

@@ -15,7 +15,7 @@ use kage::scene::{file, Scene};
 use kage::Limits;
 
 use super::state::Toggles;
-use crate::extension;
+use crate::render::extension;
 
 /// Window size when neither the command line nor the scene file gives one.
 pub const DEFAULT_SIZE: (u32, u32) = (1280, 720);

@@ -9,7 +9,7 @@ use std::path::PathBuf;
 use glam::Vec3;
 use kage::scene::framing::View;
 use kage::scene::ShadowMethod;
-use kage::shading::Component;
+use kage::Component;
 
 use super::orbit::Orbit;
 
