@@ -116,16 +116,6 @@ fn full_hd_buffers_fit_in_128_mb() {
     assert!(frame.stats.buffer_bytes < 128 << 20, "{} bytes", frame.stats.buffer_bytes);
 }
 
-fn shared(rel: &str) -> Option<std::path::PathBuf> {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets").join(rel);
-    if p.exists() {
-        Some(p)
-    } else {
-        skip::skipped(&format!("{} not present", p.display()));
-        None
-    }
-}
-
 /// The share of the image the model covers (its ground aside).
 fn coverage(path: &Path) -> f32 {
     let scene = scene_for_model(path, 96, 72).unwrap();
@@ -149,7 +139,7 @@ fn real_models_load_and_frame() {
         "csg/ex004_cube_minus_sphere.stl",
         "scenes/cornell-box/CornellBox-Original.obj",
     ] {
-        let Some(p) = shared(rel) else { continue };
+        let Some(p) = skip::asset(rel) else { continue };
         let c = coverage(&p);
         assert!(c > 0.05 && c < 0.95, "{rel}: covers {:.0}% of the image", 100.0 * c);
     }
@@ -158,12 +148,12 @@ fn real_models_load_and_frame() {
 /// glTF cameras and KHR_lights_punctual lights are honoured.
 #[test]
 fn gltf_cameras_and_lights() {
-    if let Some(p) = shared("gltf/Cameras/Cameras.gltf") {
+    if let Some(p) = skip::asset("gltf/Cameras/Cameras.gltf") {
         let own = kage::scene::model::ModelOptions { file_camera: true, ..Default::default() };
         let scene = kage::scene::model::scene_for_model_with(&p, 64, 48, &own).unwrap();
         assert!(scene.camera.eye.z > 1.0, "the file's camera, not a fitted one: {:?}", scene.camera);
     }
-    if let Some(p) = shared("gltf/LightsPunctualLamp/LightsPunctualLamp.gltf") {
+    if let Some(p) = skip::asset("gltf/LightsPunctualLamp/LightsPunctualLamp.gltf") {
         let scene = scene_for_model(&p, 64, 48).unwrap();
         assert!(
             !scene.lights.is_empty()

@@ -13,13 +13,7 @@ use kage::scene::model::scene_for_model;
 use kage::{render, RenderOptions, Scene};
 
 fn asset(rel: &str) -> Option<PathBuf> {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/gltf").join(rel);
-    if p.exists() {
-        Some(p)
-    } else {
-        skip::skipped(&format!("{} is absent", p.display()));
-        None
-    }
+    skip::asset(&format!("gltf/{rel}"))
 }
 
 /// Mean colour of the pixels showing the model (not the ground, not the

@@ -271,12 +271,7 @@ fn a_model_that_encloses_its_centre_is_framed_from_inside_and_says_so() {
 /// front (+z), lit by its ceiling light (material `light`, `Ke 17 12 4`).
 #[test]
 fn the_cornell_box_is_seen_through_its_open_front() {
-    let path =
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/scenes/cornell-box/CornellBox-Original.obj");
-    if !path.exists() {
-        skip::skipped(&format!("{} is absent", path.display()));
-        return;
-    }
+    let Some(path) = skip::asset("scenes/cornell-box/CornellBox-Original.obj") else { return };
     let scene = scene_for_model(&path, 160, 120).unwrap();
     let (lo, hi) = scene.bounds().unwrap();
     let cam = scene.camera;

@@ -131,7 +131,7 @@ fn an_interrupted_reference_keeps_the_rows_already_traced() {
 
 /// The scenes the reference is held to: the demo, every example scene, and
 /// models framed and lit by kage's defaults (a plain STL part, the same part as
-/// CSG, and, where the shared assets are present, a room seen from inside).
+/// CSG, and the Cornell box, a room seen through its open side).
 fn reference_cases() -> Vec<(String, kage::Scene)> {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
     let mut scenes: Vec<(String, kage::Scene)> = vec![("demo".into(), kage::scene::demo::demo_scene().unwrap())];
@@ -146,11 +146,7 @@ fn reference_cases() -> Vec<(String, kage::Scene)> {
         root.join("tests/data/csg/ex004_cube_minus_sphere.stl"),
         root.join("tests/data/csg/ex004_cube_minus_sphere.csg"),
     ];
-    let room = root.join("../shared/assets/scenes/cornell-box/CornellBox-Original.obj");
-    match room.exists() {
-        true => models.push(room),
-        false => skip::skipped("reference vs raster: no Cornell box (../shared/assets absent)"),
-    }
+    models.extend(skip::asset("scenes/cornell-box/CornellBox-Original.obj"));
     for path in models {
         let name = path.file_name().unwrap().to_string_lossy().into_owned();
         scenes.push((name, kage::scene::model::scene_for_model(&path, 128, 72).unwrap()));

@@ -16,3 +16,22 @@ pub fn skipped(why: &str) {
         }
     }
 }
+
+/// A real model by its path in the shared corpus (`gltf/Box/Box.glb`):
+/// from `../shared/assets` where present, else from the copies the
+/// repository keeps of the small ones (`tests/data/assets`; `tests/data/csg`
+/// holds two OpenSCAD models), else `None`, the skip recorded.
+#[allow(dead_code, reason = "each test crate includes this file; not all of them read models")]
+pub fn asset(rel: &str) -> Option<std::path::PathBuf> {
+    // The repository's root, from the library's tests or a member crate's.
+    let here = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let root = here.ancestors().find(|d| d.join("tests/data/assets").is_dir()).unwrap_or(here);
+    let found = ["../shared/assets", "tests/data/assets", "tests/data"]
+        .iter()
+        .map(|dir| root.join(dir).join(rel))
+        .find(|p| p.exists());
+    if found.is_none() {
+        skipped(&format!("{rel} is neither in ../shared/assets nor kept in tests/data"));
+    }
+    found
+}
