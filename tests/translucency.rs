@@ -127,3 +127,37 @@ fn the_reference_blends_translucent_layers_as_the_raster_does() {
         c.rmse
     );
 }
+
+/// Translucent surfaces are shadowed by the same maps as opaque ones (fitted
+/// to the casters, not to the whole scene with its floor): the glass example
+/// with its glass made all but opaque (α = 0.9999, drawn by the translucency
+/// pass) renders as with it opaque (drawn by the opaque passes).
+#[test]
+fn translucent_surfaces_are_shadowed_by_the_opaque_passes_maps() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenes/glass.toml");
+    let mut scene = kage::scene::file::load_scene(&path).unwrap();
+    (scene.width, scene.height) = (240, 135);
+    scene.antialias = kage::scene::Antialias::None;
+    // Coarse maps, so that maps fitted differently show it along the edges;
+    // the white ball moved between the light and the blue glass box, so its
+    // shadow's edge crosses the box.
+    scene.lights.iter_mut().for_each(|l| (l.shadow.resolution, l.shadow.by_need) = (256, false));
+    let ball = scene.objects.iter_mut().find(|o| o.name == "white ball").unwrap();
+    ball.transform =
+        Affine3A::from_scale_rotation_translation(Vec3::splat(0.3), Quat::IDENTITY, Vec3::new(-1.0, 2.4, 1.9));
+    let glass: Vec<usize> = (0..scene.materials.len()).filter(|&m| scene.materials[m].opacity < 1.0).collect();
+    assert!(!glass.is_empty(), "the glass example has translucent materials");
+    let mut opaque = scene.clone();
+    glass.iter().for_each(|&m| opaque.materials[m].opacity = 1.0);
+    glass.iter().for_each(|&m| scene.materials[m].opacity = 0.9999);
+    let almost = render(&scene, &RenderOptions::default()).unwrap();
+    assert!(almost.stats.translucent_fragments > 1000);
+    let solid = render(&opaque, &RenderOptions::default()).unwrap();
+    let c = kage::compare::compare(&almost.image, &solid.image, 0.02).unwrap();
+    assert!(
+        c.share_over < 0.001,
+        "{:.3}% of pixels differ by more than 0.02 (rmse {:.5})",
+        100.0 * c.share_over,
+        c.rmse
+    );
+}

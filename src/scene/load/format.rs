@@ -49,16 +49,16 @@ const TABLE: [Row; 7] = [
 ];
 
 impl InputFormat {
-    /// Every format.
-    pub const ALL: [InputFormat; 7] = [
-        InputFormat::Scene,
-        InputFormat::Obj,
-        InputFormat::Stl,
-        InputFormat::Off,
-        InputFormat::Gltf,
-        InputFormat::Csg,
-        InputFormat::Scad,
-    ];
+    /// Every format, in the table's order.
+    pub const ALL: [InputFormat; TABLE.len()] = {
+        let mut all = [InputFormat::Scene; TABLE.len()];
+        let mut i = 0;
+        while i < TABLE.len() {
+            all[i] = TABLE[i].format;
+            i += 1;
+        }
+        all
+    };
 
     /// The format a file's extension (in any letter case) names, if any.
     #[must_use]
