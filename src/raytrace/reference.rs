@@ -10,7 +10,8 @@
 //! It reads the scene exactly as the raster pipeline does, or it would not be
 //! an oracle: a light whose shadow method is `none` is shadowed by neither
 //! ([`crate::scene::Light::casts_shadows`]); a single-sided back face, which
-//! the eye's pass culls, lets rays through; fog is laid on by the distance to
+//! the eye's pass culls, lets the eye's rays through (mirror and refracted rays
+//! still meet the inside of the glass they are in); fog is laid on by the distance to
 //! the first surface a ray meets, as the fog pass does. A test holds every
 //! example scene, the demo and kage-framed models to their reference.
 //!

@@ -70,6 +70,17 @@ pub fn occluded_towards(trace: &TraceScene, origin: Vec3, target: Vec3) -> bool 
     trace.occluded(&Ray { origin, dir: to / dist }, dist * (1.0 - 1e-4))
 }
 
+/// Where a ray comes from, which decides whether single-sided back faces
+/// stop it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Seen {
+    /// From the eye (and on behind translucent layers): what the eye's pass
+    /// draws, back faces culled.
+    FromEye,
+    /// A mirror or refracted ray.
+    Bounced,
+}
+
 /// Shades points hit by rays: eq. 1 with shadow rays (as `L` casts them),
 /// plus mirror and glass bounces.
 pub struct Tracer<'a, L: LightRays = ShadowRay> {
@@ -93,11 +104,11 @@ impl<'a, L: LightRays> Tracer<'a, L> {
     /// the ray meets behind them: α · their colour + (1 − α) · the rest.
     #[must_use]
     pub fn radiance(&self, ray: &Ray, depth: u32) -> Vec3 {
-        self.through_layers(ray, depth, MAX_LAYERS, &Cell::new(MAX_RAYS))
+        self.through_layers(ray, Seen::FromEye, depth, MAX_LAYERS, &Cell::new(MAX_RAYS))
     }
 
     /// [`Tracer::radiance`] with at most `rays` left of the call's budget.
-    fn through_layers(&self, ray: &Ray, depth: u32, layers: u32, rays: &Cell<u32>) -> Vec3 {
+    fn through_layers(&self, ray: &Ray, seen: Seen, depth: u32, layers: u32, rays: &Cell<u32>) -> Vec3 {
         if rays.get() == 0 {
             return self.scene.background_along(ray.dir);
         }
@@ -113,13 +124,16 @@ impl<'a, L: LightRays> Tracer<'a, L> {
         let behind = || {
             let next = Ray { origin: s.position + ray.dir * self.epsilon, dir: ray.dir };
             if layers > 0 {
-                self.through_layers(&next, depth, layers - 1, rays)
+                self.through_layers(&next, seen, depth, layers - 1, rays)
             } else {
                 self.scene.background_along(ray.dir)
             }
         };
-        if !material.two_sided && !s.front {
-            return behind(); // a culled back face, as the eye's pass draws it
+        if !material.two_sided && !s.front && (seen == Seen::FromEye || material.translucent()) {
+            // A back face the eye's pass culls; a bounced ray meets the
+            // inside of a glass it is in, but not a translucent back face,
+            // which the polygon pass never draws.
+            return behind();
         }
         let mut acc = Components { emission: k.parts().3, ..Default::default() };
         for (i, light) in self.scene.lights.iter().enumerate() {
@@ -162,7 +176,7 @@ impl<'a, L: LightRays> Tracer<'a, L> {
             let n = facing(d, s.normal);
             let r = reflect(d, n);
             let mirror = Ray { origin: s.position + n * self.epsilon, dir: r };
-            out += m.kr * self.through_layers(&mirror, depth - 1, MAX_LAYERS, rays);
+            out += m.kr * self.through_layers(&mirror, Seen::Bounced, depth - 1, MAX_LAYERS, rays);
         }
         if m.kt.max_element() > 0.0 {
             // Entering when the ray meets the front (outward) side of the surface.
@@ -172,7 +186,7 @@ impl<'a, L: LightRays> Tracer<'a, L> {
                 None => (reflect(d, s.normal), 1.0),
             };
             let origin = s.position + s.normal * (sign * self.epsilon);
-            out += m.kt * self.through_layers(&Ray { origin, dir }, depth - 1, MAX_LAYERS, rays);
+            out += m.kt * self.through_layers(&Ray { origin, dir }, Seen::Bounced, depth - 1, MAX_LAYERS, rays);
         }
         out
     }
@@ -261,11 +275,11 @@ mod tests {
         let tracer = Tracer::new(&scene, &trace, &frames, Unshadowed);
         let ray = Ray { origin: Vec3::new(0.1, 0.2, 5.0), dir: Vec3::NEG_Z };
         let unbounded = Cell::new(u32::MAX);
-        let _ = tracer.through_layers(&ray, 4, MAX_LAYERS, &unbounded);
+        let _ = tracer.through_layers(&ray, Seen::FromEye, 4, MAX_LAYERS, &unbounded);
         let needed = u32::MAX - unbounded.get();
         assert!(needed > 50 * MAX_RAYS, "the stack needs {needed} rays");
         let budget = Cell::new(MAX_RAYS);
-        let c = tracer.through_layers(&ray, 4, MAX_LAYERS, &budget);
+        let c = tracer.through_layers(&ray, Seen::FromEye, 4, MAX_LAYERS, &budget);
         assert!(budget.get() == 0 && c.is_finite(), "{c}, {} rays left", budget.get());
     }
 }
