@@ -406,3 +406,142 @@ fn every_methods_maps_fit_the_memory_it_budgets() {
     }
     assert!(failed.is_empty(), "{failed:#?}");
 }
+
+/// A cube on a ground, seen from `view` (azimuth, elevation in degrees), lit
+/// by `light`: the cube's faces that face the light are lit everywhere (no
+/// caster lies between them and it).
+fn cube_on_ground(view: (f32, f32), light: Light) -> Scene {
+    let dir = |(az, el): (f32, f32)| {
+        let (az, el) = (az.to_radians(), el.to_radians());
+        Vec3::new(el.cos() * az.sin(), el.sin(), el.cos() * az.cos())
+    };
+    let camera = kage::camera::Camera {
+        eye: dir(view) * 4.0,
+        target: Vec3::ZERO,
+        up: Vec3::Y,
+        near: 0.1,
+        far: 50.0,
+        projection: kage::camera::Projection::Perspective { fov_y_deg: 40.0 },
+        shift: Vec2::ZERO,
+    };
+    let mut scene = common::scene_with(shapes::cube(), camera, 320, 240, false);
+    let ground =
+        Affine3A::from_scale_rotation_translation(Vec3::splat(8.0), glam::Quat::IDENTITY, Vec3::new(0.0, -0.5, 0.0));
+    scene.objects.push(Object::mesh("ground", Arc::new(shapes::plane()), ground, 0));
+    scene.lights = vec![light];
+    scene
+}
+
+/// Pixels of the cube's faces that face the light (N·L above 0.05) whose
+/// shadow term is below 0.99: acne, since nothing lies between them and the
+/// light. Returns (acne, lit-face pixels).
+fn acne(scene: &Scene) -> (usize, usize) {
+    let options = RenderOptions { shadow_images: true, ..RenderOptions::default() };
+    let frame = render(scene, &options).unwrap();
+    let normals = frame.normals(scene);
+    let light = &scene.lights[0];
+    let rays = scene.camera.pixel_rays(Vec2::new(scene.width as f32, scene.height as f32));
+    let (mut bad, mut all) = (0, 0);
+    for (i, (item, n)) in frame.visibility.items().iter().zip(&normals).enumerate() {
+        if item.is_none() || item.object != 0 {
+            continue;
+        }
+        let (x, y) = (i as u32 % scene.width, i as u32 / scene.width);
+        let ray = rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
+        let p = ray.at(scene.camera.distance_at_depth(&ray, frame.visibility.depth(x, y)));
+        let to_light = light.incident(p).to_light;
+        if n.dot(to_light) > 0.05 {
+            all += 1;
+            bad += usize::from(frame.shadows[0].get(x, y).x < 0.99);
+        }
+    }
+    (bad, all)
+}
+
+#[test]
+fn no_acne_on_the_lit_faces_of_a_cube() {
+    let mut report = Vec::new();
+    for el in [30.0f32, 40.0, 50.0, 60.0, 70.0, 80.0] {
+        for az in [10.0f32, 35.0, 60.0] {
+            let (a, e) = (az.to_radians(), el.to_radians());
+            let towards = Vec3::new(e.cos() * a.sin(), e.sin(), e.cos() * a.cos());
+            for (kind, light) in [
+                ("sun", Light { kind: LightKind::Directional { direction: -towards }, ..Light::default() }),
+                ("lamp", Light { kind: LightKind::Point { position: towards * 6.0 }, ..Light::default() }),
+            ] {
+                let scene = cube_on_ground((25.0, 30.0), light);
+                let (bad, all) = acne(&scene);
+                println!("{kind} el {el} az {az}: {bad} of {all}");
+                if bad > 0 {
+                    report
+                        .push(format!("{kind} at elevation {el}°, azimuth {az}°: {bad} of {all} lit pixels shadowed"));
+                }
+            }
+        }
+    }
+    assert!(report.is_empty(), "{report:#?}");
+}
+
+/// A thin lid (2 × 0.01 × 2, turned 20° about y) one unit over a ground, under
+/// a sun at `elevation`°, its map `resolution`² texels: where the map's
+/// decision on the ground differs from a shadow ray's, the rays' boundary
+/// lies within one texel (the texel's footprint on the ground). Returns
+/// (decisions farther than that, decisions compared).
+fn thin_lid_error(elevation: f32, resolution: u32) -> (usize, usize) {
+    let e = elevation.to_radians();
+    let direction = -Vec3::new(e.cos() * 0.6, e.sin(), e.cos() * 0.8).normalize();
+    let mut scene =
+        cube_on_ground((0.0, 89.0), Light { kind: LightKind::Directional { direction }, ..Light::default() });
+    scene.objects[0].transform = Affine3A::from_scale_rotation_translation(
+        Vec3::new(2.0, 0.01, 2.0),
+        glam::Quat::from_rotation_y(20f32.to_radians()),
+        Vec3::new(0.0, 0.5, 0.0),
+    );
+    scene.lights[0].shadow = ShadowSettings { resolution, by_need: false, ..ShadowSettings::default() };
+    let term = ShadowTerm::build(&scene, &scene.lights[0]);
+    let ShadowTerm::Map(map, settings) = &term else { panic!("a sun's term is one map") };
+    let trace = kage::raytrace::TraceScene::new(&scene);
+    let ground = Vec3::new(0.0, -0.5, 0.0);
+    let lit =
+        |p: Vec3| !trace.occluded(&kage::camera::Ray { origin: p + Vec3::Y * 1e-4, dir: -direction }, f32::INFINITY);
+    let receiver = kage::shadows::Receiver { object: 1, plane: Vec3::Y };
+    let cos = -direction.y;
+    let (mut far, mut compared) = (0, 0);
+    for i in 0..200 {
+        for k in 0..200 {
+            let p =
+                ground + Vec3::new(-2.5 + 5.0 * (i as f32 + 0.5) / 200.0, 0.0, -2.5 + 5.0 * (k as f32 + 0.5) / 200.0);
+            let Some(located) = map.locate(p, cos, settings, 1.0) else { continue };
+            compared += 1;
+            let truth = lit(p);
+            if (term.lit(p, cos, &receiver) >= 0.5) == truth {
+                continue;
+            }
+            // One texel across the light's rays, stretched on the ground.
+            let reach = located.texel / cos;
+            let near = (0..16).any(|a| {
+                let t = a as f32 * std::f32::consts::TAU / 16.0;
+                lit(p + Vec3::new(t.cos(), 0.0, t.sin()) * reach) != truth
+            });
+            far += usize::from(!near);
+        }
+    }
+    (far, compared)
+}
+
+/// A thin plate's shadow boundary lies within a texel of the shadow rays'
+/// everywhere: no light leaks under it, no boundary moves off it.
+#[test]
+fn a_thin_lids_shadow_boundary_is_within_a_texel_of_the_rays() {
+    let mut report = Vec::new();
+    for elevation in [25.0, 45.0, 70.0] {
+        for resolution in [256, 1024] {
+            let (far, compared) = thin_lid_error(elevation, resolution);
+            println!("sun at {elevation}°, {resolution}²: {far} of {compared} decisions farther than a texel");
+            if far > 0 || compared < 10_000 {
+                report.push(format!("{elevation}° {resolution}²: {far} of {compared}"));
+            }
+        }
+    }
+    assert!(report.is_empty(), "{report:#?}");
+}
