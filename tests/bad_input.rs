@@ -40,6 +40,36 @@ fn wrong_types_and_unknown_keys_point_at_the_value() {
     assert!(e.starts_with("bad.toml:2:8") && e.contains("unknown variant `laser`"), "{e}");
 }
 
+/// A shadow key the light's method does not read is a located warning that
+/// names it and what the method reads; the example scenes give none.
+#[test]
+fn shadow_keys_a_method_does_not_read_are_warned_with_their_line() {
+    let fs = FileSystem { base: scratch("shadow-keys") };
+    let text = format!(
+        "[[light]]\ntype = \"point\"\nposition = [0, 5, 0]\n[light.shadow]\nmethod = \"map\"\nbits = 12\npcf = 3\n{OK_OBJECT}"
+    );
+    let scene = SceneFile::parse(&text, Path::new("keys.toml")).and_then(|f| f.build(&fs)).unwrap();
+    let said: Vec<&String> = scene.warnings.iter().filter(|w| w.contains("does not read")).collect();
+    assert_eq!(said.len(), 1, "{:?}", scene.warnings);
+    assert!(
+        said[0].starts_with("keys.toml:4:") && said[0].contains("`bits`") && !said[0].contains("`pcf` (ignored)"),
+        "{}",
+        said[0]
+    );
+    assert!(said[0].contains("it reads `resolution`, `bias`, `slope`, `pcf`, `samples`"), "{}", said[0]);
+    // A soft shadow with silhouette-line hard shadows reads the SLB's keys.
+    let soft = text.replace("method = \"map\"", "method = \"soft\"\nhard = \"slb\"");
+    let scene = SceneFile::parse(&soft, Path::new("keys.toml")).and_then(|f| f.build(&fs)).unwrap();
+    assert!(scene.warnings.iter().any(|w| w.contains("`soft` does not read `pcf` (ignored)")), "{:?}", scene.warnings);
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenes");
+    for entry in
+        std::fs::read_dir(&dir).unwrap().flatten().filter(|e| e.path().extension().is_some_and(|x| x == "toml"))
+    {
+        let scene = kage::scene::file::load_scene(&entry.path()).unwrap();
+        assert!(!scene.warnings.iter().any(|w| w.contains("does not read")), "{:?}", scene.warnings);
+    }
+}
+
 #[test]
 fn semantic_errors_point_at_the_value() {
     let e = parse_err("[[object]]\nshape = \"cube\"\nmaterial = \"gold\"\n");

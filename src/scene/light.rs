@@ -130,6 +130,29 @@ pub enum ShadowMethod {
     Pcss,
 }
 
+impl ShadowSettings {
+    /// Whether the scene-file key `key` of a light's `[light.shadow]` table
+    /// changes what these settings' method computes: the one table of which
+    /// settings each method reads (a two-map soft shadow reads its hard
+    /// shadows' settings too). Keys it does not read are ignored, with a
+    /// warning, where a scene file gives them.
+    #[must_use]
+    pub fn applies(&self, key: &str) -> bool {
+        use ShadowMethod as M;
+        let (m, slb_hard) = (self.method, self.method == M::Soft && self.hard == HardShadows::Slb);
+        match key {
+            "method" => true,
+            "resolution" | "bias" | "slope" => m != M::None,
+            "pcf" => m == M::Map || (m == M::Soft && !slb_hard),
+            "samples" => matches!(m, M::Map | M::Slb),
+            "bits" | "scale" | "antialias" => m == M::Slb || slb_hard,
+            "focus" | "search" | "falloff" | "depth_aware" | "hard" | "points" => m == M::Soft,
+            "blockers" | "filter" => m == M::Pcss,
+            _ => false,
+        }
+    }
+}
+
 impl ShadowMethod {
     /// Every method, by its name in scene files and on the command line.
     pub const NAMES: [(&'static str, ShadowMethod); 5] = [

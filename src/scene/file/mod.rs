@@ -658,6 +658,11 @@ impl SceneFile {
             limits: from.limits,
             camera_path: None,
         };
+        for (rec, light) in self.lights.iter().zip(&scene.lights) {
+            if let Some(shadow) = &rec.get_ref().shadow {
+                scene.warnings.extend(self.shadow_key_warnings(shadow, &light.shadow));
+            }
+        }
         let mut models = Vec::new();
         let mut produced = Vec::new();
         let mut triangles = 0;

@@ -193,6 +193,45 @@ impl SceneFile {
         })
     }
 
+    /// A warning, located at the light's `[light.shadow]` table, for each key
+    /// it gives that its method does not read ([`ShadowSettings::applies`]).
+    pub(super) fn shadow_key_warnings(&self, rec: &Spanned<ShadowRec>, settings: &ShadowSettings) -> Vec<String> {
+        let r = rec.get_ref();
+        let given = [
+            ("resolution", r.resolution.is_some()),
+            ("bias", r.bias.is_some()),
+            ("slope", r.slope.is_some()),
+            ("pcf", r.pcf.is_some()),
+            ("samples", r.samples.is_some()),
+            ("bits", r.bits.is_some()),
+            ("scale", r.scale.is_some()),
+            ("antialias", r.antialias.is_some()),
+            ("focus", r.focus.is_some()),
+            ("search", r.search.is_some()),
+            ("falloff", r.falloff.is_some()),
+            ("depth_aware", r.depth_aware.is_some()),
+            ("hard", r.hard.is_some()),
+            ("points", r.points.is_some()),
+            ("blockers", r.blockers.is_some()),
+            ("filter", r.filter.is_some()),
+        ];
+        let ignored: Vec<&str> =
+            given.iter().filter(|(k, set)| *set && !settings.applies(k)).map(|(k, _)| *k).collect();
+        if ignored.is_empty() {
+            return Vec::new();
+        }
+        let origin = self.origin.clone().unwrap_or(Origin { path: "<scene>".into(), text: Arc::from("") });
+        let at = SourceLocation::new(origin.path, origin.text, rec.span());
+        let method = ShadowMethod::NAMES.iter().find(|(_, m)| *m == settings.method).map_or("?", |(n, _)| n);
+        let read: Vec<&str> = given.iter().map(|(k, _)| *k).filter(|k| settings.applies(k)).collect();
+        let list = |keys: &[&str]| keys.iter().map(|k| format!("`{k}`")).collect::<Vec<_>>().join(", ");
+        vec![format!(
+            "{at}: shadow method `{method}` does not read {} (ignored); it reads {}",
+            list(&ignored),
+            if read.is_empty() { "nothing else".to_string() } else { list(&read) }
+        )]
+    }
+
     pub(super) fn shadow(&self, rec: Option<&Spanned<ShadowRec>>) -> Result<ShadowSettings> {
         let mut s = ShadowSettings::default();
         let Some(rec) = rec else { return Ok(s) };
