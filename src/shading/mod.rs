@@ -212,12 +212,15 @@ impl TriangleCache {
 /// samples') and its selective-lighting list.
 pub fn shade_into_scalar(scene: &Scene, vb: &VisibilityBuffer, image: &mut LinearImage) {
     let lights = passes::frame_lights(scene);
-    let mut terms: Vec<Vec<ShadowTerm>> =
-        lights.iter().map(|l| l.samples.iter().map(|s| ShadowTerm::build(scene, s)).collect()).collect();
-    if terms.iter().flatten().any(ShadowTerm::per_pixel) {
-        let surfaces = surface::screen_surfaces(scene, vb);
-        terms.iter_mut().flatten().for_each(|t| t.prepare(&surfaces));
-    }
+    let mut frame = passes::ShadowFrame::new(scene, vb);
+    let terms: Vec<Vec<ShadowTerm>> = lights
+        .iter()
+        .map(|l| {
+            let mut terms: Vec<ShadowTerm> = l.samples.iter().map(|s| ShadowTerm::build(scene, s)).collect();
+            terms.iter_mut().for_each(|t| frame.ready(l, t));
+            terms
+        })
+        .collect();
     let w = vb.width() as usize;
     let frames = ObjectFrames::new(scene);
     let rays = scene.camera.pixel_rays(Vec2::new(w as f32, vb.height() as f32));

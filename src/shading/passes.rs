@@ -88,32 +88,47 @@ fn frame_lights_within(scene: &Scene, (lo, hi): (Vec3, Vec3)) -> Vec<FrameLight>
     scene.lights.iter().map(|l| FrameLight { light: l.clone(), samples: l.jittered(centre) }).collect()
 }
 
-/// What a frame's shadow terms are built from: the scene, its visibility
-/// buffer, the casters' bounds, and the surfaces its pixels show (found
-/// once, when a per-pixel term first needs them).
-struct ShadowFrame<'a> {
+/// A frame's shadow terms made ready for its lookups — the one place that
+/// does it, for the passes, the shadow images and the scalar reference: each
+/// term set to look up the frame's pixels through the light's view
+/// ([`light_view`]), a per-pixel term computed at every pixel from the
+/// surfaces the pixels show (found once, when a per-pixel term first needs
+/// them). Translucent layers, which lie off those surfaces, read the terms
+/// without it.
+pub(crate) struct ShadowFrame<'a> {
     scene: &'a Scene,
     vb: &'a VisibilityBuffer,
     bounds: (Vec3, Vec3),
     surfaces: Option<ScreenSurfaces>,
 }
 
-impl ShadowFrame<'_> {
+impl<'a> ShadowFrame<'a> {
+    /// The frame of `scene` whose visibility buffer is `vb`.
+    pub(crate) fn new(scene: &'a Scene, vb: &'a VisibilityBuffer) -> ShadowFrame<'a> {
+        ShadowFrame { scene, vb, bounds: scene.caster_bounds().unwrap_or_default(), surfaces: None }
+    }
+
+    /// The surface each pixel shows (found on the first call).
+    pub(crate) fn surfaces(&mut self) -> &ScreenSurfaces {
+        let (scene, vb) = (self.scene, self.vb);
+        self.surfaces.get_or_insert_with(|| screen_surfaces(scene, vb))
+    }
+
+    /// Makes `term`, one of `light`'s samples' terms, ready for this frame's
+    /// lookups.
+    pub(crate) fn ready(&mut self, light: &FrameLight, term: &mut ShadowTerm) {
+        term.set_view(light_view(self.scene, light));
+        if term.per_pixel() {
+            term.prepare(self.surfaces());
+        }
+    }
+
     /// The shadow terms of `light`'s samples (taken from `pool`: last frame's
-    /// where they still hold), set to look up the scene's view
-    /// ([`light_view`]), per-pixel terms computed at every pixel, all timed
-    /// into `stats`.
+    /// where they still hold), made ready, all timed into `stats`.
     fn terms(&mut self, light: &FrameLight, pool: &mut MapPool, stats: &mut PassStats) -> Vec<ShadowTerm> {
         let t = Instant::now();
         let mut terms = pool.terms(self.scene, &light.samples, self.bounds);
-        let view = light_view(self.scene, light);
-        for term in &mut terms {
-            term.set_view(view);
-            if term.per_pixel() {
-                let (scene, vb) = (self.scene, self.vb);
-                term.prepare(self.surfaces.get_or_insert_with(|| screen_surfaces(scene, vb)));
-            }
-        }
+        terms.iter_mut().for_each(|term| self.ready(light, term));
         stats.shadow_ms += t.elapsed().as_secs_f64() * 1e3;
         terms
     }
@@ -123,7 +138,7 @@ impl ShadowFrame<'_> {
 /// pixel rays when the light has one sample, none for an area light's
 /// jittered samples (they average their edges already: antialiasing each
 /// would cost as much again for little).
-pub(crate) fn light_view(scene: &Scene, light: &FrameLight) -> Option<PixelView> {
+fn light_view(scene: &Scene, light: &FrameLight) -> Option<PixelView> {
     let rays = scene.camera.pixel_rays(Vec2::new(scene.width as f32, scene.height as f32));
     (light.samples.len() == 1).then(|| PixelView::new(&rays))
 }
@@ -161,7 +176,7 @@ pub fn shade_lit_beside(
     let mut budget = FUSED_SHADOW_BUDGET;
     let bounds = scene.caster_bounds().unwrap_or_default();
     let lights = frame_lights_within(scene, bounds);
-    let mut frame = ShadowFrame { scene, vb, bounds, surfaces: None };
+    let mut frame = ShadowFrame::new(scene, vb);
     let (mut fused, mut own) = (Vec::new(), Vec::new());
     for light in &lights {
         let bytes: usize = light.samples.iter().map(|s| ShadowTerm::bytes_needed(s, bounds)).sum();

@@ -8,8 +8,7 @@
 use glam::Vec3;
 use rayon::prelude::*;
 
-use super::passes::{frame_lights, light_view};
-use super::surface::screen_surfaces;
+use super::passes::{frame_lights, ShadowFrame};
 use crate::image::LinearImage;
 use crate::scene::Scene;
 use crate::shadows::MapPool;
@@ -22,18 +21,16 @@ use crate::visibility::VisibilityBuffer;
 pub fn shadow_term_images(scene: &Scene, vb: &VisibilityBuffer, pool: &mut MapPool, images: &mut Vec<LinearImage>) {
     let (w, h) = (vb.width(), vb.height());
     images.resize_with(scene.lights.len(), LinearImage::default);
-    let surfaces = screen_surfaces(scene, vb);
+    let mut frame = ShadowFrame::new(scene, vb);
     let bounds = scene.caster_bounds().unwrap_or_default();
     for (image, light) in images.iter_mut().zip(frame_lights(scene)) {
         image.resize(w, h);
         image.pixels_mut().fill(Vec3::ZERO);
-        let (weight, view) = (1.0 / light.samples.len() as f32, light_view(scene, &light));
+        let weight = 1.0 / light.samples.len() as f32;
         for sample in &light.samples {
             pool.with_term(scene, sample, bounds, |term| {
-                term.set_view(view);
-                if term.per_pixel() {
-                    term.prepare(&surfaces);
-                }
+                frame.ready(&light, term);
+                let surfaces = frame.surfaces();
                 image.pixels_mut().par_iter_mut().zip(&surfaces.surfaces).for_each(|(px, surface)| {
                     let lit = match surface {
                         None => 1.0,
