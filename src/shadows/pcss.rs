@@ -69,14 +69,30 @@ pub fn lit(map: &DepthMap, p: Vec3, cos_theta: f32, settings: &ShadowSettings, l
     lit.count() as f32 / n as f32
 }
 
+/// Most taps a search or filter takes (the scene format's limit).
+const MAX_TAPS: usize = 256;
+
+/// The unit directions of the spiral's taps, (cos, sin) of i·(golden angle):
+/// computed once, then turned per point by one rotation, where a sine and a
+/// cosine per tap made up most of a PCSS lookup's cost.
+fn unit_taps() -> &'static [(f32, f32); MAX_TAPS] {
+    static TAPS: std::sync::OnceLock<[(f32, f32); MAX_TAPS]> = std::sync::OnceLock::new();
+    TAPS.get_or_init(|| {
+        std::array::from_fn(|i| {
+            let (s, c) = (f64::from(i as u32) * f64::from(GOLDEN_ANGLE)).sin_cos();
+            (c as f32, s as f32)
+        })
+    })
+}
+
 /// `n` taps of a Vogel disc of `radius` turned by `turn` radians: tap i at
 /// radius·√((i + ½)/n), angle i·(golden angle) + turn.
 fn spiral(n: u32, radius: f32, turn: f32) -> impl Iterator<Item = (f32, f32)> {
-    let n = n.max(1);
-    (0..n).map(move |i| {
+    let n = n.clamp(1, MAX_TAPS as u32);
+    let (ts, tc) = turn.sin_cos();
+    unit_taps()[..n as usize].iter().enumerate().map(move |(i, &(c, s))| {
         let r = radius * ((i as f32 + 0.5) / n as f32).sqrt();
-        let (s, c) = (i as f32 * GOLDEN_ANGLE + turn).sin_cos();
-        (r * c, r * s)
+        (r * (c * tc - s * ts), r * (s * tc + c * ts))
     })
 }
 
@@ -109,5 +125,20 @@ mod tests {
         let inner = taps.iter().filter(|(x, y)| x.hypot(*y) <= 2.0 / 2f32.sqrt()).count();
         assert_eq!(inner, 32);
         assert!(spiral(16, 0.0, 1.0).all(|t| t == (0.0, 0.0)));
+    }
+
+    /// The turned table gives the spiral's definition: tap i at
+    /// radius·√((i + ½)/n), angle i·(golden angle) + turn.
+    #[test]
+    fn the_turned_table_is_the_spiral() {
+        for (n, radius, turn) in [(16u32, 3.0f32, 0.0f32), (64, 10.5, 2.7), (256, 64.0, 6.1), (1, 1.0, 1.0)] {
+            for (i, (x, y)) in spiral(n, radius, turn).enumerate() {
+                let r = radius * ((i as f32 + 0.5) / n as f32).sqrt();
+                let a = f64::from(i as u32) * f64::from(GOLDEN_ANGLE) + f64::from(turn);
+                let (want_x, want_y) = (r * a.cos() as f32, r * a.sin() as f32);
+                assert!((x - want_x).abs() < 1e-4 * radius && (y - want_y).abs() < 1e-4 * radius, "{n} {i}");
+            }
+            assert_eq!(spiral(n, radius, turn).count(), n as usize);
+        }
     }
 }
