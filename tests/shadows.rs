@@ -545,3 +545,50 @@ fn a_thin_lids_shadow_boundary_is_within_a_texel_of_the_rays() {
     }
     assert!(report.is_empty(), "{report:#?}");
 }
+
+/// PCSS eight points at a time decides as one point at a time: on the
+/// demo's visible surfaces, every light's term from `lit_lanes` against
+/// `lit` for each lane.
+#[test]
+fn pcss_eight_points_at_a_time_match_one_at_a_time() {
+    use kage::scene::ShadowMethod;
+    let mut scene = kage::scene::demo::demo_scene().unwrap();
+    (scene.width, scene.height) = (160, 90);
+    scene.lights.iter_mut().filter(|l| l.casts_shadows()).for_each(|l| {
+        l.shadow = ShadowSettings { method: ShadowMethod::Pcss, ..ShadowSettings::default() };
+        l.size = l.size.max(0.2);
+    });
+    let frame = render(&scene, &RenderOptions::default()).unwrap();
+    let normals = frame.normals(&scene);
+    let rays = scene.camera.pixel_rays(Vec2::new(scene.width as f32, scene.height as f32));
+    let points: Vec<(Vec3, Vec3)> = (0..scene.height)
+        .flat_map(|y| (0..scene.width).map(move |x| (x, y)))
+        .filter(|&(x, y)| !frame.visibility.item(x, y).is_none())
+        .map(|(x, y)| {
+            let ray = rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
+            let p = ray.at(scene.camera.distance_at_depth(&ray, frame.visibility.depth(x, y)));
+            (p, normals[(y * scene.width + x) as usize])
+        })
+        .collect();
+    let (mut compared, mut differ, mut shadowed) = (0, 0, 0);
+    for light in scene.lights.iter().filter(|l| l.casts_shadows()) {
+        let term = ShadowTerm::build(&scene, light);
+        for chunk in points.chunks_exact(8) {
+            let lane = |k: usize| wide::f32x8::new(std::array::from_fn(|i| chunk[i].0[k]));
+            let cos: [f32; 8] = std::array::from_fn(|i| chunk[i].1.dot(light.incident(chunk[i].0).to_light).max(0.01));
+            let receivers = kage::shadows::ReceiverLanes {
+                objects: [kage::shadows::UNKNOWN_RECEIVER; 8],
+                planes: [wide::f32x8::ZERO; 3],
+            };
+            let lanes = term.lit_lanes([lane(0), lane(1), lane(2)], wide::f32x8::new(cos), &receivers).to_array();
+            for i in 0..8 {
+                let one = term.lit(chunk[i].0, cos[i], &receivers.lane(i));
+                compared += 1;
+                shadowed += usize::from(one < 1.0);
+                differ += usize::from((one - lanes[i]).abs() > 1.0 / 16.0 + 1e-6);
+            }
+        }
+    }
+    assert!(shadowed > 1000, "{shadowed} of {compared} points shadowed");
+    assert!(differ * 1000 <= compared, "{differ} of {compared} points differ by more than a tap");
+}

@@ -62,6 +62,8 @@ pub struct LocatedLanes {
     pub texel: f32x8,
     /// Depth limits against other objects' surfaces ([`Located::z_other`]).
     pub z_other: f32x8,
+    /// The points' distances along the light's axis.
+    pub distance: f32x8,
 }
 
 /// Depths seen from a light through one camera.
@@ -192,6 +194,27 @@ impl DepthMap {
         }
     }
 
+    /// [`DepthMap::distance_and_texel`]'s distances for eight reversed
+    /// depths (above 0).
+    #[must_use]
+    pub fn distance_lanes(&self, z: f32x8) -> f32x8 {
+        if self.ortho {
+            f32x8::splat(self.far) - z * f32x8::splat(self.far - self.near)
+        } else {
+            f32x8::splat(self.near) / z
+        }
+    }
+
+    /// [`DepthMap::texel_size`] at eight distances.
+    #[must_use]
+    pub fn texel_size_lanes(&self, along: f32x8) -> f32x8 {
+        if self.ortho {
+            f32x8::splat(self.texel)
+        } else {
+            along * f32x8::splat(self.texel)
+        }
+    }
+
     /// The direction from `p` towards the light (not normalised).
     #[inline]
     #[must_use]
@@ -300,6 +323,19 @@ impl DepthMap {
     /// texel coordinates and depth limits (infinite for a point at the light).
     #[must_use]
     pub fn locate_lanes(&self, p: [f32x8; 3], cos_theta: f32x8, settings: &ShadowSettings, reach: f32) -> LocatedLanes {
+        self.locate_lanes_reaching(p, cos_theta, settings, f32x8::splat(reach))
+    }
+
+    /// [`DepthMap::locate_lanes`] with each point's bias reaching its own
+    /// number of texels.
+    #[must_use]
+    pub fn locate_lanes_reaching(
+        &self,
+        p: [f32x8; 3],
+        cos_theta: f32x8,
+        settings: &ShadowSettings,
+        reach: f32x8,
+    ) -> LocatedLanes {
         let m = self.view_proj;
         let row = |r: usize| {
             let (a, b, c, d) = (m.x_axis[r], m.y_axis[r], m.z_axis[r], m.w_axis[r]);
@@ -325,7 +361,7 @@ impl DepthMap {
         let texel = if self.ortho { f32x8::splat(self.texel) } else { d * f32x8::splat(self.texel) };
         let c = cos_theta.max(f32x8::splat(1e-3)).min(f32x8::ONE);
         let tan = ((f32x8::ONE - c * c).sqrt() / c).min(f32x8::splat(MAX_SLOPE));
-        let bias = f32x8::splat(settings.bias) + tan * f32x8::splat(settings.slope * reach);
+        let bias = f32x8::splat(settings.bias) + tan * f32x8::splat(settings.slope) * reach;
         let reversed = |limit: f32x8| {
             if self.ortho {
                 ((f32x8::splat(self.far) - limit) / f32x8::splat(self.far - self.near)).max(zero)
@@ -336,7 +372,7 @@ impl DepthMap {
         };
         let z_limit = reversed(d - texel * bias);
         let z_other = reversed(d - texel * f32x8::splat(other_bias(settings)));
-        LocatedLanes { inside, u, v, z_limit, texel, z_other }
+        LocatedLanes { inside, u, v, z_limit, texel, z_other, distance: d }
     }
 
     /// [`DepthMap::lit`] for eight points at once (`p` as x, y and z lanes): the

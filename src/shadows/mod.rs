@@ -279,11 +279,18 @@ impl ShadowTerm {
                 f32x8::new(std::array::from_fn(|i| faces[face[i]].lit(Vec3::new(x[i], y[i], z[i]), c[i], s)))
             }
             ShadowTerm::Slb(map, s) => map.lit_lanes(p, cos_theta, s, receivers),
-            ShadowTerm::SlbCube(..) | ShadowTerm::Soft(_) | ShadowTerm::Pcss(..) => {
-                let (x, y, z, c) = (p[0].to_array(), p[1].to_array(), p[2].to_array(), cos_theta.to_array());
-                f32x8::new(std::array::from_fn(|i| self.lit(Vec3::new(x[i], y[i], z[i]), c[i], &receivers.lane(i))))
-            }
+            ShadowTerm::Pcss(hard, light) => match hard.as_ref() {
+                ShadowTerm::Map(map, s) => pcss::lit_lanes(map, p, cos_theta, s, light),
+                _ => self.lit_each(p, cos_theta, receivers),
+            },
+            ShadowTerm::SlbCube(..) | ShadowTerm::Soft(_) => self.lit_each(p, cos_theta, receivers),
         }
+    }
+
+    /// [`ShadowTerm::lit`] at each of eight points in turn.
+    fn lit_each(&self, p: [f32x8; 3], cos_theta: f32x8, receivers: &ReceiverLanes) -> f32x8 {
+        let (x, y, z, c) = (p[0].to_array(), p[1].to_array(), p[2].to_array(), cos_theta.to_array());
+        f32x8::new(std::array::from_fn(|i| self.lit(Vec3::new(x[i], y[i], z[i]), c[i], &receivers.lane(i))))
     }
 
     /// The mean of `terms`' [`ShadowTerm::lit`] (1 when there are none): the

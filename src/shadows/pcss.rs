@@ -13,6 +13,7 @@
 //! receiver's texel and the term is the hard map's.
 
 use glam::Vec3;
+use wide::f32x8;
 
 use super::map::DepthMap;
 use crate::scene::ShadowSettings;
@@ -82,6 +83,68 @@ fn unit_taps() -> &'static [(f32, f32); MAX_TAPS] {
             let (s, c) = (f64::from(i as u32) * f64::from(GOLDEN_ANGLE)).sin_cos();
             (c as f32, s as f32)
         })
+    })
+}
+
+/// [`lit`] for eight points (`p` as x, y and z lanes): the projection, the
+/// searches' radii, the taps' positions and the depth tests as vector
+/// arithmetic, eight points a tap; the texel reads one lane at a time.
+#[must_use]
+pub fn lit_lanes(
+    map: &DepthMap,
+    p: [f32x8; 3],
+    cos_theta: f32x8,
+    settings: &ShadowSettings,
+    light: &PcssLight,
+) -> f32x8 {
+    let at = map.locate_lanes(p, cos_theta, settings, 1.0);
+    if at.inside.to_array().iter().all(|&m| m == 0.0) {
+        return f32x8::ONE;
+    }
+    let (x, y, z) = (p[0].to_array(), p[1].to_array(), p[2].to_array());
+    let turn: [f32; 8] = std::array::from_fn(|i| hash_angle(Vec3::new(x[i], y[i], z[i])));
+    let d = at.distance;
+    let size = f32x8::splat(light.size);
+    let nearest = f32x8::splat(light.nearest).min(d);
+    let search = (size * (d - nearest) / d / map.texel_size_lanes(nearest)).min(f32x8::splat(MAX_RADIUS));
+    let (mut sum, mut found) = (f32x8::ZERO, f32x8::ZERO);
+    for (du, dv) in spiral_lanes(settings.blockers, search, turn) {
+        let z = depths(map, at.u + du, at.v + dv);
+        let blocks = z.simd_gt(at.z_limit);
+        sum += blocks.select(map.distance_lanes(z.max(f32x8::splat(f32::MIN_POSITIVE))), f32x8::ZERO);
+        found += blocks.select(f32x8::ONE, f32x8::ZERO);
+    }
+    let none = found.simd_eq(f32x8::ZERO) | at.inside.simd_eq(f32x8::ZERO);
+    if none.to_array().iter().all(|&m| m != 0.0) {
+        return f32x8::ONE;
+    }
+    let blocker = (sum / found.max(f32x8::ONE)).max(f32x8::splat(f32::MIN_POSITIVE));
+    let radius =
+        (size * (d - blocker).max(f32x8::ZERO) / blocker / map.texel_size_lanes(d)).min(f32x8::splat(MAX_RADIUS));
+    let at = map.locate_lanes_reaching(p, cos_theta, settings, f32x8::ONE + radius.min(f32x8::splat(8.0)));
+    let n = settings.filter.max(1);
+    let mut lit = f32x8::ZERO;
+    for (du, dv) in spiral_lanes(n, radius, turn.map(|t| t + 1.0)) {
+        lit += depths(map, at.u + du, at.v + dv).simd_le(at.z_limit).select(f32x8::ONE, f32x8::ZERO);
+    }
+    none.select(f32x8::ONE, lit / f32x8::splat(n.min(MAX_TAPS as u32) as f32))
+}
+
+/// The map's depths at eight texel positions (clamped to the map).
+fn depths(map: &DepthMap, u: f32x8, v: f32x8) -> f32x8 {
+    let (u, v) = (u.to_array(), v.to_array());
+    f32x8::new(std::array::from_fn(|i| map.texel_depth_clamped(u[i], v[i])))
+}
+
+/// [`spiral`] for eight points at once, each with its own radius and turn.
+fn spiral_lanes(n: u32, radius: f32x8, turn: [f32; 8]) -> impl Iterator<Item = (f32x8, f32x8)> {
+    let n = n.clamp(1, MAX_TAPS as u32);
+    let (ts, tc): ([f32; 8], [f32; 8]) = (turn.map(|t| t.sin_cos().0), turn.map(|t| t.sin_cos().1));
+    let (ts, tc) = (f32x8::new(ts), f32x8::new(tc));
+    unit_taps()[..n as usize].iter().enumerate().map(move |(i, &(c, s))| {
+        let r = radius * f32x8::splat(((i as f32 + 0.5) / n as f32).sqrt());
+        let (c, s) = (f32x8::splat(c), f32x8::splat(s));
+        (r * (c * tc - s * ts), r * (s * tc + c * ts))
     })
 }
 

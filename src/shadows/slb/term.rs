@@ -175,7 +175,8 @@ impl SlbMap {
         settings: &ShadowSettings,
         receivers: &ReceiverLanes,
     ) -> f32x8 {
-        let LocatedLanes { inside, u, v, z_limit, texel, z_other } = self.map.locate_lanes(p, cos_theta, settings, 1.0);
+        let LocatedLanes { inside, u, v, z_limit, texel, z_other, .. } =
+            self.map.locate_lanes(p, cos_theta, settings, 1.0);
         let mask = inside.to_bitmask();
         let (u, v, own, other) = (u.to_array(), v.to_array(), z_limit.to_array(), z_other.to_array());
         let (x, y, z, c) = (p[0].to_array(), p[1].to_array(), p[2].to_array(), cos_theta.to_array());
