@@ -11,6 +11,16 @@
 //! sample different texels and the pattern becomes fine noise instead of
 //! bands. A light of size 0 gives radius-0 searches: every tap reads the
 //! receiver's texel and the term is the hard map's.
+//!
+//! How it runs: the spiral's unit directions are a table, turned by one
+//! rotation per point, and the shading passes ask for eight points at once
+//! ([`lit_lanes`]): projection, radii, tap positions and depth tests as 8-lane
+//! arithmetic, the texel reads one lane at a time. The three ways measured on
+//! the 1920×1080 demo with `--shadows pcss` (the shading time
+//! `kage render --shadows pcss --width 1920 --height 1080 --threads 1` prints;
+//! 2-core machine): a sine and a cosine per tap 700 ms, the turned table
+//! 455 ms, the table eight points at a time 278 ms (two threads: 354, 232,
+//! 146 ms); the images agree to an RMSE of 2e-5.
 
 use glam::Vec3;
 use wide::f32x8;
