@@ -547,12 +547,20 @@ fn a_thin_lids_shadow_boundary_is_within_a_texel_of_the_rays() {
 }
 
 /// PCSS eight points at a time decides as one point at a time: on the
-/// demo's visible surfaces, every light's term from `lit_lanes` against
-/// `lit` for each lane.
+/// visible surfaces of the demo and of the Cornell box (whose lamp's map is
+/// a cube), every light's term from `lit_lanes` against `lit` for each lane.
 #[test]
 fn pcss_eight_points_at_a_time_match_one_at_a_time() {
+    pcss_lanes_match_in(kage::scene::demo::demo_scene().unwrap());
+    // A lamp inside a room: its map is a cube.
+    let room =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/assets/scenes/cornell-box/CornellBox-Original.obj");
+    pcss_lanes_match_in(kage::scene::model::scene_for_model(&room, 160, 120).unwrap());
+}
+
+/// [`pcss_eight_points_at_a_time_match_one_at_a_time`] in `scene`.
+fn pcss_lanes_match_in(mut scene: Scene) {
     use kage::scene::ShadowMethod;
-    let mut scene = kage::scene::demo::demo_scene().unwrap();
     (scene.width, scene.height) = (160, 90);
     scene.lights.iter_mut().filter(|l| l.casts_shadows()).for_each(|l| {
         l.shadow = ShadowSettings { method: ShadowMethod::Pcss, ..ShadowSettings::default() };

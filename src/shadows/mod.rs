@@ -268,19 +268,18 @@ impl ShadowTerm {
         match self {
             ShadowTerm::Unshadowed => f32x8::ONE,
             ShadowTerm::Map(map, s) => map.lit_lanes(p, cos_theta, s),
-            ShadowTerm::Cube(faces, centre, s) => {
-                let (x, y, z) = (p[0].to_array(), p[1].to_array(), p[2].to_array());
-                let face: [usize; 8] = std::array::from_fn(|i| cube_face(Vec3::new(x[i], y[i], z[i]) - *centre));
-                if face.iter().all(|&f| f == face[0]) {
-                    // Neighbouring pixels usually look into the same face.
-                    return faces[face[0]].lit_lanes(p, cos_theta, s);
-                }
-                let c = cos_theta.to_array();
-                f32x8::new(std::array::from_fn(|i| faces[face[i]].lit(Vec3::new(x[i], y[i], z[i]), c[i], s)))
-            }
+            ShadowTerm::Cube(faces, centre, s) => match same_cube_face(p, *centre) {
+                // Neighbouring pixels usually look into the same face.
+                Some(face) => faces[face].lit_lanes(p, cos_theta, s),
+                None => self.lit_each(p, cos_theta, receivers),
+            },
             ShadowTerm::Slb(map, s) => map.lit_lanes(p, cos_theta, s, receivers),
             ShadowTerm::Pcss(hard, light) => match hard.as_ref() {
                 ShadowTerm::Map(map, s) => pcss::lit_lanes(map, p, cos_theta, s, light),
+                ShadowTerm::Cube(faces, centre, s) => match same_cube_face(p, *centre) {
+                    Some(face) => pcss::lit_lanes(&faces[face], p, cos_theta, s, light),
+                    None => self.lit_each(p, cos_theta, receivers),
+                },
                 _ => self.lit_each(p, cos_theta, receivers),
             },
             ShadowTerm::SlbCube(..) | ShadowTerm::Soft(_) => self.lit_each(p, cos_theta, receivers),
@@ -624,6 +623,14 @@ impl MapPool {
         let kept = self.kept.iter().chain(&self.previous).map(|(_, t)| t.memory_bytes()).sum::<usize>();
         self.free.iter().map(VisibilityBuffer::memory_bytes).sum::<usize>() + kept
     }
+}
+
+/// The cube face every one of eight points (x, y, z lanes) lies in, seen
+/// from `centre`, if they share one.
+fn same_cube_face(p: [f32x8; 3], centre: Vec3) -> Option<usize> {
+    let (x, y, z) = (p[0].to_array(), p[1].to_array(), p[2].to_array());
+    let first = cube_face(Vec3::new(x[0], y[0], z[0]) - centre);
+    (1..8).all(|i| cube_face(Vec3::new(x[i], y[i], z[i]) - centre) == first).then_some(first)
 }
 
 /// The cube face (+x, −x, +y, −y, +z, −z) that direction `d` from the centre
