@@ -259,19 +259,23 @@ fn jittered_passes_share_the_maps_fitted_to_the_view() {
     assert!(aliased.pixels() == render(&scene, &RenderOptions::default()).unwrap().image.pixels());
 }
 
-/// A wide floor that casts no shadow under a small box, lit by a point light
-/// above: the light's map is fitted to the box alone.
-fn box_on_a_shadowless_floor() -> Scene {
-    let camera = kage::camera::Camera {
-        eye: Vec3::new(0.0, 6.0, 8.0),
+/// A 40° perspective camera at `eye` looking at the origin, y up.
+fn towards_origin(eye: Vec3) -> kage::camera::Camera {
+    kage::camera::Camera {
+        eye,
         target: Vec3::ZERO,
         up: Vec3::Y,
         near: 0.1,
         far: 50.0,
         projection: kage::camera::Projection::Perspective { fov_y_deg: 40.0 },
         shift: Vec2::ZERO,
-    };
-    let mut scene = common::scene_with(shapes::plane(), camera, 160, 120, false);
+    }
+}
+
+/// A wide floor that casts no shadow under a small box, lit by a point light
+/// above: the light's map is fitted to the box alone.
+fn box_on_a_shadowless_floor() -> Scene {
+    let mut scene = common::scene_with(shapes::plane(), towards_origin(Vec3::new(0.0, 6.0, 8.0)), 160, 120, false);
     scene.objects[0].transform = Affine3A::from_scale(Vec3::splat(40.0));
     scene.objects[0].casts_shadows = false;
     let lifted = Affine3A::from_translation(Vec3::new(0.0, 0.6, 0.0)) * Affine3A::from_scale(Vec3::splat(0.5));
@@ -415,16 +419,7 @@ fn cube_on_ground(view: (f32, f32), light: Light) -> Scene {
         let (az, el) = (az.to_radians(), el.to_radians());
         Vec3::new(el.cos() * az.sin(), el.sin(), el.cos() * az.cos())
     };
-    let camera = kage::camera::Camera {
-        eye: dir(view) * 4.0,
-        target: Vec3::ZERO,
-        up: Vec3::Y,
-        near: 0.1,
-        far: 50.0,
-        projection: kage::camera::Projection::Perspective { fov_y_deg: 40.0 },
-        shift: Vec2::ZERO,
-    };
-    let mut scene = common::scene_with(shapes::cube(), camera, 320, 240, false);
+    let mut scene = common::scene_with(shapes::cube(), towards_origin(dir(view) * 4.0), 320, 240, false);
     let ground =
         Affine3A::from_scale_rotation_translation(Vec3::splat(8.0), glam::Quat::IDENTITY, Vec3::new(0.0, -0.5, 0.0));
     scene.objects.push(Object::mesh("ground", Arc::new(shapes::plane()), ground, 0));

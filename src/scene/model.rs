@@ -372,9 +372,10 @@ struct Enclosure {
 }
 
 impl Enclosure {
-    /// Directions around the level that must meet an inward face: 16
-    /// azimuths at 0° and ±25° of elevation.
+    /// Azimuths of the directions round the centre that are tried, evenly
+    /// spaced.
     const AZIMUTHS: u32 = 16;
+    /// Their elevations: level, and 25° below and above.
     const ELEVATIONS_DEG: [f32; 3] = [-25.0, 0.0, 25.0];
     /// Share of those directions that must meet the model from its inside
     /// (a face turned towards the centre): a courtyard's arcades let a few
