@@ -37,6 +37,14 @@ fn view(args: &[&str]) -> (bool, String) {
     (out.status.success(), text)
 }
 
+/// Writes `script` to `dir/run.script` and runs `kage view args... --script`
+/// on it (see [`view`]).
+fn scripted(dir: &Path, script: &str, args: &[&str]) -> (bool, String) {
+    let path = dir.join("run.script");
+    std::fs::write(&path, script).unwrap();
+    view(&[args, &["--script", path.to_str().unwrap()]].concat())
+}
+
 fn kage(args: &[&str]) {
     let out = Command::new(env!("CARGO_BIN_EXE_kage")).args(args).output().unwrap();
     assert!(out.status.success(), "kage {args:?}: {}", String::from_utf8_lossy(&out.stderr));
@@ -92,8 +100,7 @@ fn a_screenshot_equals_the_render_of_the_same_camera() {
     let dir = scratch("equal");
     let file = dir.join("scene.toml");
     std::fs::write(&file, scene("sphere", "[0.8, 0.3, 0.2]")).unwrap();
-    std::fs::write(dir.join("run.script"), "key a\nkey a\nwait\nscreenshot shot.png\nquit\n").unwrap();
-    let (ok, out) = view(&[file.to_str().unwrap(), "--script", dir.join("run.script").to_str().unwrap()]);
+    let (ok, out) = scripted(&dir, "key a\nkey a\nwait\nscreenshot shot.png\nquit\n", &[file.to_str().unwrap()]);
     assert!(ok, "{out}");
     let reference = dir.join("render.png");
     kage(&["render", file.to_str().unwrap(), "-o", reference.to_str().unwrap()]);
@@ -114,8 +121,7 @@ fn an_edited_scene_file_is_shown_again() {
     std::fs::write(dir.join("edited.toml"), scene("cube", "[0.2, 0.3, 0.8]")).unwrap();
     let script = "key a\nkey a\nwait\nscreenshot before.png\ncopy edited.toml scene.toml\nsleep 1.5\nwait\n\
                   screenshot after.png\nquit\n";
-    std::fs::write(dir.join("run.script"), script).unwrap();
-    let (ok, out) = view(&[file.to_str().unwrap(), "--script", dir.join("run.script").to_str().unwrap()]);
+    let (ok, out) = scripted(&dir, script, &[file.to_str().unwrap()]);
     assert!(ok, "{out}");
     let (before, after) = (read(&dir.join("before.png")), read(&dir.join("after.png")));
     assert!(rmse(&before, &after) > 0.01, "the change is shown");
@@ -139,8 +145,7 @@ fn a_broken_scene_file_keeps_the_window_and_draws_the_error() {
     std::fs::write(dir.join("broken.toml"), "[camera]\neye = \"up\"\n").unwrap();
     let script = "key z\nkey a\nwait\ncapture good.png\nscreenshot before.png\ncopy broken.toml scene.toml\n\
                   sleep 1.5\nwait\ncapture bad.png\nscreenshot image.png\nquit\n";
-    std::fs::write(dir.join("run.script"), script).unwrap();
-    let (ok, out) = view(&[file.to_str().unwrap(), "--script", dir.join("run.script").to_str().unwrap()]);
+    let (ok, out) = scripted(&dir, script, &[file.to_str().unwrap()]);
     assert!(ok, "the viewer exits cleanly after the bad edit: {out}");
     assert!(out.contains("scene.toml:2:"), "the error names file and line: {out}");
     assert_eq!(out.matches("scene.toml:2:").count(), 1, "the error is said once: {out}");
@@ -166,8 +171,11 @@ fn the_refined_image_equals_64_jittered_passes() {
     let dir = scratch("refined");
     let file = dir.join("scene.toml");
     std::fs::write(&file, scene("cube", "[0.3, 0.7, 0.3]")).unwrap();
-    std::fs::write(dir.join("run.script"), "wait 8\nkey r\nkey r\nwait\nscreenshot shot.png\nquit\n").unwrap();
-    let (ok, out) = view(&[file.to_str().unwrap(), "--timings", "--script", dir.join("run.script").to_str().unwrap()]);
+    let (ok, out) = scripted(
+        &dir,
+        "wait 8\nkey r\nkey r\nwait\nscreenshot shot.png\nquit\n",
+        &[file.to_str().unwrap(), "--timings"],
+    );
     assert!(ok, "{out}");
     let given_up = out.split(" steps given up").next().and_then(|s| s.rsplit(' ').next()).and_then(|n| n.parse().ok());
     assert!(given_up.is_some_and(|n: u32| n >= 1), "a rendering step is given up for the keys: {out}");
@@ -190,8 +198,7 @@ fn a_dropped_file_opens() {
     let other_scene = scene("cube", "[0.2, 0.3, 0.8]").replace("eye = [2.0, 2.0, 4.0]", "eye = [-3.0, 1.5, 3.0]");
     std::fs::write(&other, other_scene).unwrap();
     let script = "key a\nkey a\nwait\ndrop other.toml\nwait\nscreenshot shot.png\nquit\n";
-    std::fs::write(dir.join("run.script"), script).unwrap();
-    let (ok, out) = view(&[first.to_str().unwrap(), "--script", dir.join("run.script").to_str().unwrap()]);
+    let (ok, out) = scripted(&dir, script, &[first.to_str().unwrap()]);
     assert!(ok, "{out}");
     let reference = dir.join("render.png");
     kage(&["render", other.to_str().unwrap(), "-o", reference.to_str().unwrap()]);
@@ -211,8 +218,7 @@ fn wait_for_passes_after_a_drop_waits_for_the_dropped_file() {
     std::fs::write(&first, scene("sphere", "[0.8, 0.3, 0.2]")).unwrap();
     std::fs::write(&other, scene("cube", "[0.2, 0.3, 0.8]")).unwrap();
     let script = "wait\ndrop other.toml\nwait 8\nscreenshot shot.png\nquit\n";
-    std::fs::write(dir.join("run.script"), script).unwrap();
-    let (ok, out) = view(&[first.to_str().unwrap(), "--script", dir.join("run.script").to_str().unwrap()]);
+    let (ok, out) = scripted(&dir, script, &[first.to_str().unwrap()]);
     assert!(ok, "{out}");
     let (was, now) = (dir.join("first.png"), dir.join("other.png"));
     kage(&["render", first.to_str().unwrap(), "-o", was.to_str().unwrap()]);
@@ -234,8 +240,11 @@ fn the_refined_demo_differs_from_64_jittered_passes_only_in_its_penumbrae() {
         return;
     }
     let dir = scratch("demo");
-    std::fs::write(dir.join("run.script"), "wait\nscreenshot shot.png\nkey h\ncapture window.png\nquit\n").unwrap();
-    let (ok, out) = view(&["--width", "480", "--height", "270", "--script", dir.join("run.script").to_str().unwrap()]);
+    let (ok, out) = scripted(
+        &dir,
+        "wait\nscreenshot shot.png\nkey h\ncapture window.png\nquit\n",
+        &["--width", "480", "--height", "270"],
+    );
     assert!(ok, "{out}");
     let reference = dir.join("render.png");
     kage(&[
