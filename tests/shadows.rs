@@ -554,34 +554,81 @@ fn pcss_eight_points_at_a_time_match_one_at_a_time() {
 }
 
 /// [`pcss_eight_points_at_a_time_match_one_at_a_time`] in `scene`.
-fn pcss_lanes_match_in(mut scene: Scene) {
+fn pcss_lanes_match_in(scene: Scene) {
     use kage::scene::ShadowMethod;
-    (scene.width, scene.height) = (160, 90);
+    let pcss = ShadowSettings { method: ShadowMethod::Pcss, ..ShadowSettings::default() };
+    let (compared, differ, shadowed) = lanes_against_one_at_a_time(scene, pcss, Some(0.2), (160, 90));
+    assert!(shadowed > 1000, "{shadowed} of {compared} points shadowed");
+    assert!(differ * 1000 <= compared, "{differ} of {compared} points differ by more than a tap");
+}
+
+/// The silhouette-line buffer decides eight points at a time (most by one
+/// look at what the texels round each hold) as it decides each on its own,
+/// antialiased over the pixels' footprints, on the demo's and the Cornell
+/// box's visible surfaces under point lights.
+#[test]
+fn slb_eight_points_at_a_time_match_one_at_a_time() {
+    let room =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/assets/scenes/cornell-box/CornellBox-Original.obj");
+    let scenes =
+        [kage::scene::demo::demo_scene().unwrap(), kage::scene::model::scene_for_model(&room, 160, 120).unwrap()];
+    // Texels wider than the pixels: most footprints reach a texel or less.
+    let slb = ShadowSettings { resolution: 256, ..ShadowSettings::SLB };
+    for scene in scenes {
+        let (compared, differ, shadowed) = lanes_against_one_at_a_time(scene, slb, None, (640, 360));
+        eprintln!("{differ} of {compared} differ, {shadowed} shadowed");
+        assert!(shadowed > 1000, "{shadowed} of {compared} points shadowed");
+        assert!(differ * 2000 <= compared, "{differ} of {compared} points differ by more than a tap");
+    }
+}
+
+/// Every shadowed light's term of `scene` (at `pixels`, its lights set to
+/// `shadow`, their size raised to `size` where given, else made points)
+/// from `lit_lanes` against `lit` for each lane, at the points the pixels
+/// show; for an antialiased method (the SLB) the terms see the pixels' rays
+/// and each point's object and plane. (Points compared, differing by more
+/// than a tap, shadowed.)
+fn lanes_against_one_at_a_time(
+    mut scene: Scene,
+    shadow: ShadowSettings,
+    size: Option<f32>,
+    pixels: (u32, u32),
+) -> (usize, usize, usize) {
+    let antialiased = shadow.method == kage::scene::ShadowMethod::Slb;
+    (scene.width, scene.height) = pixels;
     scene.lights.iter_mut().filter(|l| l.casts_shadows()).for_each(|l| {
-        l.shadow = ShadowSettings { method: ShadowMethod::Pcss, ..ShadowSettings::default() };
-        l.size = l.size.max(0.2);
+        l.shadow = shadow;
+        l.size = size.map_or(0.0, |s| l.size.max(s));
     });
     let frame = render(&scene, &RenderOptions::default()).unwrap();
     let normals = frame.normals(&scene);
     let rays = scene.camera.pixel_rays(Vec2::new(scene.width as f32, scene.height as f32));
-    let points: Vec<(Vec3, Vec3)> = (0..scene.height)
+    let points: Vec<(Vec3, Vec3, u32)> = (0..scene.height)
         .flat_map(|y| (0..scene.width).map(move |x| (x, y)))
         .filter(|&(x, y)| !frame.visibility.item(x, y).is_none())
         .map(|(x, y)| {
             let ray = rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
             let p = ray.at(scene.camera.distance_at_depth(&ray, frame.visibility.depth(x, y)));
-            (p, normals[(y * scene.width + x) as usize])
+            (p, normals[(y * scene.width + x) as usize], frame.visibility.item(x, y).object)
         })
         .collect();
     let (mut compared, mut differ, mut shadowed) = (0, 0, 0);
     for light in scene.lights.iter().filter(|l| l.casts_shadows()) {
-        let term = ShadowTerm::build(&scene, light);
+        let mut term = ShadowTerm::build(&scene, light);
+        if antialiased {
+            term.set_view(Some(kage::shadows::PixelView::new(&rays)));
+        }
         for chunk in points.chunks_exact(8) {
             let lane = |k: usize| wide::f32x8::new(std::array::from_fn(|i| chunk[i].0[k]));
             let cos: [f32; 8] = std::array::from_fn(|i| chunk[i].1.dot(light.incident(chunk[i].0).to_light).max(0.01));
-            let receivers = kage::shadows::ReceiverLanes {
-                objects: [kage::shadows::UNKNOWN_RECEIVER; 8],
-                planes: [wide::f32x8::ZERO; 3],
+            let receivers = if antialiased {
+                let plane = |k: usize| wide::f32x8::new(std::array::from_fn(|i| chunk[i].1[k]));
+                kage::shadows::ReceiverLanes {
+                    objects: std::array::from_fn(|i| chunk[i].2),
+                    planes: [0, 1, 2].map(plane),
+                }
+            } else {
+                kage::shadows::ReceiverLanes::UNKNOWN
             };
             let lanes = term.lit_lanes([lane(0), lane(1), lane(2)], wide::f32x8::new(cos), &receivers).to_array();
             for i in 0..8 {
@@ -592,6 +639,5 @@ fn pcss_lanes_match_in(mut scene: Scene) {
             }
         }
     }
-    assert!(shadowed > 1000, "{shadowed} of {compared} points shadowed");
-    assert!(differ * 1000 <= compared, "{differ} of {compared} points differ by more than a tap");
+    (compared, differ, shadowed)
 }

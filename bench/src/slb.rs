@@ -34,6 +34,10 @@ pub struct SlbArgs {
     /// Only the scenes whose name contains this.
     #[arg(long)]
     only: Option<String>,
+    /// Only these methods, by their names in the table (repeatable; e.g.
+    /// `--method "map 2048²" --method "SLB 1024², k = 8"`).
+    #[arg(long = "method")]
+    methods: Vec<String>,
 }
 
 /// One column of the comparison: a method and its settings.
@@ -255,7 +259,8 @@ pub fn run(args: &SlbArgs) -> Result<()> {
         }
         let base = with(&scene, &ShadowSettings::MAP, check);
         let truth = truth(&base)?;
-        for method in methods() {
+        let chosen = methods().into_iter().filter(|m| args.methods.is_empty() || args.methods.contains(&m.name));
+        for method in chosen {
             let checked = with(&scene, &method.settings, check);
             let (wrong, rmse) = errors(&checked, &truth)?;
             let full = with(&scene, &method.settings, (c.width, c.height));

@@ -123,6 +123,33 @@ impl PixelView {
             }
         })
     }
+
+    /// The lengths of [`PixelView::footprint`]'s two sides added, for eight
+    /// points `p` (x, y, z lanes) on planes of unit normals `n`.
+    #[must_use]
+    pub fn footprint_span_lanes(&self, p: [f32x8; 3], n: [f32x8; 3]) -> f32x8 {
+        let splat = |v: Vec3| [v.x, v.y, v.z].map(f32x8::splat);
+        let dot = |a: &[f32x8; 3], b: &[f32x8; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+        let (dir, scale) = if self.ortho {
+            (splat(self.axis), f32x8::ONE)
+        } else {
+            let o = splat(self.origin);
+            let e = [p[0] - o[0], p[1] - o[1], p[2] - o[2]];
+            let scale = dot(&e, &splat(self.axis)).max(f32x8::ZERO);
+            (e, scale)
+        };
+        let facing = dot(&n, &dir);
+        let edge_on = facing.abs().simd_le(f32x8::splat(f32::MIN_POSITIVE));
+        let side = |step: Vec3| {
+            let w = splat(step).map(|c| c * scale);
+            let plain = dot(&w, &w).sqrt();
+            let k = dot(&n, &w) / facing;
+            let moved = [w[0] - dir[0] * k, w[1] - dir[1] * k, w[2] - dir[2] * k];
+            let len = dot(&moved, &moved).sqrt().min(plain * f32x8::splat(MAX_STRETCH));
+            edge_on.select(plain, len)
+        };
+        side(self.right) + side(self.down)
+    }
 }
 
 #[cfg(test)]

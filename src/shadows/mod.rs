@@ -355,14 +355,16 @@ const SLB_LINES_PER_TEXEL: f64 = 0.08;
 
 /// Bytes a silhouette-line buffer adds to a map of `res` × `res` texels:
 /// the map's item per texel (which object is nearest the light), its edge
-/// bits, ranks and solids' step bits (1.5 + 1 bits a texel), and per budgeted
-/// line its record, its texel's start indices and a surface over the
-/// texel's centre.
+/// bits, ranks and solids' step bits (1.5 + 1 bits a texel), the busy bits
+/// and ranks of the texels round the lines (1.5 bits a texel), and per
+/// budgeted line its record, its texel's start indices, a surface over the
+/// texel's centre and the nearest depth round three texels (a line's texel
+/// and the two beside it across the line).
 #[must_use]
 pub fn slb_bytes(res: usize) -> usize {
     let texels = res * res;
-    let per_line = std::mem::size_of::<slb::line::SilhouetteLine>() + std::mem::size_of::<slb::line::Layer>() + 8;
-    let per_texel = std::mem::size_of::<crate::visibility::ItemId>() * 16 + 5;
+    let per_line = std::mem::size_of::<slb::line::SilhouetteLine>() + std::mem::size_of::<slb::line::Layer>() + 8 + 12;
+    let per_texel = std::mem::size_of::<crate::visibility::ItemId>() * 16 + 8;
     texels * per_texel / 16 + (texels as f64 * SLB_LINES_PER_TEXEL) as usize * per_line
 }
 

@@ -6,12 +6,15 @@
 //! them), `solid` (a CSG solid's outline, traced by rays, as triangles),
 //! `walk` (the supercover walk of an edge through the texels), `line` (one
 //! line's record and its reconstruction), `buffer` (the light pass: records,
-//! shared- and hidden-line removal, the compact store), `region` (the eye
-//! pass inside one edge texel) and `term` (the light's shadow term).
+//! shared- and hidden-line removal, the compact store), `neighbourhood` (what
+//! the texels round each texel hold, deciding most points of the eye pass at
+//! one look), `region` (the eye pass inside one edge texel) and `term` (the
+//! light's shadow term).
 
 pub mod buffer;
 pub mod light;
 pub mod line;
+pub mod neighbourhood;
 pub mod region;
 pub mod solid;
 pub mod term;
