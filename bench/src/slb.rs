@@ -116,9 +116,51 @@ fn torus_scene() -> Scene {
     scene
 }
 
+/// Scanned and CAD meshes side by side on a wide floor under a sun 15° above
+/// the horizon: the Stanford bunny, dragon and armadillo and OpenSCAD's
+/// printer part, each scaled to stand 1.5 units tall (`None` when one is not
+/// among the assets).
+fn scanned_and_cad(assets: &std::path::Path) -> Result<Option<Scene>> {
+    let models = [
+        "meshes/stanford-bunny/stanford-bunny.obj",
+        "meshes/dragon/dragon.obj",
+        "meshes/armadillo/armadillo.obj",
+        "csg/mk3_x_end.csg",
+    ];
+    let mut scene = over_a_floor(Vec3::new(0.0, 5.0, 10.0), Vec3::new(0.0, 0.5, 0.0), 80.0, 40.0);
+    for (k, model) in models.iter().enumerate() {
+        let path = assets.join(model);
+        if !path.exists() {
+            eprintln!("skipped the scanned and CAD scene: {} not found", path.display());
+            return Ok(None);
+        }
+        let one = kage::scene::model::scene_for_model(&path, 640, 360).map_err(|e| miette!("{e}"))?;
+        let objects: Vec<Object> = one.objects.into_iter().filter(|o| o.name != "ground").collect();
+        let bounds = objects.iter().filter_map(Object::world_bounds).reduce(|(a, b), (c, d)| (a.min(c), b.max(d)));
+        let Some((lo, hi)) = bounds else { continue };
+        let scale = 1.5 / (hi.y - lo.y).max(1e-6);
+        let at = Vec3::new(-4.5 + 3.0 * k as f32, 0.0, 0.0);
+        let centre = Vec3::new((lo.x + hi.x) * 0.5, lo.y, (lo.z + hi.z) * 0.5);
+        let place = Affine3A::from_translation(at)
+            * Affine3A::from_scale(Vec3::splat(scale))
+            * Affine3A::from_translation(-centre);
+        let offset = scene.materials.len();
+        scene.materials.extend(one.materials);
+        scene.objects.extend(objects.into_iter().map(|o| Object {
+            transform: place * o.transform,
+            material: o.material + offset,
+            ..o
+        }));
+    }
+    let elevation = 15f32.to_radians();
+    let direction = -Vec3::new(elevation.cos() * 0.6, elevation.sin(), elevation.cos() * 0.8).normalize();
+    scene.lights.push(Light { kind: LightKind::Directional { direction }, ambient: 0.2, ..Light::default() });
+    Ok(Some(scene))
+}
+
 /// The scenes: the demo, the heat sink, atrium and CSG examples, a torus, a grid of boxes under
-/// grazing light, and the Stanford bunny and dragon and a CAD part from OpenSCAD when the shared
-/// assets are there.
+/// grazing light, and the Stanford bunny and dragon and a CAD part from OpenSCAD, and all
+/// three with the armadillo on one floor under a low sun, when the shared assets are there.
 fn scenes(c: &Common) -> Result<Vec<(String, Scene)>> {
     let mut out = Vec::new();
     let demo = kage::scene::demo::demo_scene().map_err(|e| miette!("{e}"))?;
@@ -139,6 +181,9 @@ fn scenes(c: &Common) -> Result<Vec<(String, Scene)>> {
         } else {
             eprintln!("skipped {} (not found)", path.display());
         }
+    }
+    if let Some(scene) = scanned_and_cad(&c.assets())? {
+        out.push(("scanned and CAD, sun at 15°".to_string(), scene));
     }
     Ok(out)
 }

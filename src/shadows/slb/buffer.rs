@@ -494,21 +494,27 @@ fn silhouette_edges(snapped: &[Snapped]) -> Vec<(usize, usize)> {
         })
         .collect();
     let keys = sort_by_hash(keys);
-    let mut kept = Vec::new();
-    for same in keys.chunk_by(|a, b| (a.0, a.1) == (b.0, b.1)) {
-        match same {
-            // An edge of one triangle alone: a silhouette.
-            [(_, _, e)] => kept.push(*e),
-            // Two triangles' (the usual case): shared when they lie on
-            // opposite sides of it.
-            [(_, _, a), (_, _, b)] => {
-                if (a ^ b) & LEFT == 0 {
-                    kept.extend([*a, *b]);
+    let same = |a: &(u64, u32, u32), b: &(u64, u32, u32)| (a.0, a.1) == (b.0, b.1);
+    let pair = |piece: &[(u64, u32, u32)]| {
+        let mut kept = Vec::new();
+        for run in piece.chunk_by(same) {
+            match run {
+                // An edge of one triangle alone: a silhouette.
+                [(_, _, e)] => kept.push(*e),
+                // Two triangles' (the usual case): shared when they lie on
+                // opposite sides of it.
+                [(_, _, a), (_, _, b)] => {
+                    if (a ^ b) & LEFT == 0 {
+                        kept.extend([*a, *b]);
+                    }
                 }
+                _ => kept.extend(unpaired(run, |_, _| true, |e| e.2 & LEFT != 0).into_iter().map(|e| e.2)),
             }
-            _ => kept.extend(unpaired(same, |_, _| true, |e| e.2 & LEFT != 0).into_iter().map(|e| e.2)),
         }
-    }
+        kept
+    };
+    // Paired across the workers, in pieces cut between runs.
+    let kept: Vec<u32> = runs_in_pieces(&keys, same, 1 << 14).par_iter().flat_map_iter(|piece| pair(piece)).collect();
     kept.into_iter()
         .filter(|e| e & OPEN == 0)
         .map(|e| {
@@ -516,6 +522,23 @@ fn silhouette_edges(snapped: &[Snapped]) -> Vec<(usize, usize)> {
             (e / 3, e % 3)
         })
         .collect()
+}
+
+/// `sorted` cut into pieces of about `size` items, never inside a run of
+/// `same` items.
+fn runs_in_pieces<T>(sorted: &[T], same: impl Fn(&T, &T) -> bool, size: usize) -> Vec<&[T]> {
+    let mut pieces = Vec::new();
+    let mut rest = sorted;
+    while !rest.is_empty() {
+        let mut end = size.min(rest.len());
+        while end < rest.len() && same(&rest[end - 1], &rest[end]) {
+            end += 1;
+        }
+        let (piece, tail) = rest.split_at(end);
+        pieces.push(piece);
+        rest = tail;
+    }
+    pieces
 }
 
 /// `keys` sorted: a counting sort on the hashes' top bits (about one bucket
