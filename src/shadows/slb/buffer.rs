@@ -256,16 +256,7 @@ impl SilhouetteLineBuffer {
         for t in texels {
             self.edge[t as usize / 64] |= 1 << (t % 64);
         }
-        let mut total = 0u32;
-        self.rank = self
-            .edge
-            .iter()
-            .map(|w| {
-                let r = total;
-                total += w.count_ones();
-                r
-            })
-            .collect();
+        self.rank = ranks(&self.edge);
     }
 
     /// Every triangle over the centre of every edge texel, and every solid
@@ -414,13 +405,7 @@ impl SilhouetteLineBuffer {
         if x >= self.width || y >= self.height {
             return None;
         }
-        let t = (y * self.width + x) as usize;
-        let word = self.edge[t / 64];
-        if word >> (t % 64) & 1 == 0 {
-            return None;
-        }
-        let below = word & ((1u64 << (t % 64)) - 1);
-        let i = (self.rank[t / 64] + below.count_ones()) as usize;
+        let i = ranked(&self.edge, &self.rank, (y * self.width + x) as usize)?;
         let (l0, l1) = (self.line_start[i] as usize, self.line_start[i + 1] as usize);
         let (m0, m1) = (self.layer_start[i] as usize, self.layer_start[i + 1] as usize);
         Some(Entry { lines: &self.lines[l0..l1], layers: &self.layers[m0..m1] })
@@ -459,6 +444,33 @@ impl SilhouetteLineBuffer {
             + self.lines.len() * std::mem::size_of::<SilhouetteLine>()
             + self.layers.len() * std::mem::size_of::<Layer>()
     }
+}
+
+/// Per word of a bit set, how many bits are set in the words before it.
+#[must_use]
+pub(super) fn ranks(words: &[u64]) -> Vec<u32> {
+    let mut total = 0u32;
+    words
+        .iter()
+        .map(|w| {
+            let r = total;
+            total += w.count_ones();
+            r
+        })
+        .collect()
+}
+
+/// Bit `t`'s place among the set bits of `words` (whose [`ranks`] are
+/// `rank`), if it is set.
+#[inline]
+#[must_use]
+pub(super) fn ranked(words: &[u64], rank: &[u32], t: usize) -> Option<usize> {
+    let word = *words.get(t / 64)?;
+    if word >> (t % 64) & 1 == 0 {
+        return None;
+    }
+    let below = word & ((1u64 << (t % 64)) - 1);
+    Some((rank[t / 64] + below.count_ones()) as usize)
 }
 
 /// §3.3.2 once per edge rather than once per texel: the edges of one

@@ -18,7 +18,7 @@
 
 use rayon::prelude::*;
 
-use super::buffer::SilhouetteLineBuffer;
+use super::buffer::{ranked, ranks, SilhouetteLineBuffer};
 use super::line::TexelDepth;
 use crate::shadows::map::DepthMap;
 use crate::visibility::Workers;
@@ -60,15 +60,7 @@ impl Neighbourhood {
         for (w, &word) in steps.iter().enumerate() {
             set_bits(word).for_each(|b| mark(w * 64 + b));
         }
-        let mut total = 0u32;
-        let rank = busy
-            .iter()
-            .map(|w| {
-                let r = total;
-                total += w.count_ones();
-                r
-            })
-            .collect();
+        let rank = ranks(&busy);
         // A texel's own nearest surface: the map's, or over an edge texel
         // every line's and layer's plane at the texel's corners.
         let own = |x: usize, y: usize| {
@@ -106,12 +98,7 @@ impl Neighbourhood {
     #[inline]
     #[must_use]
     pub fn nearest(&self, t: usize) -> f32 {
-        let Some(&word) = self.busy.get(t / 64) else { return f32::INFINITY };
-        if word >> (t % 64) & 1 == 0 {
-            return f32::INFINITY;
-        }
-        let below = (word & ((1u64 << (t % 64)) - 1)).count_ones();
-        self.nearest[(self.rank[t / 64] + below) as usize]
+        ranked(&self.busy, &self.rank, t).map_or(f32::INFINITY, |i| self.nearest[i])
     }
 
     /// Bytes held.
