@@ -377,7 +377,7 @@ fn truth(scene: &Scene, side: u32, rays: u32) -> Result<Vec<Option<f32>>> {
     // there a mesh's shading normal and its facets disagree on what the
     // light reaches, for every method alike.
     let surfaces = kage::shading::screen_surfaces(&base, &frame.visibility);
-    for (t, s) in truth.iter_mut().zip(&surfaces.surfaces) {
+    for (t, s) in truth.iter_mut().zip(&surfaces.all()) {
         if s.is_some_and(|s| s.normal.dot(base.lights[key].incident(s.position).to_light) <= 0.1) {
             *t = None;
         }

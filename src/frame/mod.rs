@@ -215,7 +215,7 @@ impl Frame {
     #[must_use]
     pub fn normals(&self, scene: &Scene) -> Vec<Vec3> {
         let surfaces = crate::shading::screen_surfaces(scene, &self.visibility);
-        surfaces.surfaces.iter().map(|s| s.map_or(Vec3::ZERO, |s| s.normal)).collect()
+        surfaces.all().iter().map(|s| s.map_or(Vec3::ZERO, |s| s.normal)).collect()
     }
 }
 

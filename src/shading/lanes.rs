@@ -323,6 +323,42 @@ pub fn shade_run(
     }
 }
 
+/// The position and unit normal (facing the eye) that each of `count` pixels
+/// from column `x0` of the row `rays` describes sees on `tri`, eight at a
+/// time, as [`shade_run`] finds them: `at(i, position, normal)` for pixel
+/// `x0 + i`.
+pub fn run_surfaces(
+    tri: &PreparedTriangle,
+    rays: &RowRays,
+    x0: usize,
+    count: usize,
+    mut at: impl FnMut(usize, Vec3, Vec3),
+) {
+    let g = tri.geometry();
+    let inputs = LaneInputs {
+        a: V3::splat(g.a),
+        e1: V3::splat(g.e1),
+        e2: V3::splat(g.e2),
+        n: g.normals.map(V3::splat),
+        geometric: V3::splat(g.geometric),
+        ka: V3::splat(Vec3::ZERO),
+        kd: V3::splat(Vec3::ZERO),
+        ks: V3::splat(Vec3::ZERO),
+        ke: V3::splat(Vec3::ZERO),
+        shininess: F::ONE,
+        whole: None,
+        exponents: [0; LANES],
+        object: [tri.item.object; LANES],
+    };
+    let row = TriangleRow::new(&g, &rays.line(x0));
+    for k0 in (0..count).step_by(LANES) {
+        let s = row.surface(&inputs, k0);
+        for i in 0..LANES.min(count - k0) {
+            at(k0 + i, s.p.lane(i), s.n.lane(i));
+        }
+    }
+}
+
 /// One triangle and material per lane, in vector registers.
 #[derive(Debug, Clone, Copy)]
 struct LaneInputs {

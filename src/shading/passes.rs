@@ -99,7 +99,7 @@ pub(crate) struct ShadowFrame<'a> {
     scene: &'a Scene,
     vb: &'a VisibilityBuffer,
     bounds: (Vec3, Vec3),
-    surfaces: Option<ScreenSurfaces>,
+    surfaces: Option<ScreenSurfaces<'a>>,
 }
 
 impl<'a> ShadowFrame<'a> {
@@ -109,7 +109,7 @@ impl<'a> ShadowFrame<'a> {
     }
 
     /// The surface each pixel shows (found on the first call).
-    pub(crate) fn surfaces(&mut self) -> &ScreenSurfaces {
+    pub(crate) fn surfaces(&mut self) -> &ScreenSurfaces<'a> {
         let (scene, vb) = (self.scene, self.vb);
         self.surfaces.get_or_insert_with(|| screen_surfaces(scene, vb))
     }

@@ -31,19 +31,23 @@ pub fn shadow_term_images(scene: &Scene, vb: &VisibilityBuffer, pool: &mut MapPo
             pool.with_term(scene, sample, bounds, |term| {
                 frame.ready(&light, term);
                 let surfaces = frame.surfaces();
-                image.pixels_mut().par_iter_mut().zip(&surfaces.surfaces).for_each(|(px, surface)| {
-                    let lit = match surface {
-                        None => 1.0,
-                        Some(s) => {
-                            let cos_theta = s.normal.dot(light.light.incident(s.position).to_light);
-                            if cos_theta > 0.0 {
-                                term.lit(s.position, cos_theta, &s.receiver)
-                            } else {
-                                0.0
+                let rows = image.pixels_mut().par_chunks_mut(w.max(1) as usize).enumerate();
+                rows.for_each_init(Vec::new, |seen, (y, row)| {
+                    surfaces.rows(y..y + 1, seen);
+                    for (px, surface) in row.iter_mut().zip(seen.iter()) {
+                        let lit = match surface {
+                            None => 1.0,
+                            Some(s) => {
+                                let cos_theta = s.normal.dot(light.light.incident(s.position).to_light);
+                                if cos_theta > 0.0 {
+                                    term.lit(s.position, cos_theta, &s.receiver)
+                                } else {
+                                    0.0
+                                }
                             }
-                        }
-                    };
-                    *px += Vec3::splat(lit * weight);
+                        };
+                        *px += Vec3::splat(lit * weight);
+                    }
                 });
             });
         }

@@ -8,14 +8,14 @@
 //! as the plane tangent to the solid there ([`ObjectFrames::tangent`]), so every
 //! shading path built for triangles shades solids unchanged.
 
+use std::ops::Range;
+
 use glam::{Affine3A, Mat3A, Vec2, Vec3};
 
-use rayon::prelude::*;
-
 use crate::scene::Scene;
-use crate::shadows::{Receiver, ScreenSurfaces, VisibleSurface};
+use crate::shadows::{Receiver, ScreenSurfaces, SurfaceRows, VisibleSurface};
 
-use crate::camera::Ray;
+use crate::camera::{PixelRays, Ray};
 use crate::visibility::{ItemId, VisibilityBuffer};
 
 /// What shading needs to know about the visible point of a pixel.
@@ -207,6 +207,34 @@ impl PreparedTriangle {
         self.uv_at([1.0 - b.x - b.y, b.x, b.y])
     }
 
+    /// Where `ray` meets the triangle's plane: the distance along it and the
+    /// barycentric weights there.
+    #[inline]
+    fn hit(&self, ray: &Ray) -> (f32, [f32; 3]) {
+        let (t, b) = intersect_plane(ray, self.a, self.e1, self.e2);
+        (t, [1.0 - b.x - b.y, b.x, b.y])
+    }
+
+    /// The unit shading normal at barycentric weights `w`, turned towards
+    /// `to_eye`.
+    #[inline]
+    fn normal_at(&self, w: [f32; 3], to_eye: Vec3) -> Vec3 {
+        let n = self.normals[0] * w[0] + self.normals[1] * w[1] + self.normals[2] * w[2];
+        let n = n.normalize_or(self.geometric);
+        if n.dot(to_eye) < 0.0 {
+            -n
+        } else {
+            n
+        }
+    }
+
+    /// [`PreparedTriangle::surface`]'s position and normal alone.
+    #[must_use]
+    pub fn position_normal(&self, ray: &Ray) -> (Vec3, Vec3) {
+        let (t, w) = self.hit(ray);
+        (ray.origin + ray.dir * t, self.normal_at(w, -ray.dir))
+    }
+
     /// The texture coordinates at barycentric weights `w` (zero without them).
     fn uv_at(&self, w: [f32; 3]) -> Vec2 {
         self.uvs.map_or(Vec2::ZERO, |u| u[0] * w[0] + u[1] * w[1] + u[2] * w[2])
@@ -215,12 +243,9 @@ impl PreparedTriangle {
     /// The surface point where `ray` meets the triangle's plane.
     #[must_use]
     pub fn surface(&self, ray: &Ray) -> SurfacePoint {
-        let (t, b) = intersect_plane(ray, self.a, self.e1, self.e2);
-        let w = [1.0 - b.x - b.y, b.x, b.y];
-        let n = self.normals[0] * w[0] + self.normals[1] * w[1] + self.normals[2] * w[2];
-        let n = n.normalize_or(self.geometric);
+        let (t, w) = self.hit(ray);
         let to_eye = -ray.dir;
-        let normal = if n.dot(to_eye) < 0.0 { -n } else { n };
+        let normal = self.normal_at(w, to_eye);
         let uv = self.uv_at(w);
         let front = self.geometric.dot(to_eye) >= 0.0;
         SurfacePoint {
@@ -273,36 +298,58 @@ pub fn intersect_plane(ray: &Ray, a: Vec3, e1: Vec3, e2: Vec3) -> (f32, Vec2) {
 /// The surface each pixel of `vb` shows (at the pixel's centre: position,
 /// shading normal, and its object and triangle plane as a shadow's
 /// receiver), seen through `scene`'s camera: what a per-pixel shadow term is
-/// computed from.
+/// computed from, found a band of rows at a time as the term asks.
 #[must_use]
-pub fn screen_surfaces(scene: &Scene, vb: &VisibilityBuffer) -> ScreenSurfaces {
-    let w = vb.width() as usize;
-    let frames = ObjectFrames::new(scene);
+pub fn screen_surfaces<'a>(scene: &'a Scene, vb: &'a VisibilityBuffer) -> ScreenSurfaces<'a> {
     let rays = scene.camera.pixel_rays(Vec2::new(vb.width() as f32, vb.height() as f32));
-    let mut surfaces = Vec::new();
-    // A mesh triangle is prepared once for the run of pixels showing it (a
-    // solid's tangent plane is each pixel's own), kept in place; the
-    // surfaces are written in place, in parallel.
-    (0..w * vb.height() as usize)
-        .into_par_iter()
-        .map_init(
-            || None::<PreparedTriangle>,
-            |last, i| {
-                let (x, y) = ((i % w) as u32, (i / w) as u32);
-                let item = vb.item(x, y);
+    let source = PixelSurfaces { scene, vb, frames: ObjectFrames::new(scene), rays };
+    ScreenSurfaces::new(scene.camera, vb.width(), vb.height(), Box::new(source))
+}
+
+/// What [`screen_surfaces`] finds the surfaces from.
+struct PixelSurfaces<'a> {
+    scene: &'a Scene,
+    vb: &'a VisibilityBuffer,
+    frames: ObjectFrames,
+    rays: PixelRays,
+}
+
+impl SurfaceRows for PixelSurfaces<'_> {
+    fn fill(&self, rows: Range<usize>, out: &mut Vec<Option<VisibleSurface>>) {
+        let (scene, vb) = (self.scene, self.vb);
+        let w = vb.width() as usize;
+        out.clear();
+        out.resize(rows.len() * w, None);
+        // A mesh triangle is prepared once for the pixels of the band that
+        // show it (a solid's tangent plane is each pixel's own).
+        let mut cache = super::TriangleCache::new(64);
+        for (y, row) in rows.zip(out.chunks_mut(w.max(1))) {
+            let items = &vb.items()[y * w..(y + 1) * w];
+            let line = super::lanes::RowRays::new(&self.rays, y);
+            let mut x = 0;
+            while x < w {
+                let item = items[x];
                 if item.is_none() {
-                    return None;
+                    x += 1;
+                    continue;
                 }
-                let ray = rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
-                if item.primitive().is_some() || last.as_ref().is_none_or(|t| t.item != item) {
-                    *last = Some(frames.prepare_at(scene, vb, x, y, &ray));
+                let (receiver, end) = (|plane| Receiver { object: item.object, plane }, super::run_end(items, x));
+                if item.primitive().is_some() {
+                    // A solid: each pixel's own tangent plane.
+                    let ray = self.rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
+                    let tangent = self.frames.prepare_at(scene, vb, x as u32, y as u32, &ray);
+                    let (position, normal) = tangent.position_normal(&ray);
+                    row[x] = Some(VisibleSurface { position, normal, receiver: receiver(tangent.geometric) });
+                    x += 1;
+                    continue;
                 }
-                let triangle = last.as_ref().expect("prepared above");
-                let s = triangle.surface(&ray);
-                let receiver = Receiver { object: item.object, plane: triangle.geometric };
-                Some(VisibleSurface { position: s.position, normal: s.normal, receiver })
-            },
-        )
-        .collect_into_vec(&mut surfaces);
-    ScreenSurfaces::new(scene.camera, vb.width(), vb.height(), surfaces)
+                let triangle = cache.get(scene, &self.frames, item);
+                let plane = triangle.geometric;
+                super::lanes::run_surfaces(triangle, &line, x, end - x, |i, position, normal| {
+                    row[x + i] = Some(VisibleSurface { position, normal, receiver: receiver(plane) });
+                });
+                x = end;
+            }
+        }
+    }
 }

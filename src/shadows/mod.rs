@@ -22,7 +22,7 @@ use wide::f32x8;
 pub use footprint::{PixelView, Receiver, ReceiverLanes, UNKNOWN_RECEIVER};
 pub use map::{DepthMap, Located, LocatedLanes};
 pub use pcss::PcssLight;
-pub use screen::{ScreenSurfaces, ScreenTerm, VisibleSurface};
+pub use screen::{ScreenSurfaces, ScreenTerm, SurfaceRows, VisibleSurface};
 pub use slb::SlbMap;
 pub use soft::TwoMaps;
 

@@ -7,8 +7,10 @@
 //! reflection's, one behind a silhouette) is not in the buffer and the term
 //! that owns the buffer answers for it on its own.
 
+use std::ops::Range;
+
 use glam::{Mat4, Vec2, Vec3};
-use rayon::prelude::*;
+use wide::f32x8;
 
 use super::Receiver;
 use crate::camera::{Camera, Projection};
@@ -24,24 +26,27 @@ pub struct VisibleSurface {
     pub receiver: Receiver,
 }
 
-/// The surfaces every pixel of a frame shows, row by row, the camera they
-/// are seen through, and where neighbouring pixels' surfaces lie apart.
-#[derive(Debug, Clone)]
-pub struct ScreenSurfaces {
+/// Finds the surfaces a frame's pixels show, a band of rows at a time: what
+/// a per-pixel term is computed from. Implemented by the shading stage,
+/// which knows the frame's visibility buffer and the scene's geometry.
+pub trait SurfaceRows: Sync {
+    /// Fills `out` (cleared first) with the surfaces of the frame's rows
+    /// `rows`, row by row, one entry per pixel; `None` where no object is
+    /// seen.
+    fn fill(&self, rows: Range<usize>, out: &mut Vec<Option<VisibleSurface>>);
+}
+
+/// The surfaces a frame's pixels show — found on demand, a band of rows at a
+/// time ([`ScreenSurfaces::rows`]), so that no whole-frame copy of them is
+/// kept — and the camera they are seen through.
+pub struct ScreenSurfaces<'a> {
     /// The frame's camera.
     pub camera: Camera,
     /// Pixels across.
     pub width: u32,
     /// Pixels down.
     pub height: u32,
-    /// One per pixel; `None` where no object is seen.
-    pub surfaces: Vec<Option<VisibleSurface>>,
-    /// Per pixel: bit 0 set where it lies apart from the pixel right of it,
-    /// bit 1 from the one below ([`ScreenSurfaces::lie_apart`]).
-    cuts: Vec<u8>,
-    /// Per pixel: the world size of its footprint on its surface (0 where
-    /// none is seen).
-    footprints: Vec<f32>,
+    source: Box<dyn SurfaceRows + 'a>,
     /// A pixel's world size per unit distance along the view (perspective)
     /// or absolute (orthographic).
     pixel_scale: f32,
@@ -49,66 +54,38 @@ pub struct ScreenSurfaces {
     forward: Vec3,
 }
 
-impl ScreenSurfaces {
-    /// The `width` × `height` pixels' `surfaces` seen through `camera`.
-    ///
-    /// # Panics
-    ///
-    /// If `surfaces` does not hold one entry per pixel.
+impl std::fmt::Debug for ScreenSurfaces<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ScreenSurfaces").field("width", &self.width).field("height", &self.height).finish()
+    }
+}
+
+impl<'a> ScreenSurfaces<'a> {
+    /// The `width` × `height` pixels seen through `camera`, their surfaces
+    /// found by `source`.
     #[must_use]
-    pub fn new(camera: Camera, width: u32, height: u32, surfaces: Vec<Option<VisibleSurface>>) -> ScreenSurfaces {
-        assert_eq!(surfaces.len(), width as usize * height as usize, "one surface per pixel");
+    pub fn new(camera: Camera, width: u32, height: u32, source: Box<dyn SurfaceRows + 'a>) -> ScreenSurfaces<'a> {
         let pixel_scale = match camera.projection {
             Projection::Perspective { fov_y_deg } => 2.0 * (fov_y_deg.to_radians() * 0.5).tan(),
             Projection::Orthographic { height } => height,
         } / height.max(1) as f32;
         let forward = (camera.target - camera.eye).normalize_or(Vec3::NEG_Z);
-        let mut s = ScreenSurfaces {
-            camera,
-            width,
-            height,
-            surfaces,
-            cuts: Vec::new(),
-            footprints: Vec::new(),
-            pixel_scale,
-            forward,
-        };
-        let footprints: Vec<f32> = s.surfaces.par_iter().map(|v| v.as_ref().map_or(0.0, |v| s.footprint(v))).collect();
-        s.footprints = footprints;
-        let w = width as usize;
-        let cuts: Vec<u8> = (0..s.surfaces.len())
-            .into_par_iter()
-            .map(|i| {
-                let (x, y) = (i % w, i / w);
-                let right = x + 1 < w && s.lie_apart((x, y), (x + 1, y));
-                let down = y + 1 < height as usize && s.lie_apart((x, y), (x, y + 1));
-                u8::from(right) | u8::from(down) << 1
-            })
-            .collect();
-        s.cuts = cuts;
-        s
+        ScreenSurfaces { camera, width, height, source, pixel_scale, forward }
     }
 
-    /// Whether pixel `a` and its neighbour `b` (right of it or below it)
-    /// show surfaces that lie apart (found once, at [`ScreenSurfaces::new`]).
-    #[inline]
-    #[must_use]
-    pub fn apart(&self, a: (usize, usize), b: (usize, usize)) -> bool {
-        let bit = if b.1 > a.1 { 2 } else { 1 };
-        self.cuts[a.1 * self.width as usize + a.0] & bit != 0
+    /// The surfaces of rows `rows` (clamped to the frame), row by row, into
+    /// `out`.
+    pub fn rows(&self, rows: Range<usize>, out: &mut Vec<Option<VisibleSurface>>) {
+        let rows = rows.start.min(self.height as usize)..rows.end.min(self.height as usize);
+        self.source.fill(rows, out);
     }
 
-    /// The surface pixel `(x, y)` shows.
+    /// The surfaces of every pixel, row by row.
     #[must_use]
-    pub fn at(&self, x: usize, y: usize) -> Option<&VisibleSurface> {
-        self.surfaces[y * self.width as usize + x].as_ref()
-    }
-
-    /// The world size of pixel `i`'s footprint on its surface (row by row;
-    /// 0 where no object is seen).
-    #[must_use]
-    pub fn footprint_at(&self, i: usize) -> f32 {
-        self.footprints[i]
+    pub fn all(&self) -> Vec<Option<VisibleSurface>> {
+        let mut out = Vec::new();
+        self.rows(0..self.height as usize, &mut out);
+        out
     }
 
     /// The world size of one pixel's footprint on `v`'s surface: a pixel
@@ -122,6 +99,29 @@ impl ScreenSurfaces {
         self.pixel_size(v.position) / v.normal.dot(to_eye).abs().max(0.2)
     }
 
+    /// [`ScreenSurfaces::footprint`] and [`ScreenSurfaces::distance`] of
+    /// eight surfaces at once: their points `p` and unit normals `n` (x, y,
+    /// z lanes).
+    #[must_use]
+    pub fn footprint_lanes(&self, p: [f32x8; 3], n: [f32x8; 3]) -> (f32x8, f32x8) {
+        let c = &self.camera;
+        let (eye, forward) = ([c.eye.x, c.eye.y, c.eye.z].map(f32x8::splat), self.forward);
+        let d = [p[0] - eye[0], p[1] - eye[1], p[2] - eye[2]];
+        let along = d[0] * forward.x + d[1] * forward.y + d[2] * forward.z;
+        let (size, facing, distance) = match c.projection {
+            Projection::Perspective { .. } => {
+                let length = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+                let facing = (n[0] * d[0] + n[1] * d[1] + n[2] * d[2]) / length.max(f32x8::splat(f32::MIN_POSITIVE));
+                (along.max(f32x8::splat(c.near)) * f32x8::splat(self.pixel_scale), facing, length)
+            }
+            Projection::Orthographic { .. } => {
+                let facing = n[0] * forward.x + n[1] * forward.y + n[2] * forward.z;
+                (f32x8::splat(self.pixel_scale), facing, along)
+            }
+        };
+        (size / facing.abs().max(f32x8::splat(0.2)), distance)
+    }
+
     /// The world size of one pixel at point `p`, across the view.
     #[must_use]
     pub fn pixel_size(&self, p: Vec3) -> f32 {
@@ -133,20 +133,55 @@ impl ScreenSurfaces {
         }
     }
 
-    /// Whether the surfaces of neighbouring pixels `a` and `b` lie apart: one
-    /// shows an object and the other none, or their points are further
-    /// apart than four pixel footprints on the surface with the larger one
-    /// (a depth discontinuity of the eye's view, not a crease).
-    fn lie_apart(&self, a: (usize, usize), b: (usize, usize)) -> bool {
-        match (self.at(a.0, a.1), self.at(b.0, b.1)) {
+    /// How far from the eye `p` lies: from the eye itself (perspective) or
+    /// along the view axis (orthographic), as [`ScreenTerm::at`] measures.
+    #[must_use]
+    pub fn distance(&self, p: Vec3) -> f32 {
+        match self.camera.projection {
+            Projection::Perspective { .. } => (p - self.camera.eye).length(),
+            Projection::Orthographic { .. } => (p - self.camera.eye).dot(self.forward),
+        }
+    }
+
+    /// Whether neighbouring pixels' surfaces `a` and `b` (their footprints
+    /// `fa`, `fb`) lie apart: one shows an object and the other none, or
+    /// their points are further apart than four pixel footprints on the
+    /// surface with the larger one (a depth discontinuity of the eye's view,
+    /// not a crease).
+    #[must_use]
+    pub fn lie_apart(a: Option<&VisibleSurface>, fa: f32, b: Option<&VisibleSurface>, fb: f32) -> bool {
+        match (a, b) {
             (None, None) => false,
             (Some(_), None) | (None, Some(_)) => true,
             (Some(s), Some(t)) => {
-                let w = self.width as usize;
-                let most = self.footprints[a.1 * w + a.0].max(self.footprints[b.1 * w + b.0]);
+                let most = fa.max(fb);
                 (s.position - t.position).length_squared() > 16.0 * most * most
             }
         }
+    }
+
+    /// The per-pixel term `values` of these surfaces: `distances` from the
+    /// eye ([`ScreenSurfaces::distance`], NaN where no object is seen) and
+    /// `reach` (how far a point may lie from a pixel's surface point and
+    /// still be read there), one each per pixel, row by row.
+    ///
+    /// # Panics
+    ///
+    /// If the three do not hold one value per pixel.
+    #[must_use]
+    pub fn term(&self, distances: Vec<f32>, reach: Vec<f32>, values: Vec<f32>) -> ScreenTerm {
+        let (w, h) = (self.width as usize, self.height as usize);
+        assert!(
+            [distances.len(), reach.len(), values.len()].iter().all(|&n| n == w * h),
+            "one distance, reach and value per pixel"
+        );
+        let c = &self.camera;
+        let axis = match c.projection {
+            Projection::Perspective { .. } => None,
+            Projection::Orthographic { .. } => Some(self.forward),
+        };
+        let view_proj = c.view_projection(w as f32 / h.max(1) as f32);
+        ScreenTerm { view_proj, width: w, height: h, eye: c.eye, axis, distances, reach, values }
     }
 }
 
@@ -172,27 +207,6 @@ pub struct ScreenTerm {
 }
 
 impl ScreenTerm {
-    /// The term `values` (one per pixel of `surfaces`, row by row).
-    ///
-    /// # Panics
-    ///
-    /// If `values` does not hold one value per pixel.
-    #[must_use]
-    pub fn new(surfaces: &ScreenSurfaces, values: Vec<f32>) -> ScreenTerm {
-        assert_eq!(values.len(), surfaces.surfaces.len(), "one value per pixel");
-        let (w, h) = (surfaces.width as usize, surfaces.height as usize);
-        let c = &surfaces.camera;
-        let axis = match c.projection {
-            Projection::Perspective { .. } => None,
-            Projection::Orthographic { .. } => Some((c.target - c.eye).normalize_or(Vec3::NEG_Z)),
-        };
-        let distance = |p: Vec3| axis.map_or((p - c.eye).length(), |a| (p - c.eye).dot(a));
-        let distances = surfaces.surfaces.par_iter().map(|s| s.map_or(f32::NAN, |s| distance(s.position))).collect();
-        let reach = surfaces.footprints.par_iter().map(|f| 2.0 * f).collect();
-        let view_proj = surfaces.camera.view_projection(w as f32 / h.max(1) as f32);
-        ScreenTerm { view_proj, width: w, height: h, eye: c.eye, axis, distances, reach, values }
-    }
-
     /// The term per pixel, row by row.
     #[must_use]
     pub fn values(&self) -> &[f32] {

@@ -5,9 +5,11 @@
 //! Seed 001 finds, for each penumbra pixel, the screen distances to the
 //! nearest umbra pixel and the nearest lit pixel by searching around it
 //! (every N-th pixel, the rest interpolated). Two transforms give both
-//! distances for every pixel at once, exactly, in O(pixels): one pass down
-//! each column, then one along each row, each the lower envelope of the
-//! parabolas (x − q)² + f(q) rooted at the samples q.
+//! distances for every pixel at once, exactly, in O(pixels): first each
+//! pixel's distance to the nearest set pixel of its column (two sweeps over
+//! the rows, down and up, many columns at a time: [`Columns`]), then along
+//! each row the lower envelope of the parabolas (x − q)² + g(q)² rooted at
+//! the columns' distances g.
 //!
 //! The transform may be told where it must not carry a distance across
 //! (`apart`): between two neighbouring pixels of one row or column whose
@@ -50,34 +52,126 @@ pub fn squared_distances_apart(
     apart: impl Fn((usize, usize), (usize, usize)) -> bool + Sync,
 ) -> Vec<f32> {
     assert_eq!(mask.len(), width * height, "a mask of {width} × {height}");
-    if width == 0 || height == 0 {
-        return Vec::new();
-    }
-    // Down each column (transposed, so each column is one slice and the
-    // columns run in parallel): the squared distance to the nearest set
-    // pixel of the same column.
-    let mut columns = vec![UNREACHED; width * height];
-    columns.par_chunks_mut(height).enumerate().for_each_init(
-        || Envelope::with_capacity(height),
-        |scratch, (x, column)| {
-            column.iter_mut().enumerate().for_each(|(y, v)| *v = if mask[y * width + x] { 0.0 } else { UNREACHED });
-            scratch.transform_runs(column, |y| apart((x, y), (x, y + 1)));
-        },
-    );
-    // Along each row, over the columns' distances.
-    let mut rows = vec![UNREACHED; width * height];
-    rows.par_chunks_mut(width).enumerate().for_each_init(
+    let cuts = cuts_between(width, height, apart);
+    let columns = Columns::new(|i| mask[i], &cuts, width, height);
+    let mut out = vec![UNREACHED; width * height];
+    out.par_chunks_mut(width.max(1)).enumerate().for_each_init(
         || Envelope::with_capacity(width),
         |scratch, (y, row)| {
-            row.iter_mut().enumerate().for_each(|(x, v)| *v = columns[x * height + y]);
-            scratch.transform_runs(row, |x| apart((x, y), (x + 1, y)));
+            columns.squared_row(y, row);
+            scratch.transform_runs(row, |x| cuts[y * width + x] & CUT_RIGHT != 0);
         },
     );
-    rows
+    out
+}
+
+/// A pixel's cut bit: it lies apart from the pixel right of it.
+pub const CUT_RIGHT: u8 = 1;
+/// A pixel's cut bit: it lies apart from the pixel below it.
+pub const CUT_DOWN: u8 = 2;
+
+/// A pixel's cut bits: apart from the pixel `right` of it, from the one
+/// `below` it.
+#[must_use]
+pub fn cut_bits(right: bool, below: bool) -> u8 {
+    (u8::from(right) * CUT_RIGHT) | (u8::from(below) * CUT_DOWN)
+}
+
+/// Each pixel's cut bits ([`CUT_RIGHT`], [`CUT_DOWN`]) of a `width` ×
+/// `height` image, as `apart` says of it and its neighbours.
+#[must_use]
+pub fn cuts_between(
+    width: usize,
+    height: usize,
+    apart: impl Fn((usize, usize), (usize, usize)) -> bool + Sync,
+) -> Vec<u8> {
+    let mut cuts = vec![0u8; width * height];
+    cuts.par_chunks_mut(width.max(1)).enumerate().for_each(|(y, row)| {
+        for (x, c) in row.iter_mut().enumerate() {
+            let right = x + 1 < width && apart((x, y), (x + 1, y));
+            let down = y + 1 < height && apart((x, y), (x, y + 1));
+            *c = cut_bits(right, down);
+        }
+    });
+    cuts
+}
+
+/// Columns swept together: a strip's distances lie together in memory, so
+/// that the sweeps down and up the image read whole cache lines.
+const STRIP: usize = 64;
+
+/// Distance in pixels no set pixel reaches along a column.
+const FAR: u16 = u16::MAX;
+
+/// The first pass of the transform: for every pixel, the distance down or
+/// up its column to the nearest set pixel that no cut ([`CUT_DOWN`])
+/// separates from it — two sweeps along the image's rows, top to bottom and
+/// back, many columns at once, instead of one column at a time across the
+/// rows (which reads one value per cache line).
+pub struct Columns {
+    width: usize,
+    height: usize,
+    /// Strip by strip ([`STRIP`] columns), row by row within a strip.
+    distances: Vec<u16>,
+}
+
+impl Columns {
+    /// The column distances of the pixels `set` says are set (by index, row
+    /// by row) in a `width` × `height` image with `cuts`.
+    ///
+    /// # Panics
+    ///
+    /// If `cuts` does not hold `width` × `height` values.
+    #[must_use]
+    pub fn new(set: impl Fn(usize) -> bool + Sync, cuts: &[u8], width: usize, height: usize) -> Columns {
+        assert_eq!(cuts.len(), width * height, "cuts of {width} × {height}");
+        let mut distances = vec![FAR; width.div_ceil(STRIP) * STRIP * height];
+        distances.par_chunks_mut((STRIP * height).max(1)).enumerate().for_each(|(strip, d)| {
+            let (x0, x1) = (strip * STRIP, (strip * STRIP + STRIP).min(width));
+            for y in 0..height {
+                for x in x0..x1 {
+                    let (i, k) = (y * width + x, y * STRIP + x - x0);
+                    d[k] = if set(i) {
+                        0
+                    } else if y > 0 && cuts[i - width] & CUT_DOWN == 0 {
+                        d[k - STRIP].saturating_add(1)
+                    } else {
+                        FAR
+                    };
+                }
+            }
+            for y in (0..height.saturating_sub(1)).rev() {
+                for x in x0..x1 {
+                    let (i, k) = (y * width + x, y * STRIP + x - x0);
+                    if cuts[i] & CUT_DOWN == 0 {
+                        d[k] = d[k].min(d[k + STRIP].saturating_add(1));
+                    }
+                }
+            }
+        });
+        Columns { width, height, distances }
+    }
+
+    /// Row `y`'s squared column distances into `out` ([`UNREACHED`] where
+    /// none is set).
+    ///
+    /// # Panics
+    ///
+    /// If `out` is not one row long or `y` is past the last row.
+    pub fn squared_row(&self, y: usize, out: &mut [f32]) {
+        assert!(out.len() == self.width && y < self.height, "a row of {}", self.width);
+        for (strip, chunk) in out.chunks_mut(STRIP).enumerate() {
+            let at = (strip * self.height + y) * STRIP;
+            let len = chunk.len();
+            for (o, &d) in chunk.iter_mut().zip(&self.distances[at..at + len]) {
+                *o = if d == FAR { UNREACHED } else { f32::from(d) * f32::from(d) };
+            }
+        }
+    }
 }
 
 /// The lower envelope's working arrays, kept from line to line.
-struct Envelope {
+pub struct Envelope {
     /// The roots of the parabolas on the envelope.
     roots: Vec<usize>,
     /// Where each one starts to be the lowest (and one past the last).
@@ -87,13 +181,15 @@ struct Envelope {
 }
 
 impl Envelope {
-    fn with_capacity(n: usize) -> Envelope {
+    /// Working arrays for lines of up to `n` values.
+    #[must_use]
+    pub fn with_capacity(n: usize) -> Envelope {
         Envelope { roots: Vec::with_capacity(n), starts: Vec::with_capacity(n + 1), f: Vec::with_capacity(n) }
     }
 
     /// Transforms `line` in place, run by run: a run ends after index `i`
     /// where `cut(i)` says so.
-    fn transform_runs(&mut self, line: &mut [f32], cut: impl Fn(usize) -> bool) {
+    pub fn transform_runs(&mut self, line: &mut [f32], cut: impl Fn(usize) -> bool) {
         let mut start = 0;
         for i in 0..line.len() {
             if i + 1 == line.len() || cut(i) {
@@ -189,6 +285,39 @@ mod tests {
                 mask.iter_mut().enumerate().for_each(|(i, m)| *m = i % w == (i / w) % w);
             }
             assert_eq!(squared_distances(&mask, w, h), brute_force(&mask, w), "case {case}: {w} × {h}");
+        }
+    }
+
+    /// With random cuts, every squared distance is the brute-force nearest
+    /// set pixel among those reached by a path down (or up) a column and
+    /// then along a row that crosses no cut.
+    #[test]
+    fn random_cuts_keep_distances_to_uncut_paths() {
+        let mut rng = rand::rngs::StdRng::seed_from_u64(5);
+        for case in 0..150 {
+            let (w, h) = (rng.gen_range(1..90), rng.gen_range(1..40));
+            let mask: Vec<bool> = (0..w * h).map(|_| rng.gen_bool([0.01, 0.05, 0.3][case % 3])).collect();
+            let cuts: Vec<u8> = (0..w * h).map(|_| rng.gen_range(0..4u8) * u8::from(rng.gen_bool(0.2))).collect();
+            let apart = |a: (usize, usize), b: (usize, usize)| {
+                let bit = if b.1 > a.1 { CUT_DOWN } else { CUT_RIGHT };
+                cuts[a.1 * w + a.0] & bit != 0
+            };
+            // Whether the column `x` from row `a` to row `b` crosses no cut, and
+            // the same along row `y` from column `a` to `b`.
+            let column_open = |x: usize, a: usize, b: usize| (a.min(b)..a.max(b)).all(|y| !apart((x, y), (x, y + 1)));
+            let row_open = |y: usize, a: usize, b: usize| (a.min(b)..a.max(b)).all(|x| !apart((x, y), (x + 1, y)));
+            let got = squared_distances_apart(&mask, w, h, apart);
+            for y in 0..h {
+                for x in 0..w {
+                    let want = (0..w * h)
+                        .filter(|&i| mask[i])
+                        .map(|i| (i % w, i / w))
+                        .filter(|&(q, r)| column_open(q, r, y) && row_open(y, q, x))
+                        .map(|(q, r)| ((q as i64 - x as i64).pow(2) + (r as i64 - y as i64).pow(2)) as f32)
+                        .fold(UNREACHED, f32::min);
+                    assert_eq!(got[y * w + x], want, "case {case}: ({x}, {y}) of {w} × {h}");
+                }
+            }
         }
     }
 

@@ -72,11 +72,16 @@ use wide::f32x8;
 use super::screen::{ScreenSurfaces, ScreenTerm, VisibleSurface};
 use super::{PixelView, Receiver, ReceiverLanes, ShadowTerm, UNKNOWN_RECEIVER};
 use crate::scene::{Light, LightKind, PenumbraFalloff, PenumbraPoints, ShadowSettings};
-use penumbra::{visibility_exact, visibility_searched, Zone};
+use penumbra::{visibility_across_cuts, visibility_searched, Zone};
 
 /// Farthest the paper's search looks for an umbra or lit pixel, in pixels: a
 /// penumbra pixel that finds neither within it is half lit.
 pub const SEARCH_REACH: usize = 128;
+
+/// Rows of the frame one worker classifies at a time: enough that the
+/// triangles a band's pixels show are prepared once for many of them, few
+/// enough that a band's surfaces stay in the worker's cache.
+const BAND: usize = 16;
 
 /// A light's soft shadow from two (or more) hard shadows.
 #[derive(Debug, Clone)]
@@ -162,60 +167,117 @@ impl TwoMaps {
 
     /// Computes the term at every pixel of `surfaces` (seed 001 §3.2–3.3):
     /// the zones from the two hard shadows, then visibility from the
-    /// distances, shaped by the falloff.
+    /// distances, shaped by the falloff. The frame is taken [`BAND`] rows at
+    /// a time, each band's surfaces found, classified and let go on one
+    /// worker: only a byte of zone, a byte of cuts and the count of points
+    /// reaching each pixel are kept for the distances.
     pub fn prepare(&mut self, surfaces: &ScreenSurfaces) {
         let (w, h) = (surfaces.width as usize, surfaces.height as usize);
-        let (zones, shares): (Vec<Zone>, Vec<f32>) =
-            surfaces.surfaces.par_chunks(8).flat_map_iter(|eight| self.zones(eight)).unzip();
-        let s = &self.settings;
-        let unreached = |i: usize| shares[i];
-        let mut v = match s.search {
-            0 if s.depth_aware => visibility_exact(&zones, w, h, |a, b| surfaces.apart(a, b), unreached),
-            0 => visibility_exact(&zones, w, h, |_, _| false, unreached),
+        let n = w * h;
+        let (mut zones, mut reached, mut cuts) = (vec![Zone::Lit; n], vec![0u8; n], vec![0u8; n]);
+        let (mut distances, mut reach) = (vec![f32::NAN; n], vec![0.0f32; n]);
+        let band = BAND * w.max(1);
+        let bands = zones
+            .par_chunks_mut(band)
+            .zip(reached.par_chunks_mut(band))
+            .zip(cuts.par_chunks_mut(band))
+            .zip(distances.par_chunks_mut(band).zip(reach.par_chunks_mut(band)));
+        let depth_aware = self.settings.depth_aware && self.settings.search == 0;
+        bands.enumerate().for_each_init(
+            || (Vec::new(), Vec::new()),
+            |(seen, footprints), (b, (((zones, reached), cuts), (distances, reach)))| {
+                let rows = zones.len() / w;
+                // One row more than the band: its last row's cuts look below.
+                // One row more than the band: its last row's cuts look below.
+                surfaces.rows(b * BAND..b * BAND + rows + 1, seen);
+                let inside = rows * w;
+                footprints.clear();
+                footprints.resize(seen.len(), 0.0);
+                let eights = seen[..inside].chunks(8).zip(zones.chunks_mut(8).zip(reached.chunks_mut(8)));
+                for (k, (eight, (zones, reached))) in eights.enumerate() {
+                    let lanes = Lanes::of(eight);
+                    self.classify(&lanes, zones, reached);
+                    let (footprint, distance) = surfaces.footprint_lanes(lanes.p, lanes.normal);
+                    let (footprint, distance) = (footprint.to_array(), distance.to_array());
+                    for (i, s) in eight.iter().enumerate() {
+                        let at = k * 8 + i;
+                        (footprints[at], distances[at]) =
+                            if s.is_some() { (footprint[i], distance[i]) } else { (0.0, f32::NAN) };
+                        reach[at] = 2.0 * footprints[at];
+                    }
+                }
+                for (f, s) in footprints[inside..].iter_mut().zip(&seen[inside..]) {
+                    *f = s.as_ref().map_or(0.0, |s| surfaces.footprint(s));
+                }
+                if depth_aware {
+                    let apart = |i: usize, j: usize| {
+                        j < seen.len()
+                            && ScreenSurfaces::lie_apart(
+                                seen[i].as_ref(),
+                                footprints[i],
+                                seen[j].as_ref(),
+                                footprints[j],
+                            )
+                    };
+                    for (i, cut) in cuts.iter_mut().enumerate() {
+                        let right = (i + 1) % w != 0 && apart(i, i + 1);
+                        *cut = edt::cut_bits(right, apart(i, i + w));
+                    }
+                }
+            },
+        );
+        let all = self.hard.len().max(1) as f32;
+        let unreached = |i: usize| f32::from(reached[i]) / all;
+        let mut v = match self.settings.search {
+            0 => visibility_across_cuts(&zones, &cuts, w, h, unreached),
             n => visibility_searched(&zones, w, h, n as usize, SEARCH_REACH, unreached),
         };
-        if s.penumbra == PenumbraFalloff::Smooth {
+        if self.settings.penumbra == PenumbraFalloff::Smooth {
             v.par_iter_mut().for_each(|v| *v = disc_share(*v));
         }
-        self.screen = Some(ScreenTerm::new(surfaces, v));
+        self.screen = Some(surfaces.term(distances, reach, v));
     }
 
-    /// The zones of up to eight pixels showing `surfaces`, each with the
-    /// share of the points that reach it: umbra where a surface faces away
-    /// from the light's centre, else by the hard shadows (looked up eight at
-    /// a time); lit where nothing is seen.
-    fn zones(&self, surfaces: &[Option<VisibleSurface>]) -> Vec<(Zone, f32)> {
-        let lane = |i: usize| surfaces.get(i).copied().flatten();
-        let facing = |s: &VisibleSurface, at: Vec3| s.normal.dot((at - s.position).normalize_or(Vec3::ZERO));
-        let of =
-            |f: &dyn Fn(&VisibleSurface) -> f32| f32x8::new(std::array::from_fn(|i| lane(i).map_or(0.0, |s| f(&s))));
-        let p = [of(&|s| s.position.x), of(&|s| s.position.y), of(&|s| s.position.z)];
-        let receivers = ReceiverLanes {
-            objects: std::array::from_fn(|i| lane(i).map_or(UNKNOWN_RECEIVER, |s| s.receiver.object)),
-            planes: [of(&|s| s.receiver.plane.x), of(&|s| s.receiver.plane.y), of(&|s| s.receiver.plane.z)],
+    /// The zones of up to eight pixels showing `lanes`, and how many of
+    /// the points reach each: umbra where a surface faces away from the
+    /// light's centre, else by the hard shadows (looked up eight at a time);
+    /// lit where nothing is seen.
+    fn classify(&self, lanes: &Lanes, zones: &mut [Zone], reached: &mut [u8]) {
+        let all = self.hard.len() as u8;
+        if lanes.seen.iter().all(|&s| !s) {
+            zones.fill(Zone::Lit);
+            reached.fill(all);
+            return;
+        }
+        let (p, normal) = (lanes.p, lanes.normal);
+        // N·L towards `at`, eight at a time.
+        let facing = |at: Vec3| {
+            let to = [at.x, at.y, at.z].map(f32x8::splat);
+            let d = [to[0] - p[0], to[1] - p[1], to[2] - p[2]];
+            let length = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt().max(f32x8::splat(f32::MIN_POSITIVE));
+            (normal[0] * d[0] + normal[1] * d[1] + normal[2] * d[2]) / length
         };
-        let lit = |k: usize| {
-            let cos = of(&|s| facing(s, self.points[k]).max(1e-3));
-            self.hard[k].lit_lanes(p, cos, &receivers).to_array()
-        };
-        let mut reached = [0usize; 8];
-        for k in 0..self.hard.len() {
-            for (n, v) in reached.iter_mut().zip(lit(k)) {
-                *n += usize::from(v >= 0.5);
+        let mut count = [0u8; 8];
+        for (hard, &at) in self.hard.iter().zip(&self.points) {
+            let cos = facing(at).max(f32x8::splat(1e-3));
+            for (n, v) in count.iter_mut().zip(hard.lit_lanes(p, cos, &lanes.receivers).to_array()) {
+                *n += u8::from(v >= 0.5);
             }
         }
-        let all = self.hard.len();
-        (0..surfaces.len())
-            .map(|i| match lane(i) {
-                None => (Zone::Lit, 1.0),
-                Some(s) if facing(&s, self.centre) <= 0.0 => (Zone::Umbra, 0.0),
-                Some(_) => match reached[i] {
-                    0 => (Zone::Umbra, 0.0),
-                    n if n == all => (Zone::Lit, 1.0),
-                    n => (Zone::Penumbra, n as f32 / all as f32),
-                },
-            })
-            .collect()
+        let towards_centre = facing(self.centre).to_array();
+        for (i, (zone, reached)) in zones.iter_mut().zip(reached.iter_mut()).enumerate() {
+            (*zone, *reached) = if !lanes.seen[i] {
+                (Zone::Lit, all)
+            } else if towards_centre[i] <= 0.0 {
+                (Zone::Umbra, 0)
+            } else {
+                match count[i] {
+                    0 => (Zone::Umbra, 0),
+                    n if n == all => (Zone::Lit, all),
+                    n => (Zone::Penumbra, n),
+                }
+            };
+        }
     }
 
     /// The term at `p` on `receiver` with N·L = `cos_theta`: the prepared
@@ -241,6 +303,32 @@ impl TwoMaps {
     pub fn memory_bytes(&self) -> usize {
         self.hard.iter().map(ShadowTerm::memory_bytes).sum::<usize>()
             + self.screen.as_ref().map_or(0, ScreenTerm::memory_bytes)
+    }
+}
+
+/// Up to eight pixels' surfaces as lanes: points, normals, receivers, and
+/// which lanes show a surface (the others hold zeros).
+struct Lanes {
+    seen: [bool; 8],
+    p: [f32x8; 3],
+    normal: [f32x8; 3],
+    receivers: ReceiverLanes,
+}
+
+impl Lanes {
+    fn of(surfaces: &[Option<VisibleSurface>]) -> Lanes {
+        let (mut p, mut normal, mut planes) = ([[0.0f32; 8]; 3], [[0.0f32; 8]; 3], [[0.0f32; 8]; 3]);
+        let (mut objects, mut seen) = ([UNKNOWN_RECEIVER; 8], [false; 8]);
+        for (i, s) in surfaces.iter().take(8).enumerate() {
+            if let Some(s) = s {
+                for a in 0..3 {
+                    (p[a][i], normal[a][i], planes[a][i]) = (s.position[a], s.normal[a], s.receiver.plane[a]);
+                }
+                (objects[i], seen[i]) = (s.receiver.object, true);
+            }
+        }
+        let receivers = ReceiverLanes { objects, planes: planes.map(f32x8::new) };
+        Lanes { seen, p: p.map(f32x8::new), normal: normal.map(f32x8::new), receivers }
     }
 }
 

@@ -17,7 +17,9 @@
 //! shadows of a thin occluder need not overlap) or no lit pixel takes a value
 //! its caller gives: the share of the hard shadows' points that reach it.
 
-use super::edt::{squared_distances_apart, UNREACHED};
+use rayon::prelude::*;
+
+use super::edt::{cuts_between, Columns, Envelope, CUT_RIGHT, UNREACHED};
 
 /// What the two hard shadows say of a pixel.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -56,24 +58,58 @@ pub fn visibility_exact(
     width: usize,
     height: usize,
     apart: impl Fn((usize, usize), (usize, usize)) -> bool + Copy + Sync,
-    unreached: impl Fn(usize) -> f32,
+    unreached: impl Fn(usize) -> f32 + Sync,
 ) -> Vec<f32> {
-    let mask = |z: Zone| zones.iter().map(|&v| v == z).collect::<Vec<bool>>();
+    assert_eq!(zones.len(), width * height, "zones of {width} × {height}");
+    visibility_across_cuts(zones, &cuts_between(width, height, apart), width, height, unreached)
+}
+
+/// [`visibility_exact`] with the places distances are not carried across
+/// given as each pixel's cut bits ([`super::edt::CUT_RIGHT`],
+/// [`super::edt::CUT_DOWN`]). The distances along a row are found only in
+/// rows that hold a penumbra pixel: the others are umbra and lit alone.
+///
+/// # Panics
+///
+/// If `zones` or `cuts` do not hold `width` × `height` values.
+#[must_use]
+pub fn visibility_across_cuts(
+    zones: &[Zone],
+    cuts: &[u8],
+    width: usize,
+    height: usize,
+    unreached: impl Fn(usize) -> f32 + Sync,
+) -> Vec<f32> {
+    assert_eq!(zones.len(), width * height, "zones of {width} × {height}");
     let (to_umbra, to_lit) = rayon::join(
-        || squared_distances_apart(&mask(Zone::Umbra), width, height, apart),
-        || squared_distances_apart(&mask(Zone::Lit), width, height, apart),
+        || Columns::new(|i| zones[i] == Zone::Umbra, cuts, width, height),
+        || Columns::new(|i| zones[i] == Zone::Lit, cuts, width, height),
     );
-    let root = |d: f32| if d == UNREACHED { f32::INFINITY } else { d.sqrt() };
-    zones
-        .iter()
-        .zip(to_umbra.iter().zip(&to_lit))
-        .enumerate()
-        .map(|(i, (z, (&u, &l)))| match z {
-            Zone::Lit => 1.0,
-            Zone::Umbra => 0.0,
-            Zone::Penumbra => from_distances(root(u), root(l)).unwrap_or_else(|| unreached(i)),
-        })
-        .collect()
+    let mut out = vec![0.0; width * height];
+    let scratch = || (Envelope::with_capacity(width), vec![0.0f32; width], vec![0.0f32; width]);
+    out.par_chunks_mut(width.max(1)).enumerate().for_each_init(scratch, |(envelope, umbra, lit), (y, row)| {
+        let zones = &zones[y * width..(y + 1) * width];
+        let plain = |z: Zone| if z == Zone::Umbra { 0.0 } else { 1.0 };
+        if !zones.contains(&Zone::Penumbra) {
+            row.iter_mut().zip(zones).for_each(|(v, &z)| *v = plain(z));
+            return;
+        }
+        let cut = |x: usize| cuts[y * width + x] & CUT_RIGHT != 0;
+        for (columns, line) in [(&to_umbra, &mut *umbra), (&to_lit, &mut *lit)] {
+            columns.squared_row(y, line);
+            envelope.transform_runs(line, cut);
+        }
+        let root = |d: f32| if d == UNREACHED { f32::INFINITY } else { d.sqrt() };
+        for (x, (v, &z)) in row.iter_mut().zip(zones).enumerate() {
+            *v = match z {
+                Zone::Penumbra => {
+                    from_distances(root(umbra[x]), root(lit[x])).unwrap_or_else(|| unreached(y * width + x))
+                }
+                z => plain(z),
+            };
+        }
+    });
+    out
 }
 
 /// Light visibility by the paper's search: at every `n`-th pixel in x and y
