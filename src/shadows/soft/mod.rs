@@ -167,7 +167,7 @@ impl TwoMaps {
 
     /// Computes the term at every pixel of `surfaces` (seed 001 §3.2–3.3):
     /// the zones from the two hard shadows, then visibility from the
-    /// distances, shaped by the falloff. The frame is taken [`BAND`] rows at
+    /// distances, shaped by the falloff. The frame is taken sixteen rows at
     /// a time, each band's surfaces found, classified and let go on one
     /// worker: only a byte of zone, a byte of cuts and the count of points
     /// reaching each pixel are kept for the distances.
