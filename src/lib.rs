@@ -62,6 +62,7 @@ pub mod compare;
 pub mod csg;
 pub mod error;
 pub mod frame;
+pub mod idle;
 pub mod image;
 pub mod limits;
 pub mod output;

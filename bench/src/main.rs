@@ -125,6 +125,54 @@ pub fn median(v: &mut [f64]) -> f64 {
     v.get(v.len() / 2).copied().unwrap_or(0.0)
 }
 
+/// A scene's frames as the shadow tables time them: medians over the frames.
+#[derive(Debug, Clone, Copy)]
+pub struct FrameTimes {
+    /// Wall milliseconds of the frame.
+    pub frame: f64,
+    /// The shadow stage (maps and per-pixel terms).
+    pub shadows: f64,
+    /// Shading, the shadow stage aside.
+    pub shading: f64,
+    /// The share of the shadow stage's wall time during which a worker had
+    /// no work ([`kage::idle`]).
+    pub shadow_serial: f64,
+    /// The same of the whole frame.
+    pub frame_serial: f64,
+    /// Amdahl's prediction of the frame's milliseconds at 16 threads.
+    pub frame_16: f64,
+}
+
+/// [`FrameTimes`] of `scene` over `frames` frames after a warm-up, every
+/// shadow map rendered again each frame (as a one-shot render does), the
+/// workers' idle time measured.
+///
+/// # Errors
+///
+/// When the scene does not render.
+pub fn frame_times(scene: &kage::Scene, frames: usize) -> miette::Result<FrameTimes> {
+    let options = kage::RenderOptions { keep_shadow_maps: false, measure_idle: true, ..Default::default() };
+    let mut renderer = kage::Renderer::new(&options).map_err(|e| miette::miette!("{e}"))?;
+    renderer.render(scene).map_err(|e| miette::miette!("{e}"))?;
+    let mut v: [Vec<f64>; 6] = Default::default();
+    for _ in 0..frames.max(1) {
+        let start = std::time::Instant::now();
+        let s = renderer.render(scene).map_err(|e| miette::miette!("{e}"))?.stats;
+        let frame = s.idle.frame();
+        let row = [
+            start.elapsed().as_secs_f64() * 1e3,
+            s.shadow_ms,
+            s.shading_ms,
+            s.idle.shadows.serial_share(),
+            frame.serial_share(),
+            frame.predicted(16),
+        ];
+        v.iter_mut().zip(row).for_each(|(v, x)| v.push(x));
+    }
+    let [frame, shadows, shading, shadow_serial, frame_serial, frame_16] = v.map(|mut v| median(&mut v));
+    Ok(FrameTimes { frame, shadows, shading, shadow_serial, frame_serial, frame_16 })
+}
+
 fn main() -> miette::Result<()> {
     match Cli::parse().command {
         Command::Raster(args) => raster::run(&args),

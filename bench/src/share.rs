@@ -6,32 +6,16 @@
 
 use std::path::{Path, PathBuf};
 
-use kage::{RenderOptions, Renderer, Scene};
+use kage::Scene;
 use miette::{miette, Result};
 
-use crate::{median, Common};
+use crate::{frame_times, Common};
 
 /// `kage-bench shadow-share`.
 #[derive(clap::Args, Debug)]
 pub struct ShareArgs {
     #[command(flatten)]
     common: Common,
-}
-
-/// Median frame and shadow-map milliseconds of `scene` over `frames` frames
-/// (after a warm-up frame).
-fn timed(scene: &Scene, frames: usize) -> Result<(f64, f64)> {
-    let options = RenderOptions { keep_shadow_maps: false, ..RenderOptions::default() };
-    let mut renderer = Renderer::new(&options).map_err(|e| miette!("{e}"))?;
-    renderer.render(scene).map_err(|e| miette!("{e}"))?;
-    let (mut total, mut shadows) = (Vec::new(), Vec::new());
-    for _ in 0..frames.max(1) {
-        let start = std::time::Instant::now();
-        let s = renderer.render(scene).map_err(|e| miette!("{e}"))?.stats;
-        total.push(start.elapsed().as_secs_f64() * 1e3);
-        shadows.push(s.shadow_ms);
-    }
-    Ok((median(&mut total), median(&mut shadows)))
 }
 
 fn model(path: &Path, (w, h): (u32, u32)) -> Result<Scene> {
@@ -48,7 +32,7 @@ pub(crate) fn median_csg(dir: &Path, size: (u32, u32), frames: usize) -> Result<
     for f in files {
         // Models with nodes kage does not render are not the median user's.
         let Ok(scene) = model(&f, size) else { continue };
-        times.push((timed(&scene, frames)?.0, f));
+        times.push((frame_times(&scene, frames)?.frame, f));
     }
     times.sort_by(|a, b| a.0.total_cmp(&b.0));
     Ok(times.get(times.len() / 2).map(|(_, f)| f.clone()))
@@ -62,8 +46,11 @@ pub(crate) fn median_csg(dir: &Path, size: (u32, u32), frames: usize) -> Result<
 pub fn run(args: &ShareArgs) -> Result<()> {
     let c = &args.common;
     let assets = c.assets();
-    println!("| scene | size | frame ms | shadow maps ms | shadow share |");
-    println!("|---|---|---:|---:|---:|");
+    println!(
+        "| scene | size | frame ms | shadow maps ms | shadow share | shadow stage serial | frame serial | frame at 16 \
+         threads (Amdahl) ms |"
+    );
+    println!("|---|---|---:|---:|---:|---:|---:|---:|");
     for size in [(960, 540), (1920, 1080)] {
         let mut rows: Vec<(String, Scene)> = Vec::new();
         let mut demo = kage::scene::demo::demo_scene().map_err(|e| miette!("{e}"))?;
@@ -80,19 +67,26 @@ pub fn run(args: &ShareArgs) -> Result<()> {
             rows.push((name, model(&csg, size)?));
         }
         for (name, scene) in rows {
-            let (frame, shadows) = timed(&scene, c.frames)?;
+            let t = frame_times(&scene, c.frames)?;
             println!(
-                "| {name} | {}x{} | {frame:.1} | {shadows:.1} | {:.0}% |",
+                "| {name} | {}x{} | {:.1} | {:.1} | {:.0}% | {:.0}% | {:.0}% | {:.1} |",
                 size.0,
                 size.1,
-                100.0 * shadows / frame.max(1e-9)
+                t.frame,
+                t.shadows,
+                100.0 * t.shadows / t.frame.max(1e-9),
+                100.0 * t.shadow_serial,
+                100.0 * t.frame_serial,
+                t.frame_16
             );
         }
     }
     println!(
         "\nEach scene as `kage render FILE` sets it up (the edge pass on); every frame renders its shadow maps again; \
          median of {} frames after a warm-up frame; the median .csg is the corpus model whose frame takes the median \
-         time (3 frames each); 2 threads.",
+         time (3 frames each); 2 threads. Serial: the share of a stage's wall time during which a worker had no \
+         work, from the kernel's per-thread run and run-queue times (`kage::idle`); Amdahl: the frame's serial part \
+         as it is, the rest of its work over 16 threads.",
         c.frames
     );
     Ok(())

@@ -14,10 +14,10 @@ use kage::raytrace::shadow_truth::{self, ShadowRays};
 use kage::scene::mesh::shapes;
 use kage::scene::{Light, LightKind, Material, Object, ShadowSettings};
 use kage::shadows::ShadowTerm;
-use kage::{RenderOptions, Renderer, Scene};
+use kage::{RenderOptions, Scene};
 use miette::{miette, Result};
 
-use crate::{median, repository, Common};
+use crate::{frame_times, repository, Common};
 
 /// Options of `kage-bench slb`.
 #[derive(clap::Args, Debug)]
@@ -271,23 +271,6 @@ fn footprint(scene: &Scene) -> (usize, usize) {
     (terms.iter().map(ShadowTerm::memory_bytes).sum(), lines)
 }
 
-/// Median light pass, eye pass (shading) and frame milliseconds over `frames`
-/// frames after a warm-up, every map rendered again each frame.
-fn timed(scene: &Scene, frames: usize) -> Result<(f64, f64, f64)> {
-    let options = RenderOptions { keep_shadow_maps: false, ..RenderOptions::default() };
-    let mut renderer = Renderer::new(&options).map_err(|e| miette!("{e}"))?;
-    renderer.render(scene).map_err(|e| miette!("{e}"))?;
-    let (mut light, mut eye, mut frame) = (Vec::new(), Vec::new(), Vec::new());
-    for _ in 0..frames.max(1) {
-        let start = std::time::Instant::now();
-        let s = renderer.render(scene).map_err(|e| miette!("{e}"))?.stats;
-        frame.push(start.elapsed().as_secs_f64() * 1e3);
-        light.push(s.shadow_ms);
-        eye.push(s.shading_ms);
-    }
-    Ok((median(&mut light), median(&mut eye), median(&mut frame)))
-}
-
 /// Prints the table.
 ///
 /// # Errors
@@ -310,7 +293,8 @@ pub fn run(args: &SlbArgs) -> Result<()> {
             let (wrong, rmse) = errors(&checked, &truth)?;
             let full = with(&scene, &method.settings, (c.width, c.height));
             let (bytes, lines) = footprint(&full);
-            let (light, eye, frame) = timed(&full, c.frames)?;
+            let t = frame_times(&full, c.frames)?;
+            let (light, eye, frame) = (t.shadows, t.shading, t.frame);
             println!(
                 "| {name} | {} | {:.3}% | {rmse:.4} | {:.1} M | {} | {light:.1} | {eye:.1} | {frame:.1} |",
                 method.name,

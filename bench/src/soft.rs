@@ -13,10 +13,10 @@ use kage::raytrace::shadow_truth::ShadowRays;
 use kage::scene::file::SceneFile;
 use kage::scene::load::FileSystem;
 use kage::scene::{HardShadows, LightKind, PenumbraFalloff, PenumbraPoints, Scene, ShadowMethod, ShadowSettings};
-use kage::{RenderOptions, Renderer};
+use kage::RenderOptions;
 use miette::{miette, Result};
 
-use crate::{median, Common};
+use crate::{frame_times, Common};
 
 /// Options of `kage-bench soft`.
 #[derive(clap::Args, Debug)]
@@ -273,22 +273,6 @@ fn errors(term: &[Option<f32>], truth: &[Option<f32>], keep: impl Fn(f32) -> boo
     ((sum / n.max(1) as f64).sqrt(), most)
 }
 
-/// Median frame and shadow-stage milliseconds of `scene` over `frames`
-/// frames after a warm-up, every map rendered again each frame.
-fn timed(scene: &Scene, frames: usize) -> Result<(f64, f64)> {
-    let options = RenderOptions { keep_shadow_maps: false, ..RenderOptions::default() };
-    let mut renderer = Renderer::new(&options).map_err(|e| miette!("{e}"))?;
-    renderer.render(scene).map_err(|e| miette!("{e}"))?;
-    let (mut frame, mut shadow) = (Vec::new(), Vec::new());
-    for _ in 0..frames.max(1) {
-        let start = std::time::Instant::now();
-        let stats = renderer.render(scene).map_err(|e| miette!("{e}"))?.stats;
-        frame.push(start.elapsed().as_secs_f64() * 1e3);
-        shadow.push(stats.shadow_ms);
-    }
-    Ok((median(&mut frame), median(&mut shadow)))
-}
-
 /// Prints the table (or, with `--defects`, the defects' table).
 ///
 /// # Errors
@@ -300,10 +284,10 @@ pub fn run(args: &SoftArgs) -> Result<()> {
     let extra = if args.defects { " false umbra | false lit |" } else { "" };
     println!(
         "| scene | method | penumbra RMSE | penumbra max | image RMSE | image max |{extra} ms {0}² | ms {1}×{2} | of \
-         which shadows |",
+         which shadows | shadows serial |",
         args.check, c.width, c.height
     );
-    println!("|---|---|---:|---:|---:|---:|{}---:|---:|---:|", if args.defects { "---:|---:|" } else { "" });
+    println!("|---|---|---:|---:|---:|---:|{}---:|---:|---:|---:|", if args.defects { "---:|---:|" } else { "" });
     let (scenes, methods) = if args.defects { (defect_scenes()?, defect_methods()) } else { (scenes(c)?, methods()) };
     for (name, scene) in scenes {
         if args.only.as_ref().is_some_and(|o| !name.contains(o.as_str())) {
@@ -330,12 +314,15 @@ pub fn run(args: &SoftArgs) -> Result<()> {
             } else {
                 String::new()
             };
-            let (small, _) = timed(&with(&scene, &method.settings, check), c.frames)?;
-            let (large, shadow) = timed(&with(&scene, &method.settings, (c.width, c.height)), c.frames)?;
+            let small = frame_times(&with(&scene, &method.settings, check), c.frames)?.frame;
+            let large = frame_times(&with(&scene, &method.settings, (c.width, c.height)), c.frames)?;
             println!(
                 "| {name} | {} | {p_rmse:.4} | {p_max:.3} | {i_rmse:.4} | {i_max:.3} |{defects} {small:.1} | \
-                 {large:.1} | {shadow:.1} |",
-                method.name
+                 {:.1} | {:.1} | {:.0}% |",
+                method.name,
+                large.frame,
+                large.shadows,
+                100.0 * large.shadow_serial
             );
             crops.push((method.name.to_string(), image));
         }
@@ -349,7 +336,9 @@ pub fn run(args: &SoftArgs) -> Result<()> {
          largest error over the penumbra (truth strictly between 0 and 1) and over every pixel showing an object, \
          surfaces the light grazes (N·L ≤ 0.1) left out.{5} \
          Frame times (every map rendered again each frame; the default edge pass) at {1}² and {2}×{3}, and the \
-         shadow stage's share (maps and the per-pixel soft term), median of {4} frames after a warm-up; 2 threads.",
+         shadow stage's share (maps and the per-pixel soft term), median of {4} frames after a warm-up; 2 threads. \
+         Shadows serial: the share of the shadow stage's wall time at {2}×{3} during which a worker had no work \
+         (`kage::idle`).",
         args.truth_rays,
         args.check,
         c.width,

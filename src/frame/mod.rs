@@ -22,6 +22,7 @@ use std::time::{Duration, Instant};
 use glam::{Vec2, Vec3};
 
 use crate::error::{Error, Result};
+use crate::idle::{IdleClock, IdleTime};
 use crate::image::{LinearImage, PixelRect};
 use crate::raytrace::traced::Refine;
 use crate::raytrace::{traced, TraceCache};
@@ -63,6 +64,11 @@ pub struct RenderOptions {
     /// background or partial results outside ([`region_drawn`] says which
     /// pixels are drawn for it).
     pub region: Option<PixelRect>,
+    /// Measure, per stage, the time its workers had no work
+    /// ([`FrameStats::idle`], [`crate::idle`]): a few reads of the kernel's
+    /// per-thread statistics around each stage (tens of microseconds each),
+    /// so off by default.
+    pub measure_idle: bool,
 }
 
 /// Pixels drawn around a [`RenderOptions::region`]: more than any stage that
@@ -101,6 +107,7 @@ impl Default for RenderOptions {
             shadow_images: false,
             sparse_traced: false,
             region: None,
+            measure_idle: false,
         }
     }
 }
@@ -148,6 +155,37 @@ pub struct FrameStats {
     /// accumulation buffer of jittered passes and the largest light's shadow
     /// maps).
     pub buffer_bytes: usize,
+    /// Per stage, its wall time and the time its workers had no work
+    /// (measured only with [`RenderOptions::measure_idle`]).
+    pub idle: StageIdle,
+    /// Whether [`FrameStats::idle`] is measured.
+    measuring: bool,
+}
+
+/// Each stage's wall time and the time its workers had no work
+/// ([`crate::idle`]), summed over the frame's passes.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct StageIdle {
+    /// The visibility passes.
+    pub visibility: IdleTime,
+    /// The shadow stage: maps and per-pixel terms.
+    pub shadows: IdleTime,
+    /// Shading, fog and translucency, the shadow stage aside.
+    pub shading: IdleTime,
+    /// Reflections and refraction traced from the item buffer.
+    pub traced: IdleTime,
+    /// The edge pass's recording and blending.
+    pub edges: IdleTime,
+}
+
+impl StageIdle {
+    /// The whole frame: every stage's sum.
+    #[must_use]
+    pub fn frame(&self) -> IdleTime {
+        [self.visibility, self.shadows, self.shading, self.traced, self.edges]
+            .into_iter()
+            .fold(IdleTime::default(), IdleTime::plus)
+    }
 }
 
 /// The stages a frame's time is told by ([`FrameStats`]).
@@ -163,8 +201,18 @@ impl FrameStats {
     /// Runs `work`, adding the time it takes to `stage`'s.
     fn timed<T>(&mut self, stage: Stage, work: impl FnOnce() -> T) -> T {
         let start = Instant::now();
+        let clock = self.measuring.then(IdleClock::start);
         let out = work();
         self.add(stage, start.elapsed());
+        if let Some(clock) = clock {
+            let idle = match stage {
+                Stage::Visibility => &mut self.idle.visibility,
+                Stage::Shading => &mut self.idle.shading,
+                Stage::Traced => &mut self.idle.traced,
+                Stage::Edges => &mut self.idle.edges,
+            };
+            *idle = idle.plus(clock.stop());
+        }
         out
     }
 
@@ -182,6 +230,8 @@ impl FrameStats {
     /// Counts a pass's shading: its shadow maps' time moves from the
     /// shading's to their own.
     fn add_lit(&mut self, lit: &PassStats) {
+        self.idle.shading = self.idle.shading.minus(lit.shadow_idle);
+        self.idle.shadows = self.idle.shadows.plus(lit.shadow_idle);
         self.shading_ms -= lit.shadow_ms;
         self.shadow_ms += lit.shadow_ms;
         self.shadow_maps_reused += lit.maps_reused;
@@ -395,7 +445,8 @@ fn render_into(
     progress: &(dyn Fn(u32, u32) + Sync),
     stop: Stop,
 ) -> Result<()> {
-    frame.stats = FrameStats::default();
+    frame.stats = FrameStats { measuring: options.measure_idle, ..FrameStats::default() };
+    scratch.maps.measure_idle(options.measure_idle);
     if !options.keep_shadow_maps {
         scratch.maps.forget();
     }

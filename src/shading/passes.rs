@@ -26,6 +26,8 @@
 
 use std::time::Instant;
 
+use crate::idle::{IdleClock, IdleTime};
+
 use glam::{Vec2, Vec3};
 
 use super::reflection_map::{add_reflection_map, flat_background};
@@ -48,6 +50,9 @@ pub struct PassStats {
     /// Lights whose shadow maps were reused from the last frame (only the
     /// camera moved, or a jittered pass of the same frame).
     pub maps_reused: usize,
+    /// The shadow stage's wall time and its workers' idle time (measured
+    /// only where the pool asks: [`MapPool::measure_idle`]).
+    pub shadow_idle: IdleTime,
 }
 
 /// An image a frame's passes write: the final image (every component) or one
@@ -127,9 +132,13 @@ impl<'a> ShadowFrame<'a> {
     /// where they still hold), made ready, all timed into `stats`.
     fn terms(&mut self, light: &FrameLight, pool: &mut MapPool, stats: &mut PassStats) -> Vec<ShadowTerm> {
         let t = Instant::now();
+        let clock = pool.measures_idle().then(IdleClock::start);
         let mut terms = pool.terms(self.scene, &light.samples, self.bounds);
         terms.iter_mut().for_each(|term| self.ready(light, term));
         stats.shadow_ms += t.elapsed().as_secs_f64() * 1e3;
+        if let Some(clock) = clock {
+            stats.shadow_idle = stats.shadow_idle.plus(clock.stop());
+        }
         terms
     }
 }

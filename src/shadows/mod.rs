@@ -434,6 +434,8 @@ pub struct MapPool {
     /// The objects this frame's maps draw ([`Scene::map_casters`]), found
     /// once a frame ([`MapPool::begin_frame`]; empty: found per term).
     casters: Vec<bool>,
+    /// Whether the shadow stage measures its workers' idle time.
+    measure_idle: bool,
 }
 
 impl Default for MapPool {
@@ -447,6 +449,7 @@ impl Default for MapPool {
             view: None,
             workers: Workers::All,
             casters: Vec::new(),
+            measure_idle: false,
         }
     }
 }
@@ -593,6 +596,18 @@ impl MapPool {
     /// The view directional lights' maps are fitted to in `scene`.
     fn view<'a>(&'a self, scene: &'a Scene) -> &'a Camera {
         self.view.as_ref().unwrap_or(&scene.camera)
+    }
+
+    /// Has the shadow stage measure the time its workers have no work
+    /// ([`crate::idle`]), or not.
+    pub fn measure_idle(&mut self, on: bool) {
+        self.measure_idle = on;
+    }
+
+    /// Whether the shadow stage measures its workers' idle time.
+    #[must_use]
+    pub fn measures_idle(&self) -> bool {
+        self.measure_idle
     }
 
     /// Terms reused from the last frame since this frame began.

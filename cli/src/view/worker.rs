@@ -32,7 +32,7 @@ pub struct Job {
 pub enum Outcome {
     /// Rendered (what is shown updated, unless the step is a pass averaged
     /// but not shown yet): the frame's statistics.
-    Rendered(FrameStats),
+    Rendered(Box<FrameStats>),
     /// Given up: its stop flag was raised before what it shows was written.
     Stopped,
     /// The scene could not be rendered.
@@ -105,7 +105,7 @@ fn render(refiner: &mut Refiner, job: &Job, shown: &Mutex<Shown>) -> Done {
         Outcome::Stopped
     } else {
         match refiner.render(&job.scene, &job.viewer, job.step, &job.stop, shown) {
-            Ok(stats) => Outcome::Rendered(stats),
+            Ok(stats) => Outcome::Rendered(Box::new(stats)),
             Err(kage::Error::Stopped) => Outcome::Stopped,
             Err(e) => Outcome::Failed(e.to_string()),
         }
