@@ -114,6 +114,26 @@ fn a_two_map_penumbra_widens_with_height_as_the_truth_does() {
     assert!(widths[0] < widths[1] && widths[1] < widths[2], "the penumbra widens: {widths:?}");
 }
 
+/// Computed at every second pixel each way and read back depth-aware, the
+/// two-map term keeps the sphere's penumbra widths, and stays within a
+/// small error of the term at every pixel.
+#[test]
+fn half_resolution_keeps_the_penumbra() {
+    for height in [1.0, 3.0] {
+        let (half, truth) = renderer_and_truth(&sphere_over_plane(height, r#"{ method = "soft", half = true }"#));
+        let (full, _) = renderer_and_truth(&sphere_over_plane(height, r#"{ method = "soft" }"#));
+        let (w, t) = (penumbra_width(&half), penumbra_width(&truth));
+        assert!((w / t - 1.0).abs() < 0.12, "sphere at {height}: half-resolution penumbra {w} against the truth's {t}");
+        let both: Vec<(f32, f32)> = half.iter().zip(&full).filter_map(|(a, b)| a.zip(*b)).collect();
+        let rmse = (both.iter().map(|(a, b)| (a - b).powi(2)).sum::<f32>() / both.len() as f32).sqrt();
+        assert!(
+            both.len() > 500 && rmse < 0.02,
+            "sphere at {height}: {} pixels, rmse {rmse} from the full term",
+            both.len()
+        );
+    }
+}
+
 /// Four points round the light bound the penumbra as the disc does wherever
 /// an edge lies: the sphere's penumbra widths hold too.
 #[test]

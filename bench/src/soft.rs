@@ -99,6 +99,7 @@ fn methods() -> Vec<Method> {
             settings: ShadowSettings { penumbra: PenumbraFalloff::Linear, ..soft },
         },
         Method { name: "same + disc falloff (default)", settings: soft },
+        Method { name: "same at half resolution", settings: ShadowSettings { half: true, ..soft } },
         Method { name: "same, on SLB hard shadows", settings: ShadowSettings { hard: HardShadows::Slb, ..soft } },
         Method { name: "ring of four points", settings: ShadowSettings { points: PenumbraPoints::Ring, ..soft } },
         Method { name: "PCSS 16/16", settings: pcss(16, 16) },

@@ -146,7 +146,7 @@ impl ShadowSettings {
             "pcf" => m == M::Map || (m == M::Soft && !slb_hard),
             "samples" => matches!(m, M::Map | M::Slb),
             "bits" | "scale" | "antialias" => m == M::Slb || slb_hard,
-            "focus" | "search" | "falloff" | "depth_aware" | "hard" | "points" => m == M::Soft,
+            "focus" | "search" | "falloff" | "depth_aware" | "half" | "hard" | "points" => m == M::Soft,
             "blockers" | "filter" => m == M::Pcss,
             _ => false,
         }
@@ -254,6 +254,10 @@ pub struct ShadowSettings {
     /// discontinuities of the eye's view (a floor's penumbra does not reach
     /// onto a plate in front of it).
     pub depth_aware: bool,
+    /// Two-map soft shadows: compute the term at every second pixel each
+    /// way (a quarter of the pixels) and read each pixel's from the nearest
+    /// of those on its surface.
+    pub half: bool,
     /// Two-map soft shadows: what the two hard shadows are.
     pub hard: HardShadows,
     /// Two-map soft shadows: where the two points lie.
@@ -339,6 +343,7 @@ impl ShadowSettings {
         search: 0,
         penumbra: PenumbraFalloff::Smooth,
         depth_aware: true,
+        half: false,
         hard: HardShadows::Map,
         points: PenumbraPoints::Matched,
         blockers: 16,

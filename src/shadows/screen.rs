@@ -160,28 +160,32 @@ impl<'a> ScreenSurfaces<'a> {
         }
     }
 
-    /// The per-pixel term `values` of these surfaces: `distances` from the
-    /// eye ([`ScreenSurfaces::distance`], NaN where no object is seen) and
-    /// `reach` (how far a point may lie from a pixel's surface point and
-    /// still be read there), one each per pixel, row by row.
+    /// The term `values` of these surfaces on a `grid` of `(w, h)` points
+    /// spread over the frame (the pixels themselves, or fewer: each grid
+    /// cell covers as many pixels): `distances` from the eye
+    /// ([`ScreenSurfaces::distance`], NaN where no object is seen) and
+    /// `reach` (how far a point may lie from a cell's surface point and
+    /// still be read there), one each per cell, row by row.
     ///
     /// # Panics
     ///
-    /// If the three do not hold one value per pixel.
+    /// If the three do not hold one value per cell.
     #[must_use]
-    pub fn term(&self, distances: Vec<f32>, reach: Vec<f32>, values: Vec<f32>) -> ScreenTerm {
-        let (w, h) = (self.width as usize, self.height as usize);
+    pub fn term(&self, grid: (usize, usize), distances: Vec<f32>, reach: Vec<f32>, values: Vec<f32>) -> ScreenTerm {
+        let (w, h) = grid;
         assert!(
             [distances.len(), reach.len(), values.len()].iter().all(|&n| n == w * h),
-            "one distance, reach and value per pixel"
+            "one distance, reach and value per cell"
         );
         let c = &self.camera;
         let axis = match c.projection {
             Projection::Perspective { .. } => None,
             Projection::Orthographic { .. } => Some(self.forward),
         };
-        let view_proj = c.view_projection(w as f32 / h.max(1) as f32);
-        ScreenTerm { view_proj, width: w, height: h, eye: c.eye, axis, distances, reach, values }
+        let view_proj = c.view_projection(self.width as f32 / self.height.max(1) as f32);
+        // Where each cell's sample lies within it: at its first pixel's centre.
+        let sample = 0.5 * w as f32 / self.width.max(1) as f32;
+        ScreenTerm { view_proj, width: w, height: h, sample, eye: c.eye, axis, distances, reach, values }
     }
 }
 
@@ -191,6 +195,9 @@ pub struct ScreenTerm {
     view_proj: Mat4,
     width: usize,
     height: usize,
+    /// Where in its cell each value was sampled (0.5: the centre, a cell per
+    /// pixel; less: a cell of several pixels, sampled at its first).
+    sample: f32,
     /// The eye, and the view axis of an orthographic camera (distances are
     /// measured along it; a perspective camera's from the eye).
     eye: Vec3,
@@ -216,6 +223,8 @@ impl ScreenTerm {
     /// The term at world point `p`: the value of the pixel `p` projects into,
     /// or of the one of its eight neighbours whose surface lies nearest `p`'s
     /// distance from the eye, within two footprints; `None` when none does.
+    /// On a grid coarser than the pixels, the four samples round `p` on its
+    /// surface weighted bilinearly first (depth-aware upsampling).
     #[must_use]
     pub fn at(&self, p: Vec3) -> Option<f32> {
         let c = self.view_proj * p.extend(1.0);
@@ -226,6 +235,11 @@ impl ScreenTerm {
         let (fx, fy) = ((ndc.x * 0.5 + 0.5) * self.width as f32, (0.5 - ndc.y * 0.5) * self.height as f32);
         let (x, y) = (fx.floor() as i64, fy.floor() as i64);
         let along = self.axis.map_or((p - self.eye).length(), |a| (p - self.eye).dot(a));
+        if self.sample < 0.5 {
+            if let Some(v) = self.bilinear(fx - self.sample, fy - self.sample, along) {
+                return Some(v);
+            }
+        }
         let mut best: Option<(f32, usize)> = None;
         for (dx, dy) in [(0, 0), (-1, 0), (1, 0), (0, -1), (0, 1), (-1, -1), (1, -1), (-1, 1), (1, 1)] {
             let (u, v) = (x + dx, y + dy);
@@ -242,6 +256,30 @@ impl ScreenTerm {
             }
         }
         best.map(|(_, i)| self.values[i])
+    }
+
+    /// The values of the four samples round grid point `(u, v)` (in cells,
+    /// samples at whole numbers) weighted bilinearly, those not on the
+    /// surface at distance `along` from the eye left out; `None` when none
+    /// is.
+    fn bilinear(&self, u: f32, v: f32, along: f32) -> Option<f32> {
+        let (x0, y0) = (u.floor(), v.floor());
+        let (tx, ty) = (u - x0, v - y0);
+        let (mut sum, mut weight) = (0.0, 0.0);
+        for (dx, dy, w) in
+            [(0, 0, (1.0 - tx) * (1.0 - ty)), (1, 0, tx * (1.0 - ty)), (0, 1, (1.0 - tx) * ty), (1, 1, tx * ty)]
+        {
+            let (x, y) = (x0 as i64 + dx, y0 as i64 + dy);
+            if x < 0 || y < 0 || x >= self.width as i64 || y >= self.height as i64 {
+                continue;
+            }
+            let i = y as usize * self.width + x as usize;
+            if (self.distances[i] - along).abs() <= self.reach[i] {
+                sum += w * self.values[i];
+                weight += w;
+            }
+        }
+        (weight > 1e-3).then(|| sum / weight)
     }
 
     /// Bytes held.

@@ -349,6 +349,7 @@ struct ShadowRec {
     search: Option<Spanned<i64>>,
     falloff: Option<PenumbraRec>,
     depth_aware: Option<bool>,
+    half: Option<bool>,
     hard: Option<HardRec>,
     points: Option<PointsRec>,
     blockers: Option<Spanned<i64>>,

@@ -210,6 +210,7 @@ impl SceneFile {
             ("search", r.search.is_some()),
             ("falloff", r.falloff.is_some()),
             ("depth_aware", r.depth_aware.is_some()),
+            ("half", r.half.is_some()),
             ("hard", r.hard.is_some()),
             ("points", r.points.is_some()),
             ("blockers", r.blockers.is_some()),
@@ -263,6 +264,7 @@ impl SceneFile {
         s.blockers = count(&r.blockers, 1, 256, "shadow blockers")?.unwrap_or(s.blockers);
         s.filter = count(&r.filter, 1, 256, "shadow filter")?.unwrap_or(s.filter);
         s.depth_aware = r.depth_aware.unwrap_or(s.depth_aware);
+        s.half = r.half.unwrap_or(s.half);
         s.focus = r.focus.map(Vec3::from).or(s.focus);
         if let Some(p) = r.falloff {
             s.penumbra = match p {

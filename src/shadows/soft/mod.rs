@@ -172,7 +172,11 @@ impl TwoMaps {
     /// worker: only a byte of zone, a byte of cuts and the count of points
     /// reaching each pixel are kept for the distances.
     pub fn prepare(&mut self, surfaces: &ScreenSurfaces) {
-        let (w, h) = (surfaces.width as usize, surfaces.height as usize);
+        // The grid the term is computed on: every pixel, or every second one
+        // each way (`half`), each sample the surface at its grid point's
+        // first pixel.
+        let stride = if self.settings.half { 2 } else { 1 };
+        let (w, h) = ((surfaces.width as usize).div_ceil(stride), (surfaces.height as usize).div_ceil(stride));
         let n = w * h;
         let (mut zones, mut reached, mut cuts) = (vec![Zone::Lit; n], vec![0u8; n], vec![0u8; n]);
         let (mut distances, mut reach) = (vec![f32::NAN; n], vec![0.0f32; n]);
@@ -184,12 +188,20 @@ impl TwoMaps {
             .zip(distances.par_chunks_mut(band).zip(reach.par_chunks_mut(band)));
         let depth_aware = self.settings.depth_aware && self.settings.search == 0;
         bands.enumerate().for_each_init(
-            || (Vec::new(), Vec::new()),
-            |(seen, footprints), (b, (((zones, reached), cuts), (distances, reach)))| {
+            || (Vec::new(), Vec::new(), Vec::new()),
+            |(seen, footprints, row), (b, (((zones, reached), cuts), (distances, reach)))| {
                 let rows = zones.len() / w;
                 // One row more than the band: its last row's cuts look below.
-                // One row more than the band: its last row's cuts look below.
-                surfaces.rows(b * BAND..b * BAND + rows + 1, seen);
+                let grid_rows = b * BAND..(b * BAND + rows + 1).min(h);
+                if stride == 1 {
+                    surfaces.rows(grid_rows, seen);
+                } else {
+                    seen.clear();
+                    for y in grid_rows {
+                        surfaces.rows(y * stride..y * stride + 1, row);
+                        seen.extend(row.iter().step_by(stride));
+                    }
+                }
                 let inside = rows * w;
                 footprints.clear();
                 footprints.resize(seen.len(), 0.0);
@@ -202,12 +214,12 @@ impl TwoMaps {
                     for (i, s) in eight.iter().enumerate() {
                         let at = k * 8 + i;
                         (footprints[at], distances[at]) =
-                            if s.is_some() { (footprint[i], distance[i]) } else { (0.0, f32::NAN) };
+                            if s.is_some() { (footprint[i] * stride as f32, distance[i]) } else { (0.0, f32::NAN) };
                         reach[at] = 2.0 * footprints[at];
                     }
                 }
                 for (f, s) in footprints[inside..].iter_mut().zip(&seen[inside..]) {
-                    *f = s.as_ref().map_or(0.0, |s| surfaces.footprint(s));
+                    *f = s.as_ref().map_or(0.0, |s| surfaces.footprint(s) * stride as f32);
                 }
                 if depth_aware {
                     let apart = |i: usize, j: usize| {
@@ -235,7 +247,7 @@ impl TwoMaps {
         if self.settings.penumbra == PenumbraFalloff::Smooth {
             v.par_iter_mut().for_each(|v| *v = disc_share(*v));
         }
-        self.screen = Some(surfaces.term(distances, reach, v));
+        self.screen = Some(surfaces.term((w, h), distances, reach, v));
     }
 
     /// The zones of up to eight pixels showing `lanes`, and how many of
