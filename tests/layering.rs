@@ -13,6 +13,7 @@ const FRAME_ORDER: &[&str] = &[
     "limits",
     "error",
     "sampling",
+    "idle",
     "image",
     "camera",
     "triangle",

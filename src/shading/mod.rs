@@ -23,6 +23,7 @@ pub(crate) mod shadow_images;
 pub(crate) mod subpixel;
 pub(crate) mod surface;
 pub(crate) mod translucency;
+pub(crate) mod visible;
 
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
@@ -36,7 +37,8 @@ pub use lanes::{Blend, Lighting};
 pub use passes::{frame_lights, shade_lit, shade_lit_beside, FrameLight, PassStats, Target};
 pub use phong::{Component, ComponentSet, Components};
 pub use subpixel::{SubpixelSample, SubpixelShading};
-pub use surface::{screen_surfaces, ObjectFrames, PreparedTriangle, SurfacePoint};
+pub use surface::{ObjectFrames, PreparedTriangle, SurfacePoint};
+pub use visible::screen_surfaces;
 
 use phong::Coefficients;
 

@@ -31,7 +31,7 @@ use crate::idle::{IdleClock, IdleTime};
 use glam::{Vec2, Vec3};
 
 use super::reflection_map::{add_reflection_map, flat_background};
-use super::surface::screen_surfaces;
+use super::visible::screen_surfaces;
 use super::{shade_pass, Blend, Component, ComponentSet, Lighting, ShadingPass, SubpixelShading};
 use crate::image::LinearImage;
 use crate::scene::{Light, Scene};

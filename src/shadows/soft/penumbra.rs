@@ -116,7 +116,8 @@ pub fn visibility_across_cuts(
 /// (and the last row and column), the nearest umbra and lit pixels found by
 /// looking in square rings outwards up to `reach` pixels; every other pixel
 /// interpolated bilinearly from the four samples round it, where it is
-/// penumbra (umbra and lit pixels keep 0 and 1). A sample that reaches no
+/// penumbra (umbra and lit pixels keep 0 and 1). Rows of samples, and then
+/// of pixels, run in parallel. A sample that reaches no
 /// umbra or no lit pixel takes `unreached(i)` (`i` its pixel's index).
 ///
 /// # Panics
@@ -129,7 +130,7 @@ pub fn visibility_searched(
     height: usize,
     n: usize,
     reach: usize,
-    unreached: impl Fn(usize) -> f32,
+    unreached: impl Fn(usize) -> f32 + Sync,
 ) -> Vec<f32> {
     assert_eq!(zones.len(), width * height, "zones of {width} × {height}");
     assert!(n > 0, "a sample every n ≥ 1 pixels");
@@ -146,18 +147,18 @@ pub fn visibility_searched(
         return Vec::new();
     }
     let (gx, gy) = (sampled(width, n), sampled(height, n));
-    let samples: Vec<f32> =
-        gy.iter().flat_map(|&y| gx.iter().map(move |&x| (x, y))).map(|(x, y)| sample(x, y)).collect();
+    // The samples' rows, then the image's rows, in parallel.
+    let samples: Vec<f32> = gy.par_iter().flat_map_iter(|&y| gx.iter().map(move |&x| sample(x, y))).collect();
     let mut out = vec![0.0; width * height];
-    for y in 0..height {
-        for x in 0..width {
-            out[y * width + x] = match zone(x, y) {
+    out.par_chunks_mut(width).enumerate().for_each(|(y, row)| {
+        for (x, v) in row.iter_mut().enumerate() {
+            *v = match zone(x, y) {
                 Zone::Lit => 1.0,
                 Zone::Umbra => 0.0,
                 Zone::Penumbra => bilinear(&samples, (&gx, &gy), (x, y)),
             };
         }
-    }
+    });
     out
 }
 
