@@ -297,22 +297,7 @@ pub fn shade_run(
     out: &mut [Vec3],
 ) {
     let g = tri.geometry();
-    let (ka, kd, ks, ke, n) = k.parts();
-    let inputs = LaneInputs {
-        a: V3::splat(g.a),
-        e1: V3::splat(g.e1),
-        e2: V3::splat(g.e2),
-        n: g.normals.map(V3::splat),
-        geometric: V3::splat(g.geometric),
-        ka: V3::splat(ka),
-        kd: V3::splat(kd),
-        ks: V3::splat(ks),
-        ke: V3::splat(ke),
-        shininess: F::splat(n),
-        whole: whole_exponent(n),
-        exponents: [whole_exponent(n).unwrap_or(0); LANES],
-        object: [tri.item.object; LANES],
-    };
+    let inputs = LaneInputs::broadcast(tri, &g, Some(k));
     let row = TriangleRow::new(&g, &rays.line(x0));
     for (b, out) in out.chunks_exact_mut(LANES).enumerate() {
         let rgb = lighting.shade(&inputs, &row.surface(&inputs, b * LANES));
@@ -335,21 +320,7 @@ pub fn run_surfaces(
     mut at: impl FnMut(usize, Vec3, Vec3),
 ) {
     let g = tri.geometry();
-    let inputs = LaneInputs {
-        a: V3::splat(g.a),
-        e1: V3::splat(g.e1),
-        e2: V3::splat(g.e2),
-        n: g.normals.map(V3::splat),
-        geometric: V3::splat(g.geometric),
-        ka: V3::splat(Vec3::ZERO),
-        kd: V3::splat(Vec3::ZERO),
-        ks: V3::splat(Vec3::ZERO),
-        ke: V3::splat(Vec3::ZERO),
-        shininess: F::ONE,
-        whole: None,
-        exponents: [0; LANES],
-        object: [tri.item.object; LANES],
-    };
+    let inputs = LaneInputs::broadcast(tri, &g, None);
     let row = TriangleRow::new(&g, &rays.line(x0));
     for k0 in (0..count).step_by(LANES) {
         let s = row.surface(&inputs, k0);
@@ -382,6 +353,28 @@ struct LaneInputs {
 }
 
 impl LaneInputs {
+    /// `tri` (its geometry `g`) in every lane, with the material
+    /// coefficients `k` (zero without).
+    fn broadcast(tri: &PreparedTriangle, g: &TriangleGeometry, k: Option<&Coefficients>) -> Self {
+        let zero = Vec3::ZERO;
+        let (ka, kd, ks, ke, n) = k.map_or((zero, zero, zero, zero, 1.0), Coefficients::parts);
+        LaneInputs {
+            a: V3::splat(g.a),
+            e1: V3::splat(g.e1),
+            e2: V3::splat(g.e2),
+            n: g.normals.map(V3::splat),
+            geometric: V3::splat(g.geometric),
+            ka: V3::splat(ka),
+            kd: V3::splat(kd),
+            ks: V3::splat(ks),
+            ke: V3::splat(ke),
+            shininess: F::splat(n),
+            whole: whole_exponent(n),
+            exponents: [whole_exponent(n).unwrap_or(0); LANES],
+            object: [tri.item.object; LANES],
+        }
+    }
+
     /// The lanes' receivers of shadows: their objects and triangles' planes.
     #[inline(always)]
     fn receivers(&self) -> ReceiverLanes {
