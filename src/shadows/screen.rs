@@ -99,9 +99,10 @@ impl<'a> ScreenSurfaces<'a> {
         self.pixel_size(v.position) / v.normal.dot(to_eye).abs().max(0.2)
     }
 
-    /// [`ScreenSurfaces::footprint`] and [`ScreenSurfaces::distance`] of
-    /// eight surfaces at once: their points `p` and unit normals `n` (x, y,
-    /// z lanes).
+    /// [`ScreenSurfaces::footprint`] of eight surfaces at once (their points
+    /// `p` and unit normals `n`, x, y, z lanes), and their distances from
+    /// the eye as [`ScreenTerm::at`] measures them: from the eye itself
+    /// (perspective) or along the view axis (orthographic).
     #[must_use]
     pub fn footprint_lanes(&self, p: [f32x8; 3], n: [f32x8; 3]) -> (f32x8, f32x8) {
         let c = &self.camera;
@@ -133,16 +134,6 @@ impl<'a> ScreenSurfaces<'a> {
         }
     }
 
-    /// How far from the eye `p` lies: from the eye itself (perspective) or
-    /// along the view axis (orthographic), as [`ScreenTerm::at`] measures.
-    #[must_use]
-    pub fn distance(&self, p: Vec3) -> f32 {
-        match self.camera.projection {
-            Projection::Perspective { .. } => (p - self.camera.eye).length(),
-            Projection::Orthographic { .. } => (p - self.camera.eye).dot(self.forward),
-        }
-    }
-
     /// Whether neighbouring pixels' surfaces `a` and `b` (their footprints
     /// `fa`, `fb`) lie apart: one shows an object and the other none, or
     /// their points are further apart than four pixel footprints on the
@@ -162,8 +153,9 @@ impl<'a> ScreenSurfaces<'a> {
 
     /// The term `values` of these surfaces on a `grid` of `(w, h)` points
     /// spread over the frame (the pixels themselves, or fewer: each grid
-    /// cell covers as many pixels): `distances` from the eye
-    /// ([`ScreenSurfaces::distance`], NaN where no object is seen) and
+    /// cell covers as many pixels): `distances` from the eye (as
+    /// [`ScreenSurfaces::footprint_lanes`] gives them; NaN where no object
+    /// is seen) and
     /// `reach` (how far a point may lie from a cell's surface point and
     /// still be read there), one each per cell, row by row.
     ///
