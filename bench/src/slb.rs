@@ -13,7 +13,7 @@ use kage::camera::{Camera, Projection};
 use kage::raytrace::shadow_truth::{self, ShadowRays};
 use kage::scene::mesh::shapes;
 use kage::scene::{Light, LightKind, Material, Object, ShadowSettings};
-use kage::shadows::ShadowTerm;
+use kage::shadows::{ShadowTerm, SlbTerm};
 use kage::{RenderOptions, Scene};
 use miette::{miette, Result};
 
@@ -262,11 +262,8 @@ fn footprint(scene: &Scene) -> (usize, usize) {
     let terms = ShadowTerm::build_all(scene);
     let lines = terms
         .iter()
-        .map(|t| match t {
-            ShadowTerm::Slb(map, _) => map.buffer().line_count(),
-            ShadowTerm::SlbCube(faces, ..) => faces.iter().map(|f| f.buffer().line_count()).sum(),
-            _ => 0,
-        })
+        .filter_map(|t| t.downcast_ref::<SlbTerm>())
+        .flat_map(|t| t.maps().iter().map(|m| m.buffer().line_count()))
         .sum();
     (terms.iter().map(ShadowTerm::memory_bytes).sum(), lines)
 }

@@ -151,7 +151,7 @@ mod tests {
     #[test]
     fn help_texts_name_every_value_the_code_accepts() {
         let shadows = help("render", "shadows");
-        for (name, _) in ShadowMethod::NAMES {
+        for name in ShadowMethod::names() {
             assert!(shadows.contains(&format!("`{name}`")), "--shadows does not name `{name}`: {shadows}");
         }
         let aov = help("render", "aov");

@@ -282,11 +282,8 @@ fn parse_antialias(s: &str) -> Result<Antialias, String> {
 }
 
 fn parse_shadow_method(s: &str) -> Result<ShadowMethod, String> {
-    let found = ShadowMethod::NAMES.iter().find(|(n, _)| n.eq_ignore_ascii_case(s.trim()));
-    found.map(|(_, m)| *m).ok_or_else(|| {
-        let names: Vec<&str> = ShadowMethod::NAMES.iter().map(|(n, _)| *n).collect();
-        format!("'{s}' is not a shadow method (expected one of {})", names.join(", "))
-    })
+    ShadowMethod::named(s)
+        .ok_or_else(|| format!("'{s}' is not a shadow method (expected one of {})", ShadowMethod::names().join(", ")))
 }
 
 fn parse_tone(s: &str) -> Result<ToneCurve, String> {

@@ -28,8 +28,9 @@ use crate::raytrace::traced::Refine;
 use crate::raytrace::{traced, TraceCache};
 use crate::resolve::edges::{EdgeOptions, EdgePass};
 use crate::resolve::jitter;
-use crate::scene::{Antialias, Scene, ShadowMethod};
+use crate::scene::{Antialias, Scene};
 use crate::shading::{self, fog, translucency, Component, ComponentSet, PassStats, SubpixelShading, Target};
+use crate::shadows::methods::technique;
 use crate::shadows::MapPool;
 use crate::visibility::{self, RasterStats, VisibilityBuffer};
 
@@ -79,13 +80,14 @@ pub const REGION_GUARD_PX: u32 = 16;
 
 /// The pixels a frame limited to `region` draws: the region grown by
 /// [`REGION_GUARD_PX`], its columns widened to the shading's segment borders
-/// ([`shading::SEGMENT`]); or the whole frame when a light's shadows come
-/// from two shadow maps ([`ShadowMethod::Soft`]), whose distance transform
-/// reaches across the image.
+/// ([`shading::SEGMENT`]); or the whole frame when a light's shadow method
+/// computes its term per pixel of the frame
+/// ([`crate::shadows::Technique::per_pixel`]: the
+/// two-map soft shadow, whose distances reach across the image).
 #[must_use]
 pub fn region_drawn(scene: &Scene, region: PixelRect) -> PixelRect {
     let (w, h) = (scene.width, scene.height);
-    if scene.lights.iter().any(|l| l.shadow.method == ShadowMethod::Soft) {
+    if scene.lights.iter().any(|l| technique(l.shadow.method).per_pixel()) {
         return PixelRect::full(w, h);
     }
     let grown = region.grown(REGION_GUARD_PX, w, h);

@@ -128,40 +128,115 @@ pub enum ShadowMethod {
     /// wide as the penumbra the blockers' mean depth gives
     /// ([`ShadowSettings::blockers`], [`ShadowSettings::filter`]).
     Pcss,
+    /// A test's method: every point half lit. It shows that a method is
+    /// added by its unit in the shadow stage and its entry in the list.
+    #[cfg(test)]
+    HalfLit,
 }
 
 impl ShadowSettings {
     /// Whether the scene-file key `key` of a light's `[light.shadow]` table
-    /// changes what these settings' method computes: the one table of which
-    /// settings each method reads (a two-map soft shadow reads its hard
-    /// shadows' settings too). Keys it does not read are ignored, with a
-    /// warning, where a scene file gives them.
+    /// changes what these settings' method computes ([`ShadowMethod::keys`];
+    /// a two-map soft shadow reads its hard shadows' keys too, one map from
+    /// each point). Keys it does not read are ignored, with a warning, where
+    /// a scene file gives them.
     #[must_use]
     pub fn applies(&self, key: &str) -> bool {
-        use ShadowMethod as M;
-        let (m, slb_hard) = (self.method, self.method == M::Soft && self.hard == HardShadows::Slb);
-        match key {
-            "method" => true,
-            "resolution" | "bias" | "slope" => m != M::None,
-            "pcf" => m == M::Map || (m == M::Soft && !slb_hard),
-            "samples" => matches!(m, M::Map | M::Slb),
-            "bits" | "scale" | "antialias" => m == M::Slb || slb_hard,
-            "focus" | "search" | "falloff" | "depth_aware" | "half" | "hard" | "points" => m == M::Soft,
-            "blockers" | "filter" => m == M::Pcss,
-            _ => false,
-        }
+        let hard = match (self.method, self.hard) {
+            (ShadowMethod::Soft, HardShadows::Map) => ShadowMethod::Map.keys(),
+            (ShadowMethod::Soft, HardShadows::Slb) => ShadowMethod::Slb.keys(),
+            _ => &[],
+        };
+        key == "method" || self.method.keys().contains(&key) || (key != "samples" && hard.contains(&key))
     }
 }
 
+/// One entry of the list of methods.
+struct MethodEntry {
+    method: ShadowMethod,
+    /// Its name in scene files and on the command line.
+    name: &'static str,
+    /// What the viewer calls it.
+    label: &'static str,
+    /// The `[light.shadow]` keys it reads, besides `method`.
+    keys: &'static [&'static str],
+}
+
+/// The keys every map-based method reads.
+const MAP_KEYS: [&str; 3] = ["resolution", "bias", "slope"];
+
+/// The shadow methods: the one list of them, with what each reads. The
+/// shadow stage holds what each computes (`kage::shadows::methods`).
+const METHODS: &[MethodEntry] = &[
+    MethodEntry { method: ShadowMethod::None, name: "none", label: "none", keys: &[] },
+    MethodEntry {
+        method: ShadowMethod::Map,
+        name: "map",
+        label: "map",
+        keys: &[MAP_KEYS[0], MAP_KEYS[1], MAP_KEYS[2], "pcf", "samples"],
+    },
+    MethodEntry {
+        method: ShadowMethod::Slb,
+        name: "slb",
+        label: "SLB",
+        keys: &[MAP_KEYS[0], MAP_KEYS[1], MAP_KEYS[2], "samples", "bits", "scale", "antialias"],
+    },
+    MethodEntry {
+        method: ShadowMethod::Soft,
+        name: "soft",
+        label: "two-map soft",
+        keys: &["focus", "search", "falloff", "depth_aware", "half", "hard", "points"],
+    },
+    MethodEntry {
+        method: ShadowMethod::Pcss,
+        name: "pcss",
+        label: "PCSS",
+        keys: &[MAP_KEYS[0], MAP_KEYS[1], MAP_KEYS[2], "blockers", "filter"],
+    },
+    #[cfg(test)]
+    MethodEntry { method: ShadowMethod::HalfLit, name: "half-lit", label: "half lit", keys: &[] },
+];
+
 impl ShadowMethod {
-    /// Every method, by its name in scene files and on the command line.
-    pub const NAMES: [(&'static str, ShadowMethod); 5] = [
-        ("none", ShadowMethod::None),
-        ("map", ShadowMethod::Map),
-        ("slb", ShadowMethod::Slb),
-        ("soft", ShadowMethod::Soft),
-        ("pcss", ShadowMethod::Pcss),
-    ];
+    /// Every method, in the list's order.
+    pub fn all() -> impl Iterator<Item = ShadowMethod> {
+        METHODS.iter().map(|e| e.method)
+    }
+
+    /// The method called `name` in scene files and on the command line
+    /// (any case).
+    #[must_use]
+    pub fn named(name: &str) -> Option<ShadowMethod> {
+        METHODS.iter().find(|e| e.name.eq_ignore_ascii_case(name.trim())).map(|e| e.method)
+    }
+
+    /// Every method's name.
+    #[must_use]
+    pub fn names() -> Vec<&'static str> {
+        METHODS.iter().map(|e| e.name).collect()
+    }
+
+    fn entry(self) -> &'static MethodEntry {
+        METHODS.iter().find(|e| e.method == self).expect("every method is in the list")
+    }
+
+    /// Its name in scene files and on the command line.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        self.entry().name
+    }
+
+    /// What the viewer calls it.
+    #[must_use]
+    pub fn label(self) -> &'static str {
+        self.entry().label
+    }
+
+    /// The `[light.shadow]` keys it reads itself, besides `method`.
+    #[must_use]
+    pub fn keys(self) -> &'static [&'static str] {
+        self.entry().keys
+    }
 }
 
 /// How a two-map penumbra's visibility V = D1 / (D1 + D2) becomes the shadow

@@ -99,27 +99,20 @@ pub enum Shadows {
 }
 
 impl Shadows {
-    /// Every choice, in the order S steps through them.
-    pub const CYCLE: [Shadows; 7] = [
-        Shadows::Scene,
-        Shadows::All(ShadowMethod::None),
-        Shadows::All(ShadowMethod::Map),
-        Shadows::All(ShadowMethod::Slb),
-        Shadows::All(ShadowMethod::Soft),
-        Shadows::All(ShadowMethod::Pcss),
-        Shadows::Jittered(16),
-    ];
+    /// Every choice, in the order S steps through them: the scene's, each
+    /// method of the library's list, jittered maps.
+    #[must_use]
+    pub fn cycle() -> Vec<Shadows> {
+        let methods = ShadowMethod::all().map(Shadows::All);
+        std::iter::once(Shadows::Scene).chain(methods).chain([Shadows::Jittered(16)]).collect()
+    }
 
     /// A short name for the HUD.
     #[must_use]
     pub fn name(self) -> String {
         match self {
             Shadows::Scene => "scene's".to_string(),
-            Shadows::All(ShadowMethod::None) => "none".to_string(),
-            Shadows::All(ShadowMethod::Map) => "map".to_string(),
-            Shadows::All(ShadowMethod::Slb) => "SLB".to_string(),
-            Shadows::All(ShadowMethod::Soft) => "two-map soft".to_string(),
-            Shadows::All(ShadowMethod::Pcss) => "PCSS".to_string(),
+            Shadows::All(method) => method.label().to_string(),
             Shadows::Jittered(n) => format!("jittered {n}"),
         }
     }
@@ -345,7 +338,7 @@ impl Viewer {
             Key::Char('7') => self.orbit.look_from(View::TOP, self.framed, aspect),
             Key::Char('9') => self.orbit.look_from(View::ISO, self.framed, aspect),
             Key::Char('5') => self.orbit.toggle_projection(),
-            Key::Char('s') => t.shadows = next_of(&Shadows::CYCLE, t.shadows),
+            Key::Char('s') => t.shadows = next_of(&Shadows::cycle(), t.shadows),
             Key::Char('a') => {
                 t.smoothing = next_of(&[Smoothing::None, Smoothing::Edge, Smoothing::Progressive], t.smoothing);
             }
@@ -602,11 +595,12 @@ mod tests {
     fn toggles_cycle_and_requests_follow_keys() {
         let mut v = viewer();
         let mut seen = vec![v.toggles.shadows];
-        for _ in 1..Shadows::CYCLE.len() {
+        for _ in 1..Shadows::cycle().len() {
             v.apply(Input::Key(Key::Char('s')));
             seen.push(v.toggles.shadows);
         }
-        assert_eq!(seen, Shadows::CYCLE.to_vec());
+        assert_eq!(seen, Shadows::cycle());
+        assert_eq!(seen.len(), 7, "the scene's, five methods, jittered");
         v.apply(Input::Key(Key::Char('s')));
         assert_eq!(v.toggles.shadows, Shadows::Scene);
         let displays = Display::cycle();

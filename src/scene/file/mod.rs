@@ -335,8 +335,7 @@ struct LightRec {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct ShadowRec {
-    #[serde(default)]
-    method: ShadowMethodRec,
+    method: Option<Spanned<String>>,
     resolution: Option<Spanned<i64>>,
     bias: Option<f32>,
     slope: Option<f32>,
@@ -354,17 +353,6 @@ struct ShadowRec {
     points: Option<PointsRec>,
     blockers: Option<Spanned<i64>>,
     filter: Option<Spanned<i64>>,
-}
-
-#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq, Default)]
-#[serde(rename_all = "kebab-case")]
-enum ShadowMethodRec {
-    None,
-    #[default]
-    Map,
-    Slb,
-    Soft,
-    Pcss,
 }
 
 /// `falloff = "linear" | "smooth"` of a two-map penumbra.

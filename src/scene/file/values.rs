@@ -223,7 +223,7 @@ impl SceneFile {
         }
         let origin = self.origin.clone().unwrap_or(Origin { path: "<scene>".into(), text: Arc::from("") });
         let at = SourceLocation::new(origin.path, origin.text, rec.span());
-        let method = ShadowMethod::NAMES.iter().find(|(_, m)| *m == settings.method).map_or("?", |(n, _)| n);
+        let method = settings.method.name();
         let read: Vec<&str> = given.iter().map(|(k, _)| *k).filter(|k| settings.applies(k)).collect();
         let list = |keys: &[&str]| keys.iter().map(|k| format!("`{k}`")).collect::<Vec<_>>().join(", ");
         vec![format!(
@@ -237,13 +237,13 @@ impl SceneFile {
         let mut s = ShadowSettings::default();
         let Some(rec) = rec else { return Ok(s) };
         let r = rec.get_ref();
-        s = s.with_method(match r.method {
-            ShadowMethodRec::None => ShadowMethod::None,
-            ShadowMethodRec::Map => ShadowMethod::Map,
-            ShadowMethodRec::Slb => ShadowMethod::Slb,
-            ShadowMethodRec::Soft => ShadowMethod::Soft,
-            ShadowMethodRec::Pcss => ShadowMethod::Pcss,
-        });
+        if let Some(name) = &r.method {
+            let method = ShadowMethod::named(name.get_ref()).ok_or_else(|| {
+                let names = ShadowMethod::names().iter().map(|n| format!("`{n}`")).collect::<Vec<_>>().join(", ");
+                self.invalid(name.span(), format!("unknown shadow method `{}`; kage has {names}", name.get_ref()))
+            })?;
+            s = s.with_method(method);
+        }
         let count = |v: &Option<Spanned<i64>>, lo: i64, hi: i64, what: &str| -> Result<Option<u32>> {
             match v {
                 Some(n) if !(lo..=hi).contains(n.get_ref()) => {

@@ -84,7 +84,7 @@ pub const SEARCH_REACH: usize = 128;
 const BAND: usize = 16;
 
 /// A light's soft shadow from two (or more) hard shadows.
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 pub struct TwoMaps {
     /// The hard shadows from each of the points (L1, away from the focus,
     /// then L2, towards it; or the ring's).
