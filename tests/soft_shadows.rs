@@ -227,3 +227,83 @@ fn the_passes_shade_with_the_per_pixel_term() {
     }
     assert!(compared > 500 && penumbra > 20, "{compared} floor pixels, {penumbra} in the penumbra");
 }
+
+/// The tile classification from the hard maps' depth bounds never calls a
+/// 16 × 16 tile lit or umbra that holds a pixel the per-pixel lookup
+/// decides otherwise, on the soft-shadow example and the demo with its
+/// lights soft, each at 640 × 360; and it decides umbra tiles and at least
+/// half the tiles that are lit or umbra at every pixel.
+#[test]
+fn tiles_called_lit_or_umbra_are_so_at_every_pixel() {
+    use kage::shadows::soft::tiles::{classify_box, classify_tile, DepthBounds, TileClass};
+    use kage::shadows::{MapTerm, TwoMaps};
+    const TILE: usize = 16;
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenes");
+    for name in ["soft-shadows.toml", "demo.toml"] {
+        let mut scene = kage::scene::file::load_scene(&root.join(name)).expect("the example loads");
+        (scene.width, scene.height) = (640, 360);
+        for light in &mut scene.lights {
+            if light.size > 0.0 {
+                light.shadow = light.shadow.with_method(ShadowMethod::Soft);
+            }
+        }
+        let frame = render(&scene, &RenderOptions::default()).expect("the frame renders");
+        let surfaces = kage::shading::screen_surfaces(&scene, &frame.visibility).all();
+        let (mut decided, mut uniform, mut umbra_tiles, mut tiles, mut boxed) = (0, 0, 0, 0, 0);
+        for light in scene.lights.iter().filter(|l| l.shadow.method == ShadowMethod::Soft) {
+            let term = ShadowTerm::build(&scene, light);
+            let two = term.downcast_ref::<TwoMaps>().expect("a sized light's soft term");
+            let maps: Vec<_> = two
+                .hard()
+                .iter()
+                .map(|h| &h.downcast_ref::<MapTerm>().expect("hard shadows from plain maps").maps()[0])
+                .collect();
+            let bounds: Vec<_> = maps.iter().map(|m| DepthBounds::of(m, 8)).collect();
+            let pairs: Vec<_> = maps.iter().copied().zip(&bounds).collect();
+            let settings = ShadowSettings { pcf: 1, ..light.shadow };
+            let (w, h) = (scene.width as usize, scene.height as usize);
+            for ty in (0..h).step_by(TILE) {
+                for tx in (0..w).step_by(TILE) {
+                    let points: Vec<(Vec3, f32)> = (ty..(ty + TILE).min(h))
+                        .flat_map(|y| (tx..(tx + TILE).min(w)).map(move |x| y * w + x))
+                        .filter_map(|i| surfaces[i].as_ref())
+                        .map(|s| (s.position, s.normal.dot(light.incident(s.position).to_light)))
+                        .filter(|&(_, cos)| cos > 0.0)
+                        .collect();
+                    if points.is_empty() {
+                        continue;
+                    }
+                    tiles += 1;
+                    let each: Vec<f32> =
+                        points.iter().flat_map(|&(p, c)| maps.iter().map(move |m| m.lit(p, c, &settings))).collect();
+                    let (all_lit, all_dark) = (each.iter().all(|&v| v == 1.0), each.iter().all(|&v| v == 0.0));
+                    uniform += usize::from(all_lit || all_dark);
+                    // The same from the points' bounding box alone.
+                    let (lo, hi) = points
+                        .iter()
+                        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &(p, _)| (lo.min(p), hi.max(p)));
+                    match classify_box(&pairs, lo, hi, &settings) {
+                        TileClass::Lit => assert!(all_lit, "{name}: box of tile ({tx}, {ty}) called lit"),
+                        TileClass::Umbra => assert!(all_dark, "{name}: box of tile ({tx}, {ty}) called umbra"),
+                        TileClass::Mixed => {}
+                    }
+                    boxed += usize::from(classify_box(&pairs, lo, hi, &settings) != TileClass::Mixed);
+                    match classify_tile(&pairs, &points, &settings) {
+                        TileClass::Lit => assert!(all_lit, "{name}: tile at ({tx}, {ty}) called lit"),
+                        TileClass::Umbra => assert!(all_dark, "{name}: tile at ({tx}, {ty}) called umbra"),
+                        TileClass::Mixed => continue,
+                    }
+                    decided += 1;
+                    umbra_tiles += usize::from(all_dark);
+                }
+            }
+        }
+        eprintln!(
+            "{name}: {decided} of {tiles} tiles decided by the bounds, {boxed} by their boxes, \
+             {uniform} lit or umbra at every pixel, {umbra_tiles} umbra"
+        );
+        // Measured: 88% (the example) and 79% (the demo) of the uniform tiles.
+        assert!(umbra_tiles > 0, "{name}: no umbra tile decided");
+        assert!(2 * decided >= uniform, "{name}: the bounds decide {decided} of {uniform} uniform tiles");
+    }
+}

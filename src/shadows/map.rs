@@ -66,6 +66,19 @@ pub struct LocatedLanes {
     pub distance: f32x8,
 }
 
+/// What the points of a box can be in a map ([`DepthMap::box_bounds`]).
+#[derive(Debug, Clone, Copy)]
+pub struct BoxBounds {
+    /// The first and last texel (x, y) they fall in, clamped to the map.
+    pub texels: ((u32, u32), (u32, u32)),
+    /// Whether every point falls inside the map.
+    pub inside: bool,
+    /// The least depth limit (reversed depth) of any of them.
+    pub limit_lo: f32,
+    /// The greatest, `None` where a point's limit may reach the light.
+    pub limit_hi: Option<f32>,
+}
+
 /// Depths seen from a light through one camera.
 #[derive(Debug, Clone)]
 pub struct DepthMap {
@@ -148,6 +161,45 @@ impl DepthMap {
         // Perspective: w is the distance along the axis; orthographic: w = 1.
         let d = if self.ortho { (p - self.eye).dot(self.axis) } else { c.w };
         (u >= 0.0 && v >= 0.0 && u < n && v < n).then_some((u, v, d))
+    }
+
+    /// Bounds for every point of the box `lo`..`hi` read with `settings`
+    /// (one tap): the texels they fall in, clamped to the map, whether all
+    /// of them fall inside it, and the least and the greatest depth limit
+    /// any of them can have, whatever its N·L. `None` when part of the box
+    /// lies behind the light or at it.
+    #[must_use]
+    pub fn box_bounds(&self, lo: Vec3, hi: Vec3, settings: &ShadowSettings) -> Option<BoxBounds> {
+        let n = self.resolution as f32;
+        let (mut u0, mut v0, mut u1, mut v1) = (f32::INFINITY, f32::INFINITY, f32::NEG_INFINITY, f32::NEG_INFINITY);
+        let (mut near, mut far) = (f32::INFINITY, f32::NEG_INFINITY);
+        for k in 0..8 {
+            let c = Vec3::new([lo.x, hi.x][k & 1], [lo.y, hi.y][(k >> 1) & 1], [lo.z, hi.z][(k >> 2) & 1]);
+            let clip = self.view_proj * c.extend(1.0);
+            if clip.w <= 0.0 {
+                return None;
+            }
+            let (u, v) = ((clip.x / clip.w * 0.5 + 0.5) * n, (0.5 - clip.y / clip.w * 0.5) * n);
+            let d = if self.ortho { (c - self.eye).dot(self.axis) } else { clip.w };
+            (u0, v0, u1, v1) = (u0.min(u), v0.min(v), u1.max(u), v1.max(v));
+            (near, far) = (near.min(d), far.max(d));
+        }
+        let inside = u0 >= 0.0 && v0 >= 0.0 && u1 < n && v1 < n;
+        let last = n - 1.0;
+        let texel = |u: f32| u.floor().clamp(0.0, last) as u32;
+        // The limit lies `bias + slope · tan` texels before the point, tan
+        // between 0 and MAX_SLOPE; a perspective texel grows with distance.
+        let before = |d: f32, texels: f32| d - texels * if self.ortho { self.texel } else { self.texel * d };
+        let least = before(far, settings.bias);
+        let most = before(near, settings.bias + settings.slope * MAX_SLOPE);
+        Some(BoxBounds {
+            texels: ((texel(u0), texel(v0)), (texel(u1), texel(v1))),
+            inside,
+            // Reversed depth falls with distance; a limit at the light is
+            // lit (no bound from below there).
+            limit_lo: self.reversed(least)?,
+            limit_hi: self.reversed(most),
+        })
     }
 
     /// Where `p` falls in the map and the depth a surface there must be

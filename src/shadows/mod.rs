@@ -29,7 +29,7 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 pub use footprint::{PixelView, Receiver, ReceiverLanes, UNKNOWN_RECEIVER};
-pub use map::{DepthMap, Located, LocatedLanes};
+pub use map::{BoxBounds, DepthMap, Located, LocatedLanes};
 pub use methods::{MapTerm, PcssTerm, SlbTerm, Technique};
 pub use pcss::PcssLight;
 pub use placement::Maps;

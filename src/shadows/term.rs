@@ -12,7 +12,9 @@ use glam::Vec3;
 use wide::f32x8;
 
 use super::footprint::{PixelView, Receiver, ReceiverLanes};
+use super::map::DepthMap;
 use super::screen::ScreenSurfaces;
+use crate::scene::ShadowSettings;
 use crate::visibility::VisibilityBuffer;
 
 /// One light's built shadow term: per frame, per point.
@@ -50,6 +52,13 @@ pub trait LightTerm: Debug + Send + Sync + Any {
     /// Whether the term can shadow anything.
     fn casts(&self) -> bool {
         true
+    }
+
+    /// The one depth map the term reads, one tap a point, and the settings
+    /// it reads it with, when it is that (a plain map's term without PCF):
+    /// its depth bounds then decide whole screen tiles of a soft term.
+    fn one_tap_map(&self) -> Option<(&DepthMap, &ShadowSettings)> {
+        None
     }
 
     /// Bytes its maps hold.
@@ -157,6 +166,12 @@ impl ShadowTerm {
     #[must_use]
     pub fn lit_lanes(&self, p: [f32x8; 3], cos_theta: f32x8, receivers: &ReceiverLanes) -> f32x8 {
         self.0.lit_lanes(p, cos_theta, receivers)
+    }
+
+    /// See [`LightTerm::one_tap_map`].
+    #[must_use]
+    pub fn one_tap_map(&self) -> Option<(&DepthMap, &ShadowSettings)> {
+        self.0.one_tap_map()
     }
 
     /// See [`LightTerm::memory_bytes`].

@@ -71,6 +71,13 @@ impl LightTerm for MapTerm {
         }
     }
 
+    fn one_tap_map(&self) -> Option<(&DepthMap, &ShadowSettings)> {
+        match &self.maps {
+            Maps::One(map) if self.settings.pcf <= 1 => Some((map, &self.settings)),
+            _ => None,
+        }
+    }
+
     fn memory_bytes(&self) -> usize {
         self.maps.faces().iter().map(DepthMap::memory_bytes).sum()
     }

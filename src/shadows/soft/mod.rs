@@ -63,6 +63,7 @@
 
 pub mod edt;
 pub mod penumbra;
+pub mod tiles;
 
 use glam::Vec3;
 use rayon::prelude::*;
@@ -70,9 +71,10 @@ use rayon::prelude::*;
 use wide::f32x8;
 
 use super::screen::{ScreenSurfaces, ScreenTerm, VisibleSurface};
-use super::{PixelView, Receiver, ReceiverLanes, ShadowTerm, UNKNOWN_RECEIVER};
+use super::{DepthMap, PixelView, Receiver, ReceiverLanes, ShadowTerm, UNKNOWN_RECEIVER};
 use crate::scene::{Light, LightKind, PenumbraFalloff, PenumbraPoints, ShadowSettings};
 use penumbra::{visibility_across_cuts, visibility_searched, Zone};
+use tiles::{classify_box, DepthBounds, TileClass};
 
 /// Farthest the paper's search looks for an umbra or lit pixel, in pixels: a
 /// penumbra pixel that finds neither within it is half lit.
@@ -82,6 +84,14 @@ pub const SEARCH_REACH: usize = 128;
 /// triangles a band's pixels show are prepared once for many of them, few
 /// enough that a band's surfaces stay in the worker's cache.
 const BAND: usize = 16;
+
+/// Pixels along a side of the screen tiles the hard maps' depth bounds
+/// decide whole (as many as the rows of a band).
+const TILE: usize = BAND;
+
+/// Texels along a side of the blocks the hard maps' depth bounds are kept
+/// for.
+const BOUND_BLOCK: u32 = 8;
 
 /// A light's soft shadow from two (or more) hard shadows.
 #[derive(Debug)]
@@ -96,6 +106,9 @@ pub struct TwoMaps {
     settings: ShadowSettings,
     /// The term at every pixel of the frame it was last prepared for.
     screen: Option<ScreenTerm>,
+    /// The hard maps' depth bounds, when every hard shadow is one map read
+    /// one tap a point ([`tiles`]); found at the first frame.
+    bounds: Option<Vec<DepthBounds>>,
 }
 
 impl TwoMaps {
@@ -105,7 +118,7 @@ impl TwoMaps {
     pub fn build(light: &Light, bounds: (Vec3, Vec3), mut hard: impl FnMut(&Light) -> ShadowTerm) -> Option<TwoMaps> {
         let (centre, points) = Self::placed(light, bounds)?;
         let hard = points.iter().map(|&p| hard(&Self::moved(light, p))).collect();
-        Some(TwoMaps { hard, points, centre, settings: light.shadow, screen: None })
+        Some(TwoMaps { hard, points, centre, settings: light.shadow, screen: None, bounds: None })
     }
 
     /// The lights the hard shadows of `light` are cast from, as
@@ -187,9 +200,21 @@ impl TwoMaps {
             .zip(cuts.par_chunks_mut(band))
             .zip(distances.par_chunks_mut(band).zip(reach.par_chunks_mut(band)));
         let depth_aware = self.settings.depth_aware && self.settings.search == 0;
+        if self.bounds.is_none() {
+            let maps: Option<Vec<_>> = self.hard.iter().map(|h| h.one_tap_map()).collect();
+            let bounds = maps.map(|maps| maps.par_iter().map(|(m, _)| DepthBounds::of(m, BOUND_BLOCK)).collect());
+            self.bounds = Some(bounds.unwrap_or_default());
+        }
+        let this = &*self;
+        let bounded: Vec<_> = this.hard.iter().filter_map(|h| h.one_tap_map()).map(|(m, _)| m).collect();
+        let pairs: Vec<(&DepthMap, &DepthBounds)> = match &this.bounds {
+            Some(bounds) if !bounds.is_empty() => bounded.into_iter().zip(bounds).collect(),
+            _ => Vec::new(),
+        };
+        let hard_settings = this.hard.first().and_then(|h| h.one_tap_map()).map(|(_, s)| *s);
         bands.enumerate().for_each_init(
-            || (Vec::new(), Vec::new(), Vec::new()),
-            |(seen, footprints, row), (b, (((zones, reached), cuts), (distances, reach)))| {
+            || (Vec::new(), Vec::new(), Vec::new(), Vec::new()),
+            |(seen, footprints, row, classes), (b, (((zones, reached), cuts), (distances, reach)))| {
                 let rows = zones.len() / w;
                 // One row more than the band: its last row's cuts look below.
                 let grid_rows = b * BAND..(b * BAND + rows + 1).min(h);
@@ -203,12 +228,28 @@ impl TwoMaps {
                     }
                 }
                 let inside = rows * w;
+                classes.clear();
+                if let Some(settings) = &hard_settings {
+                    this.classify_tiles(&seen[..inside], w, &pairs, settings, classes);
+                }
+                let all = this.hard.len() as u8;
                 footprints.clear();
                 footprints.resize(seen.len(), 0.0);
                 let eights = seen[..inside].chunks(8).zip(zones.chunks_mut(8).zip(reached.chunks_mut(8)));
                 for (k, (eight, (zones, reached))) in eights.enumerate() {
                     let lanes = Lanes::of(eight);
-                    self.classify(&lanes, zones, reached);
+                    let class = |i: usize| classes.get((k * 8 + i) % w / TILE).copied().unwrap_or(TileClass::Mixed);
+                    if (0..eight.len()).all(|i| class(i) != TileClass::Mixed) {
+                        // A decided tile: what the lookups would say, unasked.
+                        for (i, s) in eight.iter().enumerate() {
+                            (zones[i], reached[i]) = match (s, class(i)) {
+                                (None, _) | (_, TileClass::Lit) => (Zone::Lit, all),
+                                _ => (Zone::Umbra, 0),
+                            };
+                        }
+                    } else {
+                        this.classify(&lanes, zones, reached);
+                    }
                     let (footprint, distance) = surfaces.footprint_lanes(lanes.p, lanes.normal);
                     let (footprint, distance) = (footprint.to_array(), distance.to_array());
                     for (i, s) in eight.iter().enumerate() {
@@ -248,6 +289,37 @@ impl TwoMaps {
             v.par_iter_mut().for_each(|v| *v = disc_share(*v));
         }
         self.screen = Some(surfaces.term((w, h), distances, reach, v));
+    }
+
+    /// The class of each tile of `TILE` columns of the band of rows whose
+    /// surfaces are `seen` (rows of `w`), into `classes`: from the box round
+    /// its surfaces in every hard map ([`classify_box`]); lit only where
+    /// every surface faces the light's centre (one facing away is umbra
+    /// whatever the maps say); lit where none is seen.
+    fn classify_tiles(
+        &self,
+        seen: &[Option<VisibleSurface>],
+        w: usize,
+        pairs: &[(&DepthMap, &DepthBounds)],
+        settings: &ShadowSettings,
+        classes: &mut Vec<TileClass>,
+    ) {
+        for x0 in (0..w).step_by(TILE) {
+            let (mut lo, mut hi, mut facing) = (Vec3::INFINITY, Vec3::NEG_INFINITY, true);
+            let surfaces = seen.chunks(w).flat_map(|row| row[x0..(x0 + TILE).min(w)].iter().flatten());
+            for s in surfaces {
+                (lo, hi) = (lo.min(s.position), hi.max(s.position));
+                facing &= s.normal.dot(self.centre - s.position) > 0.0;
+            }
+            classes.push(if lo.x > hi.x {
+                TileClass::Lit
+            } else {
+                match classify_box(pairs, lo, hi, settings) {
+                    TileClass::Lit if !facing => TileClass::Mixed,
+                    class => class,
+                }
+            });
+        }
     }
 
     /// The zones of up to eight pixels showing `lanes`, and how many of
