@@ -258,7 +258,7 @@ fn tiles_called_lit_or_umbra_are_so_at_every_pixel() {
                 .iter()
                 .map(|h| &h.downcast_ref::<MapTerm>().expect("hard shadows from plain maps").maps()[0])
                 .collect();
-            let bounds: Vec<_> = maps.iter().map(|m| DepthBounds::of(m, 8)).collect();
+            let bounds: Vec<_> = maps.iter().map(|m| DepthBounds::of(m)).collect();
             let pairs: Vec<_> = maps.iter().copied().zip(&bounds).collect();
             let settings = ShadowSettings { pcf: 1, ..light.shadow };
             let (w, h) = (scene.width as usize, scene.height as usize);

@@ -324,6 +324,13 @@ impl DepthMap {
         self.texel_depth(u.floor().clamp(0.0, last) as u32, v.floor().clamp(0.0, last) as u32)
     }
 
+    /// The reversed depth the map holds at every texel, row by row (0:
+    /// nothing).
+    #[must_use]
+    pub fn depths(&self) -> &[f32] {
+        self.depth.depths()
+    }
+
     /// The reversed depth the map holds at texel `(x, y)` (0: nothing).
     #[inline]
     #[must_use]

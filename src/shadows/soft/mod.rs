@@ -89,10 +89,6 @@ const BAND: usize = 16;
 /// decide whole (as many as the rows of a band).
 const TILE: usize = BAND;
 
-/// Texels along a side of the blocks the hard maps' depth bounds are kept
-/// for.
-const BOUND_BLOCK: u32 = 8;
-
 /// A light's soft shadow from two (or more) hard shadows.
 #[derive(Debug)]
 pub struct TwoMaps {
@@ -202,7 +198,7 @@ impl TwoMaps {
         let depth_aware = self.settings.depth_aware && self.settings.search == 0;
         if self.bounds.is_none() {
             let maps: Option<Vec<_>> = self.hard.iter().map(|h| h.one_tap_map()).collect();
-            let bounds = maps.map(|maps| maps.par_iter().map(|(m, _)| DepthBounds::of(m, BOUND_BLOCK)).collect());
+            let bounds = maps.map(|maps| maps.par_iter().map(|(m, _)| DepthBounds::of(m)).collect());
             self.bounds = Some(bounds.unwrap_or_default());
         }
         let this = &*self;

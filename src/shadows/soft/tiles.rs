@@ -8,7 +8,7 @@
 //! by the per-pixel lookup (`tiles_called_lit_or_umbra_are_so_at_every_pixel`
 //! in `tests/soft_shadows.rs` holds it to that on frames of the soft-shadow
 //! example and the demo). With 8 × 8-texel blocks it decides 659 of the 840
-//! lit tiles of the soft-shadow example at 640 × 360 (749 are lit or umbra at
+//! tiles of the soft-shadow example at 640 × 360 (749 are lit or umbra at
 //! every pixel) and 500 of the demo's 760 (636): the bias keeps a surface's
 //! own texels from shadowing it across most of a tile.
 //!
@@ -20,6 +20,8 @@
 //! still send its pixels facing away from the light to the umbra.
 
 use glam::Vec3;
+use rayon::prelude::*;
+use wide::f32x8;
 
 use crate::scene::ShadowSettings;
 use crate::shadows::DepthMap;
@@ -35,10 +37,12 @@ pub enum TileClass {
     Mixed,
 }
 
+/// Texels along a side of the blocks [`DepthBounds`] keeps.
+pub const BLOCK: usize = 8;
+
 /// A map's nearest and farthest depth over square blocks of texels.
 #[derive(Debug, Clone)]
 pub struct DepthBounds {
-    block: u32,
     blocks: u32,
     /// Per block: the smallest and largest reversed depth (the farthest and
     /// the nearest surface).
@@ -47,25 +51,38 @@ pub struct DepthBounds {
 }
 
 impl DepthBounds {
-    /// The bounds of `map` over blocks of `block` × `block` texels.
-    ///
-    /// # Panics
-    ///
-    /// If `block` is 0.
+    /// The bounds of `map` over blocks of [`BLOCK`] × [`BLOCK`] texels:
+    /// eight texels of a row at a time as one vector, folded down the
+    /// block's rows, one row of blocks per task.
     #[must_use]
-    pub fn of(map: &DepthMap, block: u32) -> DepthBounds {
-        assert!(block > 0, "a block holds texels");
-        let res = map.resolution();
-        let blocks = res.div_ceil(block);
-        let (mut lo, mut hi) =
-            (vec![f32::INFINITY; (blocks * blocks) as usize], vec![0f32; (blocks * blocks) as usize]);
-        for y in 0..res {
-            for x in 0..res {
-                let (b, d) = (((y / block) * blocks + x / block) as usize, map.texel_depth(x, y));
-                (lo[b], hi[b]) = (lo[b].min(d), hi[b].max(d));
+    pub fn of(map: &DepthMap) -> DepthBounds {
+        let res = map.resolution() as usize;
+        let blocks = res.div_ceil(BLOCK);
+        let (mut lo, mut hi) = (vec![f32::INFINITY; blocks * blocks], vec![0f32; blocks * blocks]);
+        let rows = map.depths().par_chunks(res * BLOCK);
+        rows.zip(lo.par_chunks_mut(blocks).zip(hi.par_chunks_mut(blocks))).for_each(|(texels, (lo, hi))| {
+            let (mut near, mut far) = (vec![f32x8::ZERO; blocks], vec![f32x8::splat(f32::INFINITY); blocks]);
+            for row in texels.chunks(res) {
+                let runs = row.chunks_exact(BLOCK);
+                let rest = runs.remainder();
+                for ((run, near), far) in runs.zip(near.iter_mut()).zip(far.iter_mut()) {
+                    let run = f32x8::new(run.try_into().expect("eight texels"));
+                    (*near, *far) = (near.max(run), far.min(run));
+                }
+                // A row not a whole number of blocks: its last texels one by one.
+                if let (false, Some(near), Some(far)) = (rest.is_empty(), near.last_mut(), far.last_mut()) {
+                    let mut padded = [rest[0]; BLOCK];
+                    padded[..rest.len()].copy_from_slice(rest);
+                    let run = f32x8::new(padded);
+                    (*near, *far) = (near.max(run), far.min(run));
+                }
             }
-        }
-        DepthBounds { block, blocks, lo, hi }
+            for (b, (near, far)) in near.iter().zip(&far).enumerate() {
+                hi[b] = near.to_array().into_iter().fold(0.0, f32::max);
+                lo[b] = far.to_array().into_iter().fold(f32::INFINITY, f32::min);
+            }
+        });
+        DepthBounds { blocks: blocks as u32, lo, hi }
     }
 
     /// The smallest and largest reversed depth over texels `x0..=x1` ×
@@ -73,8 +90,9 @@ impl DepthBounds {
     #[must_use]
     pub fn range(&self, (x0, y0): (u32, u32), (x1, y1): (u32, u32)) -> (f32, f32) {
         let (mut lo, mut hi) = (f32::INFINITY, 0f32);
-        for by in y0 / self.block..=(y1 / self.block).min(self.blocks - 1) {
-            for bx in x0 / self.block..=(x1 / self.block).min(self.blocks - 1) {
+        let block = BLOCK as u32;
+        for by in y0 / block..=(y1 / block).min(self.blocks - 1) {
+            for bx in x0 / block..=(x1 / block).min(self.blocks - 1) {
                 let b = (by * self.blocks + bx) as usize;
                 (lo, hi) = (lo.min(self.lo[b]), hi.max(self.hi[b]));
             }
@@ -147,5 +165,37 @@ pub fn classify_box(maps: &[(&DepthMap, &DepthBounds)], lo: Vec3, hi: Vec3, sett
         (true, false) => TileClass::Lit,
         (false, true) => TileClass::Umbra,
         _ => TileClass::Mixed,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::shadows::ShadowTerm;
+
+    /// Every block's bounds are its texels' least and greatest depth, for a
+    /// map whose side is not a whole number of blocks.
+    #[test]
+    fn block_bounds_are_their_texels_extremes() {
+        let mut scene = crate::scene::demo::demo_scene().expect("the demo loads");
+        let light = &mut scene.lights[0];
+        (light.shadow.resolution, light.shadow.by_need) = (100, false);
+        let term = ShadowTerm::build(&scene, &scene.lights[0]);
+        let (map, _) = term.one_tap_map().expect("the demo's first light has one plain map");
+        assert_eq!(map.resolution(), 100);
+        let bounds = DepthBounds::of(map);
+        let mut nonzero = 0;
+        for by in 0..13u32 {
+            for bx in 0..13u32 {
+                let texels =
+                    (by * 8..(by * 8 + 8).min(100)).flat_map(|y| (bx * 8..(bx * 8 + 8).min(100)).map(move |x| (x, y)));
+                let depths: Vec<f32> = texels.map(|(x, y)| map.texel_depth(x, y)).collect();
+                let (lo, hi) = bounds.range((bx * 8, by * 8), (bx * 8, by * 8));
+                assert_eq!(lo, depths.iter().copied().fold(f32::INFINITY, f32::min), "block ({bx}, {by})");
+                assert_eq!(hi, depths.iter().copied().fold(0.0, f32::max), "block ({bx}, {by})");
+                nonzero += usize::from(hi > 0.0);
+            }
+        }
+        assert!(nonzero > 10, "the map holds the demo's casters: {nonzero} blocks");
     }
 }
