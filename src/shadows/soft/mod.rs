@@ -49,6 +49,20 @@
 //! ring, `kage-bench soft --defects`). A pixel whose hard shadows do not
 //! overlap (reaching no umbra) takes the share of the points that reach it.
 //!
+//! # Which pixels are looked up
+//!
+//! The frame is taken 16 rows at a time; each 16 × 16 tile's surfaces are
+//! bounded by a box, and where every hard shadow is one plain map read one
+//! tap a point, the box's corners in each map and the map's depth bounds
+//! over 8 × 8-texel blocks ([`tiles`]) decide the whole tile lit or umbra
+//! when they can; only the other tiles' pixels take the hard lookups, eight
+//! at a time. On the 640 × 360 frames of the soft-shadow example and the
+//! demo the boxes decide 653 of 840 and 490 of 760 tiles. The lookups are
+//! not where the term spends its time (on the 1920×1080 demo, 2 threads:
+//! 3–7 ms for the bounds, 44–47 ms finding the surfaces, classifying and
+//! cutting the bands, 24–26 ms for the distances), so deciding tiles saves
+//! a few milliseconds of the stage's 70.
+//!
 //! # How visibility rises across the penumbra
 //!
 //! `falloff = "linear"` is the paper's V = D1/(D1 + D2). `"smooth"` (the
