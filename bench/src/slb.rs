@@ -276,8 +276,10 @@ fn footprint(scene: &Scene) -> (usize, usize) {
 pub fn run(args: &SlbArgs) -> Result<()> {
     let c = &args.common;
     let check = (args.check_width, args.check_height);
-    println!("| scene | method | misclassified | boundary RMSE | bytes | SLB lines | light ms | eye ms | frame ms |");
-    println!("|---|---|---:|---:|---:|---:|---:|---:|---:|");
+    println!(
+        "| scene | method | misclassified | boundary RMSE | bytes | SLB lines | light ms | eye ms | frame ms | shadows serial |"
+    );
+    println!("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|");
     for (name, scene) in scenes(c)? {
         if args.only.as_ref().is_some_and(|o| !name.contains(o.as_str())) {
             continue;
@@ -293,11 +295,12 @@ pub fn run(args: &SlbArgs) -> Result<()> {
             let t = frame_times(&full, c.frames)?;
             let (light, eye, frame) = (t.shadows, t.shading, t.frame);
             println!(
-                "| {name} | {} | {:.3}% | {rmse:.4} | {:.1} M | {} | {light:.1} | {eye:.1} | {frame:.1} |",
+                "| {name} | {} | {:.3}% | {rmse:.4} | {:.1} M | {} | {light:.1} | {eye:.1} | {frame:.1} | {:.0}% |",
                 method.name,
                 100.0 * wrong,
                 bytes as f64 / 1e6,
                 if lines > 0 { lines.to_string() } else { "–".into() },
+                100.0 * t.shadow_serial,
             );
         }
     }
@@ -305,7 +308,8 @@ pub fn run(args: &SlbArgs) -> Result<()> {
         "\nEvery light made a point (no size): the truth is hard shadows. Errors at {}×{} against shadow rays through the BVH (misclassified: visible points facing a light, N·L > \
          0.05, decided lit or not unlike a shadow ray; boundary RMSE: the term against 16 × 16 shadow rays per pixel \
          on the pixels where the rays' own decisions change within 3 × 3); times at {}×{}, median of {} frames after \
-         a warm-up, every map rendered again each frame; the eye pass is the shading (the light pass not in it); 2 \
+         a warm-up, every map rendered again each frame; the eye pass is the shading (the light pass not in it); \
+         shadows serial: the share of the light pass's wall time during which a worker had no work (`kage::idle`); 2 \
          threads.",
         check.0, check.1, c.width, c.height, c.frames
     );

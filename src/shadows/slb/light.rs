@@ -48,6 +48,9 @@ fn facing(points: &[DVec3; 3]) -> Facing {
 /// Texels of band beyond the map's sides that clipping keeps.
 const BAND_TEXELS: f64 = 4.0;
 
+/// Triangles of one mesh one task takes.
+const TRIANGLES_A_TASK: usize = 8192;
+
 /// The mesh triangles of the objects `casters` marks, seen by `camera` in a
 /// `resolution` × `resolution` map.
 #[must_use]
@@ -66,36 +69,39 @@ pub fn light_triangles(scene: &Scene, camera: &Camera, resolution: u32, casters:
         .enumerate()
         .filter(|(i, _)| casters.get(*i).copied().unwrap_or(false))
         .flat_map_iter(|(i, object)| {
-            let mesh = object.triangles().cloned();
+            let Some(mesh) = object.triangles().cloned() else { return Vec::new().into_iter() };
             let m: DMat4 = view_proj * Mat4::from(object.transform).as_dmat4();
-            let clip: Vec<DVec4> = mesh
-                .as_ref()
-                .map_or_else(Vec::new, |mesh| mesh.positions.iter().map(|p| m * p.as_dvec3().extend(1.0)).collect());
-            let codes: Vec<u8> = clip.iter().map(|c| planes.outcode(c.as_vec4())).collect();
-            let mut out = Vec::new();
-            let Some(mesh) = mesh else { return out.into_iter() };
-            for (t, tri) in mesh.triangles.iter().enumerate() {
-                let [a, b, c] = tri.map(|k| k as usize);
-                let (ca, cb, cc) = (codes[a], codes[b], codes[c]);
-                if ca & cb & cc != 0 {
-                    continue; // wholly outside one plane
+            // A large mesh (a scanned model is one object) is cut among the
+            // workers too, not left to the one that took the object.
+            let clip: Vec<DVec4> =
+                mesh.positions.par_iter().with_min_len(4096).map(|p| m * p.as_dvec3().extend(1.0)).collect();
+            let codes: Vec<u8> = clip.par_iter().with_min_len(4096).map(|c| planes.outcode(c.as_vec4())).collect();
+            let pieces = mesh.triangles.par_chunks(TRIANGLES_A_TASK).enumerate();
+            let triangles = pieces.flat_map_iter(|(piece, tris)| {
+                let mut out = Vec::new();
+                for (k, tri) in tris.iter().enumerate() {
+                    let [a, b, c] = tri.map(|k| k as usize);
+                    let (ca, cb, cc) = (codes[a], codes[b], codes[c]);
+                    if ca & cb & cc != 0 {
+                        continue; // wholly outside one plane
+                    }
+                    let corners = [clip[a], clip[b], clip[c]];
+                    let (object, polygon) = (i as u32, (piece * TRIANGLES_A_TASK + k) as u32);
+                    if ca | cb | cc == 0 {
+                        let points = corners.map(to_texels);
+                        out.push(LightTriangle { points, object, polygon, open: 0, facing: facing(&points) });
+                        continue;
+                    }
+                    let mut poly = [DVec4::ZERO; MAX_CLIPPED];
+                    let n = planes.clip(corners, ca | cb | cc, &mut poly);
+                    for j in 1..n.saturating_sub(1) {
+                        let points = [poly[0], poly[j], poly[j + 1]].map(to_texels);
+                        out.push(LightTriangle { points, object, polygon, open: 0, facing: facing(&points) });
+                    }
                 }
-                let corners = [clip[a], clip[b], clip[c]];
-                let object = i as u32;
-                let polygon = t as u32;
-                if ca | cb | cc == 0 {
-                    let points = corners.map(to_texels);
-                    out.push(LightTriangle { points, object, polygon, open: 0, facing: facing(&points) });
-                    continue;
-                }
-                let mut poly = [DVec4::ZERO; MAX_CLIPPED];
-                let k = planes.clip(corners, ca | cb | cc, &mut poly);
-                for j in 1..k.saturating_sub(1) {
-                    let points = [poly[0], poly[j], poly[j + 1]].map(to_texels);
-                    out.push(LightTriangle { points, object, polygon, open: 0, facing: facing(&points) });
-                }
-            }
-            out.into_iter()
+                out
+            });
+            triangles.collect::<Vec<_>>().into_iter()
         })
         .collect()
 }
