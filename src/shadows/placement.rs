@@ -8,9 +8,10 @@
 use glam::{Vec2, Vec3};
 use wide::f32x8;
 
-use super::MapPool;
+use super::{DepthMap, MapPool};
 use crate::camera::{Camera, Projection};
 use crate::scene::{Light, LightKind, Scene, ShadowSettings};
+use crate::visibility::VisibilityBuffer;
 
 /// A light's maps as placed: one, or six round a point (+x, −x, +y, −y, +z,
 /// −z).
@@ -66,6 +67,20 @@ impl<M> Maps<M> {
             Maps::One(map) => Some(map),
             Maps::Cube(faces, centre) => same_cube_face(p, *centre).map(|f| &faces[f]),
         }
+    }
+}
+
+impl Maps<DepthMap> {
+    /// Bytes the depth maps hold.
+    #[must_use]
+    pub fn memory_bytes(&self) -> usize {
+        self.faces().iter().map(DepthMap::memory_bytes).sum()
+    }
+
+    /// The maps given up: the buffers they were drawn in.
+    #[must_use]
+    pub fn into_buffers(self) -> Vec<VisibilityBuffer> {
+        self.into_faces().into_iter().map(DepthMap::into_buffer).collect()
     }
 }
 

@@ -79,11 +79,11 @@ impl LightTerm for MapTerm {
     }
 
     fn memory_bytes(&self) -> usize {
-        self.maps.faces().iter().map(DepthMap::memory_bytes).sum()
+        self.maps.memory_bytes()
     }
 
     fn into_buffers(self: Box<Self>) -> Vec<VisibilityBuffer> {
-        self.maps.into_faces().into_iter().map(DepthMap::into_buffer).collect()
+        self.maps.into_buffers()
     }
 
     fn as_any(&self) -> &dyn Any {
