@@ -19,7 +19,7 @@ shopt -s nullglob globstar
 add scene $repo/tests/data/fuzz/*.toml $repo/examples/scenes/*.toml $repo/tests/regressions/scene/* $findings/**/*.toml $assets/scenes/**/*.toml
 add obj $repo/tests/data/**/*.obj $repo/tests/regressions/obj/**/*.obj $findings/**/*.obj $assets/meshes/**/*.obj
 add stl $repo/tests/data/**/*.stl $assets/csg/ex00*.stl $assets/meshes/**/*.stl
-add gltf $repo/tests/data/fuzz/*.gltf $repo/tests/data/fuzz/*.glb $repo/tests/regressions/gltf/* $findings/**/*.gltf $findings/**/*.glb $assets/gltf/**/*.gltf $assets/gltf/**/*.glb
+add gltf $repo/tests/data/fuzz/*.gltf $repo/tests/data/fuzz/*.glb $repo/tests/data/assets/gltf/**/*.gltf $repo/tests/data/assets/gltf/**/*.glb $repo/tests/regressions/gltf/* $findings/**/*.gltf $findings/**/*.glb $assets/gltf/**/*.gltf $assets/gltf/**/*.glb
 add csg $repo/tests/data/**/*.csg $repo/tests/regressions/csg/* $findings/**/*.csg $assets/csg/*.csg
 add drawing $repo/tests/data/**/*.dxf $repo/tests/data/**/*.svg $repo/tests/regressions/csg/**/*.dxf
 add texture $repo/examples/scenes/*.png $repo/tests/data/**/*.png $repo/tests/data/**/*.jpg $repo/tests/data/**/*.exr $assets/**/*.png

@@ -1,6 +1,7 @@
 //! Texture filtering against a supersampled truth: on a finely checkered ground
 //! running to the horizon, mipmapped trilinear filtering comes much closer to the
-//! average of 64 jittered bilinear frames than bilinear sampling does.
+//! average of 64 jittered bilinear frames than bilinear sampling does. An
+//! image several materials name is decoded once.
 
 mod common;
 
@@ -54,4 +55,31 @@ fn trilinear_mipmapping_approaches_the_supersampled_truth() {
         bilinear.rmse,
         bilinear.share_over
     );
+}
+
+#[test]
+fn materials_naming_one_image_share_its_decoded_texture() {
+    let dir = std::env::temp_dir().join(format!("kage-shared-image-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let repo = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    std::fs::copy(repo.join("tests/data/fuzz/tex.png"), dir.join("tex.png")).unwrap();
+    std::fs::write(
+        dir.join("two.mtl"),
+        "newmtl a\nmap_Kd tex.png\nnewmtl b\nKd 1 0 0\nmap_Kd tex.png\nmap_Ks tex.png\n",
+    )
+    .unwrap();
+    let obj = "mtllib two.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nvt 1 1\n\
+               usemtl a\nf 1/1 2/2 3/3\nusemtl b\nf 2/2 4/4 3/3\n";
+    std::fs::write(dir.join("two.obj"), obj).unwrap();
+    let fs = kage::scene::load::FileSystem { base: dir.clone() };
+    let model = kage::scene::load::model(std::path::Path::new("two.obj"), &fs).unwrap();
+    let maps: Vec<_> = model
+        .parts
+        .iter()
+        .filter_map(|p| p.material.as_ref())
+        .flat_map(|m| m.maps.diffuse.iter().chain(&m.maps.specular))
+        .collect();
+    assert_eq!(maps.len(), 3, "three uses of the image");
+    assert!(maps.iter().all(|t| std::sync::Arc::ptr_eq(t, maps[0])), "decoded once, shared by every use");
+    std::fs::remove_dir_all(&dir).ok();
 }

@@ -71,6 +71,9 @@ pub struct ComponentMaps {
     pub specular: Vec<Arc<Texture>>,
     /// Multiply Ke.
     pub emission: Vec<Arc<Texture>>,
+    /// Multiplies Km (a glTF metal's share of the environment it mirrors,
+    /// where its metalness varies over a texture).
+    pub mirror: Option<Arc<Texture>>,
     /// Tilts the shading normal (glTF's `normalTexture`).
     pub normal: Option<NormalMap>,
     /// How the maps are filtered.

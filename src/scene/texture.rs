@@ -2,6 +2,8 @@
 //! bilinearly at the finest level, or trilinearly at the level matching a
 //! footprint (the texture-space size of the pixel), with a wrap mode.
 
+use std::sync::Arc;
+
 use glam::{Vec2, Vec3};
 
 use crate::image::srgb_to_linear;
@@ -20,6 +22,30 @@ pub enum Wrap {
     /// An equirectangular map: tiles across (longitude goes round), the top
     /// and bottom rows extend (latitude stops at the poles).
     Longitude,
+    /// Its own mode across (u) and down (v), as a glTF sampler gives them.
+    Each(Edge, Edge),
+}
+
+/// One axis's mode, for [`Wrap::Each`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum Edge {
+    /// The image tiles.
+    #[default]
+    Repeat,
+    /// The edge texels extend.
+    Clamp,
+    /// The image tiles, every other copy mirrored.
+    Mirror,
+}
+
+impl From<Edge> for Wrap {
+    fn from(edge: Edge) -> Wrap {
+        match edge {
+            Edge::Repeat => Wrap::Repeat,
+            Edge::Clamp => Wrap::Clamp,
+            Edge::Mirror => Wrap::Mirror,
+        }
+    }
 }
 
 impl Wrap {
@@ -27,6 +53,7 @@ impl Wrap {
     fn axes(self) -> (Wrap, Wrap) {
         match self {
             Wrap::Longitude => (Wrap::Repeat, Wrap::Clamp),
+            Wrap::Each(across, down) => (across.into(), down.into()),
             w => (w, w),
         }
     }
@@ -34,7 +61,8 @@ impl Wrap {
     /// Texel index `i` of a row of `n`, wrapped.
     fn index(self, i: i64, n: i64) -> i64 {
         match self {
-            Wrap::Repeat | Wrap::Longitude => i.rem_euclid(n),
+            // `Each` is split by `axes` before any lookup.
+            Wrap::Repeat | Wrap::Longitude | Wrap::Each(..) => i.rem_euclid(n),
             Wrap::Clamp => i.clamp(0, n - 1),
             Wrap::Mirror => {
                 let k = i.rem_euclid(2 * n);
@@ -127,7 +155,8 @@ fn checked_png_palette(bytes: &[u8]) -> Result<(), String> {
 /// A decoded texture in linear RGB with its mip chain.
 #[derive(Debug, Clone)]
 pub struct Texture {
-    levels: Vec<Level>,
+    /// Shared by the copies that differ in their wrap mode only.
+    levels: Arc<Vec<Level>>,
     /// Wrap mode of every lookup.
     pub wrap: Wrap,
 }
@@ -202,7 +231,7 @@ impl Texture {
             let next = last.halved();
             levels.push(next);
         }
-        Texture { levels, wrap: Wrap::Repeat }
+        Texture { levels: Arc::new(levels), wrap: Wrap::Repeat }
     }
 
     /// Width and height of the finest level, in texels.

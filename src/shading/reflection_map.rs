@@ -11,7 +11,7 @@ use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
 use super::{Component, ObjectFrames, SurfacePoint, Target};
-use crate::scene::Scene;
+use crate::scene::{Material, Scene};
 use crate::visibility::VisibilityBuffer;
 
 /// Adds Km · Mape(R) to every target holding the reflection component, and the
@@ -65,7 +65,7 @@ pub fn add_reflection_map(scene: &Scene, vb: &VisibilityBuffer, targets: &mut [T
                         })
                     };
                     let spread = |n: Option<(i32, i32)>| n.map_or(r, |(nx, ny)| mirror(nx as u32, ny as u32));
-                    let km = scene.materials[s.material].km;
+                    let km = mirrored_share(&scene.materials[s.material], &s);
                     *px += km * env.radiance_over(r, spread(beside(1, 0)), spread(beside(0, 1)));
                 }
             }
@@ -79,11 +79,16 @@ pub fn add_reflection_map(scene: &Scene, vb: &VisibilityBuffer, targets: &mut [T
 /// filters over each pixel's spread of directions).
 #[must_use]
 pub fn reflection_map(scene: &Scene, s: &SurfacePoint) -> Vec3 {
-    let km = scene.materials[s.material].km;
+    let km = mirrored_share(&scene.materials[s.material], s);
     match &scene.environment {
         Some(env) if km.max_element() > 0.0 => km * env.radiance(mirror_direction(s)),
         _ => Vec3::ZERO,
     }
+}
+
+/// Km at `s`: the material's, times its mirror map there.
+fn mirrored_share(m: &Material, s: &SurfacePoint) -> Vec3 {
+    m.km * m.maps.mirror.as_ref().map_or(Vec3::ONE, |t| t.sample_footprint(s.uv, s.duv))
 }
 
 /// R = 2(N·V)N − V.

@@ -344,6 +344,7 @@ impl SceneFile {
                 diffuse: texture(&r.kd_map, true)?,
                 specular: texture(&r.ks_map, true)?,
                 emission: texture(&r.ke_map, true)?,
+                mirror: None,
                 normal: None,
                 filter: match r.filter {
                     FilterRec::Trilinear => Filter::Trilinear,

@@ -6,8 +6,9 @@
 //! when the exact name is absent, and one not found at all is a warning and a
 //! magenta checker. [`material`] documents how `illum` maps to kage's materials.
 
+use std::collections::HashMap;
 use std::io::Cursor;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use glam::{Affine3A, DVec3, Vec2, Vec3};
@@ -16,7 +17,7 @@ use super::{checked, Files, LoadedModel, Part};
 use crate::error::Error;
 use crate::polygon::face_triangles;
 use crate::scene::mesh::{Mesh, NormalMode};
-use crate::scene::Material;
+use crate::scene::{Material, Texture};
 
 /// Parses OBJ bytes; `path` locates the MTL files and textures it names.
 pub(super) fn load(bytes: &[u8], path: &Path, from: Files) -> Result<LoadedModel, String> {
@@ -43,7 +44,10 @@ pub(super) fn load(bytes: &[u8], path: &Path, from: Files) -> Result<LoadedModel
         out.warnings.push(format!("{}: materials not loaded ({e}); using the default material", path.display()));
         Vec::new()
     });
-    let materials: Vec<Material> = materials.iter().map(|m| material(m, dir, from, &mut out.warnings)).collect();
+    // Images several materials name are decoded once.
+    let mut decoded = HashMap::new();
+    let materials: Vec<Material> =
+        materials.iter().map(|m| material(m, dir, from, &mut decoded, &mut out.warnings)).collect();
     let mut first_error = None;
     for m in models {
         let built = mesh(&m.mesh);
@@ -167,12 +171,24 @@ fn mesh(m: &tobj::Mesh) -> Result<(Mesh, crate::scene::mesh::MeshRepairs), Strin
 /// term: models 5 and 7 reflect `Ks` at every angle. Every model takes its
 /// opacity from `d` (or 1 − `Tr` when `d` is absent; 0 is read as opaque outside
 /// the glass models 4 and 9); `Ke` is the emission.
-fn material(m: &tobj::Material, dir: &Path, from: Files, warnings: &mut Vec<String>) -> Material {
+fn material(
+    m: &tobj::Material,
+    dir: &Path,
+    from: Files,
+    decoded: &mut HashMap<PathBuf, Arc<Texture>>,
+    warnings: &mut Vec<String>,
+) -> Material {
     let d = Material::default();
     let v = |c: Option<[f32; 3]>, default: Vec3| c.map_or(default, Vec3::from);
     let mut map = |name: &Option<String>| -> Vec<_> {
         name.iter()
-            .map(|n| super::texture_or_placeholder(&dir.join(n.trim()), true, from.assets, from.limits, warnings))
+            .map(|n| {
+                let path = dir.join(n.trim());
+                let texture = decoded.entry(path).or_insert_with_key(|path| {
+                    super::texture_or_placeholder(path, true, from.assets, from.limits, warnings)
+                });
+                Arc::clone(texture)
+            })
             .collect()
     };
     let kd = v(m.diffuse, d.kd);
@@ -211,6 +227,7 @@ fn material(m: &tobj::Material, dir: &Path, from: Files, warnings: &mut Vec<Stri
             diffuse,
             specular: map(&m.specular_texture),
             emission: Vec::new(),
+            mirror: None,
             normal: None,
             filter: Default::default(),
         },

@@ -5,15 +5,28 @@
 //! Kd = base colour · (1 − metallic), Ka = Kd · occlusion, Ks = mix(0.04, base
 //! colour, metallic), Km = base colour · metallic (a metal mirrors the
 //! environment: a lone model gets a studio one), n = 2/α² − 2 with α =
-//! roughness² (the Blinn-Phong exponent of equal lobe width), Ke = emissive.
-//! The base-colour texture multiplies Kd and Ka; with a metallic-roughness or
-//! occlusion texture, Kd, Ka and Ks are baked into textures texel by texel
-//! (Km and n take the material's mean). `KHR_materials_transmission` makes
-//! Kt = base colour · transmission (Kd scaled by what is not transmitted),
-//! `KHR_materials_ior` the index of refraction. The normal texture tilts the
-//! shading normal (`shading/normal_map.rs`: tangents from the texture
-//! coordinates; a `TANGENT` attribute is not read). Buffers and images may be
-//! files, GLB chunks or `data:` URIs.
+//! roughness² (the Blinn-Phong exponent of equal lobe width), Ke = emissive
+//! (times `KHR_materials_emissive_strength`). The base-colour texture
+//! multiplies Kd and Ka; with a metallic-roughness or occlusion texture, Kd,
+//! Ka, Ks and Km are baked into textures texel by texel (n takes the
+//! material's mean roughness). `KHR_materials_transmission` makes Kt = base colour ·
+//! transmission (Kd scaled by what is not transmitted), `KHR_materials_ior`
+//! the index of refraction; `KHR_materials_unlit` shows the base colour as
+//! emission, unlit. The normal texture tilts the shading normal
+//! (`shading/normal_map.rs`: tangents from the texture coordinates; a
+//! `TANGENT` attribute is not read). Buffers and images may be files, GLB
+//! chunks or `data:` URIs; an image that cannot be read or decoded is a
+//! warning and a magenta checker.
+//!
+//! Geometry: triangle lists, strips and fans (points and lines are skipped,
+//! with a warning); attributes stored as floats or as the integers of
+//! `KHR_mesh_quantization` ([`accessors`]), dense or sparse; a node that
+//! mirrors (negative determinant) has its triangles turned round so their
+//! front faces stay outside. A material's textures are read at one set of
+//! texture coordinates, transformed by its base colour's
+//! `KHR_texture_transform` (a warning where its textures ask for different
+//! ones); each texture wraps as its sampler says. Which extensions are read,
+//! drawn without or refused: [`extensions`].
 
 use std::cell::{Cell, RefCell};
 use std::collections::HashMap;
@@ -23,9 +36,13 @@ use std::sync::Arc;
 use glam::{Affine3A, Mat4, Vec2, Vec3};
 
 use super::{checked, Files, LoadedModel, Part};
+
+mod accessors;
+mod extensions;
 use crate::camera::{Camera, Projection};
 use crate::limits::{Limit, LimitExceeded};
 use crate::scene::mesh::{Mesh, NormalMode};
+use crate::scene::texture::{Edge, Wrap};
 use crate::scene::{ComponentMaps, Falloff, Light, LightKind, Material, NormalMap, Texture};
 
 struct Context<'a> {
@@ -39,6 +56,31 @@ struct Context<'a> {
     placed: Cell<u64>,
     /// Textures decoded so far, by image and colour space: materials share them.
     textures: RefCell<HashMap<(usize, bool), Arc<Texture>>>,
+    /// What was drawn otherwise than the file says (a missing texture).
+    warnings: RefCell<Vec<String>>,
+}
+
+/// The texture coordinates a material's textures are read at: a set
+/// (`TEXCOORD_n`) and a `KHR_texture_transform`.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+struct Coordinates {
+    set: u32,
+    transform: Option<glam::Affine2>,
+}
+
+impl Coordinates {
+    /// Where `info`'s texture is read.
+    fn of(info: &gltf::texture::Info) -> Coordinates {
+        let Some(t) = info.texture_transform() else { return Coordinates { set: info.tex_coord(), transform: None } };
+        // uv' = T · R · S · uv (the extension's own order), R turning
+        // (0, 1) towards (1, 0) by `rotation` (the sample model's arrow
+        // marks the direction).
+        let transform = glam::Affine2::from_translation(Vec2::from(t.offset()))
+            * glam::Affine2::from_angle(-t.rotation())
+            * glam::Affine2::from_scale(Vec2::from(t.scale()));
+        let finite = transform.to_cols_array().iter().all(|v| v.is_finite());
+        Coordinates { set: t.tex_coord().unwrap_or(info.tex_coord()), transform: finite.then_some(transform) }
+    }
 }
 
 /// Parses glTF or GLB bytes; `path` locates external buffers and images
@@ -51,11 +93,14 @@ fn load_contained(bytes: &[u8], path: &Path, from: Files) -> Result<LoadedModel,
     let gltf = gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| e.to_string())?;
     let nodes = gltf.document.as_json().nodes.len() as u64;
     from.limits.check(Limit::GltfNodes, nodes, || "the file's nodes".into()).map_err(|e| e.to_string())?;
+    let mut warnings = Vec::new();
+    let mut json = gltf.document.into_json();
+    extensions::check(&mut json, &mut warnings)?;
     // The gltf crate's own validation indexes some arrays unchecked, and its
     // image sources unwrap: what they assume is checked here first.
-    checked_references(gltf.document.as_json())?;
-    checked_accessors(gltf.document.as_json())?;
-    let document = gltf::Document::from_json(gltf.document.into_json()).map_err(|e| format!("invalid glTF: {e}"))?;
+    checked_references(&json)?;
+    checked_accessors(&json)?;
+    let document = gltf::Document::from_json(json).map_err(|e| format!("invalid glTF: {e}"))?;
     let dir = path.parent().unwrap_or(Path::new(""));
     let buffers = buffers(&document, gltf.blob, dir, from)?;
     let cx = Context {
@@ -66,8 +111,9 @@ fn load_contained(bytes: &[u8], path: &Path, from: Files) -> Result<LoadedModel,
         path,
         placed: Cell::new(0),
         textures: RefCell::new(HashMap::new()),
+        warnings: RefCell::new(warnings),
     };
-    let materials: Vec<Material> = cx.doc.materials().map(|m| cx.material(&m)).collect::<Result<_, _>>()?;
+    let materials: Vec<(Material, Coordinates)> = cx.doc.materials().map(|m| cx.material(&m)).collect();
     let mut model = LoadedModel::default();
     let scene = cx.doc.default_scene().or_else(|| cx.doc.scenes().next()).ok_or("the file has no scene")?;
     for node in scene.nodes() {
@@ -76,6 +122,8 @@ fn load_contained(bytes: &[u8], path: &Path, from: Files) -> Result<LoadedModel,
     if model.parts.is_empty() {
         return Err("the default scene has no triangle meshes".into());
     }
+    let said = cx.warnings.take().into_iter().map(|w| format!("{}: {w}", path.display()));
+    model.warnings.splice(0..0, said);
     Ok(model)
 }
 
@@ -114,18 +162,23 @@ fn checked_accessors(root: &gltf::json::Root) -> Result<(), String> {
     use gltf::json::validation::Checked;
     for (m, mesh) in root.meshes.iter().enumerate() {
         for (p, prim) in mesh.primitives.iter().enumerate() {
-            let mut used: Vec<(&str, usize, &[T], &[C])> = Vec::new();
+            let mut used: Vec<(String, usize, &[T], &[C])> = Vec::new();
             for (semantic, index) in &prim.attributes {
-                let (name, types, components): (&str, &[T], &[C]) = match semantic {
-                    Checked::Valid(Semantic::Positions) => ("POSITION", &[T::Vec3], &[C::F32]),
-                    Checked::Valid(Semantic::Normals) => ("NORMAL", &[T::Vec3], &[C::F32]),
-                    Checked::Valid(Semantic::TexCoords(0)) => ("TEXCOORD_0", &[T::Vec2], &[C::F32, C::U8, C::U16]),
+                // Floats, or the integers KHR_mesh_quantization allows.
+                let (name, types, components): (String, &[T], &[C]) = match semantic {
+                    Checked::Valid(Semantic::Positions) => {
+                        ("POSITION".into(), &[T::Vec3], &[C::F32, C::I8, C::U8, C::I16, C::U16])
+                    }
+                    Checked::Valid(Semantic::Normals) => ("NORMAL".into(), &[T::Vec3], &[C::F32, C::I8, C::I16]),
+                    Checked::Valid(Semantic::TexCoords(n)) => {
+                        (format!("TEXCOORD_{n}"), &[T::Vec2], &[C::F32, C::I8, C::U8, C::I16, C::U16])
+                    }
                     _ => continue,
                 };
                 used.push((name, index.value(), types, components));
             }
             if let Some(i) = prim.indices {
-                used.push(("indices", i.value(), &[T::Scalar], &[C::U8, C::U16, C::U32]));
+                used.push(("indices".into(), i.value(), &[T::Scalar], &[C::U8, C::U16, C::U32]));
             }
             for (what, i, types, components) in used {
                 let fail = |why: &str| Err(format!("mesh {m} primitive {p}: its {what} accessor {i} {why}"));
@@ -136,30 +189,67 @@ fn checked_accessors(root: &gltf::json::Root) -> Result<(), String> {
                 if !types.contains(&t) || !components.contains(&c.0) {
                     return fail(&format!("holds {:?} {t:?} elements, which {what} cannot be", c.0));
                 }
-                if a.sparse.is_some() {
-                    return fail("is sparse, which kage does not read");
-                }
                 if a.count.0 == 0 {
                     return fail("has no elements");
+                }
+                let size = (t.multiplicity() * c.0.size()) as u64;
+                if let Some(sparse) = &a.sparse {
+                    checked_sparse(root, sparse, a.count.0, size).map_err(|why| {
+                        format!("mesh {m} primitive {p}: its {what} accessor {i} is sparse, and its {why}")
+                    })?;
                 }
                 let Some(v) = a.buffer_view else { continue };
                 let view = root
                     .buffer_views
                     .get(v.value())
                     .ok_or_else(|| format!("accessor {i}: no buffer view {}", v.value()))?;
-                let size = (t.multiplicity() * c.0.size()) as u64;
                 let stride = view.byte_stride.map_or(size, |s| s.0 as u64);
                 if stride < size {
                     return fail("steps through its buffer view by less than one element (byteStride)");
                 }
-                let end = (a.count.0 - 1)
-                    .checked_mul(stride)
-                    .and_then(|e| e.checked_add(size + a.byte_offset.map_or(0, |o| o.0)));
-                if end.is_none_or(|end| end > view.byte_length.0) {
+                if !within(view, a.byte_offset.map_or(0, |o| o.0), a.count.0, stride, size) {
                     return fail("reaches past its buffer view");
                 }
             }
         }
+    }
+    Ok(())
+}
+
+/// Whether `count` elements of `size` bytes, `stride` apart from `offset`,
+/// lie within `view`.
+fn within(view: &gltf::json::buffer::View, offset: u64, count: u64, stride: u64, size: u64) -> bool {
+    let end = count.saturating_sub(1).checked_mul(stride).and_then(|e| e.checked_add(size + offset));
+    end.is_some_and(|end| end <= view.byte_length.0)
+}
+
+/// What the gltf crate's sparse reader assumes: at least one and at most
+/// `count` replaced elements, indices and values (of `size` bytes) within
+/// their buffer views.
+fn checked_sparse(
+    root: &gltf::json::Root,
+    sparse: &gltf::json::accessor::sparse::Sparse,
+    count: u64,
+    size: u64,
+) -> Result<(), String> {
+    use gltf::json::validation::Checked;
+    let n = sparse.count.0;
+    if n == 0 || n > count {
+        return Err(format!("count {n} is not between 1 and its accessor's {count}"));
+    }
+    let view = |v: gltf::json::Index<gltf::json::buffer::View>| {
+        root.buffer_views.get(v.value()).ok_or_else(|| format!("buffer view {} is not in the file", v.value()))
+    };
+    let index_size = match sparse.indices.component_type {
+        Checked::Valid(t) => t.0.size() as u64,
+        Checked::Invalid => return Err("indices have an unknown type".into()),
+    };
+    let (indices, values) = (view(sparse.indices.buffer_view)?, view(sparse.values.buffer_view)?);
+    if !within(indices, sparse.indices.byte_offset.0, n, index_size, index_size) {
+        return Err("indices reach past their buffer view".into());
+    }
+    if !within(values, sparse.values.byte_offset.0, n, size, size) {
+        return Err("values reach past their buffer view".into());
     }
     Ok(())
 }
@@ -173,7 +263,7 @@ impl Context<'_> {
         &self,
         node: &gltf::Node,
         parent: Mat4,
-        materials: &[Material],
+        materials: &[(Material, Coordinates)],
         out: &mut LoadedModel,
         above: &mut Vec<usize>,
     ) -> Result<(), String> {
@@ -218,10 +308,11 @@ impl Context<'_> {
         prim: &gltf::Primitive,
         name: &str,
         transform: Affine3A,
-        materials: &[Material],
+        materials: &[(Material, Coordinates)],
         out: &mut LoadedModel,
     ) -> Result<(), String> {
-        if prim.mode() != gltf::mesh::Mode::Triangles {
+        use gltf::mesh::Mode;
+        if !matches!(prim.mode(), Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan) {
             out.warnings.push(format!(
                 "{}: mesh '{name}' uses {:?}, not triangles; skipped",
                 self.path.display(),
@@ -229,55 +320,78 @@ impl Context<'_> {
             ));
             return Ok(());
         }
-        let reader = prim.reader(|b| self.buffers.get(b.index()).map(|d| &d[..]));
-        let positions: Vec<Vec3> =
-            reader.read_positions().ok_or_else(|| format!("mesh '{name}' has no positions"))?.map(Vec3::from).collect();
-        let normals = reader.read_normals().map(|n| n.map(Vec3::from).collect()).unwrap_or_default();
-        let uvs = reader.read_tex_coords(0).map(|t| t.into_f32().map(Vec2::from).collect()).unwrap_or_default();
+        use gltf::mesh::Semantic;
+        let data = |b: gltf::Buffer| self.buffers.get(b.index()).map(|d| &d[..]);
+        let reader = prim.reader(data);
+        let positions: Vec<Vec3> = prim
+            .get(&Semantic::Positions)
+            .and_then(|a| accessors::floats::<3>(&a, data))
+            .ok_or_else(|| format!("mesh '{name}' has no positions"))?
+            .into_iter()
+            .map(Vec3::from)
+            .collect();
+        if prim.get(&Semantic::Colors(0)).is_some() {
+            self.warnings.borrow_mut().push(format!("mesh '{name}' has vertex colours (COLOR_0): drawn without them"));
+        }
+        let normals = prim.get(&Semantic::Normals).and_then(|a| accessors::floats::<3>(&a, data));
+        let normals = normals.map(|n| n.into_iter().map(Vec3::from).collect()).unwrap_or_default();
+        let (material, at) = match prim.material().index().and_then(|i| materials.get(i)) {
+            Some((m, at)) => (Some(m.clone()), *at),
+            None => (None, Coordinates::default()),
+        };
+        let uvs = prim.get(&Semantic::TexCoords(at.set)).and_then(|a| accessors::floats::<2>(&a, data));
+        let uvs = uvs.map_or_else(Vec::new, |uvs| {
+            let uv = uvs.into_iter().map(Vec2::from);
+            match at.transform {
+                Some(t) => uv.map(|uv| t.transform_point2(uv)).collect(),
+                None => uv.collect(),
+            }
+        });
         let indices: Vec<u32> = match reader.read_indices() {
             Some(i) => i.into_u32().collect(),
             None => (0..positions.len() as u32).collect(),
         };
-        let triangles = indices.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+        // A node that mirrors (a negative determinant) turns each triangle's
+        // winding round: turned back, its front faces stay outside.
+        let mirrored = transform.matrix3.determinant() < 0.0;
+        let triangles =
+            triangles(prim.mode(), &indices).map(|[a, b, c]| if mirrored { [a, c, b] } else { [a, b, c] }).collect();
         let built = Mesh::new(positions, normals, uvs, triangles, NormalMode::Smooth);
         let mesh = checked(out, self.path, built, &format!("mesh '{name}'"))?;
-        let material = prim.material().index().and_then(|i| materials.get(i).cloned());
         out.parts.push(Part { name: name.to_string(), mesh: Arc::new(mesh), material, transform, ghost: false });
         Ok(())
     }
 
-    fn material(&self, m: &gltf::Material) -> Result<Material, String> {
+    /// `m` as kage's material, and the texture coordinates its textures are
+    /// read at.
+    fn material(&self, m: &gltf::Material) -> (Material, Coordinates) {
         let pbr = m.pbr_metallic_roughness();
         let [r, g, b, a] = pbr.base_color_factor();
+        let name = m.name().unwrap_or("gltf").to_string();
         let surface = Surface {
             base: Vec3::new(r, g, b),
-            base_map: pbr.base_color_texture().map(|t| self.texture(&t.texture(), true)).transpose()?,
+            base_map: pbr.base_color_texture().map(|t| self.texture(&t.texture(), true)),
             metal: pbr.metallic_factor().clamp(0.0, 1.0),
             roughness: pbr.roughness_factor().clamp(0.0, 1.0),
-            metal_roughness_map: pbr
-                .metallic_roughness_texture()
-                .map(|t| self.texture(&t.texture(), false))
-                .transpose()?,
-            occlusion: m
-                .occlusion_texture()
-                .map(|t| Ok::<_, String>((self.texture(&t.texture(), false)?, t.strength().clamp(0.0, 1.0))))
-                .transpose()?,
+            metal_roughness_map: pbr.metallic_roughness_texture().map(|t| self.texture(&t.texture(), false)),
+            occlusion: m.occlusion_texture().map(|t| (self.texture(&t.texture(), false), t.strength().clamp(0.0, 1.0))),
         };
+        let at = self.coordinates(m, &name);
         let transmission = m.transmission().map_or(0.0, |t| t.transmission_factor().clamp(0.0, 1.0));
         let mut out = surface.material();
-        out.name = m.name().unwrap_or("gltf").to_string();
-        out.ke = Vec3::from(m.emissive_factor());
-        out.maps.emission =
-            m.emissive_texture().map(|t| self.texture(&t.texture(), true)).transpose()?.into_iter().collect();
+        out.name = name;
+        let strength = m.emissive_strength().filter(|s| s.is_finite() && *s >= 0.0).unwrap_or(1.0);
+        out.ke = Vec3::from(m.emissive_factor()) * strength;
+        out.maps.emission = m.emissive_texture().map(|t| self.texture(&t.texture(), true)).into_iter().collect();
         out.maps.normal = m
             .normal_texture()
-            .map(|t| Ok::<_, String>(NormalMap { texture: self.texture(&t.texture(), false)?, scale: t.scale() }))
-            .transpose()?
+            .map(|t| NormalMap { texture: self.texture(&t.texture(), false), scale: t.scale() })
             .filter(|n| n.scale.is_finite() && n.scale != 0.0);
         out.two_sided = m.double_sided();
         // BLEND materials are translucent with the base colour's alpha; MASK and
-        // OPAQUE ones are drawn opaque (alpha cut-outs are not supported).
+        // OPAQUE ones are drawn opaque.
         out.opacity = if m.alpha_mode() == gltf::material::AlphaMode::Blend { a.clamp(0.0, 1.0) } else { 1.0 };
+        self.warn_alpha(m, &out.name);
         if transmission > 0.0 {
             // Light through the surface, tinted by the base colour, bent by
             // the index of refraction; what goes through is not diffused.
@@ -287,36 +401,146 @@ impl Context<'_> {
             out.kr = Vec3::splat(0.04 * transmission);
         }
         out.ior = m.ior().filter(|n| n.is_finite() && *n >= 1.0).unwrap_or(1.5);
-        Ok(out)
+        if m.unlit() {
+            // KHR_materials_unlit: the base colour as it is, lit or not.
+            out = Material {
+                name: out.name,
+                ka: Vec3::ZERO,
+                kd: Vec3::ZERO,
+                ks: Vec3::ZERO,
+                ke: surface.base,
+                opacity: out.opacity,
+                two_sided: out.two_sided,
+                maps: ComponentMaps { emission: surface.base_map.into_iter().collect(), ..ComponentMaps::default() },
+                ..Material::default()
+            };
+        }
+        (out, at)
     }
 
-    /// The texture of `t`'s image, decoded once however many materials use it.
-    fn texture(&self, t: &gltf::Texture, srgb: bool) -> Result<Arc<Texture>, String> {
+    /// The coordinates `m`'s textures are read at: its base colour's (else
+    /// its first texture's); a warning when its other textures ask for
+    /// others.
+    fn coordinates(&self, m: &gltf::Material, name: &str) -> Coordinates {
+        let pbr = m.pbr_metallic_roughness();
+        let infos = [pbr.base_color_texture(), pbr.metallic_roughness_texture(), m.emissive_texture()];
+        let all: Vec<Coordinates> = infos.iter().flatten().map(Coordinates::of).collect();
+        // A normal or occlusion texture's own transform does not reach here
+        // (the gltf crate drops it): its set is compared alone.
+        let sets = [m.normal_texture().map(|t| t.tex_coord()), m.occlusion_texture().map(|t| t.tex_coord())];
+        let sets: Vec<u32> = all.iter().map(|c| c.set).chain(sets.into_iter().flatten()).collect();
+        let first =
+            all.first().copied().unwrap_or(Coordinates { set: sets.first().copied().unwrap_or(0), transform: None });
+        let (set_only, transformed) = (sets.iter().any(|&s| s != first.set), all.iter().any(|c| *c != first));
+        if set_only || transformed {
+            self.warnings.borrow_mut().push(format!(
+                "material '{name}': its textures are read at different texture coordinates{}; all are drawn at its \
+                 first texture's (TEXCOORD_{})",
+                if set_only { "" } else { " or transforms" },
+                first.set
+            ));
+        }
+        first
+    }
+
+    /// Warns where `m`'s alpha is not drawn as the file asks.
+    fn warn_alpha(&self, m: &gltf::Material, name: &str) {
+        use gltf::material::AlphaMode;
+        let textured = m.pbr_metallic_roughness().base_color_texture().is_some();
+        let why = match m.alpha_mode() {
+            AlphaMode::Mask => Some("is alpha-masked (MASK): drawn opaque, without its cut-outs"),
+            AlphaMode::Blend if textured => {
+                Some("blends by its base-colour texture's alpha (BLEND): drawn with its factor's alpha only")
+            }
+            _ => None,
+        };
+        if let Some(why) = why {
+            self.warnings.borrow_mut().push(format!("material '{name}' {why}"));
+        }
+    }
+
+    /// The texture of `t`'s image, decoded once however many materials use
+    /// it; one that cannot be read or decoded is a warning and a magenta
+    /// checker ([`super::placeholder`]).
+    fn texture(&self, t: &gltf::Texture, srgb: bool) -> Arc<Texture> {
+        let decoded = self.decoded(t, srgb);
+        let wrap = wrap(t.sampler());
+        if decoded.wrap == wrap {
+            return decoded;
+        }
+        // The decoded image is shared; only the wrap mode is the texture's own.
+        let mut texture = Texture::clone(&decoded);
+        texture.wrap = wrap;
+        Arc::new(texture)
+    }
+
+    /// The image of `t` decoded (once per image and colour space), wrapping
+    /// as it may.
+    fn decoded(&self, t: &gltf::Texture, srgb: bool) -> Arc<Texture> {
         let key = (t.source().index(), srgb);
         if let Some(done) = self.textures.borrow().get(&key) {
-            return Ok(Arc::clone(done));
+            return Arc::clone(done);
         }
         let limits = self.from.limits;
         let bytes = match t.source().source() {
-            gltf::image::Source::View { view, .. } => {
-                let data = self.buffers.get(view.buffer().index()).ok_or("image view of a missing buffer")?;
-                let range = view.offset()..view.offset().saturating_add(view.length());
-                data.get(range).ok_or("image view outside its buffer")?.to_vec()
-            }
-            gltf::image::Source::Uri { uri, .. } if uri.starts_with("data:") => data_uri(uri)?,
+            gltf::image::Source::View { view, .. } => self
+                .buffers
+                .get(view.buffer().index())
+                .ok_or_else(|| "its buffer view's buffer is missing".to_string())
+                .and_then(|data| {
+                    let range = view.offset()..view.offset().saturating_add(view.length());
+                    data.get(range).map(<[u8]>::to_vec).ok_or_else(|| "its buffer view is outside its buffer".into())
+                }),
+            gltf::image::Source::Uri { uri, .. } if uri.starts_with("data:") => data_uri(uri),
             gltf::image::Source::Uri { uri, .. } => {
                 let path = self.dir.join(percent_decoded(uri));
-                let texture =
-                    crate::scene::load::texture(&path, srgb, self.from.assets, limits).map_err(|e| e.to_string())?;
+                let mut warnings = self.warnings.borrow_mut();
+                let texture = super::texture_or_placeholder(&path, srgb, self.from.assets, limits, &mut warnings);
                 self.textures.borrow_mut().insert(key, Arc::clone(&texture));
-                return Ok(texture);
+                return texture;
             }
         };
-        let texture = Texture::decode(&bytes, srgb, limits)
-            .map(Arc::new)
-            .map_err(|e| format!("embedded image {}: {e}", t.index()))?;
+        let texture = bytes.and_then(|bytes| Texture::decode(&bytes, srgb, limits)).map(Arc::new).unwrap_or_else(|e| {
+            let image = t.source().index();
+            self.warnings.borrow_mut().push(format!("embedded image {image}: {e}; drawn as a magenta checker"));
+            super::placeholder()
+        });
         self.textures.borrow_mut().insert(key, Arc::clone(&texture));
-        Ok(texture)
+        texture
+    }
+}
+
+/// The triangles a list, strip or fan of `indices` makes, front faces
+/// wound as the glTF specification says (a strip's every other triangle
+/// turned round; a fan's round its first vertex).
+fn triangles(mode: gltf::mesh::Mode, indices: &[u32]) -> Box<dyn Iterator<Item = [u32; 3]> + '_> {
+    use gltf::mesh::Mode;
+    let runs = indices.len().saturating_sub(2);
+    match mode {
+        Mode::TriangleStrip => Box::new((0..runs).map(move |i| {
+            let v = |k: usize| indices[i + k];
+            if i % 2 == 0 {
+                [v(0), v(1), v(2)]
+            } else {
+                [v(1), v(0), v(2)]
+            }
+        })),
+        Mode::TriangleFan => Box::new((0..runs).map(move |i| [indices[i + 1], indices[i + 2], indices[0]])),
+        _ => Box::new(indices.chunks_exact(3).map(|c| [c[0], c[1], c[2]])),
+    }
+}
+
+/// The wrap modes of a glTF sampler.
+fn wrap(sampler: gltf::texture::Sampler) -> Wrap {
+    use gltf::texture::WrappingMode;
+    let edge = |mode| match mode {
+        WrappingMode::ClampToEdge => Edge::Clamp,
+        WrappingMode::MirroredRepeat => Edge::Mirror,
+        WrappingMode::Repeat => Edge::Repeat,
+    };
+    match (edge(sampler.wrap_s()), edge(sampler.wrap_t())) {
+        (Edge::Repeat, Edge::Repeat) => Wrap::Repeat,
+        (across, down) => Wrap::Each(across, down),
     }
 }
 
@@ -364,30 +588,32 @@ impl Surface {
                 ..Material::default()
             };
         };
-        // One lookup of the textures per texel, for all three maps.
-        let [diffuse, ambient, specular] = bake(size, |uv| {
+        // One lookup of the textures per texel, for all four maps.
+        let [diffuse, ambient, specular, mirror] = bake(size, |uv| {
             let (base, metal, _, occlusion) = self.at(uv);
             let kd = base * (1.0 - metal);
-            [kd, kd * occlusion, Vec3::splat(0.04).lerp(base, metal)]
+            [kd, kd * occlusion, Vec3::splat(0.04).lerp(base, metal), base * metal]
         });
-        // Km and the exponent take one value per material: their means.
+        // The exponent takes one value per material: the mean roughness's.
         let n = 64usize;
         let samples = (0..n * n).map(|i| Vec2::new((i % n) as f32 + 0.5, (i / n) as f32 + 0.5) / n as f32);
-        let (mirror, rough) = samples.fold((Vec3::ZERO, 0.0), |(m, r), uv| {
-            let (base, metal, roughness, _) = self.at(uv);
-            (m + base * metal, r + roughness)
+        let (metal, rough) = samples.fold((0.0, 0.0), |(m, r), uv| {
+            let (_, metal, roughness, _) = self.at(uv);
+            (m + metal, r + roughness)
         });
         let count = (n * n) as f32;
         Material {
             ka: Vec3::ONE,
             kd: Vec3::ONE,
             ks: Vec3::ONE,
-            km: mirror / count,
+            // A metal anywhere: Km from the baked map, texel by texel.
+            km: if metal > 0.0 { Vec3::ONE } else { Vec3::ZERO },
             shininess: shininess(rough / count),
             maps: ComponentMaps {
                 ambient: vec![ambient],
                 diffuse: vec![diffuse],
                 specular: vec![specular],
+                mirror: (metal > 0.0).then_some(mirror),
                 ..ComponentMaps::default()
             },
             ..Material::default()
@@ -412,11 +638,11 @@ fn shininess(roughness: f32) -> f32 {
     (2.0 / (alpha * alpha) - 2.0).clamp(1.0, 2048.0)
 }
 
-/// Three `width × height` textures of `f`'s three values at each texel
+/// Four `width × height` textures of `f`'s four values at each texel
 /// centre's uv.
-fn bake((width, height): (u32, u32), f: impl Fn(Vec2) -> [Vec3; 3] + Sync) -> [Arc<Texture>; 3] {
+fn bake((width, height): (u32, u32), f: impl Fn(Vec2) -> [Vec3; 4] + Sync) -> [Arc<Texture>; 4] {
     use rayon::prelude::*;
-    let texels: Vec<[Vec3; 3]> = (0..width * height)
+    let texels: Vec<[Vec3; 4]> = (0..width * height)
         .into_par_iter()
         .map(|i| {
             f(Vec2::new((i % width) as f32 + 0.5, (i / width) as f32 + 0.5) / Vec2::new(width as f32, height as f32))
@@ -546,4 +772,35 @@ fn light(l: &gltf::khr_lights_punctual::Light, at: Affine3A) -> Result<Light, St
         falloff,
         ..Light::default()
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A 2 × 1 texture: `left` and `right`.
+    fn two_texels(left: Vec3, right: Vec3) -> Arc<Texture> {
+        Arc::new(Texture::from_texels(2, 1, vec![left, right]))
+    }
+
+    #[test]
+    fn a_metal_only_where_its_texture_says_mirrors_only_there() {
+        // Red base; metal on the left half (blue channel), not on the right.
+        let surface = Surface {
+            base: Vec3::new(0.8, 0.1, 0.1),
+            base_map: None,
+            metal: 1.0,
+            roughness: 0.5,
+            metal_roughness_map: Some(two_texels(Vec3::new(0.0, 1.0, 1.0), Vec3::new(0.0, 1.0, 0.0))),
+            occlusion: None,
+        };
+        let m = surface.material();
+        let mirror = m.maps.mirror.as_ref().expect("a mirror map");
+        let (left, right) = (Vec2::new(0.25, 0.5), Vec2::new(0.75, 0.5));
+        let km = |uv| m.km * mirror.sample(uv);
+        let kd = |uv| m.kd * m.maps.diffuse[0].sample(uv);
+        assert!((km(left) - surface.base).abs().max_element() < 0.05, "metal half mirrors its base: {}", km(left));
+        assert!(km(right).max_element() < 0.05, "the other half does not mirror: {}", km(right));
+        assert!(kd(left).max_element() < 0.05 && (kd(right) - surface.base).abs().max_element() < 0.05);
+    }
 }
