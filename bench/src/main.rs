@@ -15,6 +15,7 @@ mod rays;
 mod share;
 mod slb;
 mod soft;
+mod textures;
 mod view;
 
 use std::path::PathBuf;
@@ -72,6 +73,9 @@ enum Command {
     /// distance transform, depth-aware, on maps or SLBs), PCSS and the
     /// jittered light against the ray-traced area-light truth.
     Soft(soft::SoftArgs),
+    /// What textures cost a frame: each textured corpus model beside itself
+    /// with its texture maps taken away, its load time and decoded bytes.
+    Textures(textures::TexturesArgs),
     /// The preview window (`kage view`, under Xvfb) orbiting a scene beside
     /// f3d offscreen on Mesa: launch to first image, ms per frame, time to the
     /// 64-pass image.
@@ -187,6 +191,7 @@ fn main() -> miette::Result<()> {
         Command::ShadowShare(args) => share::run(&args),
         Command::Slb(args) => slb::run(&args),
         Command::Soft(args) => soft::run(&args),
+        Command::Textures(args) => textures::run(&args),
         Command::View(args) => view::run(&args),
     }
 }

@@ -240,6 +240,13 @@ impl Texture {
         (self.levels[0].width, self.levels[0].height)
     }
 
+    /// Bytes its levels hold (shared by the copies that differ in their
+    /// wrap mode only).
+    #[must_use]
+    pub fn memory_bytes(&self) -> usize {
+        self.levels.iter().map(|l| l.texels.len() * std::mem::size_of::<Vec3>()).sum()
+    }
+
     /// Bilinear sample of the finest level at `uv` (origin top-left, texel centres
     /// at +0.5).
     #[must_use]

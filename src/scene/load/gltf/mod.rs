@@ -35,10 +35,10 @@ use std::sync::Arc;
 
 use glam::{Affine3A, Mat4, Vec2, Vec3};
 
-use super::{checked, Files, LoadedModel, Part};
-
 mod accessors;
 mod extensions;
+
+use super::{checked, Files, LoadedModel, Part};
 use crate::camera::{Camera, Projection};
 use crate::limits::{Limit, LimitExceeded};
 use crate::scene::mesh::{Mesh, NormalMode};
@@ -113,6 +113,7 @@ fn load_contained(bytes: &[u8], path: &Path, from: Files) -> Result<LoadedModel,
         textures: RefCell::new(HashMap::new()),
         warnings: RefCell::new(warnings),
     };
+    cx.decode_all();
     let materials: Vec<(Material, Coordinates)> = cx.doc.materials().map(|m| cx.material(&m)).collect();
     let mut model = LoadedModel::default();
     let scene = cx.doc.default_scene().or_else(|| cx.doc.scenes().next()).ok_or("the file has no scene")?;
@@ -153,9 +154,10 @@ fn checked_references(root: &gltf::json::Root) -> Result<(), String> {
 }
 
 /// What the gltf crate's reader assumes of the accessors kage reads (positions,
-/// normals, the first texture coordinates, indices) and does not check: their
-/// element type (indices of floats are `unreachable!` to it), at least one
-/// element, every element inside the buffer view, no sparse storage.
+/// normals, texture coordinates, indices) and does not check: their element
+/// type (indices of floats are `unreachable!` to it), at least one element,
+/// every element inside the buffer view, a sparse accessor's indices and
+/// values inside theirs.
 fn checked_accessors(root: &gltf::json::Root) -> Result<(), String> {
     use gltf::json::accessor::{ComponentType as C, Type as T};
     use gltf::json::mesh::Semantic;
@@ -481,33 +483,72 @@ impl Context<'_> {
         if let Some(done) = self.textures.borrow().get(&key) {
             return Arc::clone(done);
         }
-        let limits = self.from.limits;
-        let bytes = match t.source().source() {
-            gltf::image::Source::View { view, .. } => self
-                .buffers
-                .get(view.buffer().index())
-                .ok_or_else(|| "its buffer view's buffer is missing".to_string())
-                .and_then(|data| {
-                    let range = view.offset()..view.offset().saturating_add(view.length());
-                    data.get(range).map(<[u8]>::to_vec).ok_or_else(|| "its buffer view is outside its buffer".into())
-                }),
-            gltf::image::Source::Uri { uri, .. } if uri.starts_with("data:") => data_uri(uri),
-            gltf::image::Source::Uri { uri, .. } => {
-                let path = self.dir.join(percent_decoded(uri));
-                let mut warnings = self.warnings.borrow_mut();
-                let texture = super::texture_or_placeholder(&path, srgb, self.from.assets, limits, &mut warnings);
-                self.textures.borrow_mut().insert(key, Arc::clone(&texture));
-                return texture;
-            }
-        };
-        let texture = bytes.and_then(|bytes| Texture::decode(&bytes, srgb, limits)).map(Arc::new).unwrap_or_else(|e| {
-            let image = t.source().index();
-            self.warnings.borrow_mut().push(format!("embedded image {image}: {e}; drawn as a magenta checker"));
-            super::placeholder()
-        });
+        let texture = decode(&self.buffers, self.dir, self.from, t, srgb, &mut self.warnings.borrow_mut());
         self.textures.borrow_mut().insert(key, Arc::clone(&texture));
         texture
     }
+
+    /// Decodes every image the materials use, in each colour space they
+    /// use it in, on all workers at once (a helmet's five 2048² images take
+    /// about one worker's time each); the materials then find them decoded.
+    fn decode_all(&self) {
+        use rayon::prelude::*;
+        let mut wanted: Vec<(gltf::Texture, bool)> = Vec::new();
+        for m in self.doc.materials() {
+            let pbr = m.pbr_metallic_roughness();
+            let colour = [pbr.base_color_texture(), m.emissive_texture()].into_iter().flatten().map(|i| i.texture());
+            let data = pbr.metallic_roughness_texture().map(|i| i.texture());
+            let data = data.into_iter().chain(m.occlusion_texture().map(|t| t.texture()));
+            let data = data.chain(m.normal_texture().map(|t| t.texture()));
+            wanted.extend(colour.map(|t| (t, true)).chain(data.map(|t| (t, false))));
+        }
+        wanted.sort_by_key(|(t, srgb)| (t.source().index(), *srgb));
+        wanted.dedup_by_key(|(t, srgb)| (t.source().index(), *srgb));
+        let (buffers, dir, from) = (&self.buffers, self.dir, self.from);
+        let decoded: Vec<_> = wanted
+            .par_iter()
+            .map(|(t, srgb)| {
+                let mut warnings = Vec::new();
+                let texture = decode(buffers, dir, from, t, *srgb, &mut warnings);
+                ((t.source().index(), *srgb), texture, warnings)
+            })
+            .collect();
+        for (key, texture, warnings) in decoded {
+            self.textures.borrow_mut().insert(key, texture);
+            self.warnings.borrow_mut().extend(warnings);
+        }
+    }
+}
+
+/// The image of `t` decoded from `buffers` or a file beside the model (in
+/// `dir`, read through `from`); one that cannot be read or decoded is a
+/// warning in `warnings` and a magenta checker.
+fn decode(
+    buffers: &[Vec<u8>],
+    dir: &Path,
+    from: Files,
+    t: &gltf::Texture,
+    srgb: bool,
+    warnings: &mut Vec<String>,
+) -> Arc<Texture> {
+    let bytes = match t.source().source() {
+        gltf::image::Source::View { view, .. } => buffers
+            .get(view.buffer().index())
+            .ok_or_else(|| "its buffer view's buffer is missing".to_string())
+            .and_then(|data| {
+                let range = view.offset()..view.offset().saturating_add(view.length());
+                data.get(range).map(<[u8]>::to_vec).ok_or_else(|| "its buffer view is outside its buffer".into())
+            }),
+        gltf::image::Source::Uri { uri, .. } if uri.starts_with("data:") => data_uri(uri),
+        gltf::image::Source::Uri { uri, .. } => {
+            let path = dir.join(percent_decoded(uri));
+            return super::texture_or_placeholder(&path, srgb, from.assets, from.limits, warnings);
+        }
+    };
+    bytes.and_then(|bytes| Texture::decode(&bytes, srgb, from.limits)).map(Arc::new).unwrap_or_else(|e| {
+        warnings.push(format!("embedded image {}: {e}; drawn as a magenta checker", t.source().index()));
+        super::placeholder()
+    })
 }
 
 /// The triangles a list, strip or fan of `indices` makes, front faces
