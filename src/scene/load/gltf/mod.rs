@@ -630,11 +630,21 @@ impl Surface {
             };
         };
         // One lookup of the textures per texel, for all four maps.
-        let [diffuse, ambient, specular, mirror] = bake(size, |uv| {
-            let (base, metal, _, occlusion) = self.at(uv);
-            let kd = base * (1.0 - metal);
-            [kd, kd * occlusion, Vec3::splat(0.04).lerp(base, metal), base * metal]
-        });
+        // Without an occlusion texture Ka is Kd texel for texel: one map,
+        // sampled once for both.
+        let [diffuse, ambient, specular, mirror] = if self.occlusion.is_some() {
+            bake(size, |uv| {
+                let (base, metal, _, occlusion) = self.at(uv);
+                let kd = base * (1.0 - metal);
+                [kd, kd * occlusion, Vec3::splat(0.04).lerp(base, metal), base * metal]
+            })
+        } else {
+            let [diffuse, specular, mirror] = bake(size, |uv| {
+                let (base, metal, _, _) = self.at(uv);
+                [base * (1.0 - metal), Vec3::splat(0.04).lerp(base, metal), base * metal]
+            });
+            [Arc::clone(&diffuse), diffuse, specular, mirror]
+        };
         // The exponent takes one value per material: the mean roughness's.
         let n = 64usize;
         let samples = (0..n * n).map(|i| Vec2::new((i % n) as f32 + 0.5, (i / n) as f32 + 0.5) / n as f32);
@@ -679,11 +689,11 @@ fn shininess(roughness: f32) -> f32 {
     (2.0 / (alpha * alpha) - 2.0).clamp(1.0, 2048.0)
 }
 
-/// Four `width × height` textures of `f`'s four values at each texel
+/// `N` `width × height` textures of `f`'s `N` values at each texel
 /// centre's uv.
-fn bake((width, height): (u32, u32), f: impl Fn(Vec2) -> [Vec3; 4] + Sync) -> [Arc<Texture>; 4] {
+fn bake<const N: usize>((width, height): (u32, u32), f: impl Fn(Vec2) -> [Vec3; N] + Sync) -> [Arc<Texture>; N] {
     use rayon::prelude::*;
-    let texels: Vec<[Vec3; 4]> = (0..width * height)
+    let texels: Vec<[Vec3; N]> = (0..width * height)
         .into_par_iter()
         .map(|i| {
             f(Vec2::new((i % width) as f32 + 0.5, (i / width) as f32 + 0.5) / Vec2::new(width as f32, height as f32))
@@ -843,5 +853,7 @@ mod tests {
         assert!((km(left) - surface.base).abs().max_element() < 0.05, "metal half mirrors its base: {}", km(left));
         assert!(km(right).max_element() < 0.05, "the other half does not mirror: {}", km(right));
         assert!(kd(left).max_element() < 0.05 && (kd(right) - surface.base).abs().max_element() < 0.05);
+        // No occlusion texture: Ka is Kd's map, one texture sampled once.
+        assert!(Arc::ptr_eq(&m.maps.ambient[0], &m.maps.diffuse[0]));
     }
 }
