@@ -1,6 +1,7 @@
 //! The Khronos glTF sample models that test one feature each, judged by
 //! their own markers: a card whose failing cases show red crosses shows
-//! none, a texture-transform card's arrows reach their green targets, a
+//! none, vertex colours draw the ticks their texture twin does, a
+//! texture-transform card's arrows reach their green targets, a
 //! sparse accessor's replaced vertices stand where the file puts them, a
 //! quantized file draws as its float original does, strips and fans are
 //! drawn, a compressed file the reader cannot decode is refused by name,
@@ -94,6 +95,21 @@ fn the_negative_scale_and_texture_settings_cards_show_no_red_cross() {
         assert!(green > 100, "{model}: its green ticks show ({green} pixels)");
         let red = pixels(&frame, red).len();
         assert!(red < 10, "{model}: {red} pixels of red crosses");
+    }
+}
+
+#[test]
+fn the_vertex_colour_cards_top_row_matches_its_textured_row() {
+    let Some(path) = asset("VertexColorTest/VertexColorTest.glb") else { return };
+    let (_, frame) = front_on(&path, (480, 360));
+    // The top row's ticks are vertex colours, the bottom row's a texture:
+    // the same red and green ticks above and below the middle (without
+    // vertex colours the top row shows crosses: 385 red pixels against 752).
+    for (name, is) in [("red", red as fn(Vec3) -> bool), ("green", green)] {
+        let shown = pixels(&frame, is);
+        let above = shown.iter().filter(|&&(_, y)| y < 180).count() as f32;
+        let below = shown.len() as f32 - above;
+        assert!(below > 300.0 && (above / below - 1.0).abs() < 0.15, "{name}: {above} above, {below} below");
     }
 }
 

@@ -19,6 +19,9 @@ pub struct Mesh {
     pub uvs: Vec<Vec2>,
     /// Triangles as vertex indices, counter-clockwise seen from the front.
     pub triangles: Vec<[u32; 3]>,
+    /// Linear RGB vertex colours, one per position, or empty: they multiply
+    /// the material's ambient and diffuse colours (glTF's `COLOR_0`).
+    pub colors: Vec<Vec3>,
 }
 
 /// What [`Mesh::new`] had to drop.
@@ -72,7 +75,8 @@ impl Mesh {
         }
         let uvs = if uvs.len() == positions.len() { uvs } else { Vec::new() };
         let normals_ok = normals.len() == positions.len() && normals.iter().all(|v| v.is_finite());
-        let mut mesh = Mesh { positions, normals: if normals_ok { normals } else { Vec::new() }, uvs, triangles };
+        let normals = if normals_ok { normals } else { Vec::new() };
+        let mut mesh = Mesh { positions, normals, uvs, triangles, colors: Vec::new() };
         if mesh.normals.is_empty() {
             match mode {
                 NormalMode::Smooth => mesh.compute_smooth_normals(),
@@ -81,6 +85,24 @@ impl Mesh {
         }
         mesh.normals.iter_mut().for_each(|v| *v = v.normalize_or(Vec3::Y));
         Ok((mesh, repairs))
+    }
+
+    /// Gives the mesh vertex `colors` (one per position, finite and not
+    /// negative).
+    ///
+    /// # Errors
+    ///
+    /// A message when there are not as many colours as positions, or one is
+    /// negative or not finite (the mesh is left without colours).
+    pub fn set_colors(&mut self, colors: Vec<Vec3>) -> Result<(), String> {
+        if colors.len() != self.positions.len() {
+            return Err(format!("{} vertex colours for {} vertices", colors.len(), self.positions.len()));
+        }
+        if let Some(i) = colors.iter().position(|c| !c.is_finite() || c.min_element() < 0.0) {
+            return Err(format!("vertex colour {i} is {:?}", colors[i]));
+        }
+        self.colors = colors;
+        Ok(())
     }
 
     fn compute_smooth_normals(&mut self) {
@@ -149,7 +171,7 @@ pub mod shapes {
             Vec3::new(-0.5, 0.0, -0.5),
         ];
         let uvs = vec![Vec2::new(0.0, 1.0), Vec2::new(1.0, 1.0), Vec2::new(1.0, 0.0), Vec2::ZERO];
-        Mesh { positions, normals: vec![Vec3::Y; 4], uvs, triangles: vec![[0, 1, 2], [0, 2, 3]] }
+        Mesh { positions, normals: vec![Vec3::Y; 4], uvs, triangles: vec![[0, 1, 2], [0, 2, 3]], colors: Vec::new() }
     }
 
     /// A cube of side 1 centred at the origin, flat-shaded.

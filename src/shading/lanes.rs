@@ -133,6 +133,8 @@ pub struct Block {
     textured: [bool; LANES],
     /// ∂P/∂u and ∂P/∂v of each lane's triangle (for its normal map).
     tangents: [[Vec3; 2]; LANES],
+    /// Each lane's triangle's vertex colours (white without them).
+    colors: [[Vec3; 3]; LANES],
     /// Which lanes hold a pixel that sees something.
     pub live: [bool; LANES],
     /// The object each lane's triangle belongs to.
@@ -165,6 +167,7 @@ impl Block {
         self.live[i] = true;
         self.textured[i] = k.is_none();
         self.tangents[i] = g.tangents;
+        self.colors[i] = g.colors.unwrap_or([Vec3::ONE; 3]);
         if let Some(k) = k {
             self.set_coefficients(i, k);
         }
@@ -256,6 +259,7 @@ impl Block {
         let (ur, vr) = uv_of(&surface(inputs, rays, x0 + 1));
         let (ud, vd) = uv_of(&surface(inputs, &rays.below(), x0));
         let mut normals = Gather::default();
+        let weights = s.weights.map(|w| w.to_array());
         for i in 0..LANES {
             let normal = s.n.lane(i);
             normals.set(i, normal);
@@ -272,6 +276,7 @@ impl Block {
                     tangents: self.tangents[i],
                     material: self.material[i],
                     front: geometric.dot(to_eye) >= 0.0,
+                    color: (0..3).map(|k| self.colors[i][k] * weights[k][i]).sum(),
                 };
                 let k = at(&mut point);
                 self.set_coefficients(i, &k);

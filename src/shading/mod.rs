@@ -133,7 +133,7 @@ pub fn shade_pass(scene: &Scene, vb: &VisibilityBuffer, image: &mut LinearImage,
                 } else {
                     cache.get(scene, &frames, first)
                 };
-                if let Some(k) = constants[tri.material].as_ref() {
+                if let Some(k) = constants[tri.material].as_ref().filter(|_| !tri.coloured()) {
                     lanes::shade_run(tri, k, &row, x, lighting, blend, &mut out[x..whole]);
                     x = whole;
                     continue;
@@ -156,7 +156,7 @@ pub fn shade_pass(scene: &Scene, vb: &VisibilityBuffer, image: &mut LinearImage,
                 } else {
                     cache.get(scene, &frames, item)
                 };
-                block.set(i, tri, constants[tri.material].as_ref());
+                block.set(i, tri, constants[tri.material].as_ref().filter(|_| !tri.coloured()));
             }
             if block.live.iter().any(|&l| l) {
                 block.shade(&row, x, lighting, sample, blend, &mut out[x..end]);

@@ -81,6 +81,7 @@ mod tests {
             tangents,
             material: 0,
             front: true,
+            color: Vec3::ONE,
         }
     }
 

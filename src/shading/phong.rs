@@ -168,7 +168,8 @@ impl Coefficients {
         none.then_some(Coefficients { ka: m.ka, kd: m.kd, ks: m.ks, ke: m.ke, n: m.shininess })
     }
 
-    /// Samples every map of `m` at the point's uv.
+    /// Samples every map of `m` at the point's uv (Ka and Kd times the
+    /// point's vertex colour).
     #[must_use]
     pub fn at(m: &Material, s: &SurfacePoint) -> Self {
         let sample = |t: &crate::scene::Texture| match m.maps.filter {
@@ -188,8 +189,8 @@ impl Coefficients {
         let shared = m.maps.ambient.len() == m.maps.diffuse.len()
             && m.maps.ambient.iter().zip(&m.maps.diffuse).all(|(a, d)| std::sync::Arc::ptr_eq(a, d));
         Coefficients {
-            ka: m.ka * if shared { diffuse } else { map(&m.maps.ambient) },
-            kd: m.kd * diffuse,
+            ka: m.ka * s.color * if shared { diffuse } else { map(&m.maps.ambient) },
+            kd: m.kd * s.color * diffuse,
             ks: m.ks * map(&m.maps.specular),
             ke: m.ke * map(&m.maps.emission),
             n: m.shininess,

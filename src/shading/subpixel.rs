@@ -97,7 +97,8 @@ impl SubpixelSample {
         };
         let mut point = surface.surface(&ray);
         let material = &scene.materials[point.material];
-        let coefficients = Coefficients::constant(material).unwrap_or_else(|| {
+        let constant = Coefficients::constant(material).filter(|_| !surface.coloured());
+        let coefficients = constant.unwrap_or_else(|| {
             // Texture footprint: the same surface met one pixel right and one
             // below (ray differentials, as the passes take them).
             let uv = |dx: f32, dy: f32| surface.uv(&rays.ray(self.at + Vec2::new(dx, dy)));

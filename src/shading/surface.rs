@@ -37,6 +37,9 @@ pub struct SurfacePoint {
     pub material: usize,
     /// Whether the eye sees the front (counter-clockwise, outward) side.
     pub front: bool,
+    /// The mesh's vertex colour here (white without one): it multiplies Ka
+    /// and Kd.
+    pub color: Vec3,
 }
 
 /// Object → world transforms for points and normals, computed once per frame.
@@ -108,6 +111,7 @@ impl ObjectFrames {
             geometric: normal,
             normals: [normal; 3],
             uvs: None,
+            colors: None,
             tangents: [Vec3::ZERO; 2],
             material: item.material(scene),
         }
@@ -137,6 +141,7 @@ impl ObjectFrames {
             geometric: e1.cross(e2).normalize_or(Vec3::Y),
             normals: idx.map(|i| Vec3::from(nm * glam::Vec3A::from(mesh.normals[i]))),
             uvs,
+            colors: (!mesh.colors.is_empty()).then(|| idx.map(|i| mesh.colors[i])),
             tangents: uvs.map_or([Vec3::ZERO; 2], |uv| position_derivatives(e1, e2, uv)),
             material: object.material,
         }
@@ -154,6 +159,7 @@ pub struct PreparedTriangle {
     geometric: Vec3,
     normals: [Vec3; 3],
     uvs: Option<[Vec2; 3]>,
+    colors: Option<[Vec3; 3]>,
     tangents: [Vec3; 2],
     /// Index into `Scene::materials`.
     pub material: usize,
@@ -174,6 +180,8 @@ pub struct TriangleGeometry {
     pub normals: [Vec3; 3],
     /// Vertex texture coordinates, if the mesh has them.
     pub uvs: Option<[Vec2; 3]>,
+    /// Vertex colours, if the mesh has them ([`SurfacePoint::color`]).
+    pub colors: Option<[Vec3; 3]>,
     /// ∂P/∂u and ∂P/∂v over the triangle ([`SurfacePoint::tangents`]).
     pub tangents: [Vec3; 2],
 }
@@ -189,8 +197,16 @@ impl PreparedTriangle {
             geometric: self.geometric,
             normals: self.normals,
             uvs: self.uvs,
+            colors: self.colors,
             tangents: self.tangents,
         }
+    }
+
+    /// Whether its mesh has vertex colours (then its coefficients vary over
+    /// it, as a texture's do).
+    #[must_use]
+    pub fn coloured(&self) -> bool {
+        self.colors.is_some()
     }
 
     /// The texture coordinates where `ray` meets the triangle's plane (zero
@@ -254,6 +270,7 @@ impl PreparedTriangle {
             tangents: self.tangents,
             material: self.material,
             front,
+            color: self.colors.map_or(Vec3::ONE, |c| c[0] * w[0] + c[1] * w[1] + c[2] * w[2]),
         }
     }
 }

@@ -20,7 +20,8 @@
 //!
 //! Geometry: triangle lists, strips and fans (points and lines are skipped,
 //! with a warning); attributes stored as floats or as the integers of
-//! `KHR_mesh_quantization` ([`accessors`]), dense or sparse; a node that
+//! `KHR_mesh_quantization` ([`accessors`]), dense or sparse; `COLOR_0`
+//! vertex colours (multiplying Ka and Kd); a node that
 //! mirrors (negative determinant) has its triangles turned round so their
 //! front faces stay outside. A material's textures are read at one set of
 //! texture coordinates, transformed by its base colour's
@@ -174,6 +175,9 @@ fn checked_accessors(root: &gltf::json::Root) -> Result<(), String> {
                     Checked::Valid(Semantic::Normals) => ("NORMAL".into(), &[T::Vec3], &[C::F32, C::I8, C::I16]),
                     Checked::Valid(Semantic::TexCoords(n)) => {
                         (format!("TEXCOORD_{n}"), &[T::Vec2], &[C::F32, C::I8, C::U8, C::I16, C::U16])
+                    }
+                    Checked::Valid(Semantic::Colors(0)) => {
+                        ("COLOR_0".into(), &[T::Vec3, T::Vec4], &[C::F32, C::U8, C::U16])
                     }
                     _ => continue,
                 };
@@ -332,9 +336,6 @@ impl Context<'_> {
             .into_iter()
             .map(Vec3::from)
             .collect();
-        if prim.get(&Semantic::Colors(0)).is_some() {
-            self.warnings.borrow_mut().push(format!("mesh '{name}' has vertex colours (COLOR_0): drawn without them"));
-        }
         let normals = prim.get(&Semantic::Normals).and_then(|a| accessors::floats::<3>(&a, data));
         let normals = normals.map(|n| n.into_iter().map(Vec3::from).collect()).unwrap_or_default();
         let (material, at) = match prim.material().index().and_then(|i| materials.get(i)) {
@@ -359,7 +360,20 @@ impl Context<'_> {
         let triangles =
             triangles(prim.mode(), &indices).map(|[a, b, c]| if mirrored { [a, c, b] } else { [a, b, c] }).collect();
         let built = Mesh::new(positions, normals, uvs, triangles, NormalMode::Smooth);
-        let mesh = checked(out, self.path, built, &format!("mesh '{name}'"))?;
+        let mut mesh = checked(out, self.path, built, &format!("mesh '{name}'"))?;
+        if let Some(colors) = prim.get(&Semantic::Colors(0)) {
+            let read = match colors.dimensions() {
+                gltf::accessor::Dimensions::Vec4 => accessors::floats::<4>(&colors, data)
+                    .map(|c| c.into_iter().map(|[r, g, b, _]| Vec3::new(r, g, b)).collect()),
+                _ => accessors::floats::<3>(&colors, data).map(|c| c.into_iter().map(Vec3::from).collect()),
+            };
+            let with = read.ok_or_else(|| "its data is out of reach".to_string());
+            if let Err(why) = with.and_then(|colors| mesh.set_colors(colors)) {
+                self.warnings
+                    .borrow_mut()
+                    .push(format!("mesh '{name}': its vertex colours (COLOR_0) are not drawn: {why}"));
+            }
+        }
         out.parts.push(Part { name: name.to_string(), mesh: Arc::new(mesh), material, transform, ghost: false });
         Ok(())
     }
