@@ -240,6 +240,13 @@ impl Texture {
         (self.levels[0].width, self.levels[0].height)
     }
 
+    /// Whether `other` reads the same decoded texels (a copy that differs in
+    /// its wrap mode only).
+    #[must_use]
+    pub fn shares_texels(&self, other: &Texture) -> bool {
+        Arc::ptr_eq(&self.levels, &other.levels)
+    }
+
     /// Bytes its levels hold (shared by the copies that differ in their
     /// wrap mode only).
     #[must_use]

@@ -78,6 +78,9 @@ pub fn shade_pass(scene: &Scene, vb: &VisibilityBuffer, image: &mut LinearImage,
     let frames = ObjectFrames::new(scene);
     let rays = scene.camera.pixel_rays(Vec2::new(w as f32, vb.height() as f32));
     let constants: Vec<Option<Coefficients>> = scene.materials.iter().map(Coefficients::constant).collect();
+    // A triangle's coefficients are its material's constants unless a map
+    // or its vertex colours vary them over it.
+    let constant = |tri: &PreparedTriangle| constants[tri.material].as_ref().filter(|_| !tri.coloured());
     let sample = |s: &mut SurfacePoint| phong::sample_maps(&scene.materials[s.material], s);
     let (lighting, blend) = (&pass.lighting, pass.blend);
     // Whole rows of what a replacing pass writes where it shades nothing, copied
@@ -133,7 +136,7 @@ pub fn shade_pass(scene: &Scene, vb: &VisibilityBuffer, image: &mut LinearImage,
                 } else {
                     cache.get(scene, &frames, first)
                 };
-                if let Some(k) = constants[tri.material].as_ref().filter(|_| !tri.coloured()) {
+                if let Some(k) = constant(tri) {
                     lanes::shade_run(tri, k, &row, x, lighting, blend, &mut out[x..whole]);
                     x = whole;
                     continue;
@@ -156,7 +159,7 @@ pub fn shade_pass(scene: &Scene, vb: &VisibilityBuffer, image: &mut LinearImage,
                 } else {
                     cache.get(scene, &frames, item)
                 };
-                block.set(i, tri, constants[tri.material].as_ref().filter(|_| !tri.coloured()));
+                block.set(i, tri, constant(tri));
             }
             if block.live.iter().any(|&l| l) {
                 block.shade(&row, x, lighting, sample, blend, &mut out[x..end]);
