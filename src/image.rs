@@ -287,6 +287,13 @@ impl Srgb8Encoder {
     }
 }
 
+/// The 8-bit sRGB code of a linear value in [0, 1] (clamped; NaN is 0):
+/// round(255 · sRGB(c)), without a power per value.
+#[must_use]
+pub fn linear_to_srgb8(c: f32) -> u8 {
+    SRGB8.encode(c)
+}
+
 /// sRGB transfer function, decoding direction.
 #[must_use]
 pub fn srgb_to_linear(c: f32) -> f32 {

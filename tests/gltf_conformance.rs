@@ -5,7 +5,8 @@
 //! sparse accessor's replaced vertices stand where the file puts them, a
 //! quantized file draws as its float original does, strips and fans are
 //! drawn, a compressed file the reader cannot decode is refused by name,
-//! and a missing texture is a warning and a visible placeholder.
+//! a missing texture is a warning and a visible placeholder, and alpha
+//! blends or cuts where the material says and nowhere else.
 
 #[path = "common/skip.rs"]
 mod skip;
@@ -232,4 +233,44 @@ fn a_missing_texture_is_a_warning_and_a_magenta_checker() {
     let magenta = pixels(&frame, magenta).len();
     assert!(magenta > 200, "{magenta} magenta pixels");
     std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn the_alpha_mode_card_blends_and_cuts_where_its_materials_say() {
+    let Some(path) = asset("AlphaBlendModeTest/AlphaBlendModeTest.gltf") else { return };
+    let (w, h) = (1200, 600);
+    let (_, frame) = front_on(&path, (w, h));
+    // OPAQUE ignoring the texture's alpha and BLEND blending it each show a
+    // green tick; a renderer that blends the opaque box, or does not blend
+    // the blended one, shows a red cross there instead (0 red pixels here;
+    // 23 with the blended box drawn by its factor's alpha only).
+    let red = pixels(&frame, red).len();
+    assert!(red < 10, "{red} pixels of red crosses");
+    // Each of the three MASK boxes (cutoffs 0.25, default 0.5, 0.75) is
+    // filled up to the green triangle beside it: the texture's alpha is a
+    // ramp, cut where it falls below the cutoff.
+    let marks = pixels(&frame, green);
+    let mut triangles: Vec<Vec<(u32, u32)>> = Vec::new();
+    for &(x, y) in marks.iter().filter(|&&(x, _)| x > w / 2) {
+        match triangles.iter_mut().find(|t| t.iter().any(|&(a, b)| a.abs_diff(x) + b.abs_diff(y) < 4)) {
+            Some(t) => t.push((x, y)),
+            None => triangles.push(vec![(x, y)]),
+        }
+    }
+    triangles.retain(|t| t.len() > 8);
+    triangles.sort_by_key(|t| t[0].0);
+    assert_eq!(triangles.len(), 3, "three cutoff marks: {:?}", triangles.iter().map(|t| t[0]).collect::<Vec<_>>());
+    let mut tops = Vec::new();
+    for t in &triangles {
+        let left = t.iter().map(|p| p.0).min().unwrap();
+        let tip = t.iter().map(|p| p.1).sum::<u32>() as f32 / t.len() as f32;
+        // The striped fill: the first of eight rows with yellow stripes
+        // across the columns left of the mark (not the box's thin border,
+        // where the stripes' colour bleeds into its few texels).
+        let striped = |y: u32| (left - 40..left - 4).filter(|&x| yellow(frame.get(x, y))).count() >= 5;
+        let top = (0..h - 8).find(|&y| (y..y + 8).all(striped)).expect("a striped fill");
+        assert!((top as f32 - tip).abs() <= 5.0, "the fill begins at row {top}, its mark at {tip}");
+        tops.push(top);
+    }
+    assert!(tops[0] + 20 < tops[1] && tops[1] + 20 < tops[2], "three cutoffs, three levels: {tops:?}");
 }

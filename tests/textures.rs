@@ -1,7 +1,8 @@
 //! Texture filtering against a supersampled truth: on a finely checkered ground
 //! running to the horizon, mipmapped trilinear filtering comes much closer to the
 //! average of 64 jittered bilinear frames than bilinear sampling does. An
-//! image several materials name is decoded once.
+//! image several materials name is decoded once. An alpha-tested surface is
+//! cut away for the eye and for the light alike.
 
 mod common;
 
@@ -81,5 +82,74 @@ fn materials_naming_one_image_share_its_decoded_texture() {
         .collect();
     assert_eq!(maps.len(), 3, "three uses of the image");
     assert!(maps.iter().all(|t| std::sync::Arc::ptr_eq(t, maps[0])), "decoded once, shared by every use");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A green leaf whose texture's left half is transparent, alpha-tested
+/// (cutoff 0.5), one unit above a red floor, seen and lit from straight
+/// above: through its cut-away half the eye sees the floor, lit (the cut
+/// half casts no shadow either); its kept half is green.
+#[test]
+fn an_alpha_tested_leaf_is_cut_for_the_eye_and_the_light() {
+    use kage::scene::light::LightKind;
+    use kage::scene::{Material, Object};
+    let camera = Camera {
+        eye: Vec3::new(0.0, 5.0, 0.0),
+        target: Vec3::ZERO,
+        up: Vec3::NEG_Z,
+        near: 0.1,
+        far: 50.0,
+        projection: Projection::Perspective { fov_y_deg: 40.0 },
+        shift: Vec2::ZERO,
+    };
+    let mut scene = common::scene_with(shapes::plane(), camera, 200, 200, false);
+    scene.objects[0].transform = Affine3A::from_scale(Vec3::splat(10.0));
+    scene.materials[0] =
+        Material { kd: Vec3::new(0.8, 0.1, 0.1), ka: Vec3::new(0.8, 0.1, 0.1), ks: Vec3::ZERO, ..Material::default() };
+    scene.lights[0].kind = LightKind::Directional { direction: Vec3::new(0.05, -1.0, 0.02).normalize() };
+    let mut alpha = Texture::from_texels_8bit(2, 1, vec![[255, 255, 255, 0], [255, 255, 255, 255]], true);
+    alpha.wrap = kage::scene::texture::Wrap::Clamp;
+    scene.materials.push(Material {
+        kd: Vec3::new(0.1, 0.8, 0.1),
+        ka: Vec3::new(0.1, 0.8, 0.1),
+        ks: Vec3::ZERO,
+        two_sided: true,
+        cutoff: Some(0.5),
+        maps: kage::scene::ComponentMaps { alpha: Some(Arc::new(alpha)), ..Default::default() },
+        ..Material::default()
+    });
+    let leaf = Affine3A::from_translation(Vec3::Y) * Affine3A::from_scale(Vec3::splat(2.0));
+    scene.objects.push(Object::mesh("leaf", Arc::new(shapes::plane()), leaf, 1));
+    // The raster frame, and the ray-traced reference (its rays cut alike).
+    let frame = render(&scene, &RenderOptions::default()).unwrap().image;
+    let options = kage::raytrace::reference::ReferenceOptions { pixel_samples: 1, ..Default::default() };
+    let traced = kage::raytrace::reference::render_reference(&scene, &options, &|_| {});
+    for (name, image) in [("raster", &frame), ("traced", &traced)] {
+        let at = |x, y| image.get(x, y);
+        let (open_floor, through_cut, kept) = (at(10, 100), at(60, 100), at(140, 100));
+        assert!(through_cut.x > 4.0 * through_cut.y, "{name}: the floor shows through the cut: {through_cut}");
+        let lit = (through_cut.x / open_floor.x - 1.0).abs() < 0.05;
+        assert!(lit, "{name}: lit as the open floor: {through_cut} vs {open_floor}");
+        assert!(kept.y > 4.0 * kept.x, "{name}: the kept half is the leaf: {kept}");
+    }
+}
+
+/// OBJ's dissolve map (`map_d`) as the cut-out it draws in the files that
+/// use one: a grey mask keeps the surface where it is light.
+#[test]
+fn an_obj_dissolve_map_cuts_where_its_grey_is_dark() {
+    let dir = std::env::temp_dir().join(format!("kage-map-d-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mask = ::image::GrayImage::from_fn(2, 1, |x, _| ::image::Luma([if x == 0 { 0 } else { 255 }]));
+    mask.save(dir.join("mask.png")).unwrap();
+    std::fs::write(dir.join("leaf.mtl"), "newmtl leaf\nKd 0.2 0.8 0.2\nmap_d mask.png\n").unwrap();
+    let obj = "mtllib leaf.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl leaf\nf 1/1 2/2 3/3\n";
+    std::fs::write(dir.join("leaf.obj"), obj).unwrap();
+    let fs = kage::scene::load::FileSystem { base: dir.clone() };
+    let model = kage::scene::load::model(std::path::Path::new("leaf.obj"), &fs).unwrap();
+    let m = model.parts[0].material.as_ref().unwrap();
+    assert_eq!(m.cutoff, Some(0.5));
+    assert!(m.cuts_out() && !m.translucent());
+    assert!(!m.covers(Vec2::new(0.1, 0.5)) && m.covers(Vec2::new(0.9, 0.5)));
     std::fs::remove_dir_all(&dir).ok();
 }

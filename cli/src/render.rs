@@ -484,6 +484,8 @@ pub fn render_command(args: &RenderArgs) -> miette::Result<()> {
     if let Some(method) = args.shadows {
         scene.lights.iter_mut().for_each(|l| l.shadow = l.shadow.with_method(method));
     }
+    let extra = scene.shadow_warnings();
+    scene.warnings.extend(extra);
     for w in &scene.warnings {
         eprintln!("warning: {w}");
     }

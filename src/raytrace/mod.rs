@@ -21,7 +21,9 @@ pub mod tracer;
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
-use crate::scene::Scene;
+use std::sync::Arc;
+
+use crate::scene::{Material, Mesh, Scene};
 
 use crate::csg::{CsgCaster, CsgSolid};
 
@@ -62,6 +64,10 @@ pub struct TraceScene {
     ///
     /// [`Object::casts_shadows`]: crate::scene::Object::casts_shadows
     casters: Vec<bool>,
+    /// Per object, its mesh and material where the material's alpha test
+    /// cuts some of it away (hits there pass through, for every ray);
+    /// empty when none does. Taken from the scene the BVH was built for.
+    cutouts: Vec<Option<(Arc<Mesh>, Material)>>,
 }
 
 impl TraceScene {
@@ -74,7 +80,24 @@ impl TraceScene {
         } else {
             scene.objects.iter().map(|o| o.casts_shadows).collect()
         };
-        TraceScene { casters, ..Self::built(scene) }
+        let cut = |o: &crate::scene::Object| {
+            let material = &scene.materials[o.material];
+            Some((Arc::clone(o.triangles().filter(|_| material.cuts_out())?), material.clone()))
+        };
+        let mut cutouts: Vec<_> = scene.objects.iter().map(cut).collect();
+        if cutouts.iter().all(Option::is_none) {
+            cutouts = Vec::new();
+        }
+        TraceScene { casters, cutouts, ..Self::built(scene) }
+    }
+
+    /// Whether the alpha test (if its material has one) keeps the point of
+    /// triangle `item` at barycentrics `b`.
+    fn keeps(&self, item: ItemId, b: Vec2) -> bool {
+        let Some(Some((mesh, material))) = self.cutouts.get(item.object as usize) else { return true };
+        let Some(corners) = mesh.triangles.get(item.triangle as usize) else { return true };
+        let [a, b1, b2] = corners.map(|i| mesh.uvs.get(i as usize).copied().unwrap_or(Vec2::ZERO));
+        material.covers(a * (1.0 - b.x - b.y) + b1 * b.x + b2 * b.y)
     }
 
     /// [`TraceScene::new`] but for which objects cast shadows.
@@ -100,8 +123,14 @@ impl TraceScene {
         let mut bvh = Bvh::build(&bounds);
         let order = bvh.renumber();
         let mut solids: Vec<Option<(u32, CsgSolid)>> = solids.into_iter().map(|(o, s, _)| Some((o, s))).collect();
-        let mut trace =
-            TraceScene { triangles: Vec::new(), items: Vec::new(), solids: Vec::new(), bvh, casters: Vec::new() };
+        let mut trace = TraceScene {
+            triangles: Vec::new(),
+            items: Vec::new(),
+            solids: Vec::new(),
+            bvh,
+            casters: Vec::new(),
+            cutouts: Vec::new(),
+        };
         for (leaf, &i) in order.iter().enumerate() {
             let i = i as usize;
             if i < n {
@@ -142,7 +171,7 @@ impl TraceScene {
         let order = bvh.renumber();
         let triangles = order.iter().map(|&i| triangles[i as usize]).collect();
         let items = order.iter().map(|&i| items[i as usize]).collect();
-        TraceScene { triangles, items, solids: Vec::new(), bvh, casters: Vec::new() }
+        TraceScene { triangles, items, solids: Vec::new(), bvh, casters: Vec::new(), cutouts: Vec::new() }
     }
 
     /// The solid at leaf `i`, if that leaf is one.
@@ -166,6 +195,9 @@ impl TraceScene {
                 return Some(c.t);
             }
             let (t, b) = sr.intersect(&self.triangles[i as usize], 0.0, t_max)?;
+            if !self.keeps(self.items[i as usize], b) {
+                return None;
+            }
             (hit.item, hit.barycentrics, hit.normal) = (self.items[i as usize], b, Vec3::ZERO);
             Some(t)
         })?;
@@ -181,7 +213,10 @@ impl TraceScene {
         self.bvh.occluded(ray, t_max, |i, t_max| match self.solid_at(i) {
             _ if !self.casters.is_empty() && !self.casters[self.items[i as usize].object as usize] => None,
             Some((_, _, caster)) => caster.first_hit(ray, 0.0, t_max).map(|c| c.t),
-            None => sr.intersect(&self.triangles[i as usize], 0.0, t_max).map(|h| h.0),
+            None => sr
+                .intersect(&self.triangles[i as usize], 0.0, t_max)
+                .filter(|&(_, b)| self.keeps(self.items[i as usize], b))
+                .map(|h| h.0),
         })
     }
 

@@ -100,8 +100,10 @@ impl<'a, L: LightRays> Tracer<'a, L> {
     }
 
     /// Light arriving along `ray` (unit direction), following `depth` bounces.
-    /// Translucent surfaces (opacity α < 1, seed 002 §3.4) are blended over what
-    /// the ray meets behind them: α · their colour + (1 − α) · the rest.
+    /// Translucent surfaces (opacity α < 1, seed 002 §3.4, times an alpha
+    /// map's) are blended over what the ray meets behind them: α · their
+    /// colour + (1 − α) · the rest. What an alpha test cuts away is passed
+    /// through.
     #[must_use]
     pub fn radiance(&self, ray: &Ray, depth: u32) -> Vec3 {
         self.through_layers(ray, Seen::FromEye, depth, MAX_LAYERS, &Cell::new(MAX_RAYS))
@@ -120,6 +122,7 @@ impl<'a, L: LightRays> Tracer<'a, L> {
             None => self.frames.prepare(self.scene, hit.item).surface(ray),
         };
         let material = &self.scene.materials[s.material];
+        let alpha = material.alpha_at(s.uv, s.duv);
         let k = phong::sample_maps(material, &mut s);
         let behind = || {
             let next = Ray { origin: s.position + ray.dir * self.epsilon, dir: ray.dir };
@@ -150,7 +153,7 @@ impl<'a, L: LightRays> Tracer<'a, L> {
         }
         let own = acc.total() + reflection_map(self.scene, &s) + self.bounces_within(ray, &s, depth, rays);
         if material.translucent() {
-            material.opacity * own + (1.0 - material.opacity) * behind()
+            alpha * own + (1.0 - alpha) * behind()
         } else {
             own
         }

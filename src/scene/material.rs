@@ -6,7 +6,7 @@
 
 use std::sync::Arc;
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
 use super::texture::Texture;
 
@@ -40,15 +40,41 @@ pub struct Material {
     /// environment seen in the mirror direction that is added, without tracing.
     pub km: Vec3,
     /// Opacity α (seed 002 §3.4): below 1 the surface is translucent and blended
-    /// over what lies behind it.
+    /// over what lies behind it. [`ComponentMaps::alpha`] multiplies it.
     pub opacity: f32,
+    /// An alpha test (glTF's MASK mode): where the opacity (times its map)
+    /// is at least this the surface is there, drawn opaque; elsewhere it is
+    /// cut away, for the eye, the shadow maps and traced rays alike.
+    pub cutoff: Option<f32>,
 }
 
 impl Material {
-    /// Whether the material is translucent (drawn after the opaque surfaces).
+    /// Whether the material is translucent (drawn after the opaque surfaces,
+    /// blended over them): an opacity below 1 or an alpha map, without an
+    /// alpha test.
     #[must_use]
     pub fn translucent(&self) -> bool {
-        self.opacity < 1.0
+        self.cutoff.is_none() && (self.opacity < 1.0 || self.maps.alpha.is_some())
+    }
+
+    /// Whether the material's alpha test can cut some of its surface away.
+    #[must_use]
+    pub fn cuts_out(&self) -> bool {
+        self.cutoff.is_some_and(|c| self.opacity < c || self.maps.alpha.as_ref().is_some_and(|t| t.translucent()))
+    }
+
+    /// The opacity at texture coordinates `uv` of a pixel whose texture
+    /// footprint is `duv` (see [`Texture::alpha_footprint`]).
+    #[must_use]
+    pub fn alpha_at(&self, uv: Vec2, duv: [Vec2; 2]) -> f32 {
+        self.opacity * self.maps.alpha.as_ref().map_or(1.0, |t| t.alpha_footprint(uv, duv))
+    }
+
+    /// Whether the alpha test keeps the surface at `uv` (bilinear at the
+    /// texture's finest level; always where there is no test).
+    #[must_use]
+    pub fn covers(&self, uv: Vec2) -> bool {
+        self.cutoff.is_none_or(|c| self.opacity * self.maps.alpha.as_ref().map_or(1.0, |t| t.alpha(uv)) >= c)
     }
 
     /// Whether shading this material needs secondary rays.
@@ -74,6 +100,9 @@ pub struct ComponentMaps {
     /// Multiplies Km (a glTF metal's share of the environment it mirrors,
     /// where its metalness varies over a texture).
     pub mirror: Option<Arc<Texture>>,
+    /// Multiplies the opacity (the alpha of glTF's base-colour texture, in
+    /// BLEND or MASK mode).
+    pub alpha: Option<Arc<Texture>>,
     /// Tilts the shading normal (glTF's `normalTexture`).
     pub normal: Option<NormalMap>,
     /// How the maps are filtered.
@@ -119,6 +148,7 @@ impl Default for Material {
             ior: 1.5,
             km: Vec3::ZERO,
             opacity: 1.0,
+            cutoff: None,
         }
     }
 }

@@ -298,6 +298,22 @@ impl Scene {
         Self::union_of(self.objects.iter())
     }
 
+    /// What the lights' shadow methods cannot draw as the materials ask:
+    /// the silhouette-line buffer outlines whole triangles, so an
+    /// alpha-tested cut-out shadows its whole shape there.
+    #[must_use]
+    pub fn shadow_warnings(&self) -> Vec<String> {
+        let cut = self.objects.iter().any(|o| self.materials[o.material].cuts_out());
+        let slb = self.lights.iter().any(|l| l.shadow.method == ShadowMethod::Slb);
+        if cut && slb {
+            vec!["alpha-tested cut-outs (glTF MASK, OBJ map_d) cast the shadow of their whole triangles under the \
+                  silhouette-line buffer (SLB); a shadow map cuts them"
+                .into()]
+        } else {
+            Vec::new()
+        }
+    }
+
     /// World-space bounds of the objects that cast shadows: what a light's
     /// shadow map must hold (a receiver outside it is lit, as nothing between
     /// it and the light is outside it either). A floor is left out: a flat

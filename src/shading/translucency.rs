@@ -1,5 +1,6 @@
 //! Translucency (seed 002 §3.4): opaque surfaces first, then translucent ones
-//! blended over them, far to near, with alpha = the material's opacity.
+//! blended over them, far to near, with alpha = the material's opacity (times
+//! its alpha map's at the fragment).
 //!
 //! The paper sorts translucent objects far to near and draws them with alpha
 //! blending; where they cannot be sorted it draws them in any order with z-writes
@@ -30,6 +31,10 @@ use crate::visibility::Fragment;
 /// One translucent fragment, ready to be added.
 struct Layer {
     pixel: usize,
+    /// Its opacity.
+    alpha: f32,
+    /// Its share of the pixel: its opacity times what the nearer layers let
+    /// through.
     weight: f32,
     surface: SurfacePoint,
     k: Coefficients,
@@ -65,11 +70,13 @@ pub fn composite(
     }
     let (w, h) = (targets[0].image.width(), targets[0].image.height());
     let mut transmittance = vec![1.0f32; w as usize * h as usize];
-    let weights = front_to_back_weights(scene, &fragments, &mut transmittance);
+    let mut layers = prepare(scene, &fragments, w, h);
+    front_to_back_weights(&mut layers, &mut transmittance);
+    // Where a texture's alpha is 0 the fragment adds nothing.
+    layers.retain(|l| l.weight > 0.0);
     for t in targets.iter_mut() {
         t.image.pixels_mut().par_iter_mut().zip(transmittance.par_iter()).for_each(|(p, &tr)| *p *= tr);
     }
-    let mut layers = prepare(scene, &fragments, &weights, w, h);
     let bounds = scene.caster_bounds().unwrap_or_default();
     for FrameLight { light, samples } in &frame_lights(scene) {
         let terms = pool.terms(scene, samples, bounds);
@@ -91,35 +98,33 @@ pub fn composite(
     (layers.len(), Some(transmittance))
 }
 
-/// Each fragment's weight α · (transmittance of the fragments nearer than it);
-/// leaves each pixel's total transmittance in `transmittance`.
-fn front_to_back_weights(scene: &Scene, fragments: &[Fragment], transmittance: &mut [f32]) -> Vec<f32> {
-    fragments
-        .iter()
-        .map(|f| {
-            let alpha = scene.materials[scene.objects[f.item.object as usize].material].opacity;
-            let t = &mut transmittance[f.pixel as usize];
-            let weight = alpha * *t;
-            *t *= 1.0 - alpha;
-            weight
-        })
-        .collect()
+/// Each layer's weight α · (transmittance of the layers nearer than it, in
+/// the order given); leaves each pixel's total transmittance in
+/// `transmittance`.
+fn front_to_back_weights(layers: &mut [Layer], transmittance: &mut [f32]) {
+    for l in layers {
+        let t = &mut transmittance[l.pixel];
+        l.weight = l.alpha * *t;
+        *t *= 1.0 - l.alpha;
+    }
 }
 
-/// The surface, coefficients, emission and fog of every fragment.
-fn prepare(scene: &Scene, fragments: &[Fragment], weights: &[f32], w: u32, h: u32) -> Vec<Layer> {
+/// The surface, opacity (the material's, times its alpha map's),
+/// coefficients, emission and fog of every fragment.
+fn prepare(scene: &Scene, fragments: &[Fragment], w: u32, h: u32) -> Vec<Layer> {
     let frames = ObjectFrames::new(scene);
     let rays = scene.camera.pixel_rays(Vec2::new(w as f32, h as f32));
     fragments
         .par_iter()
-        .zip(weights.par_iter())
-        .map(|(f, &weight)| {
+        .map(|f| {
             let (x, y) = (f.pixel % w, f.pixel / w);
             let mut surface = frames.surface(scene, f.item, &rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5)));
-            let k = phong::sample_maps(&scene.materials[surface.material], &mut surface);
+            let material = &scene.materials[surface.material];
+            let alpha = material.alpha_at(surface.uv, surface.duv);
+            let k = phong::sample_maps(material, &mut surface);
             let fog = scene.fog.map_or(0.0, |fog| fog.amount_at(&scene.camera, surface.position));
             let lit = Components { emission: k.parts().3, ..Default::default() };
-            Layer { pixel: f.pixel as usize, weight, surface, k, object: f.item.object as usize, fog, lit }
+            Layer { pixel: f.pixel as usize, alpha, weight: 0.0, surface, k, object: f.item.object as usize, fog, lit }
         })
         .collect()
 }

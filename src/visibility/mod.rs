@@ -5,11 +5,13 @@
 //!
 //! Stages, one file each: `clip.rs` (homogeneous clipping), [`scan`] (exact
 //! fixed-point DDA scan conversion, top-left rule) and `raster.rs` (projection,
-//! binning into bands and the band-parallel z-buffer). [`solids`] finds the
+//! binning into bands and the band-parallel z-buffer), `cutout.rs` (the alpha
+//! test of cut-out materials, in every polygon pass). [`solids`] finds the
 //! visible surfaces of CSG solids by seed 003's scanline walk and writes them
 //! into the same buffer, so solids and meshes hide each other.
 
 mod clip;
+mod cutout;
 mod raster;
 pub mod scan;
 pub mod solids;

@@ -12,6 +12,7 @@ use glam::{DMat4, DVec4, Mat4, Vec4};
 use rayon::prelude::*;
 
 use super::clip::{ClipPlanes, MAX_CLIPPED};
+use super::cutout::{CutoutTriangle, Cutouts};
 use super::scan::{column_range, row_range, scan_triangle, signed_area2, FixedPoint, SpanSink, ONE};
 use super::{ItemId, VisibilityBuffer};
 use crate::camera::Camera;
@@ -110,6 +111,8 @@ struct PolygonPass<'a> {
     band_rows: usize,
     bands: usize,
     workers: Workers,
+    /// The alpha tests of cut-out materials.
+    cutouts: Cutouts<'a>,
 }
 
 /// How a polygon pass runs (what it draws is the same either way, bit for bit).
@@ -221,8 +224,9 @@ impl<'a> PolygonPass<'a> {
             1.0 + 2.0 * GUARD_PX as f64 / h as f64,
         );
         let viewport = Viewport { width: w as f32, height: h as f32 };
-        let projected =
+        let projected: Vec<Projected> =
             scene.objects.iter().map(|o| project(scene, o, view_proj, &planes, viewport, faces, workers)).collect();
+        let cutouts = Cutouts::new(scene, |i| projected[i].to_clip, w, h);
         let band_rows = match workers {
             Workers::All => BAND_ROWS,
             Workers::One => h.max(1),
@@ -238,6 +242,7 @@ impl<'a> PolygonPass<'a> {
             band_rows,
             bands: h.div_ceil(band_rows),
             workers,
+            cutouts,
         }
     }
 
@@ -262,7 +267,9 @@ impl<'a> PolygonPass<'a> {
             items.fill(ItemId::NONE);
             let (plane, item) = (LazyPlane::default(), ItemId::NONE);
             let cols = self.cols.clone();
-            let mut sink = DepthSink { depth, items, width: w, cols, row0: row0(band), plane, item };
+            let cutouts = (!self.cutouts.is_empty()).then_some(&self.cutouts);
+            let mut sink =
+                DepthSink { depth, items, width: w, cols, row0: row0(band), plane, item, cutouts, cutout: None };
             self.draw_band(band, &mut sink, chunks, &bins);
         };
         if self.workers == Workers::One {
@@ -472,6 +479,9 @@ trait BandSink: SpanSink {
 impl BandSink for DepthSink<'_> {
     fn triangle(&mut self, item: ItemId, v: [ScreenVertex; 3]) {
         (self.item, self.plane) = (item, LazyPlane::Vertices(v));
+        if let Some(cutouts) = self.cutouts {
+            self.cutout = cutouts.triangle(item);
+        }
     }
 }
 
@@ -520,6 +530,10 @@ struct DepthSink<'a> {
     row0: i64,
     plane: LazyPlane,
     item: ItemId,
+    /// The scene's alpha tests, where some material has one.
+    cutouts: Option<&'a Cutouts<'a>>,
+    /// The current triangle's alpha test, where its material has one.
+    cutout: Option<CutoutTriangle<'a>>,
 }
 
 impl SpanSink for DepthSink<'_> {
@@ -531,6 +545,20 @@ impl SpanSink for DepthSink<'_> {
         let base = ((y - self.row0) * self.width) as usize;
         let plane = self.plane.get();
         let row_z = plane.c + plane.dy * y as f64;
+        if let Some(cutout) = &self.cutout {
+            // A cut-out triangle: the z-test, then the alpha test.
+            for x in x0..x1 {
+                let z = (row_z + plane.dx * x as f64) as f32;
+                let at = base + x as usize;
+                if z > self.depth[at] && cutout.covers(x, y) {
+                    self.depth[at] = z;
+                    if let Some(it) = self.items.get_mut(at) {
+                        *it = self.item;
+                    }
+                }
+            }
+            return;
+        }
         let depth = &mut self.depth[base + x0 as usize..base + x1 as usize];
         if self.items.is_empty() {
             for (k, d) in depth.iter_mut().enumerate() {

@@ -345,6 +345,7 @@ impl SceneFile {
                 specular: texture(&r.ks_map, true)?,
                 emission: texture(&r.ke_map, true)?,
                 mirror: None,
+                alpha: None,
                 normal: None,
                 filter: match r.filter {
                     FilterRec::Trilinear => Filter::Trilinear,
@@ -369,6 +370,7 @@ impl SceneFile {
                 Some(ior) => *ior.get_ref(),
                 None => 1.5,
             },
+            cutoff: None,
         })
     }
 }

@@ -170,7 +170,9 @@ fn mesh(m: &tobj::Mesh) -> Result<(Mesh, crate::scene::mesh::MeshRepairs), Strin
 /// Without `illum`, or for any other value, it is model 2. kage has no Fresnel
 /// term: models 5 and 7 reflect `Ks` at every angle. Every model takes its
 /// opacity from `d` (or 1 − `Tr` when `d` is absent; 0 is read as opaque outside
-/// the glass models 4 and 9); `Ke` is the emission.
+/// the glass models 4 and 9); `Ke` is the emission. A dissolve map `map_d`
+/// is an alpha test: the surface is kept where the image's alpha (or, in a
+/// grey image, its grey) is at least one half.
 fn material(
     m: &tobj::Material,
     dir: &Path,
@@ -228,6 +230,7 @@ fn material(
             specular: map(&m.specular_texture),
             emission: Vec::new(),
             mirror: None,
+            alpha: None,
             normal: None,
             filter: Default::default(),
         },
@@ -244,6 +247,12 @@ fn material(
         // A dissolve of 0 on an opaque model is an exporter's slip far more
         // often than an invisible surface.
         _ => out.opacity = if opacity > 0.0 { opacity } else { 1.0 },
+    }
+    // A dissolve map cuts the surface out (leaves, chains, fences): kept
+    // where the image's alpha, or its grey where it has none, is at least
+    // one half.
+    if let Some(mask) = map(&m.dissolve_texture).pop() {
+        (out.maps.alpha, out.cutoff) = (Some(Arc::new(mask.coverage())), Some(0.5));
     }
     out
 }

@@ -12,7 +12,10 @@
 //! material's mean roughness). `KHR_materials_transmission` makes Kt = base colour ·
 //! transmission (Kd scaled by what is not transmitted), `KHR_materials_ior`
 //! the index of refraction; `KHR_materials_unlit` shows the base colour as
-//! emission, unlit. The normal texture tilts the shading normal
+//! emission, unlit. The base colour's alpha (factor times texture) blends the
+//! surface over what lies behind it in BLEND mode and cuts it where it is
+//! below `alphaCutoff` in MASK mode (for the eye, the shadow maps and
+//! traced rays: `visibility/cutout.rs`); OPAQUE ignores it. The normal texture tilts the shading normal
 //! (`shading/normal_map.rs`: tangents from the texture coordinates; a
 //! `TANGENT` attribute is not read). Buffers and images may be files, GLB
 //! chunks or `data:` URIs; an image that cannot be read or decoded is a
@@ -43,7 +46,7 @@ use super::{checked, Files, LoadedModel, Part};
 use crate::camera::{Camera, Projection};
 use crate::limits::{Limit, LimitExceeded};
 use crate::scene::mesh::{Mesh, NormalMode};
-use crate::scene::texture::{Edge, Wrap};
+use crate::scene::texture::{encode_8bit, Edge, Wrap};
 use crate::scene::{ComponentMaps, Falloff, Light, LightKind, Material, NormalMap, Texture};
 
 struct Context<'a> {
@@ -404,10 +407,18 @@ impl Context<'_> {
             .map(|t| NormalMap { texture: self.texture(&t.texture(), false), scale: t.scale() })
             .filter(|n| n.scale.is_finite() && n.scale != 0.0);
         out.two_sided = m.double_sided();
-        // BLEND materials are translucent with the base colour's alpha; MASK and
-        // OPAQUE ones are drawn opaque.
-        out.opacity = if m.alpha_mode() == gltf::material::AlphaMode::Blend { a.clamp(0.0, 1.0) } else { 1.0 };
-        self.warn_alpha(m, &out.name);
+        // The base colour's alpha (factor times texture): blended over what
+        // lies behind (BLEND), or cutting the surface where it is below the
+        // cutoff (MASK); OPAQUE ignores it.
+        let alpha_map = surface.base_map.clone().filter(|t| t.translucent());
+        match m.alpha_mode() {
+            gltf::material::AlphaMode::Opaque => {}
+            gltf::material::AlphaMode::Blend => (out.opacity, out.maps.alpha) = (a.clamp(0.0, 1.0), alpha_map),
+            gltf::material::AlphaMode::Mask => {
+                let cutoff = m.alpha_cutoff().filter(|c| c.is_finite()).unwrap_or(0.5);
+                (out.opacity, out.maps.alpha, out.cutoff) = (a.clamp(0.0, 1.0), alpha_map, Some(cutoff));
+            }
+        }
         if transmission > 0.0 {
             // Light through the surface, tinted by the base colour, bent by
             // the index of refraction; what goes through is not diffused.
@@ -426,8 +437,13 @@ impl Context<'_> {
                 ks: Vec3::ZERO,
                 ke: surface.base,
                 opacity: out.opacity,
+                cutoff: out.cutoff,
                 two_sided: out.two_sided,
-                maps: ComponentMaps { emission: surface.base_map.into_iter().collect(), ..ComponentMaps::default() },
+                maps: ComponentMaps {
+                    emission: surface.base_map.into_iter().collect(),
+                    alpha: out.maps.alpha,
+                    ..ComponentMaps::default()
+                },
                 ..Material::default()
             };
         }
@@ -457,22 +473,6 @@ impl Context<'_> {
             ));
         }
         first
-    }
-
-    /// Warns where `m`'s alpha is not drawn as the file asks.
-    fn warn_alpha(&self, m: &gltf::Material, name: &str) {
-        use gltf::material::AlphaMode;
-        let textured = m.pbr_metallic_roughness().base_color_texture().is_some();
-        let why = match m.alpha_mode() {
-            AlphaMode::Mask => Some("is alpha-masked (MASK): drawn opaque, without its cut-outs"),
-            AlphaMode::Blend if textured => {
-                Some("blends by its base-colour texture's alpha (BLEND): drawn with its factor's alpha only")
-            }
-            _ => None,
-        };
-        if let Some(why) = why {
-            self.warnings.borrow_mut().push(format!("material '{name}' {why}"));
-        }
     }
 
     /// The texture of `t`'s image, decoded once however many materials use
@@ -703,17 +703,18 @@ fn shininess(roughness: f32) -> f32 {
     (2.0 / (alpha * alpha) - 2.0).clamp(1.0, 2048.0)
 }
 
-/// `N` `width × height` textures of `f`'s `N` values at each texel
-/// centre's uv.
+/// `N` `width × height` colour textures of `f`'s `N` values at each texel
+/// centre's uv, kept in 8 bits (sRGB) as the images they come from.
 fn bake<const N: usize>((width, height): (u32, u32), f: impl Fn(Vec2) -> [Vec3; N] + Sync) -> [Arc<Texture>; N] {
     use rayon::prelude::*;
-    let texels: Vec<[Vec3; N]> = (0..width * height)
+    let size = Vec2::new(width as f32, height as f32);
+    let texels: Vec<[[u8; 4]; N]> = (0..width * height)
         .into_par_iter()
-        .map(|i| {
-            f(Vec2::new((i % width) as f32 + 0.5, (i / width) as f32 + 0.5) / Vec2::new(width as f32, height as f32))
-        })
+        .map(|i| f(Vec2::new((i % width) as f32 + 0.5, (i / width) as f32 + 0.5) / size).map(|c| encode_8bit(c, true)))
         .collect();
-    std::array::from_fn(|k| Arc::new(Texture::from_texels(width, height, texels.iter().map(|t| t[k]).collect())))
+    std::array::from_fn(|k| {
+        Arc::new(Texture::from_texels_8bit(width, height, texels.iter().map(|t| t[k]).collect(), true))
+    })
 }
 
 /// The bytes of a `data:[<media type>][;base64],<data>` URI.
