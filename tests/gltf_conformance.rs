@@ -274,3 +274,16 @@ fn the_alpha_mode_card_blends_and_cuts_where_its_materials_say() {
     }
     assert!(tops[0] + 20 < tops[1] && tops[1] + 20 < tops[2], "three cutoffs, three levels: {tops:?}");
 }
+
+#[test]
+fn a_texture_on_the_second_coordinate_set_reads_it() {
+    let Some(path) = asset("MultiUVTest/MultiUVTest.gltf") else { return };
+    let (scene, frame) = front_on(&path, (320, 240));
+    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+    // The emissive texture is read at TEXCOORD_1, where the cube's face
+    // shows the green glTF logo; read at TEXCOORD_0 it shows "Multiple UVs
+    // not supported in this viewer" in white, and no green (2098 pixels
+    // here; 0 when it was).
+    let logo = pixels(&frame, |c| c.y - c.x.max(c.z) > 0.15).len();
+    assert!(logo > 500, "{logo} pixels of the green logo");
+}

@@ -122,7 +122,8 @@ impl<'a, L: LightRays> Tracer<'a, L> {
             None => self.frames.prepare(self.scene, hit.item).surface(ray),
         };
         let material = &self.scene.materials[s.material];
-        let alpha = material.alpha_at(s.uv, s.duv);
+        let (uv, duv) = s.coords(material.alpha_set());
+        let alpha = material.alpha_at(uv, duv);
         let k = phong::sample_maps(material, &mut s);
         let behind = || {
             let next = Ray { origin: s.position + ray.dir * self.epsilon, dir: ray.dir };

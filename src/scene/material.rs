@@ -63,7 +63,13 @@ impl Material {
         self.cutoff.is_some_and(|c| self.opacity < c || self.maps.alpha.as_ref().is_some_and(|t| t.translucent()))
     }
 
-    /// The opacity at texture coordinates `uv` of a pixel whose texture
+    /// The texture-coordinate set its alpha map is read at (0 without one).
+    #[must_use]
+    pub fn alpha_set(&self) -> u8 {
+        self.maps.alpha.as_ref().map_or(0, |t| t.set)
+    }
+
+    /// The opacity at texture coordinates `uv` (of set [`Material::alpha_set`]) of a pixel whose texture
     /// footprint is `duv` (see [`Texture::alpha_footprint`]).
     #[must_use]
     pub fn alpha_at(&self, uv: Vec2, duv: [Vec2; 2]) -> f32 {

@@ -22,6 +22,11 @@ pub struct Mesh {
     /// Linear RGB vertex colours, one per position, or empty: they multiply
     /// the material's ambient and diffuse colours (glTF's `COLOR_0`).
     pub colors: Vec<Vec3>,
+    /// A second set of texture coordinates, one per position, or empty: read
+    /// by the textures whose [`Texture::set`](super::Texture::set) is 1 (a
+    /// glTF material's textures on a second `TEXCOORD_n`). Without it those
+    /// read [`Mesh::uvs`].
+    pub uvs1: Vec<Vec2>,
 }
 
 /// What [`Mesh::new`] had to drop.
@@ -76,7 +81,7 @@ impl Mesh {
         let uvs = if uvs.len() == positions.len() { uvs } else { Vec::new() };
         let normals_ok = normals.len() == positions.len() && normals.iter().all(|v| v.is_finite());
         let normals = if normals_ok { normals } else { Vec::new() };
-        let mut mesh = Mesh { positions, normals, uvs, triangles, colors: Vec::new() };
+        let mut mesh = Mesh { positions, normals, uvs, triangles, colors: Vec::new(), uvs1: Vec::new() };
         if mesh.normals.is_empty() {
             match mode {
                 NormalMode::Smooth => mesh.compute_smooth_normals(),
@@ -102,6 +107,24 @@ impl Mesh {
             return Err(format!("vertex colour {i} is {:?}", colors[i]));
         }
         self.colors = colors;
+        Ok(())
+    }
+
+    /// Gives the mesh a second set of texture coordinates (one per position,
+    /// finite).
+    ///
+    /// # Errors
+    ///
+    /// A message when there are not as many as positions, or one is not
+    /// finite (the mesh is left without them).
+    pub fn set_second_uvs(&mut self, uvs: Vec<Vec2>) -> Result<(), String> {
+        if uvs.len() != self.positions.len() {
+            return Err(format!("{} texture coordinates for {} vertices", uvs.len(), self.positions.len()));
+        }
+        if let Some(i) = uvs.iter().position(|c| !c.is_finite()) {
+            return Err(format!("texture coordinate {i} is {:?}", uvs[i]));
+        }
+        self.uvs1 = uvs;
         Ok(())
     }
 
@@ -171,7 +194,14 @@ pub mod shapes {
             Vec3::new(-0.5, 0.0, -0.5),
         ];
         let uvs = vec![Vec2::new(0.0, 1.0), Vec2::new(1.0, 1.0), Vec2::new(1.0, 0.0), Vec2::ZERO];
-        Mesh { positions, normals: vec![Vec3::Y; 4], uvs, triangles: vec![[0, 1, 2], [0, 2, 3]], colors: Vec::new() }
+        Mesh {
+            positions,
+            normals: vec![Vec3::Y; 4],
+            uvs,
+            triangles: vec![[0, 1, 2], [0, 2, 3]],
+            colors: Vec::new(),
+            uvs1: Vec::new(),
+        }
     }
 
     /// A cube of side 1 centred at the origin, flat-shaded.

@@ -275,6 +275,9 @@ pub struct Texture {
     translucent: bool,
     /// Wrap mode of every lookup.
     pub wrap: Wrap,
+    /// Which of a mesh's texture-coordinate sets it is read at: 0
+    /// ([`Mesh::uvs`](super::Mesh::uvs)) or 1 ([`Mesh::uvs1`](super::Mesh::uvs1)).
+    pub set: u8,
 }
 
 impl Texture {
@@ -367,7 +370,7 @@ impl Texture {
             let next = last.halved(codec);
             levels.push(next);
         }
-        Texture { levels: Arc::new(levels), codec, translucent, wrap: Wrap::Repeat }
+        Texture { levels: Arc::new(levels), codec, translucent, wrap: Wrap::Repeat, set: 0 }
     }
 
     /// This texture as an alpha map: itself where some texel is less than
@@ -384,7 +387,7 @@ impl Texture {
             Texels::Floats(t) => t.iter().map(|c| [LINEAR.encode(c.x); 4]).collect(),
         };
         let level = Level { width: finest.width, height: finest.height, texels: Texels::Bytes(texels) };
-        Texture { wrap: self.wrap, ..Texture::from_levels(level, false) }
+        Texture { wrap: self.wrap, set: self.set, ..Texture::from_levels(level, false) }
     }
 
     /// Width and height of the finest level, in texels.

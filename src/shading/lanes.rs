@@ -133,6 +133,8 @@ pub struct Block {
     textured: [bool; LANES],
     /// ∂P/∂u and ∂P/∂v of each lane's triangle (for its normal map).
     tangents: [[Vec3; 2]; LANES],
+    /// Each lane's triangle's map to its second texture coordinates.
+    second: [glam::Affine2; LANES],
     /// Each lane's triangle's vertex colours (white without them).
     colors: [[Vec3; 3]; LANES],
     /// Which lanes hold a pixel that sees something.
@@ -167,6 +169,7 @@ impl Block {
         self.live[i] = true;
         self.textured[i] = k.is_none();
         self.tangents[i] = g.tangents;
+        self.second[i] = g.second;
         self.colors[i] = g.colors.unwrap_or([Vec3::ONE; 3]);
         if let Some(k) = k {
             self.set_coefficients(i, k);
@@ -277,6 +280,7 @@ impl Block {
                     material: self.material[i],
                     front: geometric.dot(to_eye) >= 0.0,
                     color: (0..3).map(|k| self.colors[i][k] * weights[k][i]).sum(),
+                    second: self.second[i],
                 };
                 let k = at(&mut point);
                 self.set_coefficients(i, &k);

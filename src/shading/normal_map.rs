@@ -43,9 +43,10 @@ pub fn tilted_normal(map: &NormalMap, filter: Filter, s: &SurfacePoint) -> Vec3 
     if t == Vec3::ZERO || b == Vec3::ZERO {
         return n;
     }
+    let (uv, duv) = s.coords(map.texture.set);
     let texel = match filter {
-        Filter::Trilinear => map.texture.sample_footprint(s.uv, s.duv),
-        Filter::Bilinear => map.texture.sample(s.uv),
+        Filter::Trilinear => map.texture.sample_footprint(uv, duv),
+        Filter::Bilinear => map.texture.sample(uv),
     };
     let local = texel * 2.0 - Vec3::ONE;
     // The eye on the back: `n` was turned round, and x and y turn with it.
@@ -82,6 +83,7 @@ mod tests {
             material: 0,
             front: true,
             color: Vec3::ONE,
+            second: glam::Affine2::IDENTITY,
         }
     }
 

@@ -172,9 +172,12 @@ impl Coefficients {
     /// point's vertex colour).
     #[must_use]
     pub fn at(m: &Material, s: &SurfacePoint) -> Self {
-        let sample = |t: &crate::scene::Texture| match m.maps.filter {
-            Filter::Trilinear => t.sample_footprint(s.uv, s.duv),
-            Filter::Bilinear => t.sample(s.uv),
+        let sample = |t: &crate::scene::Texture| {
+            let (uv, duv) = s.coords(t.set);
+            match m.maps.filter {
+                Filter::Trilinear => t.sample_footprint(uv, duv),
+                Filter::Bilinear => t.sample(uv),
+            }
         };
         // No map: the coefficient; several: one pass per map, added.
         let map = |maps: &[std::sync::Arc<crate::scene::Texture>]| {

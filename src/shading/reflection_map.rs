@@ -88,7 +88,10 @@ pub fn reflection_map(scene: &Scene, s: &SurfacePoint) -> Vec3 {
 
 /// Km at `s`: the material's, times its mirror map there.
 fn mirrored_share(m: &Material, s: &SurfacePoint) -> Vec3 {
-    m.km * m.maps.mirror.as_ref().map_or(Vec3::ONE, |t| t.sample_footprint(s.uv, s.duv))
+    m.km * m.maps.mirror.as_ref().map_or(Vec3::ONE, |t| {
+        let (uv, duv) = s.coords(t.set);
+        t.sample_footprint(uv, duv)
+    })
 }
 
 /// R = 2(N·V)N − V.

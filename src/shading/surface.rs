@@ -8,7 +8,7 @@
 //! as the plane tangent to the solid there ([`ObjectFrames::tangent`]), so every
 //! shading path built for triangles shades solids unchanged.
 
-use glam::{Affine3A, Mat3A, Vec2, Vec3};
+use glam::{Affine2, Affine3A, Mat3A, Vec2, Vec3};
 
 use crate::scene::Scene;
 
@@ -40,6 +40,23 @@ pub struct SurfacePoint {
     /// The mesh's vertex colour here (white without one): it multiplies Ka
     /// and Kd.
     pub color: Vec3,
+    /// The triangle's map from its first texture coordinates to its second
+    /// ([`Mesh::uvs1`](crate::scene::Mesh::uvs1); affine over a triangle,
+    /// the identity without them).
+    pub second: Affine2,
+}
+
+impl SurfacePoint {
+    /// The texture coordinates and footprint of coordinate set `set` (0 or
+    /// 1, a texture's [`Texture::set`](crate::scene::Texture::set)).
+    #[must_use]
+    pub fn coords(&self, set: u8) -> (Vec2, [Vec2; 2]) {
+        if set == 0 {
+            return (self.uv, self.duv);
+        }
+        let s = self.second;
+        (s.transform_point2(self.uv), self.duv.map(|d| s.transform_vector2(d)))
+    }
 }
 
 /// Object → world transforms for points and normals, computed once per frame.
@@ -113,6 +130,7 @@ impl ObjectFrames {
             uvs: None,
             colors: None,
             tangents: [Vec3::ZERO; 2],
+            second: Affine2::IDENTITY,
             material: item.material(scene),
         }
     }
@@ -143,6 +161,7 @@ impl ObjectFrames {
             uvs,
             colors: (!mesh.colors.is_empty()).then(|| idx.map(|i| mesh.colors[i])),
             tangents: uvs.map_or([Vec3::ZERO; 2], |uv| position_derivatives(e1, e2, uv)),
+            second: second_coordinates(mesh, idx),
             material: object.material,
         }
     }
@@ -161,6 +180,8 @@ pub struct PreparedTriangle {
     uvs: Option<[Vec2; 3]>,
     colors: Option<[Vec3; 3]>,
     tangents: [Vec3; 2],
+    /// From the first texture coordinates to the second.
+    second: Affine2,
     /// Index into `Scene::materials`.
     pub material: usize,
 }
@@ -184,6 +205,8 @@ pub struct TriangleGeometry {
     pub colors: Option<[Vec3; 3]>,
     /// ∂P/∂u and ∂P/∂v over the triangle ([`SurfacePoint::tangents`]).
     pub tangents: [Vec3; 2],
+    /// From the first texture coordinates to the second ([`SurfacePoint::second`]).
+    pub second: Affine2,
 }
 
 impl PreparedTriangle {
@@ -199,6 +222,7 @@ impl PreparedTriangle {
             uvs: self.uvs,
             colors: self.colors,
             tangents: self.tangents,
+            second: self.second,
         }
     }
 
@@ -271,8 +295,30 @@ impl PreparedTriangle {
             material: self.material,
             front,
             color: self.colors.map_or(Vec3::ONE, |c| c[0] * w[0] + c[1] * w[1] + c[2] * w[2]),
+            second: self.second,
         }
     }
+}
+
+/// The affine map taking a point's first texture coordinates to its second
+/// over the triangle of vertices `idx`: the one that takes each vertex's
+/// first coordinates to its second. The identity where the mesh has no
+/// second set; the second set's centroid where the first set spans no area
+/// (a constant: no footprint).
+fn second_coordinates(mesh: &crate::scene::Mesh, idx: [usize; 3]) -> Affine2 {
+    if mesh.uvs1.is_empty() {
+        return Affine2::IDENTITY;
+    }
+    let t = idx.map(|i| mesh.uvs1[i]);
+    let s = idx.map(|i| mesh.uvs.get(i).copied().unwrap_or_default());
+    let from = glam::Mat2::from_cols(s[1] - s[0], s[2] - s[0]);
+    let to = glam::Mat2::from_cols(t[1] - t[0], t[2] - t[0]);
+    let det = from.determinant();
+    if det.abs() < 1e-12 || !det.is_finite() {
+        return Affine2::from_translation((t[0] + t[1] + t[2]) / 3.0) * Affine2::from_scale(Vec2::ZERO);
+    }
+    let linear = to * from.inverse();
+    Affine2::from_mat2_translation(linear, t[0] - linear * s[0])
 }
 
 /// ∂P/∂u and ∂P/∂v of the triangle with edges `e1`, `e2` (from its first
@@ -307,4 +353,31 @@ pub fn intersect_plane(ray: &Ray, a: Vec3, e1: Vec3, e2: Vec3) -> (f32, Vec2) {
     let tvec = ray.origin - a;
     let qvec = tvec.cross(e1);
     (e2.dot(qvec) * inv, Vec2::new(tvec.dot(pvec) * inv, ray.dir.dot(qvec) * inv))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::Mesh;
+
+    /// The map between a triangle's two coordinate sets takes each vertex's
+    /// first coordinates to its second, and so every point's (both are
+    /// linear in the barycentric weights).
+    #[test]
+    fn the_second_coordinates_follow_the_first_over_a_triangle() {
+        let mut mesh = Mesh {
+            positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y],
+            uvs: vec![Vec2::new(0.1, 0.2), Vec2::new(0.9, 0.3), Vec2::new(0.2, 0.8)],
+            ..Mesh::default()
+        };
+        mesh.uvs1 = vec![Vec2::new(0.5, 0.5), Vec2::new(0.5, 0.9), Vec2::new(0.1, 0.6)];
+        let map = second_coordinates(&mesh, [0, 1, 2]);
+        for w in [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.2, 0.3, 0.5], [0.6, 0.1, 0.3]] {
+            let at = |uv: &[Vec2]| uv[0] * w[0] + uv[1] * w[1] + uv[2] * w[2];
+            let got = map.transform_point2(at(&mesh.uvs));
+            assert!((got - at(&mesh.uvs1)).length() < 1e-5, "{got} vs {}", at(&mesh.uvs1));
+        }
+        mesh.uvs1.clear();
+        assert_eq!(second_coordinates(&mesh, [0, 1, 2]), Affine2::IDENTITY);
+    }
 }

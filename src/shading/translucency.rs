@@ -120,7 +120,8 @@ fn prepare(scene: &Scene, fragments: &[Fragment], w: u32, h: u32) -> Vec<Layer> 
             let (x, y) = (f.pixel % w, f.pixel / w);
             let mut surface = frames.surface(scene, f.item, &rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5)));
             let material = &scene.materials[surface.material];
-            let alpha = material.alpha_at(surface.uv, surface.duv);
+            let (uv, duv) = surface.coords(material.alpha_set());
+            let alpha = material.alpha_at(uv, duv);
             let k = phong::sample_maps(material, &mut surface);
             let fog = scene.fog.map_or(0.0, |fog| fog.amount_at(&scene.camera, surface.position));
             let lit = Components { emission: k.parts().3, ..Default::default() };

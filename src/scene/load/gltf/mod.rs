@@ -26,10 +26,12 @@
 //! `KHR_mesh_quantization` ([`accessors`]), dense or sparse; `COLOR_0`
 //! vertex colours (multiplying Ka and Kd); a node that
 //! mirrors (negative determinant) has its triangles turned round so their
-//! front faces stay outside. A material's textures are read at one set of
-//! texture coordinates, transformed by its base colour's
-//! `KHR_texture_transform` (a warning where its textures ask for different
-//! ones); each texture wraps as its sampler says. Which extensions are read,
+//! front faces stay outside. A material's textures are read at two sets of
+//! texture coordinates at most (a set with its `KHR_texture_transform`: its
+//! first texture's, and the first other one a texture asks for, kept as the
+//! mesh's `uvs` and `uvs1`; a warning where a texture asks for a third);
+//! the metallic-roughness and occlusion textures only at the base colour's,
+//! with which they are baked. Each texture wraps as its sampler says. Which extensions are read,
 //! drawn without or refused: [`extensions`].
 
 use std::cell::{Cell, RefCell};
@@ -87,6 +89,26 @@ impl Coordinates {
     }
 }
 
+/// The (at most two) texture coordinates a material's textures are read
+/// at: the first texture's, and the first other one's (a mesh's
+/// [`Mesh::uvs`] and [`Mesh::uvs1`]).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+struct Channels {
+    first: Coordinates,
+    second: Option<Coordinates>,
+}
+
+impl Channels {
+    /// The set (0 or 1) that reads `c`, if one does.
+    fn set_of(&self, c: Coordinates) -> Option<u8> {
+        if c == self.first {
+            Some(0)
+        } else {
+            (self.second == Some(c)).then_some(1)
+        }
+    }
+}
+
 /// Parses glTF or GLB bytes; `path` locates external buffers and images
 /// (read through `from`, within its limits).
 pub(super) fn load(bytes: &[u8], path: &Path, from: Files) -> Result<LoadedModel, String> {
@@ -118,7 +140,7 @@ fn load_contained(bytes: &[u8], path: &Path, from: Files) -> Result<LoadedModel,
         warnings: RefCell::new(warnings),
     };
     cx.decode_all();
-    let materials: Vec<(Material, Coordinates)> = cx.doc.materials().map(|m| cx.material(&m)).collect();
+    let materials: Vec<(Material, Channels)> = cx.doc.materials().map(|m| cx.material(&m)).collect();
     let mut model = LoadedModel::default();
     let scene = cx.doc.default_scene().or_else(|| cx.doc.scenes().next()).ok_or("the file has no scene")?;
     for node in scene.nodes() {
@@ -272,7 +294,7 @@ impl Context<'_> {
         &self,
         node: &gltf::Node,
         parent: Mat4,
-        materials: &[(Material, Coordinates)],
+        materials: &[(Material, Channels)],
         out: &mut LoadedModel,
         above: &mut Vec<usize>,
     ) -> Result<(), String> {
@@ -317,7 +339,7 @@ impl Context<'_> {
         prim: &gltf::Primitive,
         name: &str,
         transform: Affine3A,
-        materials: &[(Material, Coordinates)],
+        materials: &[(Material, Channels)],
         out: &mut LoadedModel,
     ) -> Result<(), String> {
         use gltf::mesh::Mode;
@@ -343,16 +365,19 @@ impl Context<'_> {
         let normals = normals.map(|n| n.into_iter().map(Vec3::from).collect()).unwrap_or_default();
         let (material, at) = match prim.material().index().and_then(|i| materials.get(i)) {
             Some((m, at)) => (Some(m.clone()), *at),
-            None => (None, Coordinates::default()),
+            None => (None, Channels::default()),
         };
-        let uvs = prim.get(&Semantic::TexCoords(at.set)).and_then(|a| accessors::floats::<2>(&a, data));
-        let uvs = uvs.map_or_else(Vec::new, |uvs| {
-            let uv = uvs.into_iter().map(Vec2::from);
-            match at.transform {
-                Some(t) => uv.map(|uv| t.transform_point2(uv)).collect(),
-                None => uv.collect(),
-            }
-        });
+        let read_uvs = |c: Coordinates| {
+            let uvs = prim.get(&Semantic::TexCoords(c.set)).and_then(|a| accessors::floats::<2>(&a, data));
+            uvs.map(|uvs| {
+                let uv = uvs.into_iter().map(Vec2::from);
+                match c.transform {
+                    Some(t) => uv.map(|uv| t.transform_point2(uv)).collect(),
+                    None => uv.collect::<Vec<_>>(),
+                }
+            })
+        };
+        let uvs = read_uvs(at.first).unwrap_or_default();
         let indices: Vec<u32> = match reader.read_indices() {
             Some(i) => i.into_u32().collect(),
             None => (0..positions.len() as u32).collect(),
@@ -364,6 +389,16 @@ impl Context<'_> {
             triangles(prim.mode(), &indices).map(|[a, b, c]| if mirrored { [a, c, b] } else { [a, b, c] }).collect();
         let built = Mesh::new(positions, normals, uvs, triangles, NormalMode::Smooth);
         let mut mesh = checked(out, self.path, built, &format!("mesh '{name}'"))?;
+        if let Some(second) = at.second {
+            let with = read_uvs(second).ok_or_else(|| "the primitive has no such attribute".to_string());
+            if let Err(why) = with.and_then(|uvs| mesh.set_second_uvs(uvs)) {
+                self.warnings.borrow_mut().push(format!(
+                    "mesh '{name}': its second texture coordinates (TEXCOORD_{}) are not read ({why}); the textures \
+                     meant for them are drawn at TEXCOORD_{}",
+                    second.set, at.first.set
+                ));
+            }
+        }
         if let Some(colors) = prim.get(&Semantic::Colors(0)) {
             let read = match colors.dimensions() {
                 gltf::accessor::Dimensions::Vec4 => accessors::floats::<4>(&colors, data)
@@ -383,28 +418,58 @@ impl Context<'_> {
 
     /// `m` as kage's material, and the texture coordinates its textures are
     /// read at.
-    fn material(&self, m: &gltf::Material) -> (Material, Coordinates) {
+    fn material(&self, m: &gltf::Material) -> (Material, Channels) {
         let pbr = m.pbr_metallic_roughness();
         let [r, g, b, a] = pbr.base_color_factor();
         let name = m.name().unwrap_or("gltf").to_string();
+        let at = self.coordinates(m, &name);
+        let set = |c: Coordinates| at.set_of(c).unwrap_or(0);
+        let base_map = pbr.base_color_texture().map(|t| self.texture(&t.texture(), true, set(Coordinates::of(&t))));
+        // The metallic-roughness and occlusion textures are baked with the
+        // base colour's, texel by texel: only where they share its coordinates.
+        let base_set = base_map.as_ref().map_or(0, |t| t.set);
+        let shares = |c: Coordinates, what: &str| {
+            let same = set(c) == base_set;
+            if !same {
+                self.warnings.borrow_mut().push(format!(
+                    "material '{name}': its {what} texture is read at other texture coordinates than its base \
+                     colour's (TEXCOORD_{}); it is not drawn",
+                    c.set
+                ));
+            }
+            same
+        };
         let surface = Surface {
             base: Vec3::new(r, g, b),
-            base_map: pbr.base_color_texture().map(|t| self.texture(&t.texture(), true)),
+            base_map,
             metal: pbr.metallic_factor().clamp(0.0, 1.0),
             roughness: pbr.roughness_factor().clamp(0.0, 1.0),
-            metal_roughness_map: pbr.metallic_roughness_texture().map(|t| self.texture(&t.texture(), false)),
-            occlusion: m.occlusion_texture().map(|t| (self.texture(&t.texture(), false), t.strength().clamp(0.0, 1.0))),
+            metal_roughness_map: pbr
+                .metallic_roughness_texture()
+                .filter(|t| shares(Coordinates::of(t), "metallic-roughness"))
+                .map(|t| self.texture(&t.texture(), false, base_set)),
+            occlusion: m
+                .occlusion_texture()
+                .filter(|t| shares(Coordinates { set: t.tex_coord(), transform: None }, "occlusion"))
+                .map(|t| (self.texture(&t.texture(), false, base_set), t.strength().clamp(0.0, 1.0))),
         };
-        let at = self.coordinates(m, &name);
         let transmission = m.transmission().map_or(0.0, |t| t.transmission_factor().clamp(0.0, 1.0));
         let mut out = surface.material();
         out.name = name;
         let strength = m.emissive_strength().filter(|s| s.is_finite() && *s >= 0.0).unwrap_or(1.0);
         out.ke = Vec3::from(m.emissive_factor()) * strength;
-        out.maps.emission = m.emissive_texture().map(|t| self.texture(&t.texture(), true)).into_iter().collect();
+        out.maps.emission = m
+            .emissive_texture()
+            .map(|t| self.texture(&t.texture(), true, set(Coordinates::of(&t))))
+            .into_iter()
+            .collect();
         out.maps.normal = m
             .normal_texture()
-            .map(|t| NormalMap { texture: self.texture(&t.texture(), false), scale: t.scale() })
+            .map(|t| {
+                let texture =
+                    self.texture(&t.texture(), false, set(Coordinates { set: t.tex_coord(), transform: None }));
+                NormalMap { texture, scale: t.scale() }
+            })
             .filter(|n| n.scale.is_finite() && n.scale != 0.0);
         out.two_sided = m.double_sided();
         // The base colour's alpha (factor times texture): blended over what
@@ -451,42 +516,43 @@ impl Context<'_> {
     }
 
     /// The coordinates `m`'s textures are read at: its base colour's (else
-    /// its first texture's); a warning when its other textures ask for
-    /// others.
-    fn coordinates(&self, m: &gltf::Material, name: &str) -> Coordinates {
+    /// its first texture's), and the first other ones a texture asks for; a
+    /// warning when its textures ask for more than two.
+    fn coordinates(&self, m: &gltf::Material, name: &str) -> Channels {
         let pbr = m.pbr_metallic_roughness();
         let infos = [pbr.base_color_texture(), pbr.metallic_roughness_texture(), m.emissive_texture()];
-        let all: Vec<Coordinates> = infos.iter().flatten().map(Coordinates::of).collect();
         // A normal or occlusion texture's own transform does not reach here
-        // (the gltf crate drops it): its set is compared alone.
-        let sets = [m.normal_texture().map(|t| t.tex_coord()), m.occlusion_texture().map(|t| t.tex_coord())];
-        let sets: Vec<u32> = all.iter().map(|c| c.set).chain(sets.into_iter().flatten()).collect();
-        let first =
-            all.first().copied().unwrap_or(Coordinates { set: sets.first().copied().unwrap_or(0), transform: None });
-        let (set_only, transformed) = (sets.iter().any(|&s| s != first.set), all.iter().any(|c| *c != first));
-        if set_only || transformed {
+        // (the gltf crate drops it): its set alone.
+        let plain = |set: u32| Coordinates { set, transform: None };
+        let others =
+            [m.normal_texture().map(|t| plain(t.tex_coord())), m.occlusion_texture().map(|t| plain(t.tex_coord()))];
+        let all: Vec<Coordinates> =
+            infos.iter().flatten().map(Coordinates::of).chain(others.into_iter().flatten()).collect();
+        let first = all.first().copied().unwrap_or_default();
+        let channels = Channels { first, second: all.iter().copied().find(|c| *c != first) };
+        if let Some(lost) = all.iter().find(|c| channels.set_of(**c).is_none()) {
             self.warnings.borrow_mut().push(format!(
-                "material '{name}': its textures are read at different texture coordinates{}; all are drawn at its \
-                 first texture's (TEXCOORD_{})",
-                if set_only { "" } else { " or transforms" },
-                first.set
+                "material '{name}': its textures are read at more than two texture coordinates or transforms; those \
+                 at TEXCOORD_{} are drawn at its first texture's (TEXCOORD_{})",
+                lost.set, first.set
             ));
         }
-        first
+        channels
     }
 
-    /// The texture of `t`'s image, decoded once however many materials use
-    /// it; one that cannot be read or decoded is a warning and a magenta
-    /// checker ([`super::placeholder`]).
-    fn texture(&self, t: &gltf::Texture, srgb: bool) -> Arc<Texture> {
+    /// The texture of `t`'s image, read at coordinate set `set` (0 or 1),
+    /// decoded once however many materials use it; one that cannot be read
+    /// or decoded is a warning and a magenta checker ([`super::placeholder`]).
+    fn texture(&self, t: &gltf::Texture, srgb: bool, set: u8) -> Arc<Texture> {
         let decoded = self.decoded(t, srgb);
         let wrap = wrap(t.sampler());
-        if decoded.wrap == wrap {
+        if decoded.wrap == wrap && decoded.set == set {
             return decoded;
         }
-        // The decoded image is shared; only the wrap mode is the texture's own.
+        // The decoded image is shared; only the wrap mode and the
+        // coordinates read are the texture's own.
         let mut texture = Texture::clone(&decoded);
-        texture.wrap = wrap;
+        (texture.wrap, texture.set) = (wrap, set);
         Arc::new(texture)
     }
 
@@ -643,17 +709,21 @@ impl Surface {
                 ..Material::default()
             };
         };
+        // The baked maps wrap and read coordinates as the base colour's map
+        // (else the first map baked) does.
+        let maps = [self.base_map.as_ref(), self.metal_roughness_map.as_ref(), self.occlusion.as_ref().map(|(t, _)| t)];
+        let like: &Texture = maps.into_iter().flatten().next().expect("a baked size comes from a map");
         // One lookup of the textures per texel, for all four maps.
         // Without an occlusion texture Ka is Kd texel for texel: one map,
         // sampled once for both.
         let [diffuse, ambient, specular, mirror] = if self.occlusion.is_some() {
-            bake(size, |uv| {
+            bake(size, like, |uv| {
                 let (base, metal, _, occlusion) = self.at(uv);
                 let kd = base * (1.0 - metal);
                 [kd, kd * occlusion, Vec3::splat(0.04).lerp(base, metal), base * metal]
             })
         } else {
-            let [diffuse, specular, mirror] = bake(size, |uv| {
+            let [diffuse, specular, mirror] = bake(size, like, |uv| {
                 let (base, metal, _, _) = self.at(uv);
                 [base * (1.0 - metal), Vec3::splat(0.04).lerp(base, metal), base * metal]
             });
@@ -705,7 +775,12 @@ fn shininess(roughness: f32) -> f32 {
 
 /// `N` `width × height` colour textures of `f`'s `N` values at each texel
 /// centre's uv, kept in 8 bits (sRGB) as the images they come from.
-fn bake<const N: usize>((width, height): (u32, u32), f: impl Fn(Vec2) -> [Vec3; N] + Sync) -> [Arc<Texture>; N] {
+/// Each wraps and reads the coordinates `like` does.
+fn bake<const N: usize>(
+    (width, height): (u32, u32),
+    like: &Texture,
+    f: impl Fn(Vec2) -> [Vec3; N] + Sync,
+) -> [Arc<Texture>; N] {
     use rayon::prelude::*;
     let size = Vec2::new(width as f32, height as f32);
     let texels: Vec<[[u8; 4]; N]> = (0..width * height)
@@ -713,7 +788,9 @@ fn bake<const N: usize>((width, height): (u32, u32), f: impl Fn(Vec2) -> [Vec3; 
         .map(|i| f(Vec2::new((i % width) as f32 + 0.5, (i / width) as f32 + 0.5) / size).map(|c| encode_8bit(c, true)))
         .collect();
     std::array::from_fn(|k| {
-        Arc::new(Texture::from_texels_8bit(width, height, texels.iter().map(|t| t[k]).collect(), true))
+        let mut baked = Texture::from_texels_8bit(width, height, texels.iter().map(|t| t[k]).collect(), true);
+        (baked.wrap, baked.set) = (like.wrap, like.set);
+        Arc::new(baked)
     })
 }
 
