@@ -3,7 +3,7 @@
 //! none, vertex colours draw the ticks their texture twin does, a
 //! texture-transform card's arrows reach their green targets, a
 //! sparse accessor's replaced vertices stand where the file puts them, a
-//! quantized file draws as its float original does, strips and fans are
+//! quantized or meshopt-compressed file draws as its float original does, strips and fans are
 //! drawn, a compressed file the reader cannot decode is refused by name,
 //! a missing texture is a warning and a visible placeholder, and alpha
 //! blends or cuts where the material says and nowhere else.
@@ -155,9 +155,17 @@ fn a_sparse_accessor_raises_the_vertices_it_replaces() {
 }
 
 #[test]
-fn a_quantized_duck_is_drawn_where_the_float_duck_is() {
-    let (Some(float), Some(quantized)) = (asset("Duck/Duck.glb"), asset("DuckQuantized/Duck.gltf")) else { return };
-    let sizes: Vec<(Vec3, Vec3, f32)> = [float, quantized]
+fn quantized_and_meshopt_compressed_ducks_are_drawn_where_the_float_duck_is() {
+    let Some(float) = asset("Duck/Duck.glb") else { return };
+    for other in ["DuckQuantized/Duck.gltf", "DuckMeshopt/Duck.gltf"] {
+        let Some(other) = asset(other) else { continue };
+        same_duck(&float, &other);
+    }
+}
+
+/// Whether the ducks at `a` and `b` have the same bounds and yellow area.
+fn same_duck(a: &Path, b: &Path) {
+    let sizes: Vec<(Vec3, Vec3, f32)> = [a, b]
         .iter()
         .map(|path| {
             let scene = scene_for_model(path, 160, 120).unwrap();
@@ -173,7 +181,7 @@ fn a_quantized_duck_is_drawn_where_the_float_duck_is() {
         (lo_a - lo_b).length() < 0.01 * size && (hi_a - hi_b).length() < 0.01 * size,
         "{lo_a}..{hi_a} vs {lo_b}..{hi_b}"
     );
-    assert!(yellow_a > 500.0 && (yellow_b / yellow_a - 1.0).abs() < 0.1, "yellow {yellow_a} vs {yellow_b}");
+    assert!(yellow_a > 500.0 && (yellow_b / yellow_a - 1.0).abs() < 0.1, "{b:?}: yellow {yellow_a} vs {yellow_b}");
 }
 
 #[test]

@@ -4,7 +4,7 @@
 //! A file lists the extensions it uses (`extensionsUsed`) and those a reader
 //! must understand to draw it right (`extensionsRequired`). An extension
 //! kage reads needs no word; one it draws without (a clear coat, sheen) is a
-//! warning naming it; one it cannot decode (Draco, meshopt, KTX2 and WebP
+//! warning naming it; one it cannot decode (Draco, KTX2 and WebP
 //! images) refuses a file that requires it, with what to do instead, and is
 //! passed over where the file only uses it (its uncompressed data or its
 //! fallback image is then what is drawn). An extension kage does not know is
@@ -46,8 +46,8 @@ const EXTENSIONS: &[(&str, Support)] = &[
     ("KHR_xmp", Support::Without("the metadata is not read")),
     ("KHR_xmp_json_ld", Support::Without("the metadata is not read")),
     ("KHR_draco_mesh_compression", Support::Refused(UNCOMPRESS)),
-    ("EXT_meshopt_compression", Support::Refused(UNCOMPRESS)),
-    ("KHR_meshopt_compression", Support::Refused(UNCOMPRESS)),
+    ("EXT_meshopt_compression", Support::Read),
+    ("KHR_meshopt_compression", Support::Read),
     ("KHR_texture_basisu", Support::Refused("convert its KTX2 images to PNG or JPEG")),
     ("EXT_texture_webp", Support::Refused("convert its WebP images to PNG or JPEG")),
     ("EXT_texture_avif", Support::Refused("convert its AVIF images to PNG or JPEG")),

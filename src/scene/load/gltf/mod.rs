@@ -23,7 +23,8 @@
 //!
 //! Geometry: triangle lists, strips and fans (points and lines are skipped,
 //! with a warning); attributes stored as floats or as the integers of
-//! `KHR_mesh_quantization` ([`accessors`]), dense or sparse; `COLOR_0`
+//! `KHR_mesh_quantization` ([`accessors`]), dense or sparse, in buffer views
+//! stored plain or compressed by meshoptimizer ([`meshopt`]); `COLOR_0`
 //! vertex colours (multiplying Ka and Kd); a node that
 //! mirrors (negative determinant) has its triangles turned round so their
 //! front faces stay outside. A material's textures are read at two sets of
@@ -43,6 +44,7 @@ use glam::{Affine3A, Mat4, Vec2, Vec3};
 
 mod accessors;
 mod extensions;
+mod meshopt;
 
 use super::{checked, Files, LoadedModel, Part};
 use crate::camera::{Camera, Projection};
@@ -128,7 +130,8 @@ fn load_contained(bytes: &[u8], path: &Path, from: Files) -> Result<LoadedModel,
     checked_accessors(&json)?;
     let document = gltf::Document::from_json(json).map_err(|e| format!("invalid glTF: {e}"))?;
     let dir = path.parent().unwrap_or(Path::new(""));
-    let buffers = buffers(&document, gltf.blob, dir, from)?;
+    let mut buffers = buffers(&document, gltf.blob, dir, from)?;
+    meshopt::decode_views(&document, &mut buffers)?;
     let cx = Context {
         doc: document,
         buffers,
@@ -813,6 +816,13 @@ fn buffers(doc: &gltf::Document, mut blob: Option<Vec<u8>>, dir: &Path, from: Fi
     doc.buffers()
         .map(|b| {
             let data = match b.source() {
+                // Room for meshopt-compressed views, decoded into it.
+                _ if meshopt::is_fallback(&b) => {
+                    let bytes = b.length() as u64;
+                    let what = || format!("buffer {} (decompressed)", b.index());
+                    from.limits.check_bytes(Limit::FileMb, bytes, what).map_err(|e| e.to_string())?;
+                    vec![0; b.length()]
+                }
                 gltf::buffer::Source::Bin => blob.take().ok_or("a buffer refers to the GLB chunk, which is absent")?,
                 gltf::buffer::Source::Uri(uri) if uri.starts_with("data:") => data_uri(uri)?,
                 gltf::buffer::Source::Uri(uri) => {
