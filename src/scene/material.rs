@@ -136,6 +136,10 @@ pub enum Filter {
     /// The mip level matching each pixel's texture footprint, trilinear.
     #[default]
     Trilinear,
+    /// The mip level nearest each pixel's footprint, bilinear: half the
+    /// lookups of trilinear, with seams where the level changes (the
+    /// viewer's frames while its camera moves).
+    NearestLevel,
 }
 
 impl Default for Material {

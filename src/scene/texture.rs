@@ -7,6 +7,7 @@ use std::sync::{Arc, LazyLock};
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
+use super::material::Filter;
 use crate::image::{linear_to_srgb8, srgb_to_linear};
 use crate::limits::{Limit, Limits};
 
@@ -433,6 +434,29 @@ impl Texture {
         self.trilinear(uv, duv, |l, c| l.colour(c, self.codec), Vec3::lerp)
     }
 
+    /// The colour at `uv` for a pixel whose footprint is `duv`, filtered
+    /// as `filter` says.
+    #[must_use]
+    pub fn sample_filtered(&self, filter: Filter, uv: Vec2, duv: [Vec2; 2]) -> Vec3 {
+        match filter {
+            Filter::Trilinear => self.sample_footprint(uv, duv),
+            Filter::Bilinear => self.sample(uv),
+            Filter::NearestLevel => {
+                let level = &self.levels[self.lod(duv).round() as usize];
+                level.colour(&level.corners(uv, self.wrap), self.codec)
+            }
+        }
+    }
+
+    /// The (fractional) mip level whose texels match the longer of the
+    /// footprint's two steps, within the chain.
+    fn lod(&self, duv: [Vec2; 2]) -> f32 {
+        let size = Vec2::new(self.levels[0].width as f32, self.levels[0].height as f32);
+        let step = (duv[0] * size).length().max((duv[1] * size).length());
+        let lod = if step > 1.0 && step.is_finite() { step.log2() } else { 0.0 };
+        lod.min((self.levels.len() - 1) as f32)
+    }
+
     /// Alpha at `uv` (bilinear at the finest level), in [0, 1].
     #[must_use]
     pub fn alpha(&self, uv: Vec2) -> f32 {
@@ -454,9 +478,7 @@ impl Texture {
         read: impl Fn(&Level, &Corners) -> T,
         lerp: impl Fn(T, T, f32) -> T,
     ) -> T {
-        let size = Vec2::new(self.levels[0].width as f32, self.levels[0].height as f32);
-        let step = (duv[0] * size).length().max((duv[1] * size).length());
-        let lod = if step > 1.0 && step.is_finite() { step.log2() } else { 0.0 };
+        let lod = self.lod(duv);
         let top = self.levels.len() - 1;
         let k = (lod.floor() as usize).min(top);
         let at = |k: usize| {
@@ -552,6 +574,11 @@ mod tests {
         assert_eq!(t.sample_footprint(uv, [Vec2::new(1.0 / 64.0, 0.0), Vec2::ZERO]), t.sample(uv));
         let wide = t.sample_footprint(uv, [Vec2::new(4.0 / 64.0, 0.0), Vec2::new(0.0, 1.0 / 64.0)]);
         assert!((wide.x - 0.5).abs() < 1e-6, "{wide}");
+        // The nearest level alone: 1.4 texels a pixel rounds to the finest
+        // (no blend with the grey level above), 1.5 to the next.
+        let near = |texels: f32| t.sample_filtered(Filter::NearestLevel, uv, [Vec2::new(texels / 64.0, 0.0); 2]);
+        assert_eq!(near(1.4), t.sample(uv));
+        assert!((near(1.5).x - 0.5).abs() < 1e-6);
     }
 
     /// Eight-bit colours are averaged as light, not as codes: a black and

@@ -44,10 +44,7 @@ pub fn tilted_normal(map: &NormalMap, filter: Filter, s: &SurfacePoint) -> Vec3 
         return n;
     }
     let (uv, duv) = s.coords(map.texture.set);
-    let texel = match filter {
-        Filter::Trilinear => map.texture.sample_footprint(uv, duv),
-        Filter::Bilinear => map.texture.sample(uv),
-    };
+    let texel = map.texture.sample_filtered(filter, uv, duv);
     let local = texel * 2.0 - Vec3::ONE;
     // The eye on the back: `n` was turned round, and x and y turn with it.
     let side = if s.front { 1.0 } else { -1.0 };

@@ -8,7 +8,6 @@
 use glam::Vec3;
 
 use super::surface::SurfacePoint;
-use crate::scene::material::Filter;
 use crate::scene::{Light, Material};
 
 /// The components of seed 002 eq. 4, summed over lights.
@@ -174,10 +173,7 @@ impl Coefficients {
     pub fn at(m: &Material, s: &SurfacePoint) -> Self {
         let sample = |t: &crate::scene::Texture| {
             let (uv, duv) = s.coords(t.set);
-            match m.maps.filter {
-                Filter::Trilinear => t.sample_footprint(uv, duv),
-                Filter::Bilinear => t.sample(uv),
-            }
+            t.sample_filtered(m.maps.filter, uv, duv)
         };
         // No map: the coefficient; several: one pass per map, added.
         let map = |maps: &[std::sync::Arc<crate::scene::Texture>]| {

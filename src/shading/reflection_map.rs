@@ -90,7 +90,7 @@ pub fn reflection_map(scene: &Scene, s: &SurfacePoint) -> Vec3 {
 fn mirrored_share(m: &Material, s: &SurfacePoint) -> Vec3 {
     m.km * m.maps.mirror.as_ref().map_or(Vec3::ONE, |t| {
         let (uv, duv) = s.coords(t.set);
-        t.sample_footprint(uv, duv)
+        t.sample_filtered(m.maps.filter, uv, duv)
     })
 }
 

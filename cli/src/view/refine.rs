@@ -8,6 +8,7 @@ use std::sync::{Mutex, MutexGuard, PoisonError};
 
 use glam::Vec3;
 use kage::image::{LinearImage, ToneCurve};
+use kage::scene::material::Filter;
 use kage::scene::{Antialias, Light, Scene, ShadowMethod, ShadowSettings};
 use kage::ComponentSet;
 use kage::{FrameStats, RenderOptions, Renderer};
@@ -196,9 +197,13 @@ pub fn scene_for(base: &Scene, viewer: &Viewer, step: Step) -> Scene {
     }
     if step == Step::Quick {
         // A moving camera: each light's costlier shadows (jittered maps,
-        // silhouette-line buffers, the per-pixel soft term) as one plain map.
+        // silhouette-line buffers, the per-pixel soft term) as one plain map,
+        // and textures read at one mip level, not blended between two.
         for light in scene.lights.iter_mut().filter(|l| costly(l)) {
             light.shadow = ShadowSettings { samples: 1, ..light.shadow.with_method(ShadowMethod::Map) };
+        }
+        for m in scene.materials.iter_mut().filter(|m| m.maps.filter == Filter::Trilinear) {
+            m.maps.filter = Filter::NearestLevel;
         }
     }
     if !t.fog {

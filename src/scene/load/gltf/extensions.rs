@@ -33,9 +33,15 @@ const EXTENSIONS: &[(&str, Support)] = &[
     ("KHR_materials_unlit", Support::Read),
     ("KHR_texture_transform", Support::Read),
     ("KHR_mesh_quantization", Support::Read),
-    ("KHR_materials_clearcoat", Support::Without("the clear coat is not drawn")),
+    (
+        "KHR_materials_clearcoat",
+        Support::Without("the clear coat is approximated: its factor mirrors 4% of the environment, sharply"),
+    ),
     ("KHR_materials_sheen", Support::Without("the sheen is not drawn")),
-    ("KHR_materials_specular", Support::Without("the specular strength and colour are not read")),
+    (
+        "KHR_materials_specular",
+        Support::Without("its strength and colour factors set the highlight's reflectance; its textures are not read"),
+    ),
     ("KHR_materials_volume", Support::Without("the volume's thickness and attenuation are not drawn")),
     ("KHR_materials_iridescence", Support::Without("the iridescence is not drawn")),
     ("KHR_materials_anisotropy", Support::Without("highlights are drawn round, not stretched")),

@@ -2,9 +2,12 @@
 //! `KHR_lights_punctual` lights.
 //!
 //! Metallic-roughness materials map onto seed 002's Phong coefficients:
-//! Kd = base colour · (1 − metallic), Ka = Kd · occlusion, Ks = mix(0.04, base
-//! colour, metallic), Km = base colour · metallic (a metal mirrors the
-//! environment: a lone model gets a studio one), n = 2/α² − 2 with α =
+//! Kd = base colour · (1 − metallic), Ka = Kd · occlusion, Ks = mix(F0, base
+//! colour, metallic) with F0 = 0.04 (or `KHR_materials_specular`'s colour ×
+//! strength × 0.04), Km = base colour · metallic (a metal mirrors the
+//! environment: a lone model gets a studio one) plus 0.04 ×
+//! `KHR_materials_clearcoat`'s factor (a clear coat, approximated as a sharp
+//! 4% mirror), n = 2/α² − 2 with α =
 //! roughness² (the Blinn-Phong exponent of equal lobe width), Ke = emissive
 //! (times `KHR_materials_emissive_strength`). The base-colour texture
 //! multiplies Kd and Ka; with a metallic-roughness or occlusion texture, Kd,
@@ -455,6 +458,20 @@ impl Context<'_> {
                 .occlusion_texture()
                 .filter(|t| shares(Coordinates { set: t.tex_coord(), transform: None }, "occlusion"))
                 .map(|t| (self.texture(&t.texture(), false, base_set), t.strength().clamp(0.0, 1.0))),
+            dielectric: m.specular().map_or(Vec3::splat(0.04), |s| {
+                let f0 = Vec3::from(s.specular_color_factor()) * s.specular_factor() * 0.04;
+                if f0.is_finite() {
+                    f0.clamp(Vec3::ZERO, Vec3::ONE)
+                } else {
+                    Vec3::splat(0.04)
+                }
+            }),
+            coat: m
+                .extension_value("KHR_materials_clearcoat")
+                .and_then(|c| c.get("clearcoatFactor"))
+                .and_then(gltf::json::Value::as_f64)
+                .filter(|c| c.is_finite())
+                .map_or(0.0, |c| c.clamp(0.0, 1.0) as f32),
         };
         let transmission = m.transmission().map_or(0.0, |t| t.transmission_factor().clamp(0.0, 1.0));
         let mut out = surface.material();
@@ -679,6 +696,12 @@ struct Surface {
     metal_roughness_map: Option<Arc<Texture>>,
     /// Occlusion in red (linear), with its strength.
     occlusion: Option<(Arc<Texture>, f32)>,
+    /// A dielectric's reflectance at normal incidence: 0.04, or
+    /// `KHR_materials_specular`'s colour × strength × 0.04.
+    dielectric: Vec3,
+    /// `KHR_materials_clearcoat`'s factor: a clear layer mirroring 4% of the
+    /// environment over the surface.
+    coat: f32,
 }
 
 impl Surface {
@@ -690,8 +713,16 @@ impl Surface {
         (base, (self.metal * mr.z).clamp(0.0, 1.0), (self.roughness * mr.y).clamp(0.0, 1.0), occlusion)
     }
 
-    /// Kd = base · (1 − metal), Ka = Kd · occlusion, Ks = mix(0.04, base,
-    /// metal), Km = base · metal (the environment a metal mirrors); with a
+    /// Km: the environment a metal mirrors (base · metal), and a clear
+    /// coat's 4% over it.
+    fn mirrored(&self, base: Vec3, metal: f32) -> Vec3 {
+        base * metal + Vec3::splat(0.04 * self.coat)
+    }
+
+    /// Kd = base · (1 − metal), Ka = Kd · occlusion, Ks = mix(F0, base,
+    /// metal) with F0 the dielectric's reflectance (0.04 unless
+    /// `KHR_materials_specular` says otherwise), Km = base · metal (the
+    /// environment a metal mirrors) plus 0.04 × a clear coat's factor; with a
     /// metallic-roughness or occlusion texture each is a texture baked texel by
     /// texel, else the base-colour texture multiplies Kd and Ka. The Phong
     /// exponent comes from the mean roughness.
@@ -701,8 +732,8 @@ impl Surface {
             return Material {
                 ka: kd,
                 kd,
-                ks: Vec3::splat(0.04).lerp(self.base, self.metal),
-                km: self.base * self.metal,
+                ks: self.dielectric.lerp(self.base, self.metal),
+                km: self.mirrored(self.base, self.metal),
                 shininess: shininess(self.roughness),
                 maps: ComponentMaps {
                     ambient: self.base_map.iter().cloned().collect(),
@@ -723,12 +754,12 @@ impl Surface {
             bake(size, like, |uv| {
                 let (base, metal, _, occlusion) = self.at(uv);
                 let kd = base * (1.0 - metal);
-                [kd, kd * occlusion, Vec3::splat(0.04).lerp(base, metal), base * metal]
+                [kd, kd * occlusion, self.dielectric.lerp(base, metal), self.mirrored(base, metal)]
             })
         } else {
             let [diffuse, specular, mirror] = bake(size, like, |uv| {
                 let (base, metal, _, _) = self.at(uv);
-                [base * (1.0 - metal), Vec3::splat(0.04).lerp(base, metal), base * metal]
+                [base * (1.0 - metal), self.dielectric.lerp(base, metal), self.mirrored(base, metal)]
             });
             [Arc::clone(&diffuse), diffuse, specular, mirror]
         };
@@ -740,18 +771,19 @@ impl Surface {
             (m + metal, r + roughness)
         });
         let count = (n * n) as f32;
+        // A metal or a clear coat anywhere: Km from the baked map, texel by texel.
+        let mirrors = metal > 0.0 || self.coat > 0.0;
         Material {
             ka: Vec3::ONE,
             kd: Vec3::ONE,
             ks: Vec3::ONE,
-            // A metal anywhere: Km from the baked map, texel by texel.
-            km: if metal > 0.0 { Vec3::ONE } else { Vec3::ZERO },
+            km: if mirrors { Vec3::ONE } else { Vec3::ZERO },
             shininess: shininess(rough / count),
             maps: ComponentMaps {
                 ambient: vec![ambient],
                 diffuse: vec![diffuse],
                 specular: vec![specular],
-                mirror: (metal > 0.0).then_some(mirror),
+                mirror: mirrors.then_some(mirror),
                 ..ComponentMaps::default()
             },
             ..Material::default()
@@ -946,6 +978,8 @@ mod tests {
             roughness: 0.5,
             metal_roughness_map: Some(two_texels(Vec3::new(0.0, 1.0, 1.0), Vec3::new(0.0, 1.0, 0.0))),
             occlusion: None,
+            dielectric: Vec3::splat(0.04),
+            coat: 0.0,
         };
         let m = surface.material();
         let mirror = m.maps.mirror.as_ref().expect("a mirror map");
@@ -957,5 +991,32 @@ mod tests {
         assert!(kd(left).max_element() < 0.05 && (kd(right) - surface.base).abs().max_element() < 0.05);
         // No occlusion texture: Ka is Kd's map, one texture sampled once.
         assert!(Arc::ptr_eq(&m.maps.ambient[0], &m.maps.diffuse[0]));
+    }
+
+    /// `KHR_materials_specular` sets a dielectric's highlight (none at
+    /// strength 0; tinted by its colour), not a metal's; a clear coat
+    /// mirrors 4% of the environment over a surface that mirrors nothing
+    /// else, textured or not.
+    #[test]
+    fn specular_strength_and_a_clear_coat_reach_the_coefficients() {
+        let plain = |metal: f32, dielectric: Vec3, coat: f32, map: bool| Surface {
+            base: Vec3::new(0.2, 0.6, 0.2),
+            base_map: None,
+            metal,
+            roughness: 0.5,
+            metal_roughness_map: map.then(|| two_texels(Vec3::ONE, Vec3::ONE)),
+            occlusion: None,
+            dielectric,
+            coat,
+        };
+        assert_eq!(plain(0.0, Vec3::ZERO, 0.0, false).material().ks, Vec3::ZERO);
+        let tinted = plain(0.0, Vec3::new(0.04, 0.0, 0.0), 0.0, false).material().ks;
+        assert!(tinted.x > 0.03 && tinted.y == 0.0, "{tinted}");
+        assert_eq!(plain(1.0, Vec3::ZERO, 0.0, false).material().ks, Vec3::new(0.2, 0.6, 0.2));
+        assert!((plain(0.0, Vec3::splat(0.04), 1.0, false).material().km - Vec3::splat(0.04)).length() < 1e-6);
+        let baked = plain(0.0, Vec3::splat(0.04), 1.0, true).material();
+        let mirror = baked.maps.mirror.as_ref().expect("a coat mirrors where nothing else does");
+        let km = baked.km * mirror.sample(Vec2::splat(0.5));
+        assert!((km - Vec3::splat(0.04)).abs().max_element() < 0.01, "{km}");
     }
 }
