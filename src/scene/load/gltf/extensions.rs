@@ -4,7 +4,7 @@
 //! A file lists the extensions it uses (`extensionsUsed`) and those a reader
 //! must understand to draw it right (`extensionsRequired`). An extension
 //! kage reads needs no word; one it draws without (a clear coat, sheen) is a
-//! warning naming it; one it cannot decode (Draco, KTX2 and WebP
+//! warning naming it; one it cannot decode (KTX2, WebP, AVIF and DDS
 //! images) refuses a file that requires it, with what to do instead, and is
 //! passed over where the file only uses it (its uncompressed data or its
 //! fallback image is then what is drawn). An extension kage does not know is
@@ -20,9 +20,6 @@ enum Support {
     /// Cannot be decoded (the text says what to do instead).
     Refused(&'static str),
 }
-
-/// Re-exporting without a compression extension: how.
-const UNCOMPRESS: &str = "re-export the file without it (for example from Blender, with compression off)";
 
 /// Every extension kage knows.
 const EXTENSIONS: &[(&str, Support)] = &[
@@ -51,7 +48,7 @@ const EXTENSIONS: &[(&str, Support)] = &[
     ("KHR_animation_pointer", Support::Without("animations are not played")),
     ("KHR_xmp", Support::Without("the metadata is not read")),
     ("KHR_xmp_json_ld", Support::Without("the metadata is not read")),
-    ("KHR_draco_mesh_compression", Support::Refused(UNCOMPRESS)),
+    ("KHR_draco_mesh_compression", Support::Read),
     ("EXT_meshopt_compression", Support::Read),
     ("KHR_meshopt_compression", Support::Read),
     ("KHR_texture_basisu", Support::Refused("convert its KTX2 images to PNG or JPEG")),

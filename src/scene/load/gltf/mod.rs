@@ -27,7 +27,8 @@
 //! Geometry: triangle lists, strips and fans (points and lines are skipped,
 //! with a warning); attributes stored as floats or as the integers of
 //! `KHR_mesh_quantization` ([`accessors`]), dense or sparse, in buffer views
-//! stored plain or compressed by meshoptimizer ([`meshopt`]); `COLOR_0`
+//! stored plain or compressed by meshoptimizer ([`meshopt`]), or a
+//! primitive's whole geometry as one Draco stream ([`draco`]); `COLOR_0`
 //! vertex colours (multiplying Ka and Kd); a node that
 //! mirrors (negative determinant) has its triangles turned round so their
 //! front faces stay outside. A material's textures are read at two sets of
@@ -46,6 +47,7 @@ use std::sync::Arc;
 use glam::{Affine3A, Mat4, Vec2, Vec3};
 
 mod accessors;
+mod draco;
 mod extensions;
 mod meshopt;
 
@@ -131,9 +133,10 @@ fn load_contained(bytes: &[u8], path: &Path, from: Files) -> Result<LoadedModel,
     // image sources unwrap: what they assume is checked here first.
     checked_references(&json)?;
     checked_accessors(&json)?;
+    let zeros = zeroed_accessors(&mut json)?;
     let document = gltf::Document::from_json(json).map_err(|e| format!("invalid glTF: {e}"))?;
     let dir = path.parent().unwrap_or(Path::new(""));
-    let mut buffers = buffers(&document, gltf.blob, dir, from)?;
+    let mut buffers = buffers(&document, gltf.blob, zeros, dir, from)?;
     meshopt::decode_views(&document, &mut buffers)?;
     let cx = Context {
         doc: document,
@@ -158,6 +161,45 @@ fn load_contained(bytes: &[u8], path: &Path, from: Files) -> Result<LoadedModel,
     let said = cx.warnings.take().into_iter().map(|w| format!("{}: {w}", path.display()));
     model.warnings.splice(0..0, said);
     Ok(model)
+}
+
+/// Accessors with neither a buffer view nor sparse values: zeros, as the
+/// glTF specification says, or values an extension fills (a Draco
+/// primitive's). The gltf crate refuses them, so each is given a view of a
+/// buffer of zeros added to `root` for them; that buffer's index, if added.
+fn zeroed_accessors(root: &mut gltf::json::Root) -> Result<Option<usize>, String> {
+    use gltf::json::accessor::Type as T;
+    use gltf::json::validation::Checked;
+    let bytes = |a: &gltf::json::Accessor| {
+        let components = match a.type_ {
+            Checked::Valid(T::Scalar) => 1,
+            Checked::Valid(T::Vec2) => 2,
+            Checked::Valid(T::Vec3) => 3,
+            Checked::Valid(T::Vec4 | T::Mat2) => 4,
+            Checked::Valid(T::Mat3) => 9,
+            Checked::Valid(T::Mat4) => 16,
+            Checked::Invalid => 0,
+        };
+        let size = match a.component_type {
+            Checked::Valid(c) => c.0.size() as u64,
+            Checked::Invalid => 0,
+        };
+        a.count.0.saturating_mul(components * size)
+    };
+    let empty = |a: &gltf::json::Accessor| a.buffer_view.is_none() && a.sparse.is_none();
+    let Some(length) = root.accessors.iter().filter(|a| empty(a)).map(bytes).max() else { return Ok(None) };
+    let length = length.max(1);
+    let buffer = root.buffers.len();
+    let zeros = gltf::json::deserialize::from_str(&format!(r#"{{"byteLength": {length}}}"#));
+    root.buffers.push(zeros.map_err(|e| e.to_string())?);
+    let view = root.buffer_views.len() as u32;
+    let over = gltf::json::deserialize::from_str(&format!(r#"{{"buffer": {buffer}, "byteLength": {length}}}"#));
+    root.buffer_views.push(over.map_err(|e| e.to_string())?);
+    for a in root.accessors.iter_mut().filter(|a| empty(a)) {
+        a.buffer_view = Some(gltf::json::Index::new(view));
+        a.byte_offset = None;
+    }
+    Ok(Some(buffer))
 }
 
 /// The references the gltf crate follows without checking: each primitive's
@@ -360,21 +402,30 @@ impl Context<'_> {
         use gltf::mesh::Semantic;
         let data = |b: gltf::Buffer| self.buffers.get(b.index()).map(|d| &d[..]);
         let reader = prim.reader(data);
-        let positions: Vec<Vec3> = prim
-            .get(&Semantic::Positions)
-            .and_then(|a| accessors::floats::<3>(&a, data))
+        // Draco-compressed geometry stands in for the accessors it names.
+        let draco = draco::DracoGeometry::of(prim, &self.doc, &self.buffers, self.from.limits)
+            .map_err(|e| format!("mesh '{name}': {e}"))?;
+        let floats3 = |s: Semantic| match draco.as_ref().and_then(|d| d.floats::<3>(&s.to_string())) {
+            Some(values) => Some(values),
+            None => prim.get(&s).and_then(|a| accessors::floats::<3>(&a, data)),
+        };
+        let positions: Vec<Vec3> = floats3(Semantic::Positions)
             .ok_or_else(|| format!("mesh '{name}' has no positions"))?
             .into_iter()
             .map(Vec3::from)
             .collect();
-        let normals = prim.get(&Semantic::Normals).and_then(|a| accessors::floats::<3>(&a, data));
+        let normals = floats3(Semantic::Normals);
         let normals = normals.map(|n| n.into_iter().map(Vec3::from).collect()).unwrap_or_default();
         let (material, at) = match prim.material().index().and_then(|i| materials.get(i)) {
             Some((m, at)) => (Some(m.clone()), *at),
             None => (None, Channels::default()),
         };
         let read_uvs = |c: Coordinates| {
-            let uvs = prim.get(&Semantic::TexCoords(c.set)).and_then(|a| accessors::floats::<2>(&a, data));
+            let semantic = Semantic::TexCoords(c.set);
+            let uvs = match draco.as_ref().and_then(|d| d.floats::<2>(&semantic.to_string())) {
+                Some(uvs) => Some(uvs),
+                None => prim.get(&semantic).and_then(|a| accessors::floats::<2>(&a, data)),
+            };
             uvs.map(|uvs| {
                 let uv = uvs.into_iter().map(Vec2::from);
                 match c.transform {
@@ -384,9 +435,10 @@ impl Context<'_> {
             })
         };
         let uvs = read_uvs(at.first).unwrap_or_default();
-        let indices: Vec<u32> = match reader.read_indices() {
-            Some(i) => i.into_u32().collect(),
-            None => (0..positions.len() as u32).collect(),
+        let indices: Vec<u32> = match (&draco, reader.read_indices()) {
+            (Some(d), _) => d.indices(),
+            (None, Some(i)) => i.into_u32().collect(),
+            (None, None) => (0..positions.len() as u32).collect(),
         };
         // A node that mirrors (a negative determinant) turns each triangle's
         // winding round: turned back, its front faces stay outside.
@@ -405,7 +457,15 @@ impl Context<'_> {
                 ));
             }
         }
-        if let Some(colors) = prim.get(&Semantic::Colors(0)) {
+        if let Some(colors) = draco.as_ref().and_then(|d| d.floats::<4>(&Semantic::Colors(0).to_string())) {
+            // Three components read as four: the fourth is zero, and unused.
+            let colors = colors.into_iter().map(|[r, g, b, _]| Vec3::new(r, g, b)).collect();
+            if let Err(why) = mesh.set_colors(colors) {
+                self.warnings
+                    .borrow_mut()
+                    .push(format!("mesh '{name}': its vertex colours (COLOR_0) are not drawn: {why}"));
+            }
+        } else if let Some(colors) = prim.get(&Semantic::Colors(0)) {
             let read = match colors.dimensions() {
                 gltf::accessor::Dimensions::Vec4 => accessors::floats::<4>(&colors, data)
                     .map(|c| c.into_iter().map(|[r, g, b, _]| Vec3::new(r, g, b)).collect()),
@@ -843,13 +903,21 @@ fn data_uri(uri: &str) -> Result<Vec<u8>, String> {
 }
 
 /// The bytes of every buffer of `doc`: the GLB chunk `blob`, a `data:` URI,
-/// or a file next to the glTF (read through `from`, within its limits).
-fn buffers(doc: &gltf::Document, mut blob: Option<Vec<u8>>, dir: &Path, from: Files) -> Result<Vec<Vec<u8>>, String> {
+/// or a file next to the glTF (read through `from`, within its limits);
+/// zeros for a meshopt fallback and for buffer `zeros` ([`zeroed_accessors`]).
+fn buffers(
+    doc: &gltf::Document,
+    mut blob: Option<Vec<u8>>,
+    zeros: Option<usize>,
+    dir: &Path,
+    from: Files,
+) -> Result<Vec<Vec<u8>>, String> {
     doc.buffers()
         .map(|b| {
             let data = match b.source() {
-                // Room for meshopt-compressed views, decoded into it.
-                _ if meshopt::is_fallback(&b) => {
+                // Room for meshopt-compressed views, decoded into it, and
+                // the zeros of accessors without a view.
+                _ if meshopt::is_fallback(&b) || zeros == Some(b.index()) => {
                     let bytes = b.length() as u64;
                     let what = || format!("buffer {} (decompressed)", b.index());
                     from.limits.check_bytes(Limit::FileMb, bytes, what).map_err(|e| e.to_string())?;
