@@ -264,7 +264,9 @@ fn the_seeds_load() {
     let scene_text = std::str::from_utf8(&files.files[Path::new("scene.toml")]).unwrap().to_string();
     let built = SceneFile::parse(&scene_text, Path::new("s.toml")).and_then(|f| f.build(&files));
     assert_eq!(built.map(|s| s.objects.len()).map_err(|e| e.to_string()), Ok(5));
-    for name in ["cube.obj", "tri.stl", "part.csg", "tri.gltf", "tri.glb", "quantized.gltf", "meshopt.gltf", "draco.gltf"] {
+    for name in
+        ["cube.obj", "tri.stl", "part.csg", "tri.gltf", "tri.glb", "quantized.gltf", "meshopt.gltf", "draco.gltf"]
+    {
         let model = load::model_with(Path::new(name), &files, &CsgOptions::default(), &limits());
         assert!(model.is_ok_and(|m| !m.parts.is_empty() || !m.solids.is_empty()), "{name}");
     }
