@@ -85,15 +85,46 @@ impl Coordinates {
     /// Where `info`'s texture is read.
     fn of(info: &gltf::texture::Info) -> Coordinates {
         let Some(t) = info.texture_transform() else { return Coordinates { set: info.tex_coord(), transform: None } };
-        // uv' = T · R · S · uv (the extension's own order), R turning
-        // (0, 1) towards (1, 0) by `rotation` (the sample model's arrow
-        // marks the direction).
-        let transform = glam::Affine2::from_translation(Vec2::from(t.offset()))
-            * glam::Affine2::from_angle(-t.rotation())
-            * glam::Affine2::from_scale(Vec2::from(t.scale()));
-        let finite = transform.to_cols_array().iter().all(|v| v.is_finite());
-        Coordinates { set: t.tex_coord().unwrap_or(info.tex_coord()), transform: finite.then_some(transform) }
+        let set = t.tex_coord().unwrap_or(info.tex_coord());
+        Coordinates::transformed(set, Vec2::from(t.offset()), t.rotation(), Vec2::from(t.scale()))
     }
+
+    /// Where a normal or occlusion texture is read: its set, and its
+    /// `KHR_texture_transform` as the JSON `transform` gives it (the gltf
+    /// crate reads the extension on the other textures only).
+    fn of_json(set: u32, transform: Option<&gltf::json::Value>) -> Coordinates {
+        let Some(t) = transform else { return Coordinates { set, transform: None } };
+        let pair = |key: &str, default: f32| {
+            let v = t.get(key).and_then(gltf::json::Value::as_array);
+            let at =
+                |k: usize| v.and_then(|v| v.get(k)).and_then(gltf::json::Value::as_f64).map_or(default, |x| x as f32);
+            Vec2::new(at(0), at(1))
+        };
+        let rotation = t.get("rotation").and_then(gltf::json::Value::as_f64).map_or(0.0, |r| r as f32);
+        let set = t.get("texCoord").and_then(gltf::json::Value::as_u64).map_or(set, |s| s as u32);
+        Coordinates::transformed(set, pair("offset", 0.0), rotation, pair("scale", 1.0))
+    }
+
+    /// uv' = T · R · S · uv (the extension's own order), R turning (0, 1)
+    /// towards (1, 0) by `rotation` (the sample model's arrow marks the
+    /// direction); no transform where a value is not finite.
+    fn transformed(set: u32, offset: Vec2, rotation: f32, scale: Vec2) -> Coordinates {
+        let transform = glam::Affine2::from_translation(offset)
+            * glam::Affine2::from_angle(-rotation)
+            * glam::Affine2::from_scale(scale);
+        let finite = transform.to_cols_array().iter().all(|v| v.is_finite());
+        Coordinates { set, transform: finite.then_some(transform) }
+    }
+}
+
+/// Where a normal texture is read.
+fn normal_at(t: &gltf::material::NormalTexture) -> Coordinates {
+    Coordinates::of_json(t.tex_coord(), t.extension_value("KHR_texture_transform"))
+}
+
+/// Where an occlusion texture is read.
+fn occlusion_at(t: &gltf::material::OcclusionTexture) -> Coordinates {
+    Coordinates::of_json(t.tex_coord(), t.extension_value("KHR_texture_transform"))
 }
 
 /// The (at most two) texture coordinates a material's textures are read
@@ -516,7 +547,7 @@ impl Context<'_> {
                 .map(|t| self.texture(&t.texture(), false, base_set)),
             occlusion: m
                 .occlusion_texture()
-                .filter(|t| shares(Coordinates { set: t.tex_coord(), transform: None }, "occlusion"))
+                .filter(|t| shares(occlusion_at(t), "occlusion"))
                 .map(|t| (self.texture(&t.texture(), false, base_set), t.strength().clamp(0.0, 1.0))),
             dielectric: m.specular().map_or(Vec3::splat(0.04), |s| {
                 let f0 = Vec3::from(s.specular_color_factor()) * s.specular_factor() * 0.04;
@@ -546,8 +577,7 @@ impl Context<'_> {
         out.maps.normal = m
             .normal_texture()
             .map(|t| {
-                let texture =
-                    self.texture(&t.texture(), false, set(Coordinates { set: t.tex_coord(), transform: None }));
+                let texture = self.texture(&t.texture(), false, set(normal_at(&t)));
                 NormalMap { texture, scale: t.scale() }
             })
             .filter(|n| n.scale.is_finite() && n.scale != 0.0);
@@ -601,11 +631,7 @@ impl Context<'_> {
     fn coordinates(&self, m: &gltf::Material, name: &str) -> Channels {
         let pbr = m.pbr_metallic_roughness();
         let infos = [pbr.base_color_texture(), pbr.metallic_roughness_texture(), m.emissive_texture()];
-        // A normal or occlusion texture's own transform does not reach here
-        // (the gltf crate drops it): its set alone.
-        let plain = |set: u32| Coordinates { set, transform: None };
-        let others =
-            [m.normal_texture().map(|t| plain(t.tex_coord())), m.occlusion_texture().map(|t| plain(t.tex_coord()))];
+        let others = [m.normal_texture().map(|t| normal_at(&t)), m.occlusion_texture().map(|t| occlusion_at(&t))];
         let all: Vec<Coordinates> =
             infos.iter().flatten().map(Coordinates::of).chain(others.into_iter().flatten()).collect();
         let first = all.first().copied().unwrap_or_default();
@@ -1086,5 +1112,20 @@ mod tests {
         let mirror = baked.maps.mirror.as_ref().expect("a coat mirrors where nothing else does");
         let km = baked.km * mirror.sample(Vec2::splat(0.5));
         assert!((km - Vec3::splat(0.04)).abs().max_element() < 0.01, "{km}");
+    }
+
+    /// A normal or occlusion texture's transform, read from its JSON, is the
+    /// one the gltf crate gives the other textures for the same numbers.
+    #[test]
+    fn a_transform_read_from_json_is_the_typed_ones() {
+        let json: gltf::json::Value = gltf::json::deserialize::from_str(
+            r#"{"offset": [0.5, -0.25], "rotation": 0.7, "scale": [2, 3], "texCoord": 1}"#,
+        )
+        .unwrap();
+        let c = Coordinates::of_json(0, Some(&json));
+        assert_eq!(c, Coordinates::transformed(1, Vec2::new(0.5, -0.25), 0.7, Vec2::new(2.0, 3.0)));
+        let moved = c.transform.unwrap().transform_point2(Vec2::ZERO);
+        assert!((moved - Vec2::new(0.5, -0.25)).length() < 1e-6);
+        assert_eq!(Coordinates::of_json(2, None), Coordinates { set: 2, transform: None });
     }
 }
