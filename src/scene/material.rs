@@ -8,6 +8,7 @@ use std::sync::Arc;
 
 use glam::{Vec2, Vec3};
 
+pub use super::texture::Filter;
 use super::texture::Texture;
 
 /// A Phong material of seed 002 eq. 1.
@@ -125,21 +126,6 @@ pub struct NormalMap {
     pub texture: Arc<Texture>,
     /// How strongly it tilts the normal: 1 as painted, 0 not at all.
     pub scale: f32,
-}
-
-/// Texture filtering.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum Filter {
-    /// The finest level, bilinear (sharp; shimmers where texels are smaller
-    /// than pixels).
-    Bilinear,
-    /// The mip level matching each pixel's texture footprint, trilinear.
-    #[default]
-    Trilinear,
-    /// The mip level nearest each pixel's footprint, bilinear: half the
-    /// lookups of trilinear, with seams where the level changes (the
-    /// viewer's frames while its camera moves).
-    NearestLevel,
 }
 
 impl Default for Material {

@@ -7,7 +7,6 @@ use std::sync::{Arc, LazyLock};
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
-use super::material::Filter;
 use crate::image::{linear_to_srgb8, srgb_to_linear};
 use crate::limits::{Limit, Limits};
 
@@ -26,6 +25,21 @@ pub enum Wrap {
     Longitude,
     /// Its own mode across (u) and down (v), as a glTF sampler gives them.
     Each(Edge, Edge),
+}
+
+/// Texture filtering.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Filter {
+    /// The finest level, bilinear (sharp; shimmers where texels are smaller
+    /// than pixels).
+    Bilinear,
+    /// The mip level matching each pixel's texture footprint, trilinear.
+    #[default]
+    Trilinear,
+    /// The mip level nearest each pixel's footprint, bilinear: half the
+    /// lookups of trilinear, with seams where the level changes (the
+    /// viewer's frames while its camera moves).
+    NearestLevel,
 }
 
 /// One axis's mode, for [`Wrap::Each`].
