@@ -96,7 +96,7 @@ impl TraceScene {
     fn keeps(&self, item: ItemId, b: Vec2) -> bool {
         let Some(Some((mesh, material))) = self.cutouts.get(item.object as usize) else { return true };
         let Some(corners) = mesh.triangles.get(item.triangle as usize) else { return true };
-        let uvs = if material.alpha_set() == 1 && !mesh.uvs1.is_empty() { &mesh.uvs1 } else { &mesh.uvs };
+        let uvs = mesh.uvs_of(material.alpha_set());
         let [a, b1, b2] = corners.map(|i| uvs.get(i as usize).copied().unwrap_or(Vec2::ZERO));
         material.covers(a * (1.0 - b.x - b.y) + b1 * b.x + b2 * b.y)
     }

@@ -110,6 +110,17 @@ impl Mesh {
         Ok(())
     }
 
+    /// The texture coordinates a texture of coordinate set `set` reads:
+    /// [`Mesh::uvs1`] for set 1 where the mesh has them, else [`Mesh::uvs`].
+    #[must_use]
+    pub fn uvs_of(&self, set: u8) -> &[Vec2] {
+        if set == 1 && !self.uvs1.is_empty() {
+            &self.uvs1
+        } else {
+            &self.uvs
+        }
+    }
+
     /// Gives the mesh a second set of texture coordinates (one per position,
     /// finite).
     ///

@@ -71,7 +71,7 @@ impl<'a> Cutouts<'a> {
         let corners = *o.mesh.triangles.get(item.triangle as usize)?;
         let clip = corners.map(|i| o.to_clip * o.mesh.positions[i as usize].as_dvec3().extend(1.0));
         let weights = pixel_weights(clip, self.to_ndc)?;
-        let uvs = if o.material.alpha_set() == 1 && !o.mesh.uvs1.is_empty() { &o.mesh.uvs1 } else { &o.mesh.uvs };
+        let uvs = o.mesh.uvs_of(o.material.alpha_set());
         let uv = corners.map(|i| uvs.get(i as usize).copied().unwrap_or(Vec2::ZERO));
         Some(CutoutTriangle { material: o.material, weights, uv })
     }
