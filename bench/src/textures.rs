@@ -19,6 +19,10 @@ use crate::{median, Common};
 pub struct TexturesArgs {
     #[command(flatten)]
     common: Common,
+    /// A model to measure instead of the corpus's (repeatable): any file
+    /// `kage render` reads, by its path.
+    #[arg(long = "model")]
+    models: Vec<std::path::PathBuf>,
 }
 
 /// The corpus's textured models, by their path under `assets/`.
@@ -68,10 +72,14 @@ pub fn run(args: &TexturesArgs) -> Result<()> {
     let size = (c.width, c.height);
     println!("| model | textures (decoded MB) | load ms | textured frame ms | untextured frame ms | ratio |");
     println!("|---|---:|---:|---:|---:|---:|");
-    for rel in MODELS {
-        let path = c.assets().join(rel);
+    let paths: Vec<_> = if args.models.is_empty() {
+        MODELS.iter().map(|rel| c.assets().join(rel)).collect()
+    } else {
+        args.models.clone()
+    };
+    for path in paths {
         if !path.exists() {
-            eprintln!("skipped: {rel} is not in {}", c.assets().display());
+            eprintln!("skipped: {} does not exist", path.display());
             continue;
         }
         let start = Instant::now();

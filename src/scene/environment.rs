@@ -74,17 +74,17 @@ impl Environment {
     /// seen small does not alias the map into moiré).
     #[must_use]
     pub fn radiance_over(&self, dir: Vec3, right: Vec3, down: Vec3) -> Vec3 {
-        let uv = Self::uv(dir, self.rotation);
-        // A step across is sin(polar angle) as wide on the sphere as in the
-        // image: near the poles the image stretches a small spread of
-        // directions over many texels, which must not pick a coarse level.
-        let across = (uv.y * std::f32::consts::PI).sin();
-        let step = |other: Vec3| {
-            let d = Self::uv(other, self.rotation) - uv;
-            // Longitude goes round: the short way across the seam.
-            Vec2::new((d.x - d.x.round()) * across, d.y)
-        };
-        self.map.sample_footprint(uv, [step(right), step(down)]) * self.intensity
+        let unit = |d: Vec3| d.normalize_or(Vec3::NEG_Z);
+        let d = unit(dir);
+        // The spread: the larger angle to a neighbour's direction (the chord,
+        // which is the angle for the small spreads of neighbouring pixels).
+        // An angle θ spans θ/2π of the image across at the equator and θ/π
+        // down; across, rows near the poles hold the same texels for fewer
+        // directions, which must not pick a coarser level: the equator's
+        // width is the one taken.
+        let angle = (unit(right) - d).length().max((unit(down) - d).length());
+        let duv = [Vec2::new(angle / std::f32::consts::TAU, 0.0), Vec2::new(0.0, angle / std::f32::consts::PI)];
+        self.map.sample_footprint(Self::uv(d, self.rotation), duv) * self.intensity
     }
 
     /// The image position of direction `dir` turned by `rotation` about +y.

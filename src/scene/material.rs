@@ -148,3 +148,125 @@ impl Default for Material {
         }
     }
 }
+
+impl ComponentMaps {
+    /// The single maps of each component, the normal map's and the mirror's
+    /// (a component with several maps is left as it is).
+    fn singles(&mut self) -> Vec<&mut Arc<Texture>> {
+        fn one(v: &mut [Arc<Texture>]) -> Option<&mut Arc<Texture>> {
+            if v.len() == 1 {
+                v.first_mut()
+            } else {
+                None
+            }
+        }
+        let (ambient, diffuse, specular, emission) =
+            (&mut self.ambient, &mut self.diffuse, &mut self.specular, &mut self.emission);
+        [
+            one(diffuse),
+            one(ambient),
+            one(specular),
+            one(emission),
+            self.mirror.as_mut(),
+            self.normal.as_mut().map(|n| &mut n.texture),
+        ]
+        .into_iter()
+        .flatten()
+        .collect()
+    }
+}
+
+/// Stores the maps each material alone reads side by side in memory
+/// ([`Texture::interleaved`]): those of its largest group of maps of one
+/// size. A textured pixel reads several of its material's maps at one
+/// place (a baked glTF material: diffuse, ambient, specular, mirror,
+/// emission and normal, often all 2048²): interleaved, the lookups after
+/// the first find their texels in the cache. A texture several materials
+/// read stays where it is; one map serving two components (the same
+/// texture) stays one.
+pub fn interleave_maps<'a>(materials: impl IntoIterator<Item = &'a mut Material>) {
+    let mut materials: Vec<&mut Material> = materials.into_iter().collect();
+    let mut readers: std::collections::HashMap<usize, usize> = std::collections::HashMap::new();
+    for m in materials.iter_mut() {
+        let mut ids: Vec<usize> = m.maps.singles().iter().map(|t| t.texels_id()).collect();
+        ids.extend(
+            m.maps
+                .alpha
+                .iter()
+                .chain(m.maps.ambient.iter())
+                .chain(&m.maps.diffuse)
+                .chain(&m.maps.specular)
+                .chain(&m.maps.emission)
+                .map(|t| t.texels_id()),
+        );
+        ids.sort_unstable();
+        ids.dedup();
+        for id in ids {
+            *readers.entry(id).or_default() += 1;
+        }
+    }
+    for m in materials.iter_mut() {
+        let alpha = m.maps.alpha.as_ref().map(|t| t.texels_id());
+        let mut slots = m.maps.singles();
+        // The distinct textures only this material reads (an alpha map's
+        // texels stay where its alpha test reads them).
+        let mut own: Vec<Arc<Texture>> = Vec::new();
+        for t in slots.iter() {
+            let id = t.texels_id();
+            if readers[&id] == 1 && Some(id) != alpha && !own.iter().any(|o| Arc::ptr_eq(o, t)) {
+                own.push(Arc::clone(t));
+            }
+        }
+        // Their largest group of one size.
+        let count = |size| own.iter().filter(|t| t.size() == size).count();
+        let Some(size) = own.iter().map(|t| t.size()).max_by_key(|&s| count(s)) else { continue };
+        own.retain(|t| t.size() == size);
+        let refs: Vec<&Texture> = own.iter().map(|t| &**t).collect();
+        let Some(bundle) = Texture::interleaved(&refs) else { continue };
+        let bundle: Vec<Arc<Texture>> = bundle.into_iter().map(Arc::new).collect();
+        for slot in slots.iter_mut() {
+            if let Some(k) = own.iter().position(|o| Arc::ptr_eq(o, slot)) {
+                **slot = Arc::clone(&bundle[k]);
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn map(width: u32, code: u8) -> Arc<Texture> {
+        Arc::new(Texture::from_texels_8bit(width, 4, vec![[code, 0, 0, 255]; width as usize * 4], true))
+    }
+
+    /// A material's own maps of its most common size are bundled (a map
+    /// serving two components stays one); a map another material reads,
+    /// and one of another size, stay where they are.
+    #[test]
+    fn a_materials_own_maps_of_one_size_are_stored_together() {
+        let (base, shared, small) = (map(8, 10), map(8, 20), map(2, 30));
+        let mut own = Material::default();
+        own.maps.diffuse = vec![Arc::clone(&base)];
+        own.maps.ambient = vec![Arc::clone(&base)];
+        own.maps.specular = vec![map(8, 40)];
+        own.maps.emission = vec![Arc::clone(&small)];
+        own.maps.normal = Some(NormalMap { texture: Arc::clone(&shared), scale: 1.0 });
+        own.maps.mirror = Some(map(8, 50));
+        let mut other = Material::default();
+        other.maps.diffuse = vec![Arc::clone(&shared)];
+        let mut materials = [own, other];
+        interleave_maps(&mut materials);
+        let maps = &materials[0].maps;
+        let (diffuse, specular, mirror) = (&maps.diffuse[0], &maps.specular[0], maps.mirror.as_ref().expect("kept"));
+        assert!(diffuse.shares_texels(specular) && diffuse.shares_texels(mirror));
+        assert!(Arc::ptr_eq(diffuse, &maps.ambient[0]), "one map for two components stays one");
+        assert!(maps.emission[0].shares_texels(&small), "another size stays");
+        let normal = &maps.normal.as_ref().expect("kept").texture;
+        assert!(normal.shares_texels(&shared) && materials[1].maps.diffuse[0].shares_texels(&shared));
+        // What each reads is unchanged.
+        let uv = Vec2::new(0.3, 0.6);
+        assert_eq!(diffuse.sample(uv), base.sample(uv));
+        assert_eq!(mirror.sample(uv), map(8, 50).sample(uv));
+    }
+}

@@ -27,7 +27,7 @@ pub use light::{
 pub use material::{ComponentMaps, Material, NormalMap};
 pub use mesh::Mesh;
 pub use settings::{Antialias, EdgeFilter, EdgeMode, EdgeSelection, Exposure, Fog, FogMode, TranslucencyOrder, Up};
-pub use texture::Texture;
+pub use texture::{SharedFootprint, Texture};
 
 use crate::camera::Camera;
 use crate::csg::CsgSolid;

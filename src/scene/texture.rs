@@ -186,11 +186,20 @@ impl Corners {
 struct Level {
     width: u32,
     height: u32,
+    /// Texels of each position: 1, or the textures a [`Texture::interleaved`]
+    /// bundle holds, stored side by side (layer `k` of position `i` at
+    /// `i × layers + k`).
+    layers: usize,
     texels: Texels,
 }
 
 impl Level {
-    /// The texels around `uv` and their weights.
+    /// A level of one layer.
+    fn single(width: u32, height: u32, texels: Texels) -> Level {
+        Level { width, height, layers: 1, texels }
+    }
+
+    /// The positions around `uv` and their weights.
     fn corners(&self, uv: Vec2, wrap: Wrap) -> Corners {
         let (w, h) = (self.width as i64, self.height as i64);
         let x = uv.x * self.width as f32 - 0.5;
@@ -205,16 +214,20 @@ impl Level {
         Corners { at: [j0 + i0, j0 + i1, j1 + i0, j1 + i1], fx: x - x0, fy: y - y0 }
     }
 
-    fn colour(&self, c: &Corners, codec: &Codec) -> Vec3 {
+    /// Layer `layer`'s colour blended over `c`.
+    fn colour(&self, c: &Corners, layer: usize, codec: &Codec) -> Vec3 {
         match &self.texels {
-            Texels::Bytes(t) => c.blend(|i| codec.colour(t[i]), Vec3::lerp),
+            Texels::Bytes(t) => c.blend(|i| codec.colour(t[i * self.layers + layer]), Vec3::lerp),
             Texels::Floats(t) => c.blend(|i| t[i], Vec3::lerp),
         }
     }
 
-    fn alpha(&self, c: &Corners) -> f32 {
+    /// Layer `layer`'s alpha blended over `c`.
+    fn alpha(&self, c: &Corners, layer: usize) -> f32 {
         match &self.texels {
-            Texels::Bytes(t) => c.blend(|i| f32::from(t[i][3]), |a, b, f| a + (b - a) * f) / 255.0,
+            Texels::Bytes(t) => {
+                c.blend(|i| f32::from(t[i * self.layers + layer][3]), |a, b, f| a + (b - a) * f) / 255.0
+            }
             Texels::Floats(_) => 1.0,
         }
     }
@@ -222,6 +235,7 @@ impl Level {
     /// The next coarser level: each texel the mean of (up to) 2 × 2 texels,
     /// colours averaged as linear values.
     fn halved(&self, codec: &Codec) -> Level {
+        debug_assert_eq!(self.layers, 1, "a bundle's levels are interleaved from finished chains");
         let (w, h) = ((self.width / 2).max(1), (self.height / 2).max(1));
         // Rows in parallel: the levels of a baked 2048² map are as many
         // texels as the image, each encoded back to a code.
@@ -243,7 +257,15 @@ impl Level {
             ),
             Texels::Floats(t) => Texels::Floats(quads.map(|q| q.iter().map(|&i| t[i]).sum::<Vec3>() * 0.25).collect()),
         };
-        Level { width: w, height: h, texels }
+        Level::single(w, h, texels)
+    }
+
+    /// Layer `layer`'s 8-bit texels, in order (`None` for floats).
+    fn layer_bytes(&self, layer: usize) -> Option<impl Iterator<Item = [u8; 4]> + '_> {
+        match &self.texels {
+            Texels::Bytes(t) => Some(t.iter().skip(layer).step_by(self.layers).copied()),
+            Texels::Floats(_) => None,
+        }
     }
 }
 
@@ -282,8 +304,11 @@ pub fn encode_8bit(c: Vec3, srgb: bool) -> [u8; 4] {
 /// images (OpenEXR) keep linear floats.
 #[derive(Debug, Clone)]
 pub struct Texture {
-    /// Shared by the copies that differ in their wrap mode only.
+    /// Shared by the copies that differ in their wrap mode only, and by the
+    /// textures of one [`Texture::interleaved`] bundle.
     levels: Arc<Vec<Level>>,
+    /// Which of the levels' layers this texture reads.
+    layer: usize,
     /// What the 8-bit codes mean.
     codec: &'static Codec,
     /// Whether some texel is less than opaque.
@@ -346,7 +371,7 @@ impl Texture {
             return Ok(Texture::from_texels(width, height, texels));
         }
         let texels = decoded.into_rgba8().pixels().map(|p| p.0).collect();
-        Ok(Texture::from_levels(Level { width, height, texels: Texels::Bytes(texels) }, srgb))
+        Ok(Texture::from_levels(Level::single(width, height, Texels::Bytes(texels)), srgb))
     }
 
     /// A texture from linear texels, row 0 at the top, repeating, kept as
@@ -358,7 +383,7 @@ impl Texture {
     #[must_use]
     pub fn from_texels(width: u32, height: u32, texels: Vec<Vec3>) -> Texture {
         assert_eq!(texels.len(), (width * height) as usize, "texel count");
-        Texture::from_levels(Level { width, height, texels: Texels::Floats(texels) }, false)
+        Texture::from_levels(Level::single(width, height, Texels::Floats(texels)), false)
     }
 
     /// A texture from 8-bit texels (red, green, blue, alpha), row 0 at the
@@ -371,7 +396,7 @@ impl Texture {
     #[must_use]
     pub fn from_texels_8bit(width: u32, height: u32, texels: Vec<[u8; 4]>, srgb: bool) -> Texture {
         assert_eq!(texels.len(), (width * height) as usize, "texel count");
-        Texture::from_levels(Level { width, height, texels: Texels::Bytes(texels) }, srgb)
+        Texture::from_levels(Level::single(width, height, Texels::Bytes(texels)), srgb)
     }
 
     fn from_levels(finest: Level, srgb: bool) -> Texture {
@@ -385,7 +410,7 @@ impl Texture {
             let next = last.halved(codec);
             levels.push(next);
         }
-        Texture { levels: Arc::new(levels), codec, translucent, wrap: Wrap::Repeat, set: 0 }
+        Texture { levels: Arc::new(levels), layer: 0, codec, translucent, wrap: Wrap::Repeat, set: 0 }
     }
 
     /// This texture as an alpha map: itself where some texel is less than
@@ -397,12 +422,53 @@ impl Texture {
             return self.clone();
         }
         let finest = &self.levels[0];
-        let texels = match &finest.texels {
-            Texels::Bytes(t) => t.iter().map(|p| [p[0], p[1], p[2], p[0]]).collect(),
-            Texels::Floats(t) => t.iter().map(|c| [LINEAR.encode(c.x); 4]).collect(),
+        let texels = match (&finest.texels, finest.layer_bytes(self.layer)) {
+            (_, Some(bytes)) => bytes.map(|p| [p[0], p[1], p[2], p[0]]).collect(),
+            (Texels::Floats(t), None) => t.iter().map(|c| [LINEAR.encode(c.x); 4]).collect(),
+            (Texels::Bytes(_), None) => unreachable!("bytes have layers"),
         };
-        let level = Level { width: finest.width, height: finest.height, texels: Texels::Bytes(texels) };
+        let level = Level::single(finest.width, finest.height, Texels::Bytes(texels));
         Texture { wrap: self.wrap, set: self.set, ..Texture::from_levels(level, false) }
+    }
+
+    /// The textures of `bundle` stored side by side, each position's texels
+    /// of all of them together in memory, at every level: what a lookup of
+    /// one reads, its neighbour's lookup at the same place finds in the
+    /// cache. The results read what the inputs read (their colour spaces,
+    /// wrap modes and coordinate sets kept); `None` unless there are at
+    /// least two, all of 8-bit texels with chains of one size.
+    #[must_use]
+    pub fn interleaved(bundle: &[&Texture]) -> Option<Vec<Texture>> {
+        let first = bundle.first()?;
+        let alike = |t: &&Texture| {
+            t.levels.len() == first.levels.len()
+                && t.levels.iter().zip(first.levels.iter()).all(|(a, b)| (a.width, a.height) == (b.width, b.height))
+                && matches!(t.levels[0].texels, Texels::Bytes(_))
+        };
+        if bundle.len() < 2 || !bundle.iter().all(alike) {
+            return None;
+        }
+        let levels = (0..first.levels.len())
+            .map(|k| {
+                let mut layers: Vec<_> =
+                    bundle.iter().map(|t| t.levels[k].layer_bytes(t.layer).expect("8-bit levels")).collect();
+                let positions = (first.levels[k].width * first.levels[k].height) as usize;
+                let mut texels = Vec::with_capacity(positions * bundle.len());
+                for _ in 0..positions {
+                    texels.extend(layers.iter_mut().map(|l| l.next().expect("a texel a position")));
+                }
+                let (width, height) = (first.levels[k].width, first.levels[k].height);
+                Level { width, height, layers: bundle.len(), texels: Texels::Bytes(texels) }
+            })
+            .collect();
+        let levels = Arc::new(levels);
+        Some(
+            bundle
+                .iter()
+                .enumerate()
+                .map(|(k, t)| Texture { levels: Arc::clone(&levels), layer: k, ..(*t).clone() })
+                .collect(),
+        )
     }
 
     /// Width and height of the finest level, in texels.
@@ -424,8 +490,14 @@ impl Texture {
         Arc::ptr_eq(&self.levels, &other.levels)
     }
 
+    /// One number for the texels it reads: equal for textures that
+    /// [`Texture::shares_texels`].
+    pub(crate) fn texels_id(&self) -> usize {
+        Arc::as_ptr(&self.levels) as usize
+    }
+
     /// Bytes its levels hold (shared by the copies that differ in their
-    /// wrap mode only).
+    /// wrap mode only, and by an [`Texture::interleaved`] bundle's textures).
     #[must_use]
     pub fn memory_bytes(&self) -> usize {
         self.levels.iter().map(|l| l.texels.bytes()).sum()
@@ -435,8 +507,7 @@ impl Texture {
     /// at +0.5).
     #[must_use]
     pub fn sample(&self, uv: Vec2) -> Vec3 {
-        let level = &self.levels[0];
-        level.colour(&level.corners(uv, self.wrap), self.codec)
+        self.read(&self.footprint(Filter::Bilinear, uv, [Vec2::ZERO; 2]))
     }
 
     /// Trilinear sample for a pixel whose neighbours to the right and below are
@@ -445,20 +516,55 @@ impl Texture {
     /// bilinear sample of the finest level.
     #[must_use]
     pub fn sample_footprint(&self, uv: Vec2, duv: [Vec2; 2]) -> Vec3 {
-        self.trilinear(uv, duv, |l, c| l.colour(c, self.codec), Vec3::lerp)
+        self.read(&self.footprint(Filter::Trilinear, uv, duv))
     }
 
     /// The colour at `uv` for a pixel whose footprint is `duv`, filtered
     /// as `filter` says.
     #[must_use]
     pub fn sample_filtered(&self, filter: Filter, uv: Vec2, duv: [Vec2; 2]) -> Vec3 {
+        self.read(&self.footprint(filter, uv, duv))
+    }
+
+    /// Where a lookup at `uv` over the footprint `duv`, filtered as `filter`
+    /// says, reads: the same for every texture that
+    /// [`Texture::reads_like`] this one, so the maps of one
+    /// [`Texture::interleaved`] bundle find it once.
+    #[must_use]
+    pub fn footprint(&self, filter: Filter, uv: Vec2, duv: [Vec2; 2]) -> Footprint {
+        let at = |k: usize| (k, self.levels[k].corners(uv, self.wrap));
         match filter {
-            Filter::Trilinear => self.sample_footprint(uv, duv),
-            Filter::Bilinear => self.sample(uv),
-            Filter::NearestLevel => {
-                let level = &self.levels[self.lod(duv).round() as usize];
-                level.colour(&level.corners(uv, self.wrap), self.codec)
+            Filter::Bilinear => Footprint { fine: at(0), coarse: None },
+            Filter::NearestLevel => Footprint { fine: at(self.lod(duv).round() as usize), coarse: None },
+            Filter::Trilinear => {
+                let lod = self.lod(duv);
+                let k = lod.floor() as usize;
+                if k + 1 >= self.levels.len() {
+                    return Footprint { fine: at(self.levels.len() - 1), coarse: None };
+                }
+                let (next, corners) = at(k + 1);
+                Footprint { fine: at(k), coarse: Some((next, corners, lod - k as f32)) }
             }
+        }
+    }
+
+    /// Whether a [`Footprint`] of `other`'s is one of this texture's too:
+    /// levels of the same sizes, wrapped alike. (Both must be read at the
+    /// same texture coordinates.)
+    #[must_use]
+    pub fn reads_like(&self, other: &Texture) -> bool {
+        // A chain's sizes follow from its finest level's.
+        self.wrap.axes() == other.wrap.axes() && self.size() == other.size() && self.levels.len() == other.levels.len()
+    }
+
+    /// The colour over footprint `f` (made by this texture, or by one it
+    /// [`Texture::reads_like`]).
+    #[must_use]
+    pub fn read(&self, f: &Footprint) -> Vec3 {
+        let colour = |(k, c): (usize, Corners)| self.levels[k].colour(&c, self.layer, self.codec);
+        match f.coarse {
+            None => colour(f.fine),
+            Some((k, c, t)) => colour(f.fine).lerp(colour((k, c)), t),
         }
     }
 
@@ -466,43 +572,68 @@ impl Texture {
     /// footprint's two steps, within the chain.
     fn lod(&self, duv: [Vec2; 2]) -> f32 {
         let size = Vec2::new(self.levels[0].width as f32, self.levels[0].height as f32);
-        let step = (duv[0] * size).length().max((duv[1] * size).length());
-        let lod = if step > 1.0 && step.is_finite() { step.log2() } else { 0.0 };
+        let step = (duv[0] * size).length_squared().max((duv[1] * size).length_squared());
+        let lod = if step > 1.0 && step.is_finite() { 0.5 * step.log2() } else { 0.0 };
         lod.min((self.levels.len() - 1) as f32)
     }
 
     /// Alpha at `uv` (bilinear at the finest level), in [0, 1].
     #[must_use]
     pub fn alpha(&self, uv: Vec2) -> f32 {
-        let level = &self.levels[0];
-        level.alpha(&level.corners(uv, self.wrap))
+        self.read_alpha(&self.footprint(Filter::Bilinear, uv, [Vec2::ZERO; 2]))
     }
 
     /// Alpha for a pixel's footprint, filtered as [`Texture::sample_footprint`]
     /// filters colour.
     #[must_use]
     pub fn alpha_footprint(&self, uv: Vec2, duv: [Vec2; 2]) -> f32 {
-        self.trilinear(uv, duv, Level::alpha, |a, b, f| a + (b - a) * f)
+        self.read_alpha(&self.footprint(Filter::Trilinear, uv, duv))
     }
 
-    fn trilinear<T>(
-        &self,
-        uv: Vec2,
-        duv: [Vec2; 2],
-        read: impl Fn(&Level, &Corners) -> T,
-        lerp: impl Fn(T, T, f32) -> T,
-    ) -> T {
-        let lod = self.lod(duv);
-        let top = self.levels.len() - 1;
-        let k = (lod.floor() as usize).min(top);
-        let at = |k: usize| {
-            let level = &self.levels[k];
-            read(level, &level.corners(uv, self.wrap))
-        };
-        if k == top {
-            return at(k);
+    fn read_alpha(&self, f: &Footprint) -> f32 {
+        let alpha = |(k, c): (usize, Corners)| self.levels[k].alpha(&c, self.layer);
+        match f.coarse {
+            None => alpha(f.fine),
+            Some((k, c, t)) => {
+                let a = alpha(f.fine);
+                a + (alpha((k, c)) - a) * t
+            }
         }
-        lerp(at(k), at(k + 1), lod - k as f32)
+    }
+}
+
+/// Where a filtered texture lookup reads ([`Texture::footprint`]): the
+/// level or two levels, and the four texels blended in each.
+#[derive(Debug, Clone, Copy)]
+pub struct Footprint {
+    fine: (usize, Corners),
+    /// The next coarser level and its share, for trilinear filtering.
+    coarse: Option<(usize, Corners, f32)>,
+}
+
+/// The footprint of the last texture a surface point sampled, reused by
+/// the next one that [`Texture::reads_like`] it with the same filter: the
+/// maps of one [`Texture::interleaved`] bundle find their level and texels
+/// once a point. One is made for each point (the coordinates are the
+/// point's).
+#[derive(Debug, Default)]
+pub struct SharedFootprint<'a> {
+    last: Option<(&'a Texture, Filter, Footprint)>,
+}
+
+impl<'a> SharedFootprint<'a> {
+    /// `t` sampled at `uv` (of its coordinate set `t.set`) over `duv`, as
+    /// [`Texture::sample_filtered`] samples it.
+    pub fn sample(&mut self, t: &'a Texture, filter: Filter, uv: Vec2, duv: [Vec2; 2]) -> Vec3 {
+        let f = match self.last {
+            Some((last, by, f)) if by == filter && last.set == t.set && last.reads_like(t) => f,
+            _ => {
+                let f = t.footprint(filter, uv, duv);
+                self.last = Some((t, filter, f));
+                f
+            }
+        };
+        t.read(&f)
     }
 }
 
@@ -619,5 +750,56 @@ mod tests {
         assert!(t.coverage().shares_texels(&t));
         let grey = Texture::from_texels_8bit(2, 1, vec![[0, 0, 0, 255], [255, 255, 255, 255]], false).coverage();
         assert_eq!((grey.alpha(Vec2::new(0.25, 0.5)), grey.alpha(Vec2::new(0.75, 0.5))), (0.0, 1.0));
+    }
+
+    /// A pseudo-random 8-bit texture (odd size, alpha varying).
+    fn noise(width: u32, height: u32, seed: u32, srgb: bool) -> Texture {
+        let texel = |i: u32| {
+            let h = (i ^ seed).wrapping_mul(2_654_435_761).rotate_left(13).wrapping_mul(0x9E37_79B9);
+            h.to_le_bytes()
+        };
+        Texture::from_texels_8bit(width, height, (0..width * height).map(texel).collect(), srgb)
+    }
+
+    /// Textures stored side by side read exactly what they read alone, at
+    /// every filter, footprint and wrap, alpha included; one footprint
+    /// serves them all; the bundle's bytes are held once.
+    #[test]
+    fn interleaved_textures_read_what_they_read_alone() {
+        let mut alone = [noise(37, 23, 1, true), noise(37, 23, 2, false), noise(37, 23, 3, true)];
+        alone[1].wrap = Wrap::Each(Edge::Clamp, Edge::Mirror);
+        alone[2].set = 1;
+        let refs: Vec<&Texture> = alone.iter().collect();
+        let bundle = Texture::interleaved(&refs).expect("three 8-bit textures of one size");
+        assert!(bundle[0].shares_texels(&bundle[2]) && !bundle[0].shares_texels(&alone[0]));
+        assert_eq!(bundle[0].memory_bytes(), alone.iter().map(Texture::memory_bytes).sum::<usize>());
+        assert_eq!((bundle[1].wrap, bundle[2].set), (alone[1].wrap, 1));
+        let mut state = 7u32;
+        let mut next = || {
+            state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            (state >> 8) as f32 / (1u32 << 24) as f32
+        };
+        for _ in 0..500 {
+            let uv = Vec2::new(next() * 3.0 - 1.0, next() * 3.0 - 1.0);
+            let duv = [Vec2::new(next(), next()) * 0.3 * next(), Vec2::new(next(), next()) * 0.1];
+            for filter in [Filter::Bilinear, Filter::Trilinear, Filter::NearestLevel] {
+                let shared = bundle[0].footprint(filter, uv, duv);
+                for (b, a) in bundle.iter().zip(&alone) {
+                    assert_eq!(b.sample_filtered(filter, uv, duv), a.sample_filtered(filter, uv, duv));
+                    if b.reads_like(&bundle[0]) {
+                        assert_eq!(b.read(&shared), a.sample_filtered(filter, uv, duv));
+                    }
+                }
+            }
+            for (b, a) in bundle.iter().zip(&alone) {
+                assert_eq!(b.alpha_footprint(uv, duv), a.alpha_footprint(uv, duv));
+            }
+            assert_eq!(bundle[1].coverage().alpha(uv), alone[1].coverage().alpha(uv));
+        }
+        // Sizes that differ, or float texels, are not bundled.
+        assert!(Texture::interleaved(&[&alone[0], &noise(36, 23, 4, true)]).is_none());
+        assert!(Texture::interleaved(&[&alone[0]]).is_none());
+        let floats = Texture::from_texels(37, 23, vec![Vec3::ONE; 37 * 23]);
+        assert!(Texture::interleaved(&[&alone[0], &floats]).is_none());
     }
 }

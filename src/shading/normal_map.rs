@@ -17,7 +17,7 @@ use glam::Vec3;
 
 use super::surface::SurfacePoint;
 use crate::scene::material::Filter;
-use crate::scene::{Material, NormalMap};
+use crate::scene::{Material, NormalMap, SharedFootprint};
 
 /// Least cosine between a tilted normal and the direction to the eye: a map
 /// may tilt a normal past the silhouette, where it would shade as the
@@ -26,15 +26,20 @@ const MIN_FACING: f32 = 1e-3;
 
 /// Tilts `s.normal` by `m`'s normal map, if it has one.
 pub fn apply(m: &Material, s: &mut SurfacePoint) {
+    apply_shared(m, s, &mut SharedFootprint::default());
+}
+
+/// [`apply`], the map's footprint shared with the point's other maps
+/// through `shared`.
+pub fn apply_shared<'a>(m: &'a Material, s: &mut SurfacePoint, shared: &mut SharedFootprint<'a>) {
     if let Some(map) = &m.maps.normal {
-        s.normal = tilted_normal(map, m.maps.filter, s);
+        s.normal = tilted(map, m.maps.filter, s, shared);
     }
 }
 
 /// The normal at `s` tilted by `map` (sampled with `filter` over the point's
 /// footprint); `s.normal` unchanged where the point has no tangent frame.
-#[must_use]
-pub fn tilted_normal(map: &NormalMap, filter: Filter, s: &SurfacePoint) -> Vec3 {
+fn tilted<'a>(map: &'a NormalMap, filter: Filter, s: &SurfacePoint, shared: &mut SharedFootprint<'a>) -> Vec3 {
     let n = s.normal;
     let [dpdu, dpdv] = s.tangents;
     let t = (dpdu - n * n.dot(dpdu)).normalize_or_zero();
@@ -44,7 +49,7 @@ pub fn tilted_normal(map: &NormalMap, filter: Filter, s: &SurfacePoint) -> Vec3 
         return n;
     }
     let (uv, duv) = s.coords(map.texture.set);
-    let texel = map.texture.sample_filtered(filter, uv, duv);
+    let texel = shared.sample(&map.texture, filter, uv, duv);
     let local = texel * 2.0 - Vec3::ONE;
     // The eye on the back: `n` was turned round, and x and y turn with it.
     let side = if s.front { 1.0 } else { -1.0 };
@@ -82,6 +87,10 @@ mod tests {
             color: Vec3::ONE,
             second: glam::Affine2::IDENTITY,
         }
+    }
+
+    fn tilted_normal(map: &NormalMap, filter: Filter, s: &SurfacePoint) -> Vec3 {
+        tilted(map, filter, s, &mut SharedFootprint::default())
     }
 
     fn flat_map(rgb: Vec3, scale: f32) -> NormalMap {

@@ -5,10 +5,12 @@
 //! cosθ = N·L; cosα = R·V with R the mirror of L about N (Phong, as the paper and the
 //! peers use); the specular term is zero where N·L ≤ 0.
 
+use std::sync::Arc;
+
 use glam::Vec3;
 
 use super::surface::SurfacePoint;
-use crate::scene::{Light, Material};
+use crate::scene::{Light, Material, SharedFootprint, Texture};
 
 /// The components of seed 002 eq. 4, summed over lights.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -171,12 +173,17 @@ impl Coefficients {
     /// point's vertex colour).
     #[must_use]
     pub fn at(m: &Material, s: &SurfacePoint) -> Self {
-        let sample = |t: &crate::scene::Texture| {
+        Self::sampled(m, s, &mut SharedFootprint::default())
+    }
+
+    /// [`Coefficients::at`], the maps' footprints shared through `shared`.
+    fn sampled<'a>(m: &'a Material, s: &SurfacePoint, shared: &mut SharedFootprint<'a>) -> Self {
+        let mut sample = |t: &'a Texture| {
             let (uv, duv) = s.coords(t.set);
-            t.sample_filtered(m.maps.filter, uv, duv)
+            shared.sample(t, m.maps.filter, uv, duv)
         };
         // No map: the coefficient; several: one pass per map, added.
-        let map = |maps: &[std::sync::Arc<crate::scene::Texture>]| {
+        let mut map = |maps: &'a [Arc<Texture>]| {
             if maps.is_empty() {
                 Vec3::ONE
             } else {
@@ -185,10 +192,10 @@ impl Coefficients {
         };
         let diffuse = map(&m.maps.diffuse);
         // glTF's base colour is both maps: sampled once.
-        let shared = m.maps.ambient.len() == m.maps.diffuse.len()
-            && m.maps.ambient.iter().zip(&m.maps.diffuse).all(|(a, d)| std::sync::Arc::ptr_eq(a, d));
+        let same = m.maps.ambient.len() == m.maps.diffuse.len()
+            && m.maps.ambient.iter().zip(&m.maps.diffuse).all(|(a, d)| Arc::ptr_eq(a, d));
         Coefficients {
-            ka: m.ka * s.color * if shared { diffuse } else { map(&m.maps.ambient) },
+            ka: m.ka * s.color * if same { diffuse } else { map(&m.maps.ambient) },
             kd: m.kd * s.color * diffuse,
             ks: m.ks * map(&m.maps.specular),
             ke: m.ke * map(&m.maps.emission),
@@ -201,8 +208,9 @@ impl Coefficients {
 /// ([`super::normal_map`]), the colour maps give the coefficients.
 #[must_use]
 pub fn sample_maps(m: &Material, s: &mut SurfacePoint) -> Coefficients {
-    super::normal_map::apply(m, s);
-    Coefficients::at(m, s)
+    let mut shared = SharedFootprint::default();
+    super::normal_map::apply_shared(m, s, &mut shared);
+    Coefficients::sampled(m, s, &mut shared)
 }
 
 /// Adds light `light`'s ambient, diffuse and specular terms at `s` to `acc`, with

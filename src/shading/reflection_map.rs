@@ -7,11 +7,14 @@
 //! map's mip level matching that spread): a curved mirror seen small shows the
 //! map's average there, not moiré.
 
+use std::ops::Range;
+
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
-use super::{Component, ObjectFrames, SurfacePoint, Target};
-use crate::scene::{Material, Scene};
+use super::{Component, ObjectFrames, SurfacePoint, Target, TriangleCache};
+use crate::camera::PixelRays;
+use crate::scene::{Material, Scene, SharedFootprint};
 use crate::visibility::VisibilityBuffer;
 
 /// Adds Km · Mape(R) to every target holding the reflection component, and the
@@ -26,37 +29,43 @@ pub fn add_reflection_map(scene: &Scene, vb: &VisibilityBuffer, targets: &mut [T
     let w = vb.width() as usize;
     let frames = ObjectFrames::new(scene);
     let rays = scene.camera.pixel_rays(Vec2::new(w as f32, vb.height() as f32));
+    let mirrors = Mirrors { scene, vb, frames: &frames, rays: &rays, reflecting: &reflecting };
     for t in targets {
         let (reflection, background) = (t.parts.contains(Component::Reflection), t.parts.contains(Component::Emission));
         if !(reflection || background && env.visible) {
             continue;
         }
-        let rows = t.image.pixels_mut().par_chunks_mut(w).zip(vb.items().par_chunks(w));
-        rows.enumerate().for_each(|(y, (out, items))| {
-            for (x, (px, &item)) in out.iter_mut().zip(items).enumerate() {
-                let (x, y) = (x as u32, y as u32);
-                let ray = |x: u32, y: u32| rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
-                if item.is_none() {
-                    if background && env.visible {
-                        let dir = |x: u32, y: u32| ray(x, y).dir.normalize();
-                        *px += env.radiance_over(dir(x, y), dir(x + 1, y), dir(x, y + 1));
+        let bands = t.image.pixels_mut().par_chunks_mut(w * BAND).enumerate();
+        let scratch = || (TriangleCache::new(512), Vec::new());
+        bands.for_each_init(scratch, |(cache, band), (k, out)| {
+            let rows = k * BAND..k * BAND + out.len() / w;
+            if reflection {
+                mirrors.fill(rows.clone(), cache, band);
+            }
+            // Row y of the band is row y + 1 of `band` (it holds one more
+            // row above and below).
+            let top = rows.start as i64;
+            let at = |x: i64, y: i64| {
+                let (x, y) = (usize::try_from(x).ok().filter(|&x| x < w)?, usize::try_from(y + 1 - top).ok()?);
+                band.get(y * w + x).copied().flatten()
+            };
+            for (y, row) in rows.clone().zip(out.chunks_mut(w)) {
+                let items = &vb.items()[y * w..(y + 1) * w];
+                for (x, (px, &item)) in row.iter_mut().zip(items).enumerate() {
+                    if item.is_none() {
+                        if background && env.visible {
+                            let dir = |x: usize, y: usize| {
+                                rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5)).dir.normalize()
+                            };
+                            *px += env.radiance_over(dir(x, y), dir(x + 1, y), dir(x, y + 1));
+                        }
+                        continue;
                     }
-                    continue;
-                }
-                if reflection && reflecting[item.material(scene)] {
-                    let surface = |x: u32, y: u32| {
-                        let mut s = frames.surface_at(scene, vb, x, y, &ray(x, y));
-                        super::normal_map::apply(&scene.materials[s.material], &mut s);
-                        s
-                    };
-                    let s = surface(x, y);
-                    let mirror = |x: u32, y: u32| mirror_direction(&surface(x, y));
-                    let r = mirror_direction(&s);
+                    let Some(here) = at(x as i64, y as i64).filter(|_| reflection) else { continue };
                     // The spread of mirror directions to the pixels beside and
                     // below, taken from the other side where they show another object.
-                    let beside = |dx: i32, dy: i32| {
-                        let at = |k: i32| (x as i32 + k * dx, y as i32 + k * dy);
-                        [1, -1].into_iter().map(at).find(|&(nx, ny)| {
+                    let beside = |dx: i64, dy: i64| {
+                        [1, -1].into_iter().map(|k| (x as i64 + k * dx, y as i64 + k * dy)).find(|&(nx, ny)| {
                             nx >= 0
                                 && ny >= 0
                                 && (nx as u32) < vb.width()
@@ -64,12 +73,68 @@ pub fn add_reflection_map(scene: &Scene, vb: &VisibilityBuffer, targets: &mut [T
                                 && vb.item(nx as u32, ny as u32).object == item.object
                         })
                     };
-                    let spread = |n: Option<(i32, i32)>| n.map_or(r, |(nx, ny)| mirror(nx as u32, ny as u32));
-                    let km = mirrored_share(&scene.materials[s.material], &s);
-                    *px += km * env.radiance_over(r, spread(beside(1, 0)), spread(beside(0, 1)));
+                    let spread = |n: Option<(i64, i64)>| n.and_then(|(nx, ny)| at(nx, ny)).map_or(here.r, |m| m.r);
+                    *px += here.km * env.radiance_over(here.r, spread(beside(1, 0)), spread(beside(0, 1)));
                 }
             }
         });
+    }
+}
+
+/// Rows shaded together by the pass: each pixel's Km and mirror direction
+/// are found once for the band and read by its neighbours too.
+const BAND: usize = 16;
+
+/// What the pass needs of a reflecting pixel.
+#[derive(Debug, Clone, Copy)]
+struct Mirror {
+    /// Km there, its map applied.
+    km: Vec3,
+    /// The view's mirror direction there (the normal map's normal).
+    r: Vec3,
+}
+
+/// Finds the [`Mirror`] of each pixel of a band of rows.
+struct Mirrors<'a> {
+    scene: &'a Scene,
+    vb: &'a VisibilityBuffer,
+    frames: &'a ObjectFrames,
+    rays: &'a PixelRays,
+    reflecting: &'a [bool],
+}
+
+impl Mirrors<'_> {
+    /// The mirrors of `rows` and of the rows above and below them, row by
+    /// row into `out` (`None` where a pixel shows nothing that reflects).
+    fn fill(&self, rows: Range<usize>, cache: &mut TriangleCache, out: &mut Vec<Option<Mirror>>) {
+        let (scene, vb) = (self.scene, self.vb);
+        let w = vb.width() as usize;
+        let (first, last) = (rows.start.saturating_sub(1), (rows.end + 1).min(vb.height() as usize));
+        out.clear();
+        out.resize((rows.len() + 2) * w, None);
+        for y in first..last {
+            let row = &mut out[(y + 1 - rows.start) * w..][..w];
+            for (x, slot) in row.iter_mut().enumerate() {
+                let item = vb.item(x as u32, y as u32);
+                if item.is_none() || !self.reflecting[item.material(scene)] {
+                    continue;
+                }
+                let ray = self.rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
+                let mut s = match item.primitive() {
+                    Some(_) => self.frames.surface_at(scene, vb, x as u32, y as u32, &ray),
+                    None => cache.get(scene, self.frames, item).surface(&ray),
+                };
+                let m = &scene.materials[s.material];
+                let mut shared = SharedFootprint::default();
+                super::normal_map::apply_shared(m, &mut s, &mut shared);
+                let km = m.km
+                    * m.maps.mirror.as_ref().map_or(Vec3::ONE, |t| {
+                        let (uv, duv) = s.coords(t.set);
+                        shared.sample(t, m.maps.filter, uv, duv)
+                    });
+                *slot = Some(Mirror { km, r: mirror_direction(&s) });
+            }
+        }
     }
 }
 

@@ -46,8 +46,9 @@ pub(super) fn load(bytes: &[u8], path: &Path, from: Files) -> Result<LoadedModel
     });
     // Images several materials name are decoded once.
     let mut decoded = HashMap::new();
-    let materials: Vec<Material> =
+    let mut materials: Vec<Material> =
         materials.iter().map(|m| material(m, dir, from, &mut decoded, &mut out.warnings)).collect();
+    crate::scene::material::interleave_maps(&mut materials);
     let mut first_error = None;
     for m in models {
         let built = mesh(&m.mesh);

@@ -108,7 +108,8 @@ fn load_contained(bytes: &[u8], path: &Path, from: Files) -> Result<LoadedModel,
         warnings: RefCell::new(warnings),
     };
     cx.decode_all();
-    let materials: Vec<(Material, Channels)> = cx.doc.materials().map(|m| cx.material(&m)).collect();
+    let mut materials: Vec<(Material, Channels)> = cx.doc.materials().map(|m| cx.material(&m)).collect();
+    crate::scene::material::interleave_maps(materials.iter_mut().map(|(m, _)| m));
     let mut model = LoadedModel::default();
     let scene = cx.doc.default_scene().or_else(|| cx.doc.scenes().next()).ok_or("the file has no scene")?;
     for node in scene.nodes() {
