@@ -34,7 +34,12 @@ const EXTENSIONS: &[(&str, Support)] = &[
         "KHR_materials_clearcoat",
         Support::Without("the clear coat is approximated: its factor mirrors 4% of the environment, sharply"),
     ),
-    ("KHR_materials_sheen", Support::Without("the sheen is not drawn")),
+    (
+        "KHR_materials_sheen",
+        Support::Without(
+            "the sheen is approximated: a diffuse tint of its colour factor (a quarter of it), its textures not read",
+        ),
+    ),
     (
         "KHR_materials_specular",
         Support::Without("its strength and colour factors set the highlight's reflectance; its textures are not read"),
@@ -124,7 +129,7 @@ mod tests {
         check(&mut r, &mut warnings).unwrap();
         assert!(r.extensions_required.is_empty());
         assert_eq!(warnings.len(), 2, "{warnings:?}");
-        assert!(warnings[0].contains("KHR_materials_sheen") && warnings[0].contains("not drawn"));
+        assert!(warnings[0].contains("KHR_materials_sheen") && warnings[0].contains("approximated"));
         assert!(warnings[1].contains("EXT_frobnicate") && warnings[1].contains("ignored"));
         // Compression only used: the file's uncompressed data is drawn, no word.
         warnings.clear();

@@ -138,6 +138,7 @@ impl Context<'_> {
                 .and_then(gltf::json::Value::as_f64)
                 .filter(|c| c.is_finite())
                 .map_or(0.0, |c| c.clamp(0.0, 1.0) as f32),
+            sheen: sheen_colour(m) * SHEEN_ALBEDO,
         };
         let transmission = m.transmission().map_or(0.0, |t| t.transmission_factor().clamp(0.0, 1.0));
         let mut out = surface.material();
@@ -343,7 +344,17 @@ struct Surface {
     /// `KHR_materials_clearcoat`'s factor: a clear layer mirroring 4% of the
     /// environment over the surface.
     coat: f32,
+    /// `KHR_materials_sheen`'s colour factor times [`SHEEN_ALBEDO`]: what
+    /// the sheen layer adds to the diffuse reflectance.
+    sheen: Vec3,
 }
+
+/// The share of light a sheen layer of colour 1 reflects, taken as one
+/// number: the sheen (a velvet's grazing glow) is approximated as a diffuse
+/// tint of its colour over a base dimmed by as much, as the glTF extension
+/// layers it. 0.25 is about the mean directional albedo of its
+/// "Charlie" distribution at medium sheen roughness.
+const SHEEN_ALBEDO: f32 = 0.25;
 
 impl Surface {
     /// Base colour, metalness, roughness and occlusion at `uv`.
@@ -352,6 +363,12 @@ impl Surface {
         let mr = self.metal_roughness_map.as_ref().map_or(Vec3::ONE, |t| t.sample(uv));
         let occlusion = self.occlusion.as_ref().map_or(1.0, |(t, strength)| 1.0 + strength * (t.sample(uv).x - 1.0));
         (base, (self.metal * mr.z).clamp(0.0, 1.0), (self.roughness * mr.y).clamp(0.0, 1.0), occlusion)
+    }
+
+    /// Kd: the base's diffuse share (base · (1 − metal)), dimmed by what a
+    /// sheen layer over it reflects and tinted by it.
+    fn diffuse(&self, base: Vec3, metal: f32) -> Vec3 {
+        base * (1.0 - metal) * (1.0 - self.sheen.max_element()) + self.sheen
     }
 
     /// Km: the environment a metal mirrors (base · metal), and a clear
@@ -369,7 +386,7 @@ impl Surface {
     /// exponent comes from the mean roughness.
     fn material(&self) -> Material {
         let Some(size) = self.baked_size() else {
-            let kd = self.base * (1.0 - self.metal);
+            let kd = self.diffuse(self.base, self.metal);
             return Material {
                 ka: kd,
                 kd,
@@ -394,13 +411,13 @@ impl Surface {
         let [diffuse, ambient, specular, mirror] = if self.occlusion.is_some() {
             bake(size, like, |uv| {
                 let (base, metal, _, occlusion) = self.at(uv);
-                let kd = base * (1.0 - metal);
+                let kd = self.diffuse(base, metal);
                 [kd, kd * occlusion, self.dielectric.lerp(base, metal), self.mirrored(base, metal)]
             })
         } else {
             let [diffuse, specular, mirror] = bake(size, like, |uv| {
                 let (base, metal, _, _) = self.at(uv);
-                [base * (1.0 - metal), self.dielectric.lerp(base, metal), self.mirrored(base, metal)]
+                [self.diffuse(base, metal), self.dielectric.lerp(base, metal), self.mirrored(base, metal)]
             });
             [Arc::clone(&diffuse), diffuse, specular, mirror]
         };
@@ -433,12 +450,29 @@ impl Surface {
 
     /// The size of the largest texture when a texture varies more than the
     /// base colour (metalness, roughness or occlusion); `None` otherwise.
+    /// A sheen over a base-colour texture is baked too (it is added to Kd,
+    /// not multiplied).
     fn baked_size(&self) -> Option<(u32, u32)> {
-        if self.metal_roughness_map.is_none() && self.occlusion.is_none() {
+        let sheen = self.sheen != Vec3::ZERO && self.base_map.is_some();
+        if self.metal_roughness_map.is_none() && self.occlusion.is_none() && !sheen {
             return None;
         }
         let maps = [self.base_map.as_ref(), self.metal_roughness_map.as_ref(), self.occlusion.as_ref().map(|(t, _)| t)];
         maps.into_iter().flatten().map(|t| t.size()).reduce(|a, b| (a.0.max(b.0), a.1.max(b.1)))
+    }
+}
+
+/// `KHR_materials_sheen`'s colour factor (black without one; its textures
+/// are not read).
+fn sheen_colour(m: &gltf::Material) -> Vec3 {
+    let Some(sheen) = m.extension_value("KHR_materials_sheen") else { return Vec3::ZERO };
+    let factor = sheen.get("sheenColorFactor").and_then(gltf::json::Value::as_array);
+    let channel = |k: usize| factor.and_then(|f| f.get(k)).and_then(gltf::json::Value::as_f64).unwrap_or(0.0);
+    let colour = Vec3::new(channel(0) as f32, channel(1) as f32, channel(2) as f32);
+    if colour.is_finite() {
+        colour.clamp(Vec3::ZERO, Vec3::ONE)
+    } else {
+        Vec3::ZERO
     }
 }
 
@@ -491,6 +525,7 @@ mod tests {
             occlusion: None,
             dielectric: Vec3::splat(0.04),
             coat: 0.0,
+            sheen: Vec3::ZERO,
         };
         let m = surface.material();
         let mirror = m.maps.mirror.as_ref().expect("a mirror map");
@@ -519,6 +554,7 @@ mod tests {
             occlusion: None,
             dielectric,
             coat,
+            sheen: Vec3::ZERO,
         };
         assert_eq!(plain(0.0, Vec3::ZERO, 0.0, false).material().ks, Vec3::ZERO);
         let tinted = plain(0.0, Vec3::new(0.04, 0.0, 0.0), 0.0, false).material().ks;
@@ -529,6 +565,36 @@ mod tests {
         let mirror = baked.maps.mirror.as_ref().expect("a coat mirrors where nothing else does");
         let km = baked.km * mirror.sample(Vec2::splat(0.5));
         assert!((km - Vec3::splat(0.04)).abs().max_element() < 0.01, "{km}");
+    }
+
+    /// A black cloth under a red sheen comes out red, not black; a sheen
+    /// over a textured base tints the baked Kd map as it tints a constant
+    /// one; no sheen leaves Kd as it was.
+    #[test]
+    fn a_sheen_tints_the_diffuse_reflectance() {
+        let cloth = |base: Vec3, map: bool, sheen: Vec3| Surface {
+            base,
+            base_map: map.then(|| two_texels(Vec3::ONE, Vec3::ONE)),
+            metal: 0.0,
+            roughness: 0.8,
+            metal_roughness_map: None,
+            occlusion: None,
+            dielectric: Vec3::splat(0.04),
+            coat: 0.0,
+            sheen: sheen * SHEEN_ALBEDO,
+        };
+        let red = Vec3::new(1.0, 0.0, 0.0);
+        let kd = |s: &Surface| {
+            let m = s.material();
+            m.kd * m.maps.diffuse.first().map_or(Vec3::ONE, |t| t.sample(Vec2::splat(0.5)))
+        };
+        assert_eq!(kd(&cloth(Vec3::ZERO, false, Vec3::ZERO)), Vec3::ZERO);
+        let plain = kd(&cloth(Vec3::ZERO, false, red));
+        assert!((plain - red * SHEEN_ALBEDO).length() < 1e-6, "{plain}");
+        let textured = kd(&cloth(Vec3::ZERO, true, red));
+        assert!((textured - plain).abs().max_element() < 0.01, "{textured} vs {plain}");
+        let grey = kd(&cloth(Vec3::splat(0.5), false, red));
+        assert!((grey - Vec3::new(0.5 * 0.75 + 0.25, 0.375, 0.375)).length() < 1e-6, "{grey}");
     }
 
     /// A normal or occlusion texture's transform, read from its JSON, is the

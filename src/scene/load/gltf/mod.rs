@@ -7,7 +7,9 @@
 //! strength × 0.04), Km = base colour · metallic (a metal mirrors the
 //! environment: a lone model gets a studio one) plus 0.04 ×
 //! `KHR_materials_clearcoat`'s factor (a clear coat, approximated as a sharp
-//! 4% mirror), n = 2/α² − 2 with α =
+//! 4% mirror), Kd tinted by `KHR_materials_sheen`'s colour (a quarter of it,
+//! the base dimmed by as much: a velvet's sheen approximated as a diffuse
+//! tint), n = 2/α² − 2 with α =
 //! roughness² (the Blinn-Phong exponent of equal lobe width), Ke = emissive
 //! (times `KHR_materials_emissive_strength`). The base-colour texture
 //! multiplies Kd and Ka; with a metallic-roughness or occlusion texture, Kd,
