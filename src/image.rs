@@ -272,17 +272,25 @@ impl Srgb8Encoder {
             }
             *start = f32::from_bits(hi);
         }
-        let bucket = (0..Self::BUCKETS).map(|i| code(i as f32 / Self::BUCKETS as f32)).collect();
+        let bucket: Vec<u8> = (0..Self::BUCKETS).map(|i| code(i as f32 / Self::BUCKETS as f32)).collect();
+        // No step holds more than two codes' starts (what `encode` relies on).
+        for (i, &first) in bucket.iter().enumerate() {
+            let end = (i + 1) as f32 / Self::BUCKETS as f32;
+            let within = starts[usize::from(first) + 1..].iter().take_while(|&&s| s < end).count();
+            assert!(within <= 2, "sRGB table step {i} holds {within} code starts");
+        }
         Srgb8Encoder { starts, bucket }
     }
 
     fn encode(&self, c: f32) -> u8 {
         let c = c.clamp(0.0, 1.0);
         let i = ((c * Self::BUCKETS as f32) as usize).min(Self::BUCKETS - 1);
+        // At most two codes start within a step (checked when the table is
+        // made): two comparisons without a branch, which the frame's
+        // unpredictable colours would mispredict.
         let mut k = usize::from(self.bucket[i]);
-        while c >= self.starts[k + 1] {
-            k += 1;
-        }
+        k += usize::from(c >= self.starts[k + 1]);
+        k += usize::from(c >= self.starts[k + 1]);
         k as u8
     }
 }

@@ -1,6 +1,14 @@
 //! Colour textures, decoded once, with a mip chain: sampled
 //! bilinearly at the finest level, or trilinearly at the level matching a
 //! footprint (the texture-space size of the pixel), with a wrap mode.
+//!
+//! Textures of one size can be stored side by side ([`Texture::interleaved`]):
+//! a textured pixel reads all its material's maps at one place, and with
+//! them interleaved the lookups after the first find their texels in the
+//! cache and share one [`Footprint`] ([`SharedFootprint`]). On the
+//! DamagedHelmet (six 2048² maps a pixel) that took the viewer's quick
+//! frame from 95.7–97.7 ms to 62.4–63.7 ms together with the
+//! reflection-map pass's band of mirrors (1280×720, 2 threads, alternated).
 
 use std::sync::{Arc, LazyLock};
 
@@ -450,14 +458,21 @@ impl Texture {
         }
         let levels = (0..first.levels.len())
             .map(|k| {
-                let mut layers: Vec<_> =
-                    bundle.iter().map(|t| t.levels[k].layer_bytes(t.layer).expect("8-bit levels")).collect();
-                let positions = (first.levels[k].width * first.levels[k].height) as usize;
-                let mut texels = Vec::with_capacity(positions * bundle.len());
-                for _ in 0..positions {
-                    texels.extend(layers.iter_mut().map(|l| l.next().expect("a texel a position")));
-                }
+                // Each input's texels at level k, with its stride and layer.
+                let inputs: Vec<(&[[u8; 4]], usize, usize)> = bundle
+                    .iter()
+                    .map(|t| match &t.levels[k].texels {
+                        Texels::Bytes(b) => (&b[..], t.levels[k].layers, t.layer),
+                        Texels::Floats(_) => unreachable!("checked above: 8-bit levels"),
+                    })
+                    .collect();
                 let (width, height) = (first.levels[k].width, first.levels[k].height);
+                let mut texels = vec![[0u8; 4]; (width * height) as usize * bundle.len()];
+                texels.par_chunks_mut(bundle.len()).enumerate().for_each(|(i, out)| {
+                    for (o, &(src, layers, layer)) in out.iter_mut().zip(&inputs) {
+                        *o = src[i * layers + layer];
+                    }
+                });
                 Level { width, height, layers: bundle.len(), texels: Texels::Bytes(texels) }
             })
             .collect();
