@@ -12,6 +12,7 @@ use glam::{Vec2, Vec3};
 use wide::f32x8;
 
 use super::phong::{Coefficients, Component, ComponentSet, Components};
+use super::reflection_map::Mirror;
 use super::surface::{PreparedTriangle, SurfacePoint, TriangleGeometry};
 use crate::camera::PixelRays;
 use crate::scene::{Falloff, Light, LightKind};
@@ -129,6 +130,7 @@ pub struct Block {
     kd: Gather,
     ks: Gather,
     ke: Gather,
+    km: Gather,
     shininess: [f32; LANES],
     textured: [bool; LANES],
     /// ∂P/∂u and ∂P/∂v of each lane's triangle (for its normal map).
@@ -182,6 +184,7 @@ impl Block {
         self.kd.set(i, kd);
         self.ks.set(i, ks);
         self.ke.set(i, ke);
+        self.km.set(i, k.km());
         self.shininess[i] = n;
     }
 
@@ -212,7 +215,9 @@ impl Block {
 
     /// Shades the block: `x0` is the first pixel's column on the row of `rays`; lanes with a
     /// textured material get their coefficients from `coefficients_at`. Writes the
-    /// colours of live lanes to `out`.
+    /// colours of live lanes to `out`, and, with `mirrors`, each live lane's
+    /// [`Mirror`] where `reflects` says its material reflects.
+    #[expect(clippy::too_many_arguments, reason = "the block's row, its pass and its two outputs")]
     pub fn shade(
         &mut self,
         rays: &RowRays,
@@ -221,6 +226,7 @@ impl Block {
         coefficients_at: impl Fn(&mut SurfacePoint) -> Coefficients,
         blend: Blend,
         out: &mut [Vec3],
+        mirrors: Option<(&mut [Mirror], &[bool])>,
     ) {
         let mut inputs = self.inputs();
         let mut s = surface(&inputs, rays, x0);
@@ -229,6 +235,15 @@ impl Block {
             (inputs.ka, inputs.kd, inputs.ks, inputs.ke) = (textured.ka, textured.kd, textured.ks, textured.ke);
             (inputs.shininess, inputs.whole, inputs.exponents) =
                 (textured.shininess, textured.whole, textured.exponents);
+        }
+        if let Some((mirrors, reflects)) = mirrors {
+            let r = mirror_directions(&s);
+            let km = self.km.load();
+            for (i, m) in mirrors.iter_mut().enumerate() {
+                if self.live[i] && reflects[self.material[i]] {
+                    *m = Mirror { km: km.lane(i), r: r.lane(i) };
+                }
+            }
         }
         let rgb = lighting.shade(&inputs, &s);
         for (i, px) in out.iter_mut().enumerate() {
@@ -296,6 +311,7 @@ impl Block {
 /// show `tri` with the map-free coefficients `k`, on the row `rays` describes,
 /// starting at column `x0`: the inputs are broadcast into vector registers once for
 /// the whole run, skipping the per-lane gather.
+#[expect(clippy::too_many_arguments, reason = "the run's triangle and row, its pass and its two outputs")]
 pub fn shade_run(
     tri: &PreparedTriangle,
     k: &Coefficients,
@@ -304,17 +320,31 @@ pub fn shade_run(
     lighting: &Lighting,
     blend: Blend,
     out: &mut [Vec3],
+    mut mirrors: Option<&mut [Mirror]>,
 ) {
     let g = tri.geometry();
     let inputs = LaneInputs::broadcast(tri, &g, Some(k));
     let row = TriangleRow::new(&g, &rays.line(x0));
     for (b, out) in out.chunks_exact_mut(LANES).enumerate() {
-        let rgb = lighting.shade(&inputs, &row.surface(&inputs, b * LANES));
+        let s = row.surface(&inputs, b * LANES);
+        if let Some(mirrors) = mirrors.as_deref_mut() {
+            let r = mirror_directions(&s);
+            for (i, m) in mirrors[b * LANES..][..LANES].iter_mut().enumerate() {
+                *m = Mirror { km: k.km(), r: r.lane(i) };
+            }
+        }
+        let rgb = lighting.shade(&inputs, &s);
         let (r, g, b) = (rgb.x.to_array(), rgb.y.to_array(), rgb.z.to_array());
         for (i, px) in out.iter_mut().enumerate() {
             blend.apply(px, Vec3::new(r[i], g[i], b[i]));
         }
     }
+}
+
+/// The view's mirror direction R = 2(N·V)N − V of each lane.
+#[inline(always)]
+fn mirror_directions(s: &LaneSurface) -> V3 {
+    s.n.scale(s.n.dot(s.v) * F::splat(2.0)).sub(s.v)
 }
 
 /// The position and unit normal (facing the eye) that each of `count` pixels

@@ -26,6 +26,7 @@ pub(crate) mod translucency;
 pub(crate) mod visible;
 
 use glam::{Vec2, Vec3};
+use rayon::iter::Either;
 use rayon::prelude::*;
 
 use crate::image::LinearImage;
@@ -36,6 +37,7 @@ use crate::visibility::{ItemId, VisibilityBuffer};
 pub use lanes::{Blend, Lighting};
 pub use passes::{frame_lights, shade_lit, shade_lit_beside, FrameLight, PassStats, Target};
 pub use phong::{Component, ComponentSet, Components};
+pub use reflection_map::Mirror;
 pub use subpixel::{SubpixelSample, SubpixelShading};
 pub use surface::{ObjectFrames, PreparedTriangle, SurfacePoint};
 pub use visible::screen_surfaces;
@@ -73,6 +75,24 @@ impl ShadingPass<'_> {
 ///
 /// If `image` and `vb` differ in size.
 pub fn shade_pass(scene: &Scene, vb: &VisibilityBuffer, image: &mut LinearImage, pass: &ShadingPass) {
+    shade_pass_finding_mirrors(scene, vb, image, pass, None);
+}
+
+/// [`shade_pass`], which also writes each pixel's [`Mirror`] into `mirrors`
+/// (one a pixel, row by row; pixels that show no reflecting material are
+/// left as they are), for the reflection-map pass: the shading finds each
+/// pixel's normal-mapped normal and Km already.
+///
+/// # Panics
+///
+/// If `image` and `vb` differ in size, or `mirrors` from them.
+pub fn shade_pass_finding_mirrors(
+    scene: &Scene,
+    vb: &VisibilityBuffer,
+    image: &mut LinearImage,
+    pass: &ShadingPass,
+    mirrors: Option<&mut [Mirror]>,
+) {
     assert_eq!((image.width(), image.height()), (vb.width(), vb.height()), "image and buffer sizes");
     let w = vb.width() as usize;
     let frames = ObjectFrames::new(scene);
@@ -86,12 +106,20 @@ pub fn shade_pass(scene: &Scene, vb: &VisibilityBuffer, image: &mut LinearImage,
     // Whole rows of what a replacing pass writes where it shades nothing, copied
     // from (a block copy is faster than writing one 12-byte pixel at a time).
     let (background, black) = (vec![pass.background; w], vec![Vec3::ZERO; w]);
-    let rows = image.pixels_mut().par_chunks_mut(w).zip(vb.items().par_chunks(w));
+    let reflects: Vec<bool> = scene.materials.iter().map(|m| m.km.max_element() > 0.0).collect();
+    let mirror_rows = match mirrors {
+        Some(m) => {
+            assert_eq!(m.len(), image.pixels().len(), "a mirror a pixel");
+            Either::Left(m.par_chunks_mut(w).map(Some))
+        }
+        None => Either::Right((0..vb.height()).into_par_iter().map(|_| None)),
+    };
+    let rows = image.pixels_mut().par_chunks_mut(w).zip(vb.items().par_chunks(w)).zip(mirror_rows);
     let caches = || (TriangleCache::new(512), lanes::Block::default());
     // Only the buffer's scissor is drawn: the rest is left as it is.
     let scissor = vb.scissor();
     let (columns, drawn_rows) = (scissor.x0 as usize..scissor.x1 as usize, scissor.y0 as usize..scissor.y1 as usize);
-    rows.enumerate().for_each_init(caches, |(cache, block), (y, (out, items))| {
+    rows.enumerate().for_each_init(caches, |(cache, block), (y, ((out, items), mut mirror_row))| {
         if !drawn_rows.contains(&y) {
             return;
         }
@@ -137,7 +165,9 @@ pub fn shade_pass(scene: &Scene, vb: &VisibilityBuffer, image: &mut LinearImage,
                     cache.get(scene, &frames, first)
                 };
                 if let Some(k) = constant(tri) {
-                    lanes::shade_run(tri, k, &row, x, lighting, blend, &mut out[x..whole]);
+                    let mirrors =
+                        mirror_row.as_deref_mut().filter(|_| reflects[tri.material]).map(|m| &mut m[x..whole]);
+                    lanes::shade_run(tri, k, &row, x, lighting, blend, &mut out[x..whole], mirrors);
                     x = whole;
                     continue;
                 }
@@ -162,7 +192,8 @@ pub fn shade_pass(scene: &Scene, vb: &VisibilityBuffer, image: &mut LinearImage,
                 block.set(i, tri, constant(tri));
             }
             if block.live.iter().any(|&l| l) {
-                block.shade(&row, x, lighting, sample, blend, &mut out[x..end]);
+                let mirrors = mirror_row.as_deref_mut().map(|m| (&mut m[x..end], &reflects[..]));
+                block.shade(&row, x, lighting, sample, blend, &mut out[x..end], mirrors);
             }
             x = end;
         }

@@ -29,11 +29,14 @@ use std::time::Instant;
 use crate::idle::{IdleClock, IdleTime};
 
 use glam::{Vec2, Vec3};
+use rayon::prelude::*;
 
 use super::reflection_map::{add_reflection_map, flat_background};
 use super::visible::screen_surfaces;
-use super::{shade_pass, Blend, Component, ComponentSet, Lighting, ShadingPass, SubpixelShading};
-use crate::image::LinearImage;
+use super::{
+    shade_pass_finding_mirrors, Blend, Component, ComponentSet, Lighting, Mirror, ShadingPass, SubpixelShading,
+};
+use crate::image::{LinearImage, PixelRect};
 use crate::scene::{Light, Scene};
 use crate::shadows::{MapPool, PixelView, ScreenSurfaces, ShadowTerm};
 use crate::visibility::VisibilityBuffer;
@@ -201,7 +204,8 @@ pub fn shade_lit_beside(
     let ambient = lights.iter().map(|l| &l.light).filter(|l| l.only.is_none());
     let first = Lighting::pass(ambient, direct, true);
     let first = LitPass { lighting: &first, blend: Blend::Replace, receivers: None };
-    run(scene, vb, targets, subpixel, first, beside);
+    let mut mirrors = mirror_buffer(scene, vb, targets);
+    run(scene, vb, targets, subpixel, first, beside, mirrors.as_deref_mut());
     stats.passes = 1;
     // The fused terms stay for the next frame (within the same budget).
     for (light, terms) in fused {
@@ -216,11 +220,11 @@ pub fn shade_lit_beside(
         let ambient = light.only.is_some().then_some(light);
         let lighting = Lighting::pass(ambient, vec![(light, &terms)], false);
         let pass = LitPass { lighting: &lighting, blend: Blend::Add, receivers };
-        run(scene, vb, targets, subpixel, pass, |_| {});
+        run(scene, vb, targets, subpixel, pass, |_| {}, None);
         stats.passes += 1;
         terms.into_iter().for_each(|t| pool.recycle(t));
     }
-    add_reflection_map(scene, vb, targets);
+    add_reflection_map(scene, vb, targets, mirrors.as_deref());
     stats.maps_reused = pool.reused();
     stats
 }
@@ -233,8 +237,30 @@ struct LitPass<'a> {
     receivers: Option<Vec<bool>>,
 }
 
+/// Most pixels whose [`Mirror`]s the first pass hands the reflection-map pass
+/// (24 bytes each: a 3840 × 2160 frame's are 200 MB); a larger frame's pass
+/// finds them itself, a band of rows at a time.
+const MIRROR_PIXELS: usize = 3840 * 2160;
+
+/// A buffer for each pixel's [`Mirror`] when the frame draws a reflection
+/// map (an environment, a material with a Km, a target with the reflection
+/// component) over the whole frame within [`MIRROR_PIXELS`].
+fn mirror_buffer(scene: &Scene, vb: &VisibilityBuffer, targets: &[Target]) -> Option<Vec<Mirror>> {
+    let pixels = vb.width() as usize * vb.height() as usize;
+    let wanted = scene.environment.is_some()
+        && scene.materials.iter().any(|m| m.km.max_element() > 0.0)
+        && targets.iter().any(|t| t.parts.contains(Component::Reflection))
+        && vb.scissor() == PixelRect::full(vb.width(), vb.height())
+        && pixels <= MIRROR_PIXELS;
+    wanted.then(|| {
+        let mut buffer = Vec::new();
+        (0..pixels).into_par_iter().map(|_| Mirror::NONE).collect_into_vec(&mut buffer);
+        buffer
+    })
+}
+
 /// One pass into every target and, beside it, at every sub-pixel sample, once
-/// `prepare` has set them up.
+/// `prepare` has set them up; the first target's pass writes `mirrors`.
 fn run(
     scene: &Scene,
     vb: &VisibilityBuffer,
@@ -242,6 +268,7 @@ fn run(
     subpixel: &mut SubpixelShading,
     pass: LitPass,
     prepare: impl FnOnce(&mut SubpixelShading) + Send,
+    mut mirrors: Option<&mut [Mirror]>,
 ) {
     let LitPass { lighting, blend, receivers } = pass;
     let pixels = || {
@@ -252,7 +279,7 @@ fn run(
             }
             let background = if t.parts.contains(Component::Emission) { flat_background(scene) } else { Vec3::ZERO };
             let pass = ShadingPass { lighting, blend, background, receivers: receivers.clone() };
-            shade_pass(scene, vb, t.image, &pass);
+            shade_pass_finding_mirrors(scene, vb, t.image, &pass, mirrors.take());
         }
     };
     let samples = || {

@@ -147,6 +147,8 @@ pub struct Coefficients {
     ks: Vec3,
     ke: Vec3,
     n: f32,
+    /// Km, times the mirror map where the material reflects.
+    km: Vec3,
 }
 
 impl Coefficients {
@@ -154,6 +156,13 @@ impl Coefficients {
     #[must_use]
     pub fn parts(&self) -> (Vec3, Vec3, Vec3, Vec3, f32) {
         (self.ka, self.kd, self.ks, self.ke, self.n)
+    }
+
+    /// Km: the share of the environment mirrored (seed 002 eq. 4's
+    /// reflection-map coefficient), its map applied.
+    #[must_use]
+    pub fn km(&self) -> Vec3 {
+        self.km
     }
 
     /// The coefficients of a material without maps (`None` if it has any: then they
@@ -165,8 +174,9 @@ impl Coefficients {
             && maps.diffuse.is_empty()
             && maps.specular.is_empty()
             && maps.emission.is_empty()
-            && maps.normal.is_none();
-        none.then_some(Coefficients { ka: m.ka, kd: m.kd, ks: m.ks, ke: m.ke, n: m.shininess })
+            && maps.normal.is_none()
+            && maps.mirror.is_none();
+        none.then_some(Coefficients { ka: m.ka, kd: m.kd, ks: m.ks, ke: m.ke, n: m.shininess, km: m.km })
     }
 
     /// Samples every map of `m` at the point's uv (Ka and Kd times the
@@ -200,6 +210,10 @@ impl Coefficients {
             ks: m.ks * map(&m.maps.specular),
             ke: m.ke * map(&m.maps.emission),
             n: m.shininess,
+            km: match &m.maps.mirror {
+                Some(t) if m.km.max_element() > 0.0 => m.km * sample(t),
+                _ => m.km,
+            },
         }
     }
 }
