@@ -43,11 +43,14 @@ fn tilted<'a>(map: &'a NormalMap, filter: Filter, s: &SurfacePoint, shared: &mut
     let n = s.normal;
     let [dpdu, dpdv] = s.tangents;
     let t = (dpdu - n * n.dot(dpdu)).normalize_or_zero();
-    let b = -dpdv - n * n.dot(-dpdv) - t * t.dot(-dpdv);
-    let b = b.normalize_or_zero();
-    if t == Vec3::ZERO || b == Vec3::ZERO {
+    // What Gram–Schmidt leaves of −∂P/∂v, perpendicular to the unit n and
+    // t, lies along n × t (already of unit length): only its side is needed.
+    let up = n.cross(t);
+    let handedness = up.dot(-dpdv);
+    if t == Vec3::ZERO || handedness == 0.0 || !handedness.is_finite() {
         return n;
     }
+    let b = if handedness > 0.0 { up } else { -up };
     let (uv, duv) = s.coords(map.texture.set);
     let texel = shared.sample(&map.texture, filter, uv, duv);
     let local = texel * 2.0 - Vec3::ONE;
