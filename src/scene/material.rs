@@ -84,6 +84,13 @@ impl Material {
         self.cutoff.is_none_or(|c| self.opacity * self.maps.alpha.as_ref().map_or(1.0, |t| t.alpha(uv)) >= c)
     }
 
+    /// Whether it mirrors the environment (a Km above zero): the
+    /// reflection-map pass looks the environment up where it is seen.
+    #[must_use]
+    pub fn reflects_environment(&self) -> bool {
+        self.km.max_element() > 0.0
+    }
+
     /// Whether shading this material needs secondary rays.
     #[must_use]
     pub fn traces(&self) -> bool {

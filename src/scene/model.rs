@@ -214,7 +214,7 @@ pub fn scene_for_loaded_model(
     } else {
         model.lights.iter().map(|l| Light { kind: l.kind.transformed(&turn), ..l.clone() }).collect()
     };
-    if scene.environment.is_none() && scene.materials.iter().any(|m| m.km.max_element() > 0.0) {
+    if scene.environment.is_none() && scene.materials.iter().any(Material::reflects_environment) {
         // Metals mirror their surroundings: without any, they would be black.
         scene.environment = Some(Environment::studio());
     }

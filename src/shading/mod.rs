@@ -30,7 +30,7 @@ use rayon::iter::Either;
 use rayon::prelude::*;
 
 use crate::image::LinearImage;
-use crate::scene::Scene;
+use crate::scene::{Material, Scene};
 use crate::shadows::{Receiver, ShadowTerm};
 use crate::visibility::{ItemId, VisibilityBuffer};
 
@@ -106,7 +106,7 @@ pub fn shade_pass_finding_mirrors(
     // Whole rows of what a replacing pass writes where it shades nothing, copied
     // from (a block copy is faster than writing one 12-byte pixel at a time).
     let (background, black) = (vec![pass.background; w], vec![Vec3::ZERO; w]);
-    let reflects: Vec<bool> = scene.materials.iter().map(|m| m.km.max_element() > 0.0).collect();
+    let reflects: Vec<bool> = scene.materials.iter().map(Material::reflects_environment).collect();
     let mirror_rows = match mirrors {
         Some(m) => {
             assert_eq!(m.len(), image.pixels().len(), "a mirror a pixel");

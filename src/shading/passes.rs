@@ -37,7 +37,7 @@ use super::{
     shade_pass_finding_mirrors, Blend, Component, ComponentSet, Lighting, Mirror, ShadingPass, SubpixelShading,
 };
 use crate::image::{LinearImage, PixelRect};
-use crate::scene::{Light, Scene};
+use crate::scene::{Light, Material, Scene};
 use crate::shadows::{MapPool, PixelView, ScreenSurfaces, ShadowTerm};
 use crate::visibility::VisibilityBuffer;
 
@@ -248,7 +248,7 @@ const MIRROR_PIXELS: usize = 3840 * 2160;
 fn mirror_buffer(scene: &Scene, vb: &VisibilityBuffer, targets: &[Target]) -> Option<Vec<Mirror>> {
     let pixels = vb.width() as usize * vb.height() as usize;
     let wanted = scene.environment.is_some()
-        && scene.materials.iter().any(|m| m.km.max_element() > 0.0)
+        && scene.materials.iter().any(Material::reflects_environment)
         && targets.iter().any(|t| t.parts.contains(Component::Reflection))
         && vb.scissor() == PixelRect::full(vb.width(), vb.height())
         && pixels <= MIRROR_PIXELS;

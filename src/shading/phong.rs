@@ -211,7 +211,7 @@ impl Coefficients {
             ke: m.ke * map(&m.maps.emission),
             n: m.shininess,
             km: match &m.maps.mirror {
-                Some(t) if m.km.max_element() > 0.0 => m.km * sample(t),
+                Some(t) if m.reflects_environment() => m.km * sample(t),
                 _ => m.km,
             },
         }

@@ -33,7 +33,7 @@ use crate::visibility::VisibilityBuffer;
 /// frame); without it the pass finds them itself, a band of rows at a time.
 pub fn add_reflection_map(scene: &Scene, vb: &VisibilityBuffer, targets: &mut [Target], found: Option<&[Mirror]>) {
     let Some(env) = &scene.environment else { return };
-    let reflecting: Vec<bool> = scene.materials.iter().map(|m| m.km.max_element() > 0.0).collect();
+    let reflecting: Vec<bool> = scene.materials.iter().map(Material::reflects_environment).collect();
     if !env.visible && !reflecting.contains(&true) {
         return;
     }
