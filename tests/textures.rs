@@ -153,3 +153,60 @@ fn an_obj_dissolve_map_cuts_where_its_grey_is_dark() {
     assert!(!m.covers(Vec2::new(0.1, 0.5)) && m.covers(Vec2::new(0.9, 0.5)));
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// A roughness that varies over a texture (a glTF metallic-roughness map,
+/// baked into the specular map's alpha) sets the Phong exponent texel by
+/// texel: each half of a plane whose map is smooth on the left and rough
+/// on the right is drawn as the same plane with that half's exponent
+/// everywhere, and the two exponents' highlights differ there.
+#[test]
+fn a_roughness_map_sets_the_exponent_texel_by_texel() {
+    use kage::scene::light::LightKind;
+    use kage::scene::{phong_exponent, Material};
+    let camera = Camera {
+        eye: Vec3::new(0.0, 5.0, 0.0),
+        target: Vec3::ZERO,
+        up: Vec3::NEG_Z,
+        near: 0.1,
+        far: 50.0,
+        projection: Projection::Perspective { fov_y_deg: 40.0 },
+        shift: Vec2::ZERO,
+    };
+    let plane = |material: Material| {
+        let mut scene = common::scene_with(shapes::plane(), camera, 200, 200, false);
+        scene.objects[0].transform = Affine3A::from_scale(Vec3::splat(10.0));
+        scene.lights[0].kind = LightKind::Directional { direction: Vec3::new(0.02, -1.0, 0.01).normalize() };
+        scene.materials[0] = material;
+        render(&scene, &RenderOptions::default()).unwrap().image
+    };
+    let base = Material { kd: Vec3::splat(0.3), ka: Vec3::splat(0.3), ks: Vec3::splat(0.6), ..Material::default() };
+    // Roughness codes 64 (0.25) on the left half, 255 (1.0) on the right.
+    let (smooth, rough) = (64u8, 255u8);
+    let texels = (0..64 * 4).map(|i| [255, 255, 255, if i % 64 < 32 { smooth } else { rough }]).collect();
+    let map = Arc::new(Texture::from_texels_8bit(64, 4, texels, true));
+    let mapped = plane(Material {
+        maps: kage::scene::ComponentMaps {
+            specular: vec![Arc::clone(&map)],
+            roughness: Some(map),
+            ..Default::default()
+        },
+        ..base.clone()
+    });
+    let exponent = |code: u8| phong_exponent(f32::from(code) / 255.0);
+    let constant = |code| plane(Material { shininess: exponent(code), ..base.clone() });
+    let (smooth_plane, rough_plane) = (constant(smooth), constant(rough));
+    assert!(exponent(smooth) > 100.0 && exponent(rough) == 1.0);
+    // The seam lies at column 100; one texel is about 9 columns.
+    let (mut left, mut right, mut apart) = (0.0f32, 0.0f32, 0.0f32);
+    for y in (10..190).step_by(4) {
+        for x in 10..88 {
+            left = left.max((mapped.get(x, y) - smooth_plane.get(x, y)).abs().max_element());
+            apart = apart.max((smooth_plane.get(x, y) - rough_plane.get(x, y)).abs().max_element());
+        }
+        for x in 112..190 {
+            right = right.max((mapped.get(x, y) - rough_plane.get(x, y)).abs().max_element());
+        }
+    }
+    assert!(apart > 0.05, "the two exponents' highlights differ by only {apart}");
+    assert!(left < 2e-3 && right < 2e-3, "the smooth half is off by {left}, the rough half by {right}");
+}

@@ -98,6 +98,17 @@ impl Material {
     }
 }
 
+/// The Phong exponent of a microfacet roughness r: n = 2/α² − 2 with
+/// α = r² (the Blinn-Phong exponent whose lobe is as wide as the microfacet
+/// distribution's), rounded to a whole number within 1 to 2048 (whole
+/// exponents are raised by repeated squaring, also eight lanes of different
+/// exponents at once). r is taken as at least 0.05 (a mirror-like 2048).
+#[must_use]
+pub fn phong_exponent(roughness: f32) -> f32 {
+    let alpha = if roughness.is_nan() { 1.0 } else { roughness.clamp(0.05, 1.0).powi(2) };
+    (2.0 / (alpha * alpha) - 2.0).clamp(1.0, 2048.0).round()
+}
+
 /// The textures of each shading component (seed 002 §3.2, attribute mapping).
 /// A component with several maps is several passes added: Kd · (map₁ + map₂ + …);
 /// with none, the coefficient alone.
@@ -117,6 +128,12 @@ pub struct ComponentMaps {
     /// Multiplies the opacity (the alpha of glTF's base-colour texture, in
     /// BLEND or MASK mode).
     pub alpha: Option<Arc<Texture>>,
+    /// Its alpha is a roughness r ∈ [0, 1] that sets the Phong exponent
+    /// point by point ([`phong_exponent`]), in place of
+    /// [`Material::shininess`] (a glTF roughness that varies over its
+    /// texture; baked into the specular map's alpha, where one lookup reads
+    /// both).
+    pub roughness: Option<Arc<Texture>>,
     /// Tilts the shading normal (glTF's `normalTexture`).
     pub normal: Option<NormalMap>,
     /// How the maps are filtered.
@@ -175,6 +192,7 @@ impl ComponentMaps {
             one(specular),
             one(emission),
             self.mirror.as_mut(),
+            self.roughness.as_mut(),
             self.normal.as_mut().map(|n| &mut n.texture),
         ]
         .into_iter()

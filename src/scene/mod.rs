@@ -24,7 +24,7 @@ pub use framing::framing;
 pub use light::{
     Falloff, HardShadows, Light, LightKind, PenumbraFalloff, PenumbraPoints, ShadowMethod, ShadowSettings,
 };
-pub use material::{ComponentMaps, Material, NormalMap};
+pub use material::{phong_exponent, ComponentMaps, Material, NormalMap};
 pub use mesh::Mesh;
 pub use settings::{Antialias, EdgeFilter, EdgeMode, EdgeSelection, Exposure, Fog, FogMode, TranslucencyOrder, Up};
 pub use texture::{SharedFootprint, Texture};

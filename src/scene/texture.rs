@@ -12,7 +12,7 @@
 
 use std::sync::{Arc, LazyLock};
 
-use glam::{Vec2, Vec3};
+use glam::{Vec2, Vec3, Vec4};
 use rayon::prelude::*;
 
 use crate::image::{linear_to_srgb8, srgb_to_linear};
@@ -227,6 +227,21 @@ impl Level {
         match &self.texels {
             Texels::Bytes(t) => c.blend(|i| codec.colour(t[i * self.layers + layer]), Vec3::lerp),
             Texels::Floats(t) => c.blend(|i| t[i], Vec3::lerp),
+        }
+    }
+
+    /// Layer `layer`'s colour and alpha blended over `c` (one fetch of
+    /// each texel for both).
+    fn colour_alpha(&self, c: &Corners, layer: usize, codec: &Codec) -> Vec4 {
+        match &self.texels {
+            Texels::Bytes(t) => c.blend(
+                |i| {
+                    let texel = t[i * self.layers + layer];
+                    codec.colour(texel).extend(f32::from(texel[3]) / 255.0)
+                },
+                Vec4::lerp,
+            ),
+            Texels::Floats(t) => c.blend(|i| t[i].extend(1.0), Vec4::lerp),
         }
     }
 
@@ -583,6 +598,17 @@ impl Texture {
         }
     }
 
+    /// The colour and alpha over footprint `f`, as [`Texture::read`] and
+    /// [`Texture::alpha`] read them, in one lookup.
+    #[must_use]
+    pub fn read_rgba(&self, f: &Footprint) -> Vec4 {
+        let rgba = |(k, c): (usize, Corners)| self.levels[k].colour_alpha(&c, self.layer, self.codec);
+        match f.coarse {
+            None => rgba(f.fine),
+            Some((k, c, t)) => rgba(f.fine).lerp(rgba((k, c)), t),
+        }
+    }
+
     /// The (fractional) mip level whose texels match the longer of the
     /// footprint's two steps, within the chain.
     fn lod(&self, duv: [Vec2; 2]) -> f32 {
@@ -640,15 +666,30 @@ impl<'a> SharedFootprint<'a> {
     /// `t` sampled at `uv` (of its coordinate set `t.set`) over `duv`, as
     /// [`Texture::sample_filtered`] samples it.
     pub fn sample(&mut self, t: &'a Texture, filter: Filter, uv: Vec2, duv: [Vec2; 2]) -> Vec3 {
-        let f = match self.last {
+        t.read(&self.find(t, filter, uv, duv))
+    }
+
+    /// `t`'s alpha at `uv` over `duv`, filtered as `filter` says (as
+    /// [`SharedFootprint::sample`] reads its colour).
+    pub fn alpha(&mut self, t: &'a Texture, filter: Filter, uv: Vec2, duv: [Vec2; 2]) -> f32 {
+        t.read_alpha(&self.find(t, filter, uv, duv))
+    }
+
+    /// `t`'s colour and alpha at once ([`Texture::read_rgba`]).
+    pub fn sample_rgba(&mut self, t: &'a Texture, filter: Filter, uv: Vec2, duv: [Vec2; 2]) -> Vec4 {
+        t.read_rgba(&self.find(t, filter, uv, duv))
+    }
+
+    /// The last footprint if `t` reads like its texture, else `t`'s own.
+    fn find(&mut self, t: &'a Texture, filter: Filter, uv: Vec2, duv: [Vec2; 2]) -> Footprint {
+        match self.last {
             Some((last, by, f)) if by == filter && last.set == t.set && last.reads_like(t) => f,
             _ => {
                 let f = t.footprint(filter, uv, duv);
                 self.last = Some((t, filter, f));
                 f
             }
-        };
-        t.read(&f)
+        }
     }
 }
 
@@ -808,6 +849,10 @@ mod tests {
             }
             for (b, a) in bundle.iter().zip(&alone) {
                 assert_eq!(b.alpha_footprint(uv, duv), a.alpha_footprint(uv, duv));
+                // Colour and alpha in one lookup: each as read alone.
+                let rgba = b.read_rgba(&b.footprint(Filter::Trilinear, uv, duv));
+                assert_eq!(rgba.truncate(), a.sample_footprint(uv, duv));
+                assert!((rgba.w - a.alpha_footprint(uv, duv)).abs() < 1e-6);
             }
             assert_eq!(bundle[1].coverage().alpha(uv), alone[1].coverage().alpha(uv));
         }

@@ -10,7 +10,7 @@ use std::sync::Arc;
 use glam::Vec3;
 
 use super::surface::SurfacePoint;
-use crate::scene::{Light, Material, SharedFootprint, Texture};
+use crate::scene::{phong_exponent, Light, Material, SharedFootprint, Texture};
 
 /// The components of seed 002 eq. 4, summed over lights.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -175,7 +175,8 @@ impl Coefficients {
             && maps.specular.is_empty()
             && maps.emission.is_empty()
             && maps.normal.is_none()
-            && maps.mirror.is_none();
+            && maps.mirror.is_none()
+            && maps.roughness.is_none();
         none.then_some(Coefficients { ka: m.ka, kd: m.kd, ks: m.ks, ke: m.ke, n: m.shininess, km: m.km })
     }
 
@@ -188,9 +189,24 @@ impl Coefficients {
 
     /// [`Coefficients::at`], the maps' footprints shared through `shared`.
     fn sampled<'a>(m: &'a Material, s: &SurfacePoint, shared: &mut SharedFootprint<'a>) -> Self {
+        let filter = m.maps.filter;
+        // A roughness baked into the specular map's alpha is read with Ks,
+        // in one lookup.
+        let (specular, n) = match (&m.maps.roughness, m.maps.specular.as_slice()) {
+            (None, _) => (None, m.shininess),
+            (Some(r), [ks]) if Arc::ptr_eq(r, ks) => {
+                let (uv, duv) = s.coords(ks.set);
+                let rgba = shared.sample_rgba(ks, filter, uv, duv);
+                (Some(rgba.truncate()), phong_exponent(rgba.w))
+            }
+            (Some(r), _) => {
+                let (uv, duv) = s.coords(r.set);
+                (None, phong_exponent(shared.alpha(r, filter, uv, duv)))
+            }
+        };
         let mut sample = |t: &'a Texture| {
             let (uv, duv) = s.coords(t.set);
-            shared.sample(t, m.maps.filter, uv, duv)
+            shared.sample(t, filter, uv, duv)
         };
         // No map: the coefficient; several: one pass per map, added.
         let mut map = |maps: &'a [Arc<Texture>]| {
@@ -207,9 +223,9 @@ impl Coefficients {
         Coefficients {
             ka: m.ka * s.color * if same { diffuse } else { map(&m.maps.ambient) },
             kd: m.kd * s.color * diffuse,
-            ks: m.ks * map(&m.maps.specular),
+            ks: m.ks * specular.unwrap_or_else(|| map(&m.maps.specular)),
             ke: m.ke * map(&m.maps.emission),
-            n: m.shininess,
+            n,
             km: match &m.maps.mirror {
                 Some(t) if m.reflects_environment() => m.km * sample(t),
                 _ => m.km,

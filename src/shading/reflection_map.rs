@@ -155,12 +155,7 @@ impl Mirrors<'_> {
                 let m = &scene.materials[s.material];
                 let mut shared = SharedFootprint::default();
                 super::normal_map::apply_shared(m, &mut s, &mut shared);
-                let km = m.km
-                    * m.maps.mirror.as_ref().map_or(Vec3::ONE, |t| {
-                        let (uv, duv) = s.coords(t.set);
-                        shared.sample(t, m.maps.filter, uv, duv)
-                    });
-                *slot = Mirror { km, r: mirror_direction(&s) };
+                *slot = Mirror { km: mirrored_share(m, &s, &mut shared), r: mirror_direction(&s) };
             }
         }
     }
@@ -172,18 +167,19 @@ impl Mirrors<'_> {
 /// filters over each pixel's spread of directions).
 #[must_use]
 pub fn reflection_map(scene: &Scene, s: &SurfacePoint) -> Vec3 {
-    let km = mirrored_share(&scene.materials[s.material], s);
+    let km = mirrored_share(&scene.materials[s.material], s, &mut SharedFootprint::default());
     match &scene.environment {
         Some(env) if km.max_element() > 0.0 => km * env.radiance(mirror_direction(s)),
         _ => Vec3::ZERO,
     }
 }
 
-/// Km at `s`: the material's, times its mirror map there.
-fn mirrored_share(m: &Material, s: &SurfacePoint) -> Vec3 {
+/// Km at `s`: the material's, times its mirror map there (read through
+/// the point's `shared` footprint).
+fn mirrored_share<'a>(m: &'a Material, s: &SurfacePoint, shared: &mut SharedFootprint<'a>) -> Vec3 {
     m.km * m.maps.mirror.as_ref().map_or(Vec3::ONE, |t| {
         let (uv, duv) = s.coords(t.set);
-        t.sample_filtered(m.maps.filter, uv, duv)
+        shared.sample(t, m.maps.filter, uv, duv)
     })
 }
 

@@ -345,6 +345,7 @@ impl SceneFile {
                 specular: texture(&r.ks_map, true)?,
                 emission: texture(&r.ke_map, true)?,
                 mirror: None,
+                roughness: None,
                 alpha: None,
                 normal: None,
                 filter: match r.filter {

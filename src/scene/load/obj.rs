@@ -231,6 +231,7 @@ fn material(
             specular: map(&m.specular_texture),
             emission: Vec::new(),
             mirror: None,
+            roughness: None,
             alpha: None,
             normal: None,
             filter: Default::default(),

@@ -6,12 +6,12 @@
 use std::path::Path;
 use std::sync::Arc;
 
-use glam::{Vec2, Vec3};
+use glam::{Vec2, Vec3, Vec4};
 
 use super::{data_uri, percent_decoded, Context};
 use crate::scene::load::Files;
 use crate::scene::texture::{encode_8bit, Edge, Wrap};
-use crate::scene::{ComponentMaps, Material, NormalMap, Texture};
+use crate::scene::{phong_exponent, ComponentMaps, Material, NormalMap, Texture};
 
 /// The texture coordinates a material's textures are read at: a set
 /// (`TEXCOORD_n`) and a `KHR_texture_transform`.
@@ -371,6 +371,11 @@ impl Surface {
         base * (1.0 - metal) * (1.0 - self.sheen.max_element()) + self.sheen
     }
 
+    /// Ks = mix(F0, base, metal) with the roughness beside it (in alpha).
+    fn specular(&self, base: Vec3, metal: f32, roughness: f32) -> Vec4 {
+        self.dielectric.lerp(base, metal).extend(roughness)
+    }
+
     /// Km: the environment a metal mirrors (base · metal), and a clear
     /// coat's 4% over it.
     fn mirrored(&self, base: Vec3, metal: f32) -> Vec3 {
@@ -383,7 +388,9 @@ impl Surface {
     /// environment a metal mirrors) plus 0.04 × a clear coat's factor; with a
     /// metallic-roughness or occlusion texture each is a texture baked texel by
     /// texel, else the base-colour texture multiplies Kd and Ka. The Phong
-    /// exponent comes from the mean roughness.
+    /// exponent comes from the roughness: with a metallic-roughness
+    /// texture texel by texel (baked into the Ks map's alpha), else the
+    /// factor's.
     fn material(&self) -> Material {
         let Some(size) = self.baked_size() else {
             let kd = self.diffuse(self.base, self.metal);
@@ -392,7 +399,7 @@ impl Surface {
                 kd,
                 ks: self.dielectric.lerp(self.base, self.metal),
                 km: self.mirrored(self.base, self.metal),
-                shininess: shininess(self.roughness),
+                shininess: phong_exponent(self.roughness),
                 maps: ComponentMaps {
                     ambient: self.base_map.iter().cloned().collect(),
                     diffuse: self.base_map.iter().cloned().collect(),
@@ -405,23 +412,34 @@ impl Surface {
         // (else the first map baked) does.
         let maps = [self.base_map.as_ref(), self.metal_roughness_map.as_ref(), self.occlusion.as_ref().map(|(t, _)| t)];
         let like: &Texture = maps.into_iter().flatten().next().expect("a baked size comes from a map");
-        // One lookup of the textures per texel, for all four maps.
+        // One lookup of the textures per texel, for all four maps; the
+        // specular map's alpha holds the roughness.
         // Without an occlusion texture Ka is Kd texel for texel: one map,
         // sampled once for both.
         let [diffuse, ambient, specular, mirror] = if self.occlusion.is_some() {
             bake(size, like, |uv| {
-                let (base, metal, _, occlusion) = self.at(uv);
+                let (base, metal, rough, occlusion) = self.at(uv);
                 let kd = self.diffuse(base, metal);
-                [kd, kd * occlusion, self.dielectric.lerp(base, metal), self.mirrored(base, metal)]
+                [
+                    kd.extend(1.0),
+                    (kd * occlusion).extend(1.0),
+                    self.specular(base, metal, rough),
+                    self.mirrored(base, metal).extend(1.0),
+                ]
             })
         } else {
             let [diffuse, specular, mirror] = bake(size, like, |uv| {
-                let (base, metal, _, _) = self.at(uv);
-                [self.diffuse(base, metal), self.dielectric.lerp(base, metal), self.mirrored(base, metal)]
+                let (base, metal, rough, _) = self.at(uv);
+                [
+                    self.diffuse(base, metal).extend(1.0),
+                    self.specular(base, metal, rough),
+                    self.mirrored(base, metal).extend(1.0),
+                ]
             });
             [Arc::clone(&diffuse), diffuse, specular, mirror]
         };
-        // The exponent takes one value per material: the mean roughness's.
+        // The mean roughness's exponent, for a reader of the coefficients
+        // alone; with a roughness texture the shading reads it texel by texel.
         let n = 64usize;
         let samples = (0..n * n).map(|i| Vec2::new((i % n) as f32 + 0.5, (i / n) as f32 + 0.5) / n as f32);
         let (metal, rough) = samples.fold((0.0, 0.0), |(m, r), uv| {
@@ -436,10 +454,11 @@ impl Surface {
             kd: Vec3::ONE,
             ks: Vec3::ONE,
             km: if mirrors { Vec3::ONE } else { Vec3::ZERO },
-            shininess: shininess(rough / count),
+            shininess: phong_exponent(rough / count),
             maps: ComponentMaps {
                 ambient: vec![ambient],
                 diffuse: vec![diffuse],
+                roughness: self.metal_roughness_map.is_some().then(|| Arc::clone(&specular)),
                 specular: vec![specular],
                 mirror: mirrors.then_some(mirror),
                 ..ComponentMaps::default()
@@ -476,26 +495,24 @@ fn sheen_colour(m: &gltf::Material) -> Vec3 {
     }
 }
 
-/// n = 2/α² − 2 with α = roughness², the Blinn-Phong exponent whose lobe is
-/// as wide as the microfacet distribution's.
-fn shininess(roughness: f32) -> f32 {
-    let alpha = roughness.clamp(0.05, 1.0).powi(2);
-    (2.0 / (alpha * alpha) - 2.0).clamp(1.0, 2048.0)
-}
-
 /// `N` `width × height` colour textures of `f`'s `N` values at each texel
 /// centre's uv, kept in 8 bits (sRGB) as the images they come from.
 /// Each wraps and reads the coordinates `like` does.
 fn bake<const N: usize>(
     (width, height): (u32, u32),
     like: &Texture,
-    f: impl Fn(Vec2) -> [Vec3; N] + Sync,
+    f: impl Fn(Vec2) -> [Vec4; N] + Sync,
 ) -> [Arc<Texture>; N] {
     use rayon::prelude::*;
     let size = Vec2::new(width as f32, height as f32);
     let texels: Vec<[[u8; 4]; N]> = (0..width * height)
         .into_par_iter()
-        .map(|i| f(Vec2::new((i % width) as f32 + 0.5, (i / width) as f32 + 0.5) / size).map(|c| encode_8bit(c, true)))
+        .map(|i| {
+            f(Vec2::new((i % width) as f32 + 0.5, (i / width) as f32 + 0.5) / size).map(|c| {
+                let [r, g, b, _] = encode_8bit(c.truncate(), true);
+                [r, g, b, (c.w.clamp(0.0, 1.0) * 255.0 + 0.5) as u8]
+            })
+        })
         .collect();
     std::array::from_fn(|k| {
         let mut baked = Texture::from_texels_8bit(width, height, texels.iter().map(|t| t[k]).collect(), true);
@@ -537,6 +554,34 @@ mod tests {
         assert!(kd(left).max_element() < 0.05 && (kd(right) - surface.base).abs().max_element() < 0.05);
         // No occlusion texture: Ka is Kd's map, one texture sampled once.
         assert!(Arc::ptr_eq(&m.maps.ambient[0], &m.maps.diffuse[0]));
+    }
+
+    /// A roughness texture rides in the baked specular map's alpha (one
+    /// texture: read with Ks), texel by texel, times the roughness factor;
+    /// without one the exponent is the factor's and no map is made.
+    #[test]
+    fn a_roughness_texture_is_baked_beside_the_specular_reflectance() {
+        let surface = |map: bool| Surface {
+            base: Vec3::new(0.8, 0.1, 0.1),
+            base_map: None,
+            metal: 0.0,
+            roughness: 0.5,
+            metal_roughness_map: map.then(|| two_texels(Vec3::new(0.0, 0.2, 0.0), Vec3::new(0.0, 1.0, 0.0))),
+            occlusion: None,
+            dielectric: Vec3::splat(0.04),
+            coat: 0.0,
+            sheen: Vec3::ZERO,
+        };
+        let m = surface(true).material();
+        let roughness = m.maps.roughness.as_ref().expect("a roughness map");
+        assert!(Arc::ptr_eq(roughness, &m.maps.specular[0]));
+        let (left, right) = (roughness.alpha(Vec2::new(0.25, 0.5)), roughness.alpha(Vec2::new(0.75, 0.5)));
+        assert!((left - 0.1).abs() <= 1.0 / 255.0 && (right - 0.5).abs() <= 1.0 / 255.0, "{left} {right}");
+        let ks = m.ks * m.maps.specular[0].sample(Vec2::new(0.25, 0.5));
+        assert!((ks - Vec3::splat(0.04)).abs().max_element() < 0.005, "{ks}");
+        let plain = surface(false).material();
+        assert!(plain.maps.roughness.is_none());
+        assert_eq!(plain.shininess, phong_exponent(0.5));
     }
 
     /// `KHR_materials_specular` sets a dielectric's highlight (none at

@@ -10,11 +10,13 @@
 //! 4% mirror), Kd tinted by `KHR_materials_sheen`'s colour (a quarter of it,
 //! the base dimmed by as much: a velvet's sheen approximated as a diffuse
 //! tint), n = 2/α² − 2 with α =
-//! roughness² (the Blinn-Phong exponent of equal lobe width), Ke = emissive
+//! roughness² (the Blinn-Phong exponent of equal lobe width, rounded:
+//! [`phong_exponent`](crate::scene::phong_exponent)), Ke = emissive
 //! (times `KHR_materials_emissive_strength`). The base-colour texture
 //! multiplies Kd and Ka; with a metallic-roughness or occlusion texture, Kd,
-//! Ka, Ks and Km are baked into textures texel by texel (n takes the
-//! material's mean roughness). `KHR_materials_transmission` makes Kt = base colour ·
+//! Ka, Ks and Km are baked into textures texel by texel, the roughness in
+//! the Ks map's alpha (n set point by point where a metallic-roughness
+//! texture varies it). `KHR_materials_transmission` makes Kt = base colour ·
 //! transmission (Kd scaled by what is not transmitted), `KHR_materials_ior`
 //! the index of refraction; `KHR_materials_unlit` shows the base colour as
 //! emission, unlit. The base colour's alpha (factor times texture) blends the
