@@ -16,6 +16,7 @@ mod share;
 mod slb;
 mod soft;
 mod textures;
+mod threads;
 mod view;
 
 use std::path::PathBuf;
@@ -76,6 +77,9 @@ enum Command {
     /// What textures cost a frame: each textured corpus model beside itself
     /// with its texture maps taken away, its load time and decoded bytes.
     Textures(textures::TexturesArgs),
+    /// Each stage's wall time and serial share on the first scenes a user
+    /// meets, and Amdahl's frame at 16 threads.
+    Threads(threads::ThreadsArgs),
     /// The preview window (`kage view`, under Xvfb) orbiting a scene beside
     /// f3d offscreen on Mesa: launch to first image, ms per frame, time to the
     /// 64-pass image.
@@ -192,6 +196,7 @@ fn main() -> miette::Result<()> {
         Command::Slb(args) => slb::run(&args),
         Command::Soft(args) => soft::run(&args),
         Command::Textures(args) => textures::run(&args),
+        Command::Threads(args) => threads::run(&args),
         Command::View(args) => view::run(&args),
     }
 }

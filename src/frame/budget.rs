@@ -16,7 +16,7 @@ use std::sync::Arc;
 use crate::error::Result;
 use crate::limits::Limit;
 use crate::scene::{Body, Light, Scene};
-use crate::shading::frame_lights;
+use crate::shading::frame_lights_within;
 use crate::shadows::ShadowTerm;
 
 /// Bytes a triangle takes while a frame is drawn, on the generous side: its
@@ -99,7 +99,7 @@ fn shadow_bytes(scene: &Scene, checked: bool) -> Result<u64> {
     let limits = &scene.limits;
     let Some(bounds) = scene.caster_bounds() else { return Ok(0) };
     let mut total = 0;
-    for (i, light) in frame_lights(scene).iter().enumerate() {
+    for (i, light) in frame_lights_within(scene, bounds).iter().enumerate() {
         let bytes: u64 = light.samples.iter().map(|s| ShadowTerm::bytes_needed(s, bounds) as u64).sum();
         if checked {
             limits.check_bytes(Limit::LightShadowMb, bytes, || light_named(i, &light.light, light.samples.len()))?;

@@ -35,6 +35,7 @@ use crate::shadows::{Receiver, ShadowTerm};
 use crate::visibility::{ItemId, VisibilityBuffer};
 
 pub use lanes::{Blend, Lighting};
+pub(crate) use passes::frame_lights_within;
 pub use passes::{frame_lights, shade_lit, shade_lit_beside, FrameLight, PassStats, Target};
 pub use phong::{Component, ComponentSet, Components};
 pub use reflection_map::Mirror;

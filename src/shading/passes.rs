@@ -91,7 +91,7 @@ pub fn frame_lights(scene: &Scene) -> Vec<FrameLight> {
 /// [`frame_lights`] with the bounds of the scene's shadow casters already
 /// known ([`Scene::caster_bounds`]: what the maps are fitted to, and what an
 /// area light's samples face).
-fn frame_lights_within(scene: &Scene, (lo, hi): (Vec3, Vec3)) -> Vec<FrameLight> {
+pub(crate) fn frame_lights_within(scene: &Scene, (lo, hi): (Vec3, Vec3)) -> Vec<FrameLight> {
     let centre = (lo + hi) * 0.5;
     scene.lights.iter().map(|l| FrameLight { light: l.clone(), samples: l.jittered(centre) }).collect()
 }
@@ -113,7 +113,12 @@ pub(crate) struct ShadowFrame<'a> {
 impl<'a> ShadowFrame<'a> {
     /// The frame of `scene` whose visibility buffer is `vb`.
     pub(crate) fn new(scene: &'a Scene, vb: &'a VisibilityBuffer) -> ShadowFrame<'a> {
-        ShadowFrame { scene, vb, bounds: scene.caster_bounds().unwrap_or_default(), surfaces: None }
+        Self::within(scene, vb, scene.caster_bounds().unwrap_or_default())
+    }
+
+    /// [`ShadowFrame::new`] with the casters' bounds already found.
+    fn within(scene: &'a Scene, vb: &'a VisibilityBuffer, bounds: (Vec3, Vec3)) -> ShadowFrame<'a> {
+        ShadowFrame { scene, vb, bounds, surfaces: None }
     }
 
     /// The surface each pixel shows (found on the first call).
@@ -184,11 +189,13 @@ pub fn shade_lit_beside(
     beside: impl FnOnce(&mut SubpixelShading) + Send,
 ) -> PassStats {
     let mut stats = PassStats::default();
-    pool.begin_frame(scene);
+    // The casters are found once for the pool, the lights and the frame.
+    let (casters, bounds) = scene.shadow_casters();
+    let bounds = bounds.unwrap_or_default();
+    pool.begin_frame_drawing(scene, casters);
     let mut budget = FUSED_SHADOW_BUDGET;
-    let bounds = scene.caster_bounds().unwrap_or_default();
     let lights = frame_lights_within(scene, bounds);
-    let mut frame = ShadowFrame::new(scene, vb);
+    let mut frame = ShadowFrame::within(scene, vb, bounds);
     let (mut fused, mut own) = (Vec::new(), Vec::new());
     for light in &lights {
         let bytes: usize = light.samples.iter().map(|s| ShadowTerm::bytes_needed(s, bounds)).sum();

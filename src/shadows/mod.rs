@@ -179,6 +179,12 @@ impl MapPool {
     /// the geometry changed ([`GeometryKey`]: an object's body, transform or
     /// whether it casts shadows), which drops them all.
     pub fn begin_frame(&mut self, scene: &Scene) {
+        self.begin_frame_drawing(scene, scene.map_casters());
+    }
+
+    /// [`MapPool::begin_frame`] with the objects the maps draw already
+    /// found ([`Scene::shadow_casters`]).
+    pub fn begin_frame_drawing(&mut self, scene: &Scene, casters: Vec<bool>) {
         if !self.geometry.matches(scene) {
             self.geometry = GeometryKey::of(scene);
             let stale: Vec<_> = self.kept.drain(..).chain(self.previous.drain(..)).collect();
@@ -188,7 +194,7 @@ impl MapPool {
         let older = std::mem::replace(&mut self.previous, previous);
         older.into_iter().for_each(|(_, term)| self.recycle(term));
         self.reused = 0;
-        self.casters = scene.map_casters();
+        self.casters = casters;
     }
 
     /// The objects the maps of `scene` draw: this frame's, or found now when

@@ -93,71 +93,76 @@ pub fn find_outline_blends(scene: &Scene, vb: &VisibilityBuffer, trace: &TraceSc
     let (w, h) = (vb.width() as i64, vb.height() as i64);
     let rays = scene.camera.pixel_rays(Vec2::new(w as f32, h as f32));
     let item = |x: i64, y: i64| vb.item(x as u32, y as u32);
-    let rows: Vec<Vec<OutlineBlend>> = (0..h)
-        .into_par_iter()
-        .map(|y| {
-            let mut out = Vec::new();
-            for x in 0..w {
-                let me = item(x, y);
-                let inside = |(nx, ny): (i64, i64)| (0..w).contains(&nx) && (0..h).contains(&ny);
-                let sides = [(x - 1, y), (x + 1, y), (x, y - 1), (x, y + 1)];
-                let outline = |(nx, ny): (i64, i64)| {
-                    let other = item(nx, ny);
-                    solid_outline(me, other)
-                        && !one_surface(vb, me, other, (x as u32, y as u32), (nx as u32, ny as u32))
-                };
-                if !sides.into_iter().any(|n| inside(n) && outline(n)) {
-                    continue;
-                }
-                let near: Vec<(i64, i64)> = (-1..=1)
-                    .flat_map(|dy| (-1..=1).map(move |dx| (x + dx, y + dy)))
-                    .filter(|&n| n != (x, y) && inside(n))
-                    .collect();
-                // Each ray takes the colour of the nearest pixel (itself first)
-                // that shows what the ray sees; a ray that sees something no
-                // neighbour shows keeps the pixel's own colour.
-                let hit = |k: u32| {
-                    let offset = stratified(k, SAMPLES, hash3(x as u32, y as u32, k));
-                    let ray = rays.ray(Vec2::new(x as f32, y as f32) + offset);
-                    trace.intersect(&ray, f32::INFINITY)
-                };
-                let cast = |k: u32| hit(k).map_or(ItemId::NONE, |h| h.item);
-                // The four corner cells first: all four on the pixel's own item,
-                // or on one surface of its solid, leave it as it is (the outline
-                // runs in the neighbour).
-                let corners = CORNERS.map(hit);
-                if corners.iter().all(|c| c.is_some_and(|c| c.item == me)) || corners_on_one_surface(me, &corners) {
-                    continue;
-                }
-                let mut seen = [None; (SAMPLES * SAMPLES) as usize];
-                for (k, c) in CORNERS.iter().zip(&corners) {
-                    seen[*k as usize] = Some(c.map_or(ItemId::NONE, |c| c.item));
-                }
-                let mut weights: Vec<(u32, f32)> = Vec::new();
-                let share = 1.0 / (SAMPLES * SAMPLES) as f32;
-                for k in 0..SAMPLES * SAMPLES {
-                    let seen = seen[k as usize].unwrap_or_else(|| cast(k));
-                    // The same item, else the same object (another triangle of
-                    // a mesh, another primitive of a solid), else itself.
-                    let around = || std::iter::once((x, y)).chain(near.iter().copied());
-                    let same_object =
-                        |i: ItemId| i.object == seen.object && i.primitive().is_some() == seen.primitive().is_some();
-                    let source = around()
-                        .find(|&(nx, ny)| item(nx, ny) == seen)
-                        .or_else(|| around().find(|&(nx, ny)| same_object(item(nx, ny))))
-                        .unwrap_or((x, y));
-                    let index = (source.1 * w + source.0) as u32;
-                    match weights.iter_mut().find(|(p, _)| *p == index) {
-                        Some((_, wgt)) => *wgt += share,
-                        None => weights.push((index, share)),
-                    }
-                }
-                out.push(OutlineBlend { pixel: (y * w + x) as u32, weights });
-            }
-            out
+    let inside = |(nx, ny): (i64, i64)| (0..w).contains(&nx) && (0..h).contains(&ny);
+    // A pixel lies on an outline when a side neighbour shows another item
+    // across a solid's outline.
+    let on_outline = |x: i64, y: i64| {
+        let me = item(x, y);
+        [(x - 1, y), (x + 1, y), (x, y - 1), (x, y + 1)].into_iter().any(|(nx, ny)| {
+            inside((nx, ny))
+                && solid_outline(me, item(nx, ny))
+                && !one_surface(vb, me, item(nx, ny), (x as u32, y as u32), (nx as u32, ny as u32))
         })
+    };
+    // The pixels to measure, found row by row; then measured one by one on
+    // every worker (a row along a solid's top or bottom edge holds hundreds
+    // of them, its neighbours a few: rows as the pieces left one worker
+    // casting a long row's rays while the other waited).
+    let candidates: Vec<(i64, i64)> = (0..h)
+        .into_par_iter()
+        .flat_map_iter(|y| (0..w).filter(move |&x| on_outline(x, y)).map(move |x| (x, y)))
         .collect();
-    rows.concat()
+    candidates
+        .par_iter()
+        .with_min_len(8)
+        .filter_map(|&(x, y)| {
+            let me = item(x, y);
+            let near: Vec<(i64, i64)> = (-1..=1)
+                .flat_map(|dy| (-1..=1).map(move |dx| (x + dx, y + dy)))
+                .filter(|&n| n != (x, y) && inside(n))
+                .collect();
+            // Each ray takes the colour of the nearest pixel (itself first)
+            // that shows what the ray sees; a ray that sees something no
+            // neighbour shows keeps the pixel's own colour.
+            let hit = |k: u32| {
+                let offset = stratified(k, SAMPLES, hash3(x as u32, y as u32, k));
+                let ray = rays.ray(Vec2::new(x as f32, y as f32) + offset);
+                trace.intersect(&ray, f32::INFINITY)
+            };
+            let cast = |k: u32| hit(k).map_or(ItemId::NONE, |h| h.item);
+            // The four corner cells first: all four on the pixel's own item,
+            // or on one surface of its solid, leave it as it is (the outline
+            // runs in the neighbour).
+            let corners = CORNERS.map(hit);
+            if corners.iter().all(|c| c.is_some_and(|c| c.item == me)) || corners_on_one_surface(me, &corners) {
+                return None;
+            }
+            let mut seen = [None; (SAMPLES * SAMPLES) as usize];
+            for (k, c) in CORNERS.iter().zip(&corners) {
+                seen[*k as usize] = Some(c.map_or(ItemId::NONE, |c| c.item));
+            }
+            let mut weights: Vec<(u32, f32)> = Vec::new();
+            let share = 1.0 / (SAMPLES * SAMPLES) as f32;
+            for k in 0..SAMPLES * SAMPLES {
+                let seen = seen[k as usize].unwrap_or_else(|| cast(k));
+                // The same item, else the same object (another triangle of
+                // a mesh, another primitive of a solid), else itself.
+                let around = || std::iter::once((x, y)).chain(near.iter().copied());
+                let same_object =
+                    |i: ItemId| i.object == seen.object && i.primitive().is_some() == seen.primitive().is_some();
+                let source = around()
+                    .find(|&(nx, ny)| item(nx, ny) == seen)
+                    .or_else(|| around().find(|&(nx, ny)| same_object(item(nx, ny))))
+                    .unwrap_or((x, y));
+                let index = (source.1 * w + source.0) as u32;
+                match weights.iter_mut().find(|(p, _)| *p == index) {
+                    Some((_, wgt)) => *wgt += share,
+                    None => weights.push((index, share)),
+                }
+            }
+            Some(OutlineBlend { pixel: (y * w + x) as u32, weights })
+        })
+        .collect()
 }
 
 /// Applies `blends` to `image` (every blend reads the image as it was before
@@ -165,7 +170,7 @@ pub fn find_outline_blends(scene: &Scene, vb: &VisibilityBuffer, trace: &TraceSc
 pub fn apply_outline_blends(image: &mut LinearImage, blends: &[OutlineBlend]) {
     let colours: Vec<Vec3> = {
         let px = image.pixels();
-        blends.iter().map(|b| b.weights.iter().map(|&(p, wgt)| px[p as usize] * wgt).sum()).collect()
+        blends.par_iter().map(|b| b.weights.iter().map(|&(p, wgt)| px[p as usize] * wgt).sum()).collect()
     };
     let px = image.pixels_mut();
     for (b, c) in blends.iter().zip(colours) {
