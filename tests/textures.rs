@@ -89,11 +89,9 @@ fn materials_naming_one_image_share_its_decoded_texture() {
 /// (cutoff 0.5), one unit above a red floor, seen and lit from straight
 /// above: through its cut-away half the eye sees the floor, lit (the cut
 /// half casts no shadow either); its kept half is green.
-#[test]
-fn an_alpha_tested_leaf_is_cut_for_the_eye_and_the_light() {
-    use kage::scene::light::LightKind;
-    use kage::scene::{Material, Object};
-    let camera = Camera {
+/// A camera 5 units above the origin looking straight down, −z up.
+fn overhead() -> Camera {
+    Camera {
         eye: Vec3::new(0.0, 5.0, 0.0),
         target: Vec3::ZERO,
         up: Vec3::NEG_Z,
@@ -101,7 +99,14 @@ fn an_alpha_tested_leaf_is_cut_for_the_eye_and_the_light() {
         far: 50.0,
         projection: Projection::Perspective { fov_y_deg: 40.0 },
         shift: Vec2::ZERO,
-    };
+    }
+}
+
+#[test]
+fn an_alpha_tested_leaf_is_cut_for_the_eye_and_the_light() {
+    use kage::scene::light::LightKind;
+    use kage::scene::{Material, Object};
+    let camera = overhead();
     let mut scene = common::scene_with(shapes::plane(), camera, 200, 200, false);
     scene.objects[0].transform = Affine3A::from_scale(Vec3::splat(10.0));
     scene.materials[0] =
@@ -163,15 +168,7 @@ fn an_obj_dissolve_map_cuts_where_its_grey_is_dark() {
 fn a_roughness_map_sets_the_exponent_texel_by_texel() {
     use kage::scene::light::LightKind;
     use kage::scene::{phong_exponent, Material};
-    let camera = Camera {
-        eye: Vec3::new(0.0, 5.0, 0.0),
-        target: Vec3::ZERO,
-        up: Vec3::NEG_Z,
-        near: 0.1,
-        far: 50.0,
-        projection: Projection::Perspective { fov_y_deg: 40.0 },
-        shift: Vec2::ZERO,
-    };
+    let camera = overhead();
     let plane = |material: Material| {
         let mut scene = common::scene_with(shapes::plane(), camera, 200, 200, false);
         scene.objects[0].transform = Affine3A::from_scale(Vec3::splat(10.0));

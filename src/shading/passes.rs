@@ -117,7 +117,7 @@ impl<'a> ShadowFrame<'a> {
     }
 
     /// [`ShadowFrame::new`] with the casters' bounds already found.
-    fn within(scene: &'a Scene, vb: &'a VisibilityBuffer, bounds: (Vec3, Vec3)) -> ShadowFrame<'a> {
+    pub(crate) fn within(scene: &'a Scene, vb: &'a VisibilityBuffer, bounds: (Vec3, Vec3)) -> ShadowFrame<'a> {
         ShadowFrame { scene, vb, bounds, surfaces: None }
     }
 

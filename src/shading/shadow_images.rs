@@ -8,7 +8,7 @@
 use glam::Vec3;
 use rayon::prelude::*;
 
-use super::passes::{frame_lights, ShadowFrame};
+use super::passes::{frame_lights_within, ShadowFrame};
 use crate::image::LinearImage;
 use crate::scene::Scene;
 use crate::shadows::MapPool;
@@ -21,9 +21,9 @@ use crate::visibility::VisibilityBuffer;
 pub fn shadow_term_images(scene: &Scene, vb: &VisibilityBuffer, pool: &mut MapPool, images: &mut Vec<LinearImage>) {
     let (w, h) = (vb.width(), vb.height());
     images.resize_with(scene.lights.len(), LinearImage::default);
-    let mut frame = ShadowFrame::new(scene, vb);
     let bounds = scene.caster_bounds().unwrap_or_default();
-    for (image, light) in images.iter_mut().zip(frame_lights(scene)) {
+    let mut frame = ShadowFrame::within(scene, vb, bounds);
+    for (image, light) in images.iter_mut().zip(frame_lights_within(scene, bounds)) {
         image.resize(w, h);
         image.pixels_mut().fill(Vec3::ZERO);
         let weight = 1.0 / light.samples.len() as f32;

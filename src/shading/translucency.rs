@@ -23,7 +23,7 @@ use rayon::prelude::*;
 
 use super::phong::{self, Coefficients, Components};
 use super::reflection_map::reflection_map;
-use super::{frame_lights, Component, FrameLight, ObjectFrames, SurfacePoint, Target};
+use super::{frame_lights_within, Component, FrameLight, ObjectFrames, SurfacePoint, Target};
 use crate::scene::{Scene, TranslucencyOrder};
 use crate::shadows::{MapPool, Receiver, ShadowTerm};
 use crate::visibility::Fragment;
@@ -78,7 +78,7 @@ pub fn composite(
         t.image.pixels_mut().par_iter_mut().zip(transmittance.par_iter()).for_each(|(p, &tr)| *p *= tr);
     }
     let bounds = scene.caster_bounds().unwrap_or_default();
-    for FrameLight { light, samples } in &frame_lights(scene) {
+    for FrameLight { light, samples } in &frame_lights_within(scene, bounds) {
         let terms = pool.terms(scene, samples, bounds);
         layers.par_iter_mut().filter(|l| light.only.as_ref().is_none_or(|o| o.contains(&l.object))).for_each(|l| {
             let s = &l.surface;
