@@ -248,8 +248,9 @@ impl TriangleCache {
 /// lights ([`passes::frame_lights`]), each one's shadow term (the mean of its
 /// samples') and its selective-lighting list.
 pub fn shade_into_scalar(scene: &Scene, vb: &VisibilityBuffer, image: &mut LinearImage) {
-    let lights = passes::frame_lights(scene);
-    let mut frame = passes::ShadowFrame::new(scene, vb);
+    let bounds = scene.caster_bounds().unwrap_or_default();
+    let lights = passes::frame_lights_within(scene, bounds);
+    let mut frame = passes::ShadowFrame::within(scene, vb, bounds);
     let terms: Vec<Vec<ShadowTerm>> = lights
         .iter()
         .map(|l| {

@@ -111,12 +111,8 @@ pub(crate) struct ShadowFrame<'a> {
 }
 
 impl<'a> ShadowFrame<'a> {
-    /// The frame of `scene` whose visibility buffer is `vb`.
-    pub(crate) fn new(scene: &'a Scene, vb: &'a VisibilityBuffer) -> ShadowFrame<'a> {
-        Self::within(scene, vb, scene.caster_bounds().unwrap_or_default())
-    }
-
-    /// [`ShadowFrame::new`] with the casters' bounds already found.
+    /// The frame of `scene` whose visibility buffer is `vb`, its shadow
+    /// casters within `bounds` ([`Scene::caster_bounds`], found once by the caller).
     pub(crate) fn within(scene: &'a Scene, vb: &'a VisibilityBuffer, bounds: (Vec3, Vec3)) -> ShadowFrame<'a> {
         ShadowFrame { scene, vb, bounds, surfaces: None }
     }
