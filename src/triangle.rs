@@ -5,6 +5,7 @@
 //! never slips between — which Möller–Trumbore does not promise.
 
 use glam::{DVec3, Vec2, Vec3};
+use wide::f32x8;
 
 use crate::camera::Ray;
 
@@ -27,21 +28,27 @@ impl ShearedRay {
     #[must_use]
     pub fn new(ray: &Ray) -> Self {
         let d = ray.dir;
-        let kz = d.abs().max_position();
-        let mut kx = (kz + 1) % 3;
-        let mut ky = (kx + 1) % 3;
-        if d[kz] < 0.0 {
-            std::mem::swap(&mut kx, &mut ky);
-        }
-        let unit = |k: usize| Vec3::AXES[k];
-        let (sx, sy) = (d[kx] / d[kz], d[ky] / d[kz]);
-        let rows = [unit(kx) - sx * unit(kz), unit(ky) - sy * unit(kz), unit(kz)];
-        ShearedRay { origin: ray.origin, rows, inv_dz: 1.0 / d[kz] }
+        let a = d.abs();
+        // The dominant axis as a unit vector, chosen without branches (rays of
+        // one image turn from one axis to another unpredictably), then the two
+        // after it in cyclic order, swapped when the ray runs down that axis
+        // so the triangle's winding is kept.
+        let on_x = (a.x >= a.y) & (a.x >= a.z);
+        let on_y = !on_x & (a.y >= a.z);
+        let z = Vec3::new(f32::from(u8::from(on_x)), f32::from(u8::from(on_y)), f32::from(u8::from(!on_x & !on_y)));
+        let x = Vec3::new(z.z, z.x, z.y);
+        let y = Vec3::new(x.z, x.x, x.y);
+        let dz = d.dot(z);
+        let down = glam::BVec3::splat(dz < 0.0);
+        let (x, y) = (Vec3::select(down, y, x), Vec3::select(down, x, y));
+        let (sx, sy) = (d.dot(x) / dz, d.dot(y) / dz);
+        ShearedRay { origin: ray.origin, rows: [x - sx * z, y - sy * z, z], inv_dz: 1.0 / dz }
     }
 
     /// Distance and barycentrics (b1, b2) of the hit with triangle `p` in
     /// `(t_min, t_max)`, from either side.
     #[must_use]
+    #[inline]
     pub fn intersect(&self, p: &[Vec3; 3], t_min: f32, t_max: f32) -> Option<(f32, Vec2)> {
         let [rx, ry, rz] = self.rows;
         // Not `p.map(..)`: array map is not inlined here and costs a call per vertex.
@@ -54,9 +61,7 @@ impl ShearedRay {
         let mut v = a.x * c.y - a.y * c.x;
         let mut w = b.x * a.y - b.y * a.x;
         if u == 0.0 || v == 0.0 || w == 0.0 {
-            // On an edge in f32: decide in f64 so neighbours agree.
-            let e = |p: Vec3, q: Vec3| (q.x as f64 * p.y as f64 - q.y as f64 * p.x as f64) as f32;
-            (u, v, w) = (e(b, c), e(c, a), e(a, b));
+            (u, v, w) = on_an_edge(a, b, c);
         }
         if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
             return None;
@@ -72,6 +77,142 @@ impl ShearedRay {
         }
         Some((t, Vec2::new(v / det, w / det)))
     }
+}
+
+/// The hits of up to [`LANES`] triangles with one ray, tested at once
+/// ([`ShearedRay::intersect_lanes`]).
+#[derive(Debug, Clone, Copy)]
+pub struct LaneHits {
+    /// A bit per triangle hit in `(t_min, t_max)`.
+    pub hits: u32,
+    /// Per lane, the distance of its hit.
+    pub t: [f32; LANES],
+    /// Per lane, the barycentric weights (b1, b2) of its hit.
+    pub b1: [f32; LANES],
+    /// See [`LaneHits::b1`].
+    pub b2: [f32; LANES],
+}
+
+/// Triangles [`ShearedRay::intersect_lanes`] tests at once.
+pub const LANES: usize = 8;
+
+/// Triangles stored coordinate by coordinate (nine columns: the x, y, z of
+/// each corner), so that eight consecutive triangles' coordinates load as
+/// eight-lane vectors with no gathering ([`ShearedRay::intersect_lanes`]).
+#[derive(Debug, Clone, Default)]
+pub struct TriangleColumns {
+    /// Corner-major: column `3 · corner + axis`, a triangle an entry, padded
+    /// with [`LANES`] zeros so any eight-lane load from a triangle fits.
+    columns: [Vec<f32>; 9],
+}
+
+impl TriangleColumns {
+    /// The columns of `triangles`, in their order.
+    #[must_use]
+    pub fn new(triangles: &[[Vec3; 3]]) -> TriangleColumns {
+        let column = |c: usize| {
+            let mut v: Vec<f32> = triangles.iter().map(|t| t[c / 3][c % 3]).collect();
+            v.resize(triangles.len() + LANES, 0.0);
+            v
+        };
+        TriangleColumns { columns: std::array::from_fn(column) }
+    }
+
+    /// Triangles stored.
+    #[must_use]
+    pub fn len(&self) -> usize {
+        self.columns[0].len().saturating_sub(LANES)
+    }
+
+    /// Whether none is.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Triangle `i`.
+    ///
+    /// # Panics
+    /// If `i` is out of range.
+    #[must_use]
+    pub fn get(&self, i: usize) -> [Vec3; 3] {
+        assert!(i < self.len(), "triangle {i} of {}", self.len());
+        let c = |k: usize| self.columns[k][i];
+        [Vec3::new(c(0), c(1), c(2)), Vec3::new(c(3), c(4), c(5)), Vec3::new(c(6), c(7), c(8))]
+    }
+
+    /// Column `c` from triangle `start`, eight lanes.
+    #[inline(always)]
+    fn lanes(&self, c: usize, start: usize) -> f32x8 {
+        let v: [f32; LANES] = self.columns[c][start..start + LANES].try_into().expect("padded columns");
+        f32x8::from(v)
+    }
+}
+
+impl ShearedRay {
+    /// [`ShearedRay::intersect`] of the `count` (at most [`LANES`]) triangles
+    /// from `start` of `triangles` at once, one a lane: every lane's answer is
+    /// the one-triangle test's, bit for bit (the same operations in the same
+    /// order; a lane on an edge is decided by the one-triangle test, in f64).
+    ///
+    /// # Panics
+    /// If `count` exceeds [`LANES`] or the triangles are out of range.
+    #[must_use]
+    #[inline]
+    pub fn intersect_lanes(
+        &self,
+        triangles: &TriangleColumns,
+        start: usize,
+        count: usize,
+        t_min: f32,
+        t_max: f32,
+    ) -> LaneHits {
+        assert!(count <= LANES && start + count <= triangles.len(), "triangles {start}+{count}");
+        let [rx, ry, rz] = self.rows.map(|r| [r.x, r.y, r.z].map(f32x8::splat));
+        let o = [self.origin.x, self.origin.y, self.origin.z].map(f32x8::splat);
+        let shear = |corner: usize| {
+            let axis = |k: usize| triangles.lanes(3 * corner + k, start) - o[k];
+            let (x, y, z) = (axis(0), axis(1), axis(2));
+            let row = |r: &[f32x8; 3]| r[0] * x + r[1] * y + r[2] * z;
+            (row(&rx), row(&ry), row(&rz))
+        };
+        let ((ax, ay, az), (bx, by, bz), (cx, cy, cz)) = (shear(0), shear(1), shear(2));
+        let (u, v, w) = (cx * by - cy * bx, ax * cy - ay * cx, bx * ay - by * ax);
+        let zero = f32x8::ZERO;
+        let used = (1u32 << count) - 1;
+        let on_edge = (u.simd_eq(zero) | v.simd_eq(zero) | w.simd_eq(zero)).to_bitmask() & used;
+        let negative = u.simd_lt(zero) | v.simd_lt(zero) | w.simd_lt(zero);
+        let positive = u.simd_gt(zero) | v.simd_gt(zero) | w.simd_gt(zero);
+        let det = u + v + w;
+        let t = f32x8::splat(self.inv_dz) * (u * az + v * bz + w * cz) / det;
+        let inside = !(negative & positive) & !det.simd_eq(zero);
+        let within = t.simd_gt(f32x8::splat(t_min)) & t.simd_lt(f32x8::splat(t_max));
+        let mut out = LaneHits {
+            hits: (inside & within).to_bitmask() & used & !on_edge,
+            t: t.to_array(),
+            b1: (v / det).to_array(),
+            b2: (w / det).to_array(),
+        };
+        let mut edges = on_edge;
+        while edges != 0 {
+            let k = edges.trailing_zeros() as usize;
+            edges &= edges - 1;
+            if let Some((t, b)) = self.intersect(&triangles.get(start + k), t_min, t_max) {
+                out.hits |= 1 << k;
+                (out.t[k], out.b1[k], out.b2[k]) = (t, b.x, b.y);
+            }
+        }
+        out
+    }
+}
+
+/// The edge functions of a ray on an edge in f32, decided in f64 so neighbours
+/// agree (rare: kept out of the inlined test).
+#[cold]
+#[inline(never)]
+fn on_an_edge(a: Vec3, b: Vec3, c: Vec3) -> (f32, f32, f32) {
+    let e = |p: Vec3, q: Vec3| (q.x as f64 * p.y as f64 - q.y as f64 * p.x as f64) as f32;
+    (e(b, c), e(c, a), e(a, b))
 }
 
 /// Möller–Trumbore in f64 with the inside test, for tests and rare exact needs.
@@ -109,6 +250,47 @@ mod tests {
         assert!((t - 5.0).abs() < 1e-6 && (b - Vec2::splat(0.25)).length() < 1e-6, "{t} {b}");
         assert!(ShearedRay::new(&r).intersect(&tri, 0.0, 4.0).is_none());
         assert!(ShearedRay::new(&ray([2.0, 2.0, 0.0], [0.0, 0.0, 1.0])).intersect(&tri, 0.0, 9.0).is_none());
+    }
+
+    /// Eight lanes answer what eight one-triangle tests answer, bit for bit:
+    /// random triangles and rays, rays aimed at vertices and edges (where the
+    /// f64 decision may be taken), degenerate triangles, lanes past the count.
+    #[test]
+    fn eight_lanes_answer_as_one_triangle_tests_do() {
+        let mut seed = 7u32;
+        let mut r = || {
+            seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            (seed >> 8) as f32 / (1u32 << 24) as f32 * 2.0 - 1.0
+        };
+        let mut hits = 0;
+        for round in 0..4000 {
+            let mut tris: Vec<[Vec3; 3]> =
+                (0..LANES).map(|_| [(); 3].map(|_| Vec3::new(r(), r(), r() + 3.0))).collect();
+            // A degenerate triangle, and a ray through a vertex or an edge midpoint.
+            tris[round % LANES] = [tris[0][0]; 3];
+            let k = (round / LANES) % LANES;
+            let aim = if round % 3 == 0 { tris[k][0] } else { (tris[k][1] + tris[k][2]) * 0.5 };
+            let origin = Vec3::new(r(), r(), r() - 2.0);
+            let dir = if round % 2 == 0 { aim - origin } else { Vec3::new(r(), r(), 1.0) };
+            let sr = ShearedRay::new(&Ray { origin, dir });
+            let columns = TriangleColumns::new(&tris);
+            let (t_min, t_max) = (0.0, if round % 5 == 0 { 1.0 } else { f32::INFINITY });
+            for count in [LANES, 5] {
+                let lanes = sr.intersect_lanes(&columns, 0, count, t_min, t_max);
+                for (i, tri) in tris.iter().enumerate() {
+                    let one = sr.intersect(tri, t_min, t_max).filter(|_| i < count);
+                    let lane = (lanes.hits >> i & 1 == 1).then(|| (lanes.t[i], Vec2::new(lanes.b1[i], lanes.b2[i])));
+                    assert_eq!(
+                        one.map(|(t, b)| (t.to_bits(), b.x.to_bits(), b.y.to_bits())),
+                        lane.map(|(t, b)| (t.to_bits(), b.x.to_bits(), b.y.to_bits())),
+                        "round {round} lane {i}"
+                    );
+                    hits += usize::from(one.is_some());
+                }
+            }
+        }
+        assert!(hits > 2000, "{hits} hits: the rays must hit often enough to mean anything");
+        assert_eq!(TriangleColumns::new(&[]).len(), 0);
     }
 
     /// Rays through the shared edge of a quad split in two always hit one half.

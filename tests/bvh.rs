@@ -27,7 +27,7 @@ fn random_ray(rng: &mut StdRng) -> Ray {
 fn brute(scene: &TraceScene, ray: &Ray, t_max: f32) -> Option<(f32, usize)> {
     let sr = ShearedRay::new(ray);
     (0..scene.len())
-        .filter_map(|i| sr.intersect(scene.triangle(i), 0.0, t_max).map(|(t, _)| (t, i)))
+        .filter_map(|i| sr.intersect(&scene.triangle(i), 0.0, t_max).map(|(t, _)| (t, i)))
         .min_by(|a, b| a.0.total_cmp(&b.0))
 }
 
@@ -58,6 +58,40 @@ fn nearest_and_any_hits_match_brute_force() {
         }
     }
     assert!(hits > rays / 4, "the rays must hit something often enough to mean anything: {hits}/{rays}");
+}
+
+/// Leaves past eight triangles (many with one centre: the build cannot split
+/// them) and the same triangle many times over: still the brute-force answer.
+#[test]
+fn crowded_leaves_match_brute_force() {
+    let mut rng = StdRng::seed_from_u64(5);
+    let mut tris: Vec<[Vec3; 3]> = Vec::new();
+    for k in 0..300 {
+        // Triangles turned about one centre, and 40 copies of one triangle.
+        let a = k as f32 * 0.37;
+        let (c, s) = (a.cos(), a.sin());
+        tris.push([Vec3::new(c, s, 0.1 * c), Vec3::new(-c, -s, -0.1 * c), Vec3::new(-s, c, 0.2)]);
+    }
+    tris.extend(std::iter::repeat_n(
+        [Vec3::new(2.0, 0.0, 0.0), Vec3::new(3.0, 0.0, 0.0), Vec3::new(2.0, 1.0, 0.5)],
+        40,
+    ));
+    let items = (0..tris.len() as u32).map(|t| ItemId { object: 0, triangle: t }).collect();
+    let scene = TraceScene::from_triangles(tris, items);
+    let mut hits = 0;
+    for _ in 0..3000 {
+        let ray = random_ray(&mut rng);
+        let want = brute(&scene, &ray, f32::INFINITY);
+        let got = scene.intersect(&ray, f32::INFINITY);
+        assert_eq!(want.map(|w| w.0), got.map(|h| h.t), "distance");
+        if let (Some((t, i)), Some(h)) = (want, got) {
+            hits += 1;
+            let same = h.item.triangle as usize == i || brute(&scene, &ray, t).is_none();
+            assert!(same, "triangle {} vs {i}", h.item.triangle);
+        }
+        assert_eq!(scene.occluded(&ray, f32::INFINITY), want.is_some());
+    }
+    assert!(hits > 300, "{hits}");
 }
 
 #[test]

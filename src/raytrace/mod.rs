@@ -29,7 +29,7 @@ use crate::csg::{CsgCaster, CsgSolid};
 
 use crate::bvh::{Aabb, Bvh};
 use crate::camera::Ray;
-use crate::triangle::ShearedRay;
+use crate::triangle::{ShearedRay, TriangleColumns, LANES};
 use crate::visibility::ItemId;
 
 pub use cache::TraceCache;
@@ -53,8 +53,9 @@ pub struct Hit {
 /// cast by [`crate::csg::CsgCaster`]).
 #[derive(Debug, Clone)]
 pub struct TraceScene {
-    /// Per leaf, in leaf order; a solid's leaf holds a triangle that no ray hits.
-    triangles: Vec<[Vec3; 3]>,
+    /// Per leaf, in leaf order; a solid's leaf holds a triangle of NaNs, which no
+    /// ray hits.
+    triangles: TriangleColumns,
     items: Vec<ItemId>,
     /// The solids' leaves, sorted, with their object and caster.
     solids: Vec<(u32, u32, CsgCaster)>,
@@ -124,8 +125,9 @@ impl TraceScene {
         let mut bvh = Bvh::build(&bounds);
         let order = bvh.renumber();
         let mut solids: Vec<Option<(u32, CsgSolid)>> = solids.into_iter().map(|(o, s, _)| Some((o, s))).collect();
+        let mut leaves = Vec::with_capacity(order.len());
         let mut trace = TraceScene {
-            triangles: Vec::new(),
+            triangles: TriangleColumns::default(),
             items: Vec::new(),
             solids: Vec::new(),
             bvh,
@@ -135,15 +137,16 @@ impl TraceScene {
         for (leaf, &i) in order.iter().enumerate() {
             let i = i as usize;
             if i < n {
-                trace.triangles.push(triangles[i]);
+                leaves.push(triangles[i]);
                 trace.items.push(items[i]);
             } else {
                 let (object, solid) = solids[i - n].take().expect("each leaf once");
-                trace.triangles.push([Vec3::ZERO; 3]);
+                leaves.push([Vec3::NAN; 3]);
                 trace.items.push(ItemId::primitive_of(object, 0));
                 trace.solids.push((leaf as u32, object, CsgCaster::from_solid(solid)));
             }
         }
+        trace.triangles = TriangleColumns::new(&leaves);
         trace
     }
 
@@ -170,54 +173,96 @@ impl TraceScene {
         let bounds: Vec<Aabb> = triangles.par_iter().map(|t| Aabb::around(t)).collect();
         let mut bvh = Bvh::build(&bounds);
         let order = bvh.renumber();
-        let triangles = order.iter().map(|&i| triangles[i as usize]).collect();
+        let triangles: Vec<[Vec3; 3]> = order.iter().map(|&i| triangles[i as usize]).collect();
+        let triangles = TriangleColumns::new(&triangles);
         let items = order.iter().map(|&i| items[i as usize]).collect();
         TraceScene { triangles, items, solids: Vec::new(), bvh, casters: Vec::new(), cutouts: Vec::new() }
-    }
-
-    /// The solid at leaf `i`, if that leaf is one.
-    fn solid_at(&self, i: u32) -> Option<&(u32, u32, CsgCaster)> {
-        if self.solids.is_empty() {
-            return None;
-        }
-        self.solids.binary_search_by_key(&i, |s| s.0).ok().map(|k| &self.solids[k])
     }
 
     /// The nearest hit along `ray` in `(0, t_max)`.
     #[must_use]
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
-        let sr = ShearedRay::new(ray);
+        // Prepared at the first leaf reached (many rays reach none).
+        let mut sheared = None;
         let mut hit = Hit { t: 0.0, item: ItemId::NONE, barycentrics: Vec2::ZERO, normal: Vec3::ZERO };
-        let (i, t) = self.bvh.intersect(ray, t_max, |i, t_max| {
-            if let Some((_, object, caster)) = self.solid_at(i) {
-                let c = caster.first_hit(ray, 0.0, t_max)?;
-                hit.item = ItemId::primitive_of(*object, c.primitive);
-                hit.normal = c.normal;
-                return Some(c.t);
+        let (i, t) = self.bvh.intersect_leaves(ray, t_max, |leaf, mut t_max| {
+            let sr = *sheared.get_or_insert_with(|| ShearedRay::new(ray));
+            let leaves = Self::range(leaf);
+            let mut best = None;
+            // The leaf's triangles eight at a time (a solid's leaf holds a
+            // triangle no ray hits), then its solids.
+            for start in leaves.clone().step_by(LANES) {
+                let count = (leaves.end - start).min(LANES);
+                let lanes = sr.intersect_lanes(&self.triangles, start, count, 0.0, t_max);
+                let mut hits = lanes.hits;
+                while hits != 0 {
+                    let k = hits.trailing_zeros() as usize;
+                    hits &= hits - 1;
+                    let (t, b, item) = (lanes.t[k], Vec2::new(lanes.b1[k], lanes.b2[k]), self.items[start + k]);
+                    if t < t_max && self.keeps(item, b) {
+                        (hit.item, hit.barycentrics, hit.normal) = (item, b, Vec3::ZERO);
+                        (t_max, best) = (t, Some(((start + k) as u32, t)));
+                    }
+                }
             }
-            let (t, b) = sr.intersect(&self.triangles[i as usize], 0.0, t_max)?;
-            if !self.keeps(self.items[i as usize], b) {
-                return None;
+            for (at, object, caster) in self.solids_in(&leaves) {
+                if let Some(c) = caster.first_hit(ray, 0.0, t_max) {
+                    (hit.item, hit.barycentrics, hit.normal) =
+                        (ItemId::primitive_of(*object, c.primitive), Vec2::ZERO, c.normal);
+                    (t_max, best) = (c.t, Some((*at, c.t)));
+                }
             }
-            (hit.item, hit.barycentrics, hit.normal) = (self.items[i as usize], b, Vec3::ZERO);
-            Some(t)
+            best
         })?;
         debug_assert_eq!(hit.item.object, self.items[i as usize].object);
         Some(Hit { t, ..hit })
+    }
+
+    /// The leaves (triangles and solids) of a BVH leaf: consecutive numbers,
+    /// since the trace scene renumbers its leaves in the BVH's order.
+    fn range(leaf: &[u32]) -> std::ops::Range<usize> {
+        debug_assert!(leaf.windows(2).all(|w| w[1] == w[0] + 1), "renumbered leaves");
+        leaf[0] as usize..leaf[0] as usize + leaf.len()
+    }
+
+    /// The solids among `leaves`.
+    fn solids_in(&self, leaves: &std::ops::Range<usize>) -> &[(u32, u32, CsgCaster)] {
+        if self.solids.is_empty() {
+            return &[];
+        }
+        let from = self.solids.partition_point(|s| (s.0 as usize) < leaves.start);
+        let to = from + self.solids[from..].partition_point(|s| (s.0 as usize) < leaves.end);
+        &self.solids[from..to]
     }
 
     /// Whether anything that casts shadows lies along `ray` in `(0, t_max)`
     /// (shadow rays).
     #[must_use]
     pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
-        let sr = ShearedRay::new(ray);
-        self.bvh.occluded(ray, t_max, |i, t_max| match self.solid_at(i) {
-            _ if !self.casters.is_empty() && !self.casters[self.items[i as usize].object as usize] => None,
-            Some((_, _, caster)) => caster.first_hit(ray, 0.0, t_max).map(|c| c.t),
-            None => sr
-                .intersect(&self.triangles[i as usize], 0.0, t_max)
-                .filter(|&(_, b)| self.keeps(self.items[i as usize], b))
-                .map(|h| h.0),
+        let mut sheared = None;
+        let casts = |object: u32| self.casters.is_empty() || self.casters[object as usize];
+        self.bvh.occluded_leaves(ray, t_max, |leaf, t_max| {
+            let sr = *sheared.get_or_insert_with(|| ShearedRay::new(ray));
+            let leaves = Self::range(leaf);
+            let triangles = leaves.clone().step_by(LANES).any(|start| {
+                let count = (leaves.end - start).min(LANES);
+                let lanes = sr.intersect_lanes(&self.triangles, start, count, 0.0, t_max);
+                let mut hits = lanes.hits;
+                while hits != 0 {
+                    let k = hits.trailing_zeros() as usize;
+                    hits &= hits - 1;
+                    let item = self.items[start + k];
+                    if casts(item.object) && self.keeps(item, Vec2::new(lanes.b1[k], lanes.b2[k])) {
+                        return true;
+                    }
+                }
+                false
+            });
+            triangles
+                || self
+                    .solids_in(&leaves)
+                    .iter()
+                    .any(|(_, object, caster)| casts(*object) && caster.first_hit(ray, 0.0, t_max).is_some())
         })
     }
 
@@ -234,9 +279,12 @@ impl TraceScene {
     }
 
     /// The world-space triangle of primitive `i`.
+    ///
+    /// # Panics
+    /// If `i` is not below [`TraceScene::len`].
     #[must_use]
-    pub fn triangle(&self, i: usize) -> &[Vec3; 3] {
-        &self.triangles[i]
+    pub fn triangle(&self, i: usize) -> [Vec3; 3] {
+        self.triangles.get(i)
     }
 
     /// The BVH.
