@@ -276,6 +276,37 @@ impl Bvh {
         any
     }
 
+    /// Every primitive whose leaf's box `ray` enters before `t_max`, in no
+    /// particular order (a walk that keeps no order: for callers that want
+    /// them all, as the CSG caster's counts do).
+    pub fn crossed(&self, ray: &Ray, t_max: f32, mut visit: impl FnMut(u32)) {
+        if self.nodes.is_empty() {
+            return;
+        }
+        let inv = ray.dir.recip();
+        let origin = [f32x8::splat(ray.origin.x), f32x8::splat(ray.origin.y), f32x8::splat(ray.origin.z)];
+        let inv = [f32x8::splat(inv.x), f32x8::splat(inv.y), f32x8::splat(inv.z)];
+        let mut stack = Stack { fixed: [0; 32], len: 0, spilled: Vec::new() };
+        let mut at = 0usize;
+        loop {
+            let node = &self.nodes[at];
+            let (_, mut enters) = node.entries(origin, inv, t_max);
+            while enters != 0 {
+                let k = enters.trailing_zeros() as usize;
+                enters &= enters - 1;
+                let (child, count) = (node.child[k] as usize, node.count[k] as usize);
+                if count > 0 {
+                    self.order[child..child + count].iter().for_each(|&i| visit(i));
+                } else {
+                    stack.push(postponed((at * WIDTH + k) as u32, 0.0));
+                }
+            }
+            let Some(p) = stack.pop() else { return };
+            let (parent, k, _) = postponed_slot(p);
+            at = self.nodes[parent].child[k] as usize;
+        }
+    }
+
     /// Visits the leaves the ray reaches (their primitives), nearer child first
     /// (by entry distance); `visit` returns true to stop. A postponed child is
     /// skipped when the ray has since found a hit nearer than its box.
@@ -550,5 +581,48 @@ mod tests {
         }
         assert!(seen.iter().all(|&n| n == 1), "each primitive once");
         assert!(wide * 2 > bvh.nodes.len(), "most nodes are wider than binary: {wide} of {}", bvh.nodes.len());
+    }
+
+    /// The unordered walk finds every primitive the ordered walk reaches, and
+    /// every primitive whose own box the ray enters.
+    #[test]
+    fn the_unordered_walk_reaches_what_the_ordered_one_does() {
+        let mut seed = 11u32;
+        let mut r = || {
+            seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            (seed >> 8) as f32 / (1u32 << 24) as f32 * 2.0 - 1.0
+        };
+        let boxes: Vec<Aabb> = (0..3000)
+            .map(|_| {
+                let p = Vec3::new(r(), r(), r()) * 4.0;
+                Aabb { min: p, max: p + Vec3::new(r().abs(), r().abs(), r().abs()) * 0.3 }
+            })
+            .collect();
+        let bvh = Bvh::build(&boxes);
+        let mut met = 0;
+        for _ in 0..500 {
+            let origin = Vec3::new(r(), r(), r()) * 6.0;
+            let ray = Ray { origin, dir: (Vec3::new(r(), r(), r()) - origin).normalize() };
+            let t_max = if r() > 0.0 { 5.0 } else { f32::INFINITY };
+            let (mut ordered, mut unordered) = (Vec::new(), Vec::new());
+            bvh.intersect(&ray, t_max, |i, _| {
+                ordered.push(i);
+                None
+            });
+            bvh.crossed(&ray, t_max, |i| unordered.push(i));
+            ordered.sort_unstable();
+            unordered.sort_unstable();
+            assert_eq!(ordered, unordered);
+            let inv = ray.dir.recip();
+            for (i, b) in boxes.iter().enumerate() {
+                let (t0, t1) = ((b.min - origin) * inv, (b.max - origin) * inv);
+                let (near, far) = (t0.min(t1).max_element().max(0.0), t0.max(t1).min_element());
+                if near <= far && near < t_max {
+                    met += 1;
+                    assert!(unordered.binary_search(&(i as u32)).is_ok(), "box {i} entered but not reached");
+                }
+            }
+        }
+        assert!(met > 500, "{met}");
     }
 }

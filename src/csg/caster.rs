@@ -496,10 +496,7 @@ impl CsgCaster {
         };
         SCRATCH.with_borrow_mut(|s| {
             let mut met = std::mem::take(&mut s.met);
-            bvh.intersect(ray, t_max, |i, _| {
-                met.push(i);
-                None
-            });
+            bvh.crossed(ray, t_max, |i| met.push(i));
             let hit = if met.len() * Self::NODES_PER_COUNTED < shape.len() {
                 // Few primitives met: they occupy the ray (seed 003's counts,
                 // [`OccupancyTree`]) and the booleans visit only what they make
