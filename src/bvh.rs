@@ -23,6 +23,7 @@ use rayon::prelude::*;
 use wide::f32x8;
 
 use crate::camera::Ray;
+use crate::triangle::set_bits;
 
 /// An axis-aligned box.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -123,6 +124,14 @@ fn postponed_slot(p: Postponed) -> (usize, usize, f32) {
     (slot / WIDTH, slot % WIDTH, f32::from_bits((p >> 32) as u32))
 }
 
+/// The ray's origin and reciprocal direction, each axis in eight lanes.
+#[inline(always)]
+fn ray_lanes(ray: &Ray) -> ([f32x8; 3], [f32x8; 3]) {
+    let inv = ray.dir.recip();
+    let lanes = |v: Vec3| [f32x8::splat(v.x), f32x8::splat(v.y), f32x8::splat(v.z)];
+    (lanes(ray.origin), lanes(inv))
+}
+
 /// Postponed children of one walk: a fixed array, spilling to the heap only
 /// on trees deeper than a binned build makes.
 struct Stack {
@@ -132,6 +141,11 @@ struct Stack {
 }
 
 impl Stack {
+    #[inline(always)]
+    fn new() -> Stack {
+        Stack { fixed: [0; 32], len: 0, spilled: Vec::new() }
+    }
+
     #[inline(always)]
     fn push(&mut self, p: Postponed) {
         if self.len < self.fixed.len() {
@@ -283,17 +297,13 @@ impl Bvh {
         if self.nodes.is_empty() {
             return;
         }
-        let inv = ray.dir.recip();
-        let origin = [f32x8::splat(ray.origin.x), f32x8::splat(ray.origin.y), f32x8::splat(ray.origin.z)];
-        let inv = [f32x8::splat(inv.x), f32x8::splat(inv.y), f32x8::splat(inv.z)];
-        let mut stack = Stack { fixed: [0; 32], len: 0, spilled: Vec::new() };
+        let (origin, inv) = ray_lanes(ray);
+        let mut stack = Stack::new();
         let mut at = 0usize;
         loop {
             let node = &self.nodes[at];
-            let (_, mut enters) = node.entries(origin, inv, t_max);
-            while enters != 0 {
-                let k = enters.trailing_zeros() as usize;
-                enters &= enters - 1;
+            let (_, enters) = node.entries(origin, inv, t_max);
+            for k in set_bits(enters) {
                 let (child, count) = (node.child[k] as usize, node.count[k] as usize);
                 if count > 0 {
                     self.order[child..child + count].iter().for_each(|&i| visit(i));
@@ -314,10 +324,8 @@ impl Bvh {
         if self.nodes.is_empty() {
             return;
         }
-        let inv = ray.dir.recip();
-        let origin = [f32x8::splat(ray.origin.x), f32x8::splat(ray.origin.y), f32x8::splat(ray.origin.z)];
-        let inv = [f32x8::splat(inv.x), f32x8::splat(inv.y), f32x8::splat(inv.z)];
-        let mut stack = Stack { fixed: [0; 32], len: 0, spilled: Vec::new() };
+        let (origin, inv) = ray_lanes(ray);
+        let mut stack = Stack::new();
         // The node walked now, or a leaf's primitives (`leaf` > 0 of them).
         let (mut at, mut leaf) = (0usize, 0u8);
         loop {
@@ -327,7 +335,7 @@ impl Bvh {
                 }
             } else {
                 let node = &self.nodes[at];
-                let (near, mut enters) = node.entries(origin, inv, *t_max);
+                let (near, enters) = node.entries(origin, inv, *t_max);
                 if enters != 0 && enters & (enters - 1) == 0 {
                     // One child entered: walk it.
                     let k = enters.trailing_zeros() as usize;
@@ -340,9 +348,7 @@ impl Bvh {
                     let near = near.to_array();
                     let mut entered = [(0.0f32, 0usize); WIDTH];
                     let mut n = 0;
-                    while enters != 0 {
-                        let k = enters.trailing_zeros() as usize;
-                        enters &= enters - 1;
+                    for k in set_bits(enters) {
                         let mut j = n;
                         while j > 0 && entered[j - 1].0 <= near[k] {
                             entered[j] = entered[j - 1];
@@ -547,7 +553,7 @@ mod tests {
     /// fixed part too (a tree deeper than a balanced build).
     #[test]
     fn the_stack_spills_and_stays_last_in_first_out() {
-        let mut stack = Stack { fixed: [0; 32], len: 0, spilled: Vec::new() };
+        let mut stack = Stack::new();
         (0..100u32).for_each(|i| stack.push(postponed(i, i as f32 * 0.5)));
         for i in (0..100u32).rev() {
             let (parent, lane, t) = postponed_slot(stack.pop().expect("pushed"));

@@ -93,6 +93,22 @@ pub struct LaneHits {
     pub b2: [f32; LANES],
 }
 
+impl LaneHits {
+    /// The lanes hit, in lane order.
+    pub fn lanes(&self) -> impl Iterator<Item = usize> {
+        set_bits(self.hits)
+    }
+}
+
+/// The bits set in `mask`, lowest first (a lane mask's lanes).
+pub(crate) fn set_bits(mut mask: u32) -> impl Iterator<Item = usize> {
+    std::iter::from_fn(move || {
+        let k = (mask != 0).then(|| mask.trailing_zeros() as usize)?;
+        mask &= mask - 1;
+        Some(k)
+    })
+}
+
 /// Triangles [`ShearedRay::intersect_lanes`] tests at once.
 pub const LANES: usize = 8;
 
@@ -193,10 +209,7 @@ impl ShearedRay {
             b1: (v / det).to_array(),
             b2: (w / det).to_array(),
         };
-        let mut edges = on_edge;
-        while edges != 0 {
-            let k = edges.trailing_zeros() as usize;
-            edges &= edges - 1;
+        for k in set_bits(on_edge) {
             if let Some((t, b)) = self.intersect(&triangles.get(start + k), t_min, t_max) {
                 out.hits |= 1 << k;
                 (out.t[k], out.b1[k], out.b2[k]) = (t, b.x, b.y);

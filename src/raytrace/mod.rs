@@ -194,10 +194,7 @@ impl TraceScene {
             for start in leaves.clone().step_by(LANES) {
                 let count = (leaves.end - start).min(LANES);
                 let lanes = sr.intersect_lanes(&self.triangles, start, count, 0.0, t_max);
-                let mut hits = lanes.hits;
-                while hits != 0 {
-                    let k = hits.trailing_zeros() as usize;
-                    hits &= hits - 1;
+                for k in lanes.lanes() {
                     let (t, b, item) = (lanes.t[k], Vec2::new(lanes.b1[k], lanes.b2[k]), self.items[start + k]);
                     if t < t_max && self.keeps(item, b) {
                         (hit.item, hit.barycentrics, hit.normal) = (item, b, Vec3::ZERO);
@@ -247,16 +244,10 @@ impl TraceScene {
             let triangles = leaves.clone().step_by(LANES).any(|start| {
                 let count = (leaves.end - start).min(LANES);
                 let lanes = sr.intersect_lanes(&self.triangles, start, count, 0.0, t_max);
-                let mut hits = lanes.hits;
-                while hits != 0 {
-                    let k = hits.trailing_zeros() as usize;
-                    hits &= hits - 1;
+                lanes.lanes().any(|k| {
                     let item = self.items[start + k];
-                    if casts(item.object) && self.keeps(item, Vec2::new(lanes.b1[k], lanes.b2[k])) {
-                        return true;
-                    }
-                }
-                false
+                    casts(item.object) && self.keeps(item, Vec2::new(lanes.b1[k], lanes.b2[k]))
+                })
             });
             triangles
                 || self
