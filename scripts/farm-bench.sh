@@ -11,8 +11,10 @@
 #
 #   cargo build --release && scripts/farm-bench.sh [FRAMES [TILES]]
 #
-# Defaults: 120 frames of 1920x1080, 16 tiles of 7680x4320. Needs openjd
-# (.ci/venv/bin/openjd, which .ci/run installs, or on the PATH) for its rows.
+# Defaults: 120 frames of 1920x1080, 16 tiles of 7680x4320; FRAMES = 0 measures
+# the poster alone. Needs openjd (.ci/venv/bin/openjd, which .ci/run installs,
+# or on the PATH) for its rows, and GNU time (/usr/bin/time, Debian's `time`)
+# for the poster's core-seconds and peak memory.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 frames=${1:-120}
@@ -63,6 +65,7 @@ echo "Machine: $(nproc) cores ($(grep -m1 'model name' /proc/cpuinfo | cut -d: -
 echo
 
 # --- Turntable ------------------------------------------------------------
+turntable() {
 w=1920 h=1080
 mkdir -p "$work/a" "$work/b" "$work/c"
 start=$(now)
@@ -109,12 +112,22 @@ echo "| a frame inside the one-process run (mean) | $(printf '%.0f' "$(echo "100
 echo "| \`--frame 7\` in a process of its own | $(printf '%.0f' "$(echo "1000 * $unit" | bc -l)") ms |"
 echo "| start-up, scene load, BVH and maps (an 8x8 image) | $(printf '%.0f' "$(echo "1000 * $tiny" | bc -l)") ms |"
 echo
+}
+[ "$frames" = 0 ] || turntable
+
+# A command's wall, user and system seconds and peak resident kilobytes, into
+# file $1 (empty without GNU time).
+timed() {
+  local out=$1
+  shift
+  if [ -x /usr/bin/time ]; then /usr/bin/time -f "%e %U %S %M" -o "$out" "$@"; else : >"$out" && "$@"; fi
+}
 
 # --- Poster ---------------------------------------------------------------
 w=7680 h=4320
 rm -rf "$work/a" "$work/b" "$work/c" && mkdir -p "$work/a" "$work/b" "$work/c"
 start=$(now)
-"$kage" render "$scene" --width $w --height $h -o "$work/a/poster.exr" 2>/dev/null
+timed "$work/whole.time" "$kage" render "$scene" --width $w --height $h -o "$work/a/poster.exr" 2>/dev/null
 one=$(since "$start")
 two=""
 if [ -n "$openjd" ]; then
@@ -123,8 +136,9 @@ if [ -n "$openjd" ]; then
   two=$(since "$start")
 fi
 start=$(now)
-seq 0 $((tiles - 1)) | xargs -P "$cores" -I{} "$kage" render "$scene" --tile "{}/$tiles" --threads 1 \
-  --width $w --height $h -o "$work/c/tile.{}.exr" 2>/dev/null
+export -f timed
+seq 0 $((tiles - 1)) | xargs -P "$cores" -I{} bash -c "timed '$work/c/{}.time' '$kage' render '$scene' \
+  --tile '{}/$tiles' --threads 1 --width $w --height $h -o '$work/c/tile.{}.exr' 2>/dev/null"
 "$kage" merge "$work"/c/tile.*.exr -o "$work/c/poster.exr" 2>/dev/null
 split=$(since "$start")
 start=$(now)
@@ -143,3 +157,16 @@ prow "one process, $cores threads, the whole image" "$one"
 prow "$tiles tile processes, $cores at a time, 1 thread each, then \`kage merge\`" "$split"
 echo
 echo "One tile in a process of its own: $(fmt "$tile") s."
+if [ -s "$work/whole.time" ]; then
+  # Core-seconds (user + system) and peak resident memory: the whole image in
+  # one process against the tiles' processes.
+  read -r _ wu ws wm <"$work/whole.time"
+  cat "$work"/c/*.time | awk -v cs="$(echo "$wu + $ws" | bc -l)" -v wm="$wm" -v n="$tiles" '
+    { core += $2 + $3; if ($4 > peak) peak = $4 }
+    END {
+      printf "\n| | core-seconds | peak memory |\n|---|---|---|\n"
+      printf "| the whole image, one process | %.1f s | %.0f MB |\n", cs, wm / 1024
+      printf "| %d tiles, a process each | %.1f s (%.2fx) | %.0f MB a tile at most (%.3f of the whole) |\n",
+        n, core, core / cs, peak / 1024, peak / wm
+    }'
+fi

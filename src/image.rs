@@ -12,8 +12,9 @@ use rayon::prelude::*;
 pub use tone::ToneCurve;
 
 /// A rectangle of pixels, `x0..x1` × `y0..y1` (half-open), in the
-/// coordinates of a whole image: what a tile of a frame covers.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+/// coordinates of a whole image: what a tile of a frame covers (the
+/// default: empty, at the origin).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Hash)]
 pub struct PixelRect {
     /// First column.
     pub x0: u32,
@@ -60,6 +61,25 @@ impl PixelRect {
     #[must_use]
     pub fn contains(self, x: u32, y: u32) -> bool {
         (self.x0..self.x1).contains(&x) && (self.y0..self.y1).contains(&y)
+    }
+
+    /// Whether it lies inside `outer`.
+    #[must_use]
+    pub fn inside(self, outer: PixelRect) -> bool {
+        self.x0 >= outer.x0 && self.y0 >= outer.y0 && self.x1 <= outer.x1 && self.y1 <= outer.y1
+    }
+
+    /// The same pixels counted from `outer`'s top left pixel (where they lie
+    /// in an image that holds `outer` alone).
+    ///
+    /// # Panics
+    ///
+    /// If it does not lie [`PixelRect::inside`] `outer`.
+    #[must_use]
+    pub fn relative_to(self, outer: PixelRect) -> PixelRect {
+        assert!(self.inside(outer), "{self:?} is not inside {outer:?}");
+        let (dx, dy) = (outer.x0, outer.y0);
+        PixelRect { x0: self.x0 - dx, y0: self.y0 - dy, x1: self.x1 - dx, y1: self.y1 - dy }
     }
 
     /// Grown by `by` pixels on every side, kept inside a `width` × `height`

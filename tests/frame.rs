@@ -82,15 +82,18 @@ fn lights_add_up() {
 
 /// What is computed does not depend on how it is parallelised.
 #[test]
-fn one_and_two_threads_give_identical_frames() {
+fn one_two_five_and_sixteen_threads_give_identical_frames() {
     let scene = kage::scene::demo::demo_scene().unwrap();
     let a = render(&scene, &RenderOptions { threads: Some(1), ..Default::default() }).unwrap();
     let b = render(&scene, &RenderOptions { threads: Some(2), ..Default::default() }).unwrap();
     let c = render(&scene, &RenderOptions { threads: Some(5), ..Default::default() }).unwrap();
+    let d = render(&scene, &RenderOptions { threads: Some(16), ..Default::default() }).unwrap();
     assert_eq!(a.visibility.items(), b.visibility.items());
     assert_eq!(a.visibility.depths(), c.visibility.depths());
+    assert_eq!(a.visibility.items(), d.visibility.items());
     assert_eq!(a.image, b.image);
     assert_eq!(a.image, c.image);
+    assert_eq!(a.image, d.image);
 }
 
 /// The demo is not a silent black image: every object shows and is lit.

@@ -214,6 +214,14 @@ fn memory_mb_bounds_the_frames_estimate() {
     let Err(refused) = render(&scene, &RenderOptions::default()) else { panic!("rendered one MiB under") };
     let refused = refused.to_string();
     assert!(refused.contains(&format!("over the `memory_mb` limit of {}", at - 1)), "{refused}");
+    // A tile counts the pixels it draws: a sixteenth of the frame fits where
+    // the whole does not.
+    let tile = kage::image::PixelRect::tile(5, 16, 640, 480);
+    let options = RenderOptions { region: Some(tile), ..RenderOptions::default() };
+    let frame = render(&scene, &options).expect("a tile within the limit");
+    let drawn = kage::frame::region_drawn(&scene, tile);
+    assert_eq!(frame.rect(), drawn);
+    assert!(u64::from(drawn.width() * drawn.height()) * 4 < 640 * 480, "{drawn:?}");
 }
 
 #[test]

@@ -1,14 +1,17 @@
 //! Tiles of a frame: a region rendered on its own equals the same pixels of
 //! the whole frame, bit for bit, with every technique on (edge antialiasing
 //! and jittered passes, every shadow method, a mirror, glass, translucent
-//! surfaces, fog, a CSG solid, a texture), for random tilings.
+//! surfaces, fog, a CSG solid, a texture; an environment, the viewer's sparse
+//! rays, every component and shadow term on its own), for random tilings on 1,
+//! 5, 16 and 2 workers; and a tile's buffers cost its area.
 
 use std::path::Path;
 
 use kage::image::{LinearImage, PixelRect};
 use kage::scene::file::load_scene;
 use kage::scene::{Antialias, Scene, ShadowMethod};
-use kage::{render, RenderOptions, Renderer};
+use kage::shading::{Component, ComponentSet};
+use kage::{render, Frame, RenderOptions, Renderer};
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 
@@ -41,34 +44,73 @@ fn random_tiling(rng: &mut StdRng, w: u32, h: u32) -> Vec<PixelRect> {
 /// Renders `scene` whole, then tile by tile for `tilings` random tilings, and
 /// asserts every tile's pixels equal the whole frame's, bit for bit.
 fn tiles_equal_the_frame(scene: &Scene, what: &str, seed: u64, tilings: usize) {
-    let whole = render(scene, &RenderOptions::default()).expect("whole frame").image;
+    tiles_equal_the_frame_with(scene, &RenderOptions::default(), what, seed, tilings);
+}
+
+/// The images of a frame: the final one, each component's and each light's
+/// shadow term.
+fn images(frame: &Frame) -> Vec<&LinearImage> {
+    std::iter::once(&frame.image).chain(frame.aovs.iter().map(|(_, a)| a)).chain(&frame.shadows).collect()
+}
+
+/// Worker counts the tilings are rendered with, one after the other (the
+/// whole frame with one per core): what is computed does not depend on how
+/// it is shared out.
+const THREADS: [usize; 4] = [1, 5, 16, 2];
+
+/// As [`tiles_equal_the_frame`], rendered with `options`, every image of the
+/// frame compared (components and shadow terms too), tilings rendered on
+/// [`THREADS`] workers in turn.
+fn tiles_equal_the_frame_with(scene: &Scene, options: &RenderOptions, what: &str, seed: u64, tilings: usize) {
+    let whole = render(scene, options).expect("whole frame");
+    assert_eq!(whole.rect(), PixelRect::full(scene.width, scene.height), "a whole frame holds every pixel");
+    let whole: Vec<LinearImage> = images(&whole).into_iter().cloned().collect();
     let mut rng = StdRng::seed_from_u64(seed);
-    for _ in 0..tilings {
+    for (_, threads) in (0..tilings).zip(THREADS.iter().cycle()) {
+        let options = &RenderOptions { threads: Some(*threads), ..*options };
+        let what = &format!("{what}, {threads} threads");
         let tiling = random_tiling(&mut rng, scene.width, scene.height);
-        let mut merged = LinearImage::new(scene.width, scene.height);
+        let mut merged = vec![LinearImage::new(scene.width, scene.height); whole.len()];
         // One renderer for every tile: what a tile leaves outside itself
         // (the tile before's pixels) must not reach the next.
-        let mut renderer = Renderer::new(&RenderOptions::default()).expect("renderer");
+        let mut renderer = Renderer::new(options).expect("renderer");
         for &tile in &tiling {
-            renderer.set_options(&RenderOptions { region: Some(tile), ..RenderOptions::default() }).expect("options");
-            let part = renderer.render(scene).expect("tile").image.crop(tile);
-            merged.paste(&part, tile.x0, tile.y0);
+            renderer.set_options(&RenderOptions { region: Some(tile), ..*options }).expect("options");
+            let frame = renderer.render(scene).expect("tile");
+            assert_eq!(frame.rect(), kage::frame::region_drawn(scene, tile), "a tile holds what it draws");
+            for (m, image) in merged.iter_mut().zip(images(frame)) {
+                m.paste(&image.crop(tile.relative_to(frame.rect())), tile.x0, tile.y0);
+            }
         }
-        let differ = whole
-            .pixels()
-            .iter()
-            .zip(merged.pixels())
-            .position(|(a, b)| a.to_array().map(f32::to_bits) != b.to_array().map(f32::to_bits));
-        if let Some(i) = differ {
-            let (x, y) = (i as u32 % scene.width, i as u32 / scene.width);
-            let count = whole.pixels().iter().zip(merged.pixels()).filter(|(a, b)| a != b).count();
-            panic!(
-                "{what}: tiling {tiling:?}: pixel ({x}, {y}) is {} whole and {} tiled ({count} pixels differ)",
-                whole.get(x, y),
-                merged.get(x, y)
-            );
+        for (k, (whole, merged)) in whole.iter().zip(&merged).enumerate() {
+            let differ = whole
+                .pixels()
+                .iter()
+                .zip(merged.pixels())
+                .position(|(a, b)| a.to_array().map(f32::to_bits) != b.to_array().map(f32::to_bits));
+            if let Some(i) = differ {
+                let (x, y) = (i as u32 % scene.width, i as u32 / scene.width);
+                let count = whole.pixels().iter().zip(merged.pixels()).filter(|(a, b)| a != b).count();
+                panic!(
+                    "{what}: image {k}: tiling {tiling:?}: pixel ({x}, {y}) is {} whole and {} tiled ({count} pixels differ)",
+                    whole.get(x, y),
+                    merged.get(x, y)
+                );
+            }
         }
     }
+}
+
+/// The test scene with its two-map soft light's shadows mapped instead: no
+/// light's term is computed per pixel of the frame, so a tile draws only
+/// itself and a guard band.
+fn without_soft_shadows(mut scene: Scene) -> Scene {
+    for light in &mut scene.lights {
+        if light.shadow.method == ShadowMethod::Soft {
+            light.shadow = light.shadow.with_method(ShadowMethod::Map);
+        }
+    }
+    scene
 }
 
 #[test]
@@ -86,12 +128,7 @@ fn tiles_of_a_jittered_frame_equal_the_frame() {
 /// the band must hold everything its pixels look at.
 #[test]
 fn tiles_drawn_with_a_guard_band_equal_the_frame() {
-    let mut scene = everything();
-    for light in &mut scene.lights {
-        if light.shadow.method == ShadowMethod::Soft {
-            light.shadow = light.shadow.with_method(ShadowMethod::Map);
-        }
-    }
+    let scene = without_soft_shadows(everything());
     let drawn = kage::frame::region_drawn(&scene, PixelRect { x0: 40, y0: 30, x1: 60, y1: 50 });
     assert_eq!(drawn, PixelRect { x0: 0, y0: 14, x1: 128, y1: 66 }, "a region grown by the guard band");
     let none = Scene { antialias: Antialias::None, ..scene.clone() };
@@ -99,6 +136,51 @@ fn tiles_drawn_with_a_guard_band_equal_the_frame() {
     tiles_equal_the_frame(&scene, "edge, no soft light", 3, 4);
     let scene = Scene { antialias: Antialias::Jitter(3), ..scene };
     tiles_equal_the_frame(&scene, "jitter:3, no soft light", 4, 2);
+}
+
+/// A reflection map seen through a visible environment (each pixel's filter
+/// reaches its neighbours), the viewer's sparse traced term (every other
+/// pixel traced), every component on its own and each light's shadow term:
+/// tiles equal the frame in every image.
+#[test]
+fn tiles_of_an_environment_with_sparse_rays_and_every_image_equal_the_frame() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenes/environment.toml");
+    let scene = Scene { width: 150, height: 85, ..load_scene(&path).expect("environment.toml") };
+    let scene = without_soft_shadows(Scene { antialias: Antialias::None, ..scene });
+    let options =
+        RenderOptions { sparse_traced: true, shadow_images: true, aovs: ComponentSet::ALL, ..RenderOptions::default() };
+    tiles_equal_the_frame_with(&scene, &options, "environment, sparse", 5, 3);
+    let edge = Scene { antialias: Antialias::Edge(Default::default()), ..scene };
+    tiles_equal_the_frame_with(&edge, &RenderOptions { sparse_traced: false, ..options }, "environment, edge", 6, 2);
+}
+
+/// A tile's buffers hold its pixels and its guard band alone: the bytes of
+/// its buffers of one entry a pixel are the whole frame's per pixel times the
+/// pixels it draws, and a sixteenth of a frame draws well under a quarter of
+/// its pixels.
+#[test]
+fn a_tiles_buffers_cost_its_area() {
+    let scene = Scene { width: 768, height: 432, ..without_soft_shadows(everything()) };
+    for antialias in [Antialias::None, Antialias::Jitter(2)] {
+        let scene = Scene { antialias, ..scene.clone() };
+        let options = RenderOptions { aovs: ComponentSet::only(Component::Diffuse), ..RenderOptions::default() };
+        let whole = render(&scene, &options).expect("whole frame").stats.pixel_bytes;
+        let area = |r: PixelRect| r.width() as usize * r.height() as usize;
+        let per_pixel = whole / area(PixelRect::full(scene.width, scene.height));
+        assert!(per_pixel >= 36, "{per_pixel} bytes a pixel: at least depth, item and two images");
+        for index in [0, 5, 15] {
+            let tile = PixelRect::tile(index, 16, scene.width, scene.height);
+            let frame = render(&scene, &RenderOptions { region: Some(tile), ..options }).expect("tile");
+            let drawn = frame.rect();
+            assert_eq!(
+                frame.stats.pixel_bytes,
+                per_pixel * area(drawn),
+                "{antialias:?}: tile {tile:?} drawn as {drawn:?}"
+            );
+            assert!(4 * area(drawn) < area(PixelRect::full(scene.width, scene.height)), "{drawn:?}");
+            assert_eq!((frame.image.width(), frame.image.height()), (drawn.width(), drawn.height()));
+        }
+    }
 }
 
 #[test]

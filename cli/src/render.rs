@@ -547,14 +547,17 @@ fn write_frame(
 ) -> kage::error::Result<()> {
     let exposure = args.exposure.unwrap_or(scene.exposure);
     let scale = exposure.scale(&frame.image);
+    // A tile's images hold the pixels drawn for it (`frame.rect()`): the
+    // tile and a guard band.
+    let held = frame.rect();
     let write = |image: &kage::image::LinearImage, path: &Path, scale: f32, tone: ToneCurve| match part {
         None => kage::output::write_image(image, path, scale, tone),
         Some(rect) if extension(path) == "exr" => {
-            let whole = (image.width(), image.height());
-            tiles::write_tile(&image.crop(rect), rect, whole, exposure, tone, path)
+            let whole = (scene.width, scene.height);
+            tiles::write_tile(&image.crop(rect.relative_to(held)), rect, whole, exposure, tone, path)
                 .map_err(|message| kage::Error::Output { path: path.to_path_buf(), message })
         }
-        Some(rect) => kage::output::write_image(&image.crop(rect), path, scale, tone),
+        Some(rect) => kage::output::write_image(&image.crop(rect.relative_to(held)), path, scale, tone),
     };
     write(&frame.image, path, scale, scene.tone)?;
     for (c, image) in &frame.aovs {

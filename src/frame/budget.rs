@@ -7,13 +7,15 @@
 //! hierarchies ([`BYTES_PER_TRIANGLE`]); per texture, its texels and mip
 //! chain (16 bytes a texel); the shadow maps at their configured resolution,
 //! counted from what each light's method builds
-//! ([`ShadowTerm::bytes_needed`]); per pixel, the item buffer, the component
-//! images and the edge pass's records ([`BYTES_PER_PIXEL`]).
+//! ([`ShadowTerm::bytes_needed`]); per pixel drawn (a tile's pixels and guard
+//! band alone), the item buffer, the component images and the edge pass's
+//! records ([`BYTES_PER_PIXEL`]).
 
 use std::collections::HashSet;
 use std::sync::Arc;
 
 use crate::error::Result;
+use crate::image::PixelRect;
 use crate::limits::Limit;
 use crate::scene::{Body, Light, Scene};
 use crate::shading::frame_lights_within;
@@ -29,19 +31,20 @@ pub const BYTES_PER_TRIANGLE: u64 = 256;
 /// and the traced term's records (about 36).
 pub const BYTES_PER_PIXEL: u64 = 160;
 
-/// Checks what a frame of `scene` asks for against `scene.limits`.
+/// Checks what a frame of `scene` drawing the pixels `drawn` asks for
+/// against `scene.limits`.
 ///
 /// # Errors
 ///
 /// [`crate::Error::Limit`] naming the first limit passed: [`Limit::Triangles`],
 /// [`Limit::LightShadowMb`] (naming the light), [`Limit::FrameShadowMb`] or
 /// [`Limit::MemoryMb`].
-pub fn check(scene: &Scene) -> Result<()> {
+pub fn check(scene: &Scene, drawn: PixelRect) -> Result<()> {
     let limits = &scene.limits;
     let triangles: u64 = scene.objects.iter().filter_map(|o| o.triangles()).map(|m| m.triangles.len() as u64).sum();
     limits.check(Limit::Triangles, triangles, || "the scene's objects".into())?;
     let shadows = shadow_bytes(scene, true)?;
-    let need = MemoryNeeded::of(scene, shadows);
+    let need = MemoryNeeded::of(scene, shadows, drawn);
     limits.check_bytes(Limit::MemoryMb, need.total(), || {
         let mb = |b: u64| b.div_ceil(1 << 20);
         format!(
@@ -70,19 +73,20 @@ pub struct MemoryNeeded {
 }
 
 impl MemoryNeeded {
-    /// The estimate for `scene`, what [`Limit::MemoryMb`] is checked against.
+    /// The estimate for a whole frame of `scene`, what [`Limit::MemoryMb`]
+    /// is checked against.
     #[must_use]
     pub fn estimate(scene: &Scene) -> MemoryNeeded {
         let shadows = shadow_bytes(scene, false).unwrap_or_default();
-        MemoryNeeded::of(scene, shadows)
+        MemoryNeeded::of(scene, shadows, PixelRect::full(scene.width, scene.height))
     }
 
-    fn of(scene: &Scene, shadow_maps: u64) -> MemoryNeeded {
+    fn of(scene: &Scene, shadow_maps: u64, drawn: PixelRect) -> MemoryNeeded {
         MemoryNeeded {
             meshes: unique_mesh_triangles(scene) * BYTES_PER_TRIANGLE,
             textures: texture_bytes(scene),
             shadow_maps,
-            pixels: u64::from(scene.width) * u64::from(scene.height) * BYTES_PER_PIXEL,
+            pixels: u64::from(drawn.width()) * u64::from(drawn.height()) * BYTES_PER_PIXEL,
         }
     }
 

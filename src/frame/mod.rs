@@ -61,9 +61,10 @@ pub struct RenderOptions {
     pub sparse_traced: bool,
     /// Only these pixels of the frame need be right (`None`: all of them): a
     /// tile of a larger render. Every pixel inside equals the whole frame's
-    /// bit for bit; the frame's images keep the scene's size, and hold
-    /// background or partial results outside ([`region_drawn`] says which
-    /// pixels are drawn for it).
+    /// bit for bit. The frame's buffers and images hold the pixels drawn for
+    /// it alone ([`region_drawn`]: the region and a guard band, [`Frame::rect`]),
+    /// so a tile costs memory in proportion to its area; [`Frame::crop`]
+    /// cuts the region out.
     pub region: Option<PixelRect>,
     /// Measure, per stage, the time its workers had no work
     /// ([`FrameStats::idle`], [`crate::idle`]): a few reads of the kernel's
@@ -97,6 +98,12 @@ pub fn region_drawn(scene: &Scene, region: PixelRect) -> PixelRect {
         x1: grown.x1.div_ceil(segment).saturating_mul(segment).min(w),
         ..grown
     }
+}
+
+/// The pixels a frame of `scene` draws: those [`region_drawn`] says for a
+/// `region`, else all of them.
+fn drawn(scene: &Scene, region: Option<PixelRect>) -> PixelRect {
+    region.map_or(PixelRect::full(scene.width, scene.height), |r| region_drawn(scene, r))
 }
 
 impl Default for RenderOptions {
@@ -157,6 +164,10 @@ pub struct FrameStats {
     /// accumulation buffer of jittered passes and the largest light's shadow
     /// maps).
     pub buffer_bytes: usize,
+    /// Of [`FrameStats::buffer_bytes`], the buffers of one entry a pixel
+    /// held (all but the shadow maps): in proportion to the pixels drawn
+    /// ([`Frame::rect`]).
+    pub pixel_bytes: usize,
     /// Per stage, its wall time and the time its workers had no work
     /// (measured only with [`RenderOptions::measure_idle`]).
     pub idle: StageIdle,
@@ -242,7 +253,10 @@ impl FrameStats {
     }
 }
 
-/// A rendered frame and the buffer it was shaded from.
+/// A rendered frame and the buffer it was shaded from. Its images hold the
+/// pixels [`Frame::rect`] names: the whole image but for a tile of a frame
+/// ([`RenderOptions::region`]), whose images start at the rectangle's top left
+/// pixel.
 #[derive(Debug, Clone)]
 pub struct Frame {
     /// Linear RGB result.
@@ -261,9 +275,27 @@ pub struct Frame {
 }
 
 impl Frame {
+    /// The pixels of the whole image the frame's images and buffers hold
+    /// (their pixel (0, 0) is this rectangle's top left one).
+    #[must_use]
+    pub fn rect(&self) -> PixelRect {
+        self.visibility.rect()
+    }
+
+    /// The pixels `region` (whole-image coordinates) of the frame's image.
+    ///
+    /// # Panics
+    ///
+    /// If `region` does not lie inside [`Frame::rect`].
+    #[must_use]
+    pub fn crop(&self, region: PixelRect) -> LinearImage {
+        self.image.crop(region.relative_to(self.rect()))
+    }
+
     /// Each pixel's shading normal (world space, unit; zero where no object
     /// is seen), at the pixel's centre, from the visibility buffer of the
-    /// frame's last pass — `scene` is the scene it was rendered from.
+    /// frame's last pass — `scene` is the scene it was rendered from; the
+    /// pixels of [`Frame::rect`], row by row.
     #[must_use]
     pub fn normals(&self, scene: &Scene) -> Vec<Vec3> {
         let surfaces = crate::shading::screen_surfaces(scene, &self.visibility);
@@ -372,13 +404,13 @@ impl Renderer {
 
     fn render_watched(&mut self, scene: &Scene, progress: &(dyn Fn(u32, u32) + Sync), stop: Stop) -> Result<&Frame> {
         scene.validate()?;
-        budget::check(scene)?;
         if let Some(region) = self.options.region {
             if region.is_empty() || !region.fits(scene.width, scene.height) {
                 let region = (region.x0, region.y0, region.x1, region.y1);
                 return Err(Error::Region { region, width: scene.width, height: scene.height });
             }
         }
+        budget::check(scene, drawn(scene, self.options.region))?;
         let (frame, scratch) = (&mut self.frame, &mut self.scratch);
         let options = &self.options;
         match &self.pool {
@@ -452,7 +484,7 @@ fn render_into(
     if !options.keep_shadow_maps {
         scratch.maps.forget();
     }
-    fit_component_images(scene, options, frame, scratch);
+    fit_component_images(scene, drawn(scene, options.region), options, frame, scratch);
     let offsets = scene.antialias.offsets();
     if offsets.len() == 1 && offsets[0] == Vec2::ZERO {
         let edges = match scene.antialias {
@@ -466,20 +498,26 @@ fn render_into(
     } else {
         render_jittered(scene, &offsets, frame, scratch, options, progress, stop)?;
     }
-    frame.stats.buffer_bytes = frame.visibility.memory_bytes()
+    frame.stats.pixel_bytes = frame.visibility.memory_bytes()
         + std::mem::size_of_val(frame.image.pixels())
         + std::mem::size_of_val(scratch.accum.pixels())
         + (frame.aovs.len() + scratch.aovs.len() + frame.shadows.len() + scratch.shadows.len())
-            * std::mem::size_of_val(frame.image.pixels())
-        + scratch.maps.memory_bytes();
+            * std::mem::size_of_val(frame.image.pixels());
+    frame.stats.buffer_bytes = frame.stats.pixel_bytes + scratch.maps.memory_bytes();
     Ok(())
 }
 
 /// Makes the frame's component images (and one pass's, in `scratch`) the
-/// components `wanted` names, at the scene's size; the images are kept from
-/// frame to frame, like every other buffer.
-fn fit_component_images(scene: &Scene, options: &RenderOptions, frame: &mut Frame, scratch: &mut Scratch) {
-    let (w, h) = (scene.width, scene.height);
+/// components `wanted` names, the size of the pixels `held`; the images are
+/// kept from frame to frame, like every other buffer.
+fn fit_component_images(
+    scene: &Scene,
+    held: PixelRect,
+    options: &RenderOptions,
+    frame: &mut Frame,
+    scratch: &mut Scratch,
+) {
+    let (w, h) = (held.width(), held.height());
     let components: Vec<Component> = options.aovs.iter().collect();
     frame.aovs.resize_with(components.len(), || (Component::Ambient, LinearImage::default()));
     for ((slot, image), &c) in frame.aovs.iter_mut().zip(&components) {
@@ -505,7 +543,8 @@ fn render_jittered(
     progress: &(dyn Fn(u32, u32) + Sync),
     stop: Stop,
 ) -> Result<()> {
-    scratch.accum.resize(scene.width, scene.height);
+    let held = drawn(scene, options.region);
+    scratch.accum.resize(held.width(), held.height());
     scratch.accum.pixels_mut().fill(Vec3::ZERO);
     frame.aovs.iter_mut().for_each(|(_, a)| a.pixels_mut().fill(Vec3::ZERO));
     frame.shadows.iter_mut().for_each(|a| a.pixels_mut().fill(Vec3::ZERO));
@@ -548,12 +587,12 @@ fn render_pass(
     let ray_depth = options.ray_depth;
     let Frame { image, visibility, aovs, stats, .. } = frame;
     let Scratch { aovs: component_images, maps, trace, edges: edge_pass, subpixel, shadows, .. } = scratch;
-    visibility.resize(scene.width, scene.height);
-    visibility.set_scissor(options.region.map(|r| region_drawn(scene, r)));
+    visibility.resize_to(scene.width, scene.height, Some(drawn(scene, options.region)));
     stats.raster = stats.timed(Stage::Visibility, || visibility::rasterize(scene, visibility));
     stop.check()?;
     let vb = &*visibility;
-    image.resize(scene.width, scene.height);
+    let held = visibility.rect();
+    image.resize(held.width(), held.height());
     let mut images = PassImages::new(image, aovs, component_images);
     let targets = &mut images.targets;
     let beside = |s: &mut SubpixelShading| {
@@ -586,7 +625,7 @@ fn render_pass(
     stats.timed(Stage::Edges, || edge_pass.record(targets, subpixel, nothing_over));
     let fog = stats.timed(Stage::Shading, || fog::fog_targets(scene, vb, targets));
     let (blended, transmittance) =
-        stats.timed(Stage::Shading, || translucency::composite(scene, layers, targets, maps));
+        stats.timed(Stage::Shading, || translucency::composite(scene, vb, layers, targets, maps));
     stats.translucent_fragments += blended;
     let seen = seen_through(fog.as_deref(), transmittance.as_deref());
     stats.timed(Stage::Edges, || edge_pass.apply(scene, vb, targets, seen.as_deref(), trace));

@@ -99,8 +99,9 @@ pub fn add_traced(
         normal_map::apply(&scene.materials[s.material], &mut s);
         tracer.bounces(&ray, &s, depth)
     };
-    // Only the buffer's scissor is traced (the whole image but for a tile).
-    let window = vb.scissor();
+    // The pixels the buffer holds are traced (the whole image but for a
+    // tile), into `image`, which holds them too.
+    let window = vb.rect();
     let (x0, y0) = (window.x0 as usize, window.y0 as usize);
     let (ww, wh) = (window.width() as usize, window.height() as usize);
     // Each traced pixel's sample, combined into `out` by `put`: `out` holds
@@ -128,47 +129,49 @@ pub fn add_traced(
     };
     match refine {
         // One sample a pixel: straight into the image.
-        Refine::Never => {
-            let rows = &mut image.pixels_mut()[y0 * w..(y0 + wh) * w];
-            (trace_into(rows, w, (0, y0), x0..x0 + ww, |px, t| *px += t), 0)
-        }
+        Refine::Never => (trace_into(image.pixels_mut(), ww, (x0, y0), 0..ww, |px, t| *px += t), 0),
         Refine::Contrast => {
             // The samples apart first, NaN where nothing is traced: refining
             // compares neighbours' traced light alone.
             let mut traced = vec![Vec3::NAN; ww * wh];
             let count = trace_into(&mut traced, ww, (x0, y0), 0..ww, |px, t| *px = t);
             let refined = refine_edges(&mut traced, ww, |x, y, o| sample(x + x0, y + y0, o));
-            let rows = image.pixels_mut()[y0 * w..(y0 + wh) * w].par_chunks_mut(w).zip(traced.par_chunks(ww.max(1)));
+            let rows = image.pixels_mut().par_chunks_mut(ww.max(1)).zip(traced.par_chunks(ww.max(1)));
             rows.for_each(|(row, traced)| {
-                for (px, t) in row[x0..x0 + ww].iter_mut().zip(traced).filter(|(_, t)| !t.x.is_nan()) {
+                for (px, t) in row.iter_mut().zip(traced).filter(|(_, t)| !t.x.is_nan()) {
                     *px += *t;
                 }
             });
             (count, refined)
         }
         Refine::Sparse => {
-            // The samples at block corners, a grid of half the size.
-            let (cw, ch) = (w.div_ceil(2), h.div_ceil(2));
-            let mut corners = vec![Vec3::NAN; cw * ch];
+            // The samples at the image's even pixels among those held, a
+            // grid of half the size from corner (cx0, cy0).
+            let (cx0, cy0) = (x0 / 2, y0 / 2);
+            let cw = (x0 + ww).div_ceil(2) - cx0;
+            let mut corners = vec![Vec3::NAN; cw * ((y0 + wh).div_ceil(2) - cy0)];
+            let held = |x: usize, y: usize| window.contains(x as u32, y as u32);
             let traced: usize = corners
-                .par_chunks_mut(cw)
+                .par_chunks_mut(cw.max(1))
                 .enumerate()
                 .map(|(cy, row)| {
-                    let mut count = 0;
-                    for (cx, c) in row.iter_mut().enumerate().filter(|(cx, _)| traces(2 * cx, 2 * cy)) {
-                        *c = sample(2 * cx, 2 * cy, Vec2::ZERO);
+                    let (mut count, y) = (0, 2 * (cy + cy0));
+                    for (x, c) in (2 * cx0..).step_by(2).zip(row).filter(|&(x, _)| held(x, y) && traces(x, y)) {
+                        *c = sample(x, y, Vec2::ZERO);
                         count += 1;
                     }
                     count
                 })
                 .sum();
             let object = |x: usize, y: usize| vb.item(x as u32, y as u32).object;
-            let rows = image.pixels_mut().par_chunks_mut(w).enumerate();
+            let corner = |cx: usize, cy: usize| corners[(cy / 2 - cy0) * cw + cx / 2 - cx0];
+            let rows = image.pixels_mut().par_chunks_mut(ww.max(1)).enumerate();
             let filled_by_rays: usize = rows
                 .map(|(y, row)| {
-                    let mut count = 0;
-                    for (x, px) in row.iter_mut().enumerate().filter(|(x, _)| traces(*x, y)) {
-                        *px += interpolated(&corners, (w, h), x, y, |cx, cy| object(cx, cy) == object(x, y))
+                    let (mut count, y) = (0, y + y0);
+                    for (x, px) in (x0..).zip(row).filter(|&(x, _)| traces(x, y)) {
+                        let same = |cx: usize, cy: usize| held(cx, cy) && object(cx, cy) == object(x, y);
+                        *px += interpolated((w, h), x, y, |cx, cy| same(cx, cy).then(|| corner(cx, cy)))
                             .unwrap_or_else(|| {
                                 count += 1;
                                 sample(x, y, Vec2::ZERO)
@@ -183,20 +186,18 @@ pub fn add_traced(
 }
 
 /// Pixel (`x`, `y`)'s value (of an image `size` pixels) from the traced
-/// block corners around it that `same(x, y)` accepts (`corners`: the samples
-/// at even pixels, a grid of half the size, NaN where none was traced): its
-/// own sample at a corner, else the mean of the accepted corners beside it
-/// (two along a row or column, four inside a block); `None` when none is
-/// accepted.
+/// block corners around it (`corner(cx, cy)`: the sample at even pixel
+/// (cx, cy), NaN where none was traced, `None` where the pixel does not
+/// accept it): its own sample at a corner, else the mean of the accepted
+/// corners beside it (two along a row or column, four inside a block);
+/// `None` when none is accepted.
 fn interpolated(
-    corners: &[Vec3],
     size: (usize, usize),
     x: usize,
     y: usize,
-    same: impl Fn(usize, usize) -> bool,
+    corner: impl Fn(usize, usize) -> Option<Vec3>,
 ) -> Option<Vec3> {
     let (w, h) = size;
-    let cw = w.div_ceil(2);
     let around = |v: usize, n: usize| {
         if v.is_multiple_of(2) {
             [Some(v), None]
@@ -207,8 +208,7 @@ fn interpolated(
     let (mut sum, mut count) = (Vec3::ZERO, 0u32);
     for cy in around(y, h).into_iter().flatten() {
         for cx in around(x, w).into_iter().flatten() {
-            let c = corners[(cy / 2) * cw + cx / 2];
-            if !c.x.is_nan() && same(cx, cy) {
+            if let Some(c) = corner(cx, cy).filter(|c| !c.x.is_nan()) {
                 sum += c;
                 count += 1;
             }

@@ -34,14 +34,17 @@ pub fn fog_targets(scene: &Scene, vb: &VisibilityBuffer, targets: &mut [Target])
     Some(amounts)
 }
 
-/// Per pixel, the fog amount f(d) of the surface it sees (0 where it sees nothing).
+/// Per pixel `vb` holds, the fog amount f(d) of the surface it sees (0 where
+/// it sees nothing).
 #[must_use]
 pub fn fog_amounts(scene: &Scene, fog: &Fog, vb: &VisibilityBuffer) -> Vec<f32> {
-    let w = vb.width() as usize;
-    let rays = scene.camera.pixel_rays(Vec2::new(w as f32, vb.height() as f32));
+    let held = vb.rect();
+    let w = (held.width() as usize).max(1);
+    let rays = scene.camera.pixel_rays(Vec2::new(vb.width() as f32, vb.height() as f32));
     let mut out = vec![0.0; vb.depths().len()];
     out.par_chunks_mut(w).zip(vb.depths().par_chunks(w)).enumerate().for_each(|(y, (row, depth))| {
-        for (x, (f, &z)) in row.iter_mut().zip(depth).enumerate() {
+        let y = y + held.y0 as usize;
+        for (x, (f, &z)) in (held.x0 as usize..).zip(row.iter_mut().zip(depth)) {
             if z > 0.0 {
                 let ray = rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
                 *f = fog.amount(scene.camera.distance_at_depth(&ray, z));

@@ -69,12 +69,12 @@ impl ShadingPass<'_> {
 }
 
 /// Runs one pass over `vb` into `image`, rows in parallel, eight pixels at a
-/// time (`lanes.rs`): the pixels of the buffer's scissor
-/// ([`VisibilityBuffer::scissor`]; the others are left as they are).
+/// time (`lanes.rs`): the pixels the buffer holds ([`VisibilityBuffer::rect`]),
+/// which `image` holds too.
 ///
 /// # Panics
 ///
-/// If `image` and `vb` differ in size.
+/// If `image` and the pixels `vb` holds differ in size.
 pub fn shade_pass(scene: &Scene, vb: &VisibilityBuffer, image: &mut LinearImage, pass: &ShadingPass) {
     shade_pass_finding_mirrors(scene, vb, image, pass, None);
 }
@@ -86,7 +86,7 @@ pub fn shade_pass(scene: &Scene, vb: &VisibilityBuffer, image: &mut LinearImage,
 ///
 /// # Panics
 ///
-/// If `image` and `vb` differ in size, or `mirrors` from them.
+/// If `image` and the pixels `vb` holds differ in size, or `mirrors` from them.
 pub fn shade_pass_finding_mirrors(
     scene: &Scene,
     vb: &VisibilityBuffer,
@@ -94,10 +94,13 @@ pub fn shade_pass_finding_mirrors(
     pass: &ShadingPass,
     mirrors: Option<&mut [Mirror]>,
 ) {
-    assert_eq!((image.width(), image.height()), (vb.width(), vb.height()), "image and buffer sizes");
-    let w = vb.width() as usize;
+    // Pixels are named by the image's coordinates; the image, the buffer and
+    // `mirrors` hold the columns x0.. of the held rows alone.
+    let held = vb.rect();
+    assert_eq!((image.width(), image.height()), (held.width(), held.height()), "image and buffer sizes");
+    let (w, x0) = (held.width() as usize, held.x0 as usize);
     let frames = ObjectFrames::new(scene);
-    let rays = scene.camera.pixel_rays(Vec2::new(w as f32, vb.height() as f32));
+    let rays = scene.camera.pixel_rays(Vec2::new(vb.width() as f32, vb.height() as f32));
     let constants: Vec<Option<Coefficients>> = scene.materials.iter().map(Coefficients::constant).collect();
     // A triangle's coefficients are its material's constants unless a map
     // or its vertex colours vary them over it.
@@ -113,33 +116,30 @@ pub fn shade_pass_finding_mirrors(
             assert_eq!(m.len(), image.pixels().len(), "a mirror a pixel");
             Either::Left(m.par_chunks_mut(w).map(Some))
         }
-        None => Either::Right((0..vb.height()).into_par_iter().map(|_| None)),
+        None => Either::Right((0..held.height()).into_par_iter().map(|_| None)),
     };
     let rows = image.pixels_mut().par_chunks_mut(w).zip(vb.items().par_chunks(w)).zip(mirror_rows);
     let caches = || (TriangleCache::new(512), lanes::Block::default());
-    // Only the buffer's scissor is drawn: the rest is left as it is.
-    let scissor = vb.scissor();
-    let (columns, drawn_rows) = (scissor.x0 as usize..scissor.x1 as usize, scissor.y0 as usize..scissor.y1 as usize);
     rows.enumerate().for_each_init(caches, |(cache, block), (y, ((out, items), mut mirror_row))| {
-        if !drawn_rows.contains(&y) {
-            return;
-        }
+        let y = y + held.y0 as usize;
         let row = lanes::RowRays::new(&rays, y);
-        let (mut x, w) = (columns.start, columns.end);
+        let (mut x, w) = (x0, held.x1 as usize);
+        // Row slices are indexed by column − x0.
+        let at = |x: usize| x - x0;
         while x < w {
             // Runs stop at every SEGMENT-th column, so the pixels of a segment
             // are shaded alike whatever lies outside it (a tile of the frame
             // shades them as the whole frame does).
             let segment_end = ((x / SEGMENT + 1) * SEGMENT).min(w);
-            let items = &items[..segment_end];
-            let first = items[x];
-            let run = run_end(items, x);
+            let items = &items[..at(segment_end)];
+            let first = items[at(x)];
+            let run = x0 + run_end(items, at(x));
             if !pass.receives(first) {
                 // Background, or objects this pass does not light: written once by a
                 // replacing pass, left alone by an adding one.
                 if blend == Blend::Replace {
                     let fill = if first.is_none() { &background } else { &black };
-                    out[x..run].copy_from_slice(&fill[..run - x]);
+                    out[at(x)..at(run)].copy_from_slice(&fill[..run - x]);
                 }
                 x = run;
                 continue;
@@ -167,15 +167,15 @@ pub fn shade_pass_finding_mirrors(
                 };
                 if let Some(k) = constant(tri) {
                     let mirrors =
-                        mirror_row.as_deref_mut().filter(|_| reflects[tri.material]).map(|m| &mut m[x..whole]);
-                    lanes::shade_run(tri, k, &row, x, lighting, blend, &mut out[x..whole], mirrors);
+                        mirror_row.as_deref_mut().filter(|_| reflects[tri.material]).map(|m| &mut m[at(x)..at(whole)]);
+                    lanes::shade_run(tri, k, &row, x, lighting, blend, &mut out[at(x)..at(whole)], mirrors);
                     x = whole;
                     continue;
                 }
             }
             let end = (x + lanes::LANES).min(segment_end);
             block.clear();
-            for (i, (&item, px)) in items[x..end].iter().zip(out[x..end].iter_mut()).enumerate() {
+            for (i, (&item, px)) in items[at(x)..at(end)].iter().zip(out[at(x)..at(end)].iter_mut()).enumerate() {
                 if !pass.receives(item) {
                     if blend == Blend::Replace {
                         *px = if item.is_none() { pass.background } else { Vec3::ZERO };
@@ -193,8 +193,8 @@ pub fn shade_pass_finding_mirrors(
                 block.set(i, tri, constant(tri));
             }
             if block.live.iter().any(|&l| l) {
-                let mirrors = mirror_row.as_deref_mut().map(|m| (&mut m[x..end], &reflects[..]));
-                block.shade(&row, x, lighting, sample, blend, &mut out[x..end], mirrors);
+                let mirrors = mirror_row.as_deref_mut().map(|m| (&mut m[at(x)..at(end)], &reflects[..]));
+                block.shade(&row, x, lighting, sample, blend, &mut out[at(x)..at(end)], mirrors);
             }
             x = end;
         }
@@ -259,12 +259,14 @@ pub fn shade_into_scalar(scene: &Scene, vb: &VisibilityBuffer, image: &mut Linea
             terms
         })
         .collect();
-    let w = vb.width() as usize;
+    let held = vb.rect();
+    let w = held.width() as usize;
     let frames = ObjectFrames::new(scene);
-    let rays = scene.camera.pixel_rays(Vec2::new(w as f32, vb.height() as f32));
+    let rays = scene.camera.pixel_rays(Vec2::new(vb.width() as f32, vb.height() as f32));
     let rows = image.pixels_mut().par_chunks_mut(w).zip(vb.items().par_chunks(w));
     rows.enumerate().for_each(|(y, (out, items))| {
-        for (x, (px, &item)) in out.iter_mut().zip(items).enumerate() {
+        let y = y + held.y0 as usize;
+        for (x, (px, &item)) in (held.x0 as usize..).zip(out.iter_mut().zip(items)) {
             if item.is_none() {
                 *px = scene.background;
                 continue;

@@ -36,7 +36,7 @@ use super::visible::screen_surfaces;
 use super::{
     shade_pass_finding_mirrors, Blend, Component, ComponentSet, Lighting, Mirror, ShadingPass, SubpixelShading,
 };
-use crate::image::{LinearImage, PixelRect};
+use crate::image::LinearImage;
 use crate::scene::{Light, Material, Scene};
 use crate::shadows::{MapPool, PixelView, ScreenSurfaces, ShadowTerm};
 use crate::visibility::VisibilityBuffer;
@@ -247,14 +247,17 @@ const MIRROR_PIXELS: usize = 3840 * 2160;
 
 /// A buffer for each pixel's [`Mirror`] when the frame draws a reflection
 /// map (an environment, a material with a Km, a target with the reflection
-/// component) over the whole frame within [`MIRROR_PIXELS`].
+/// component) in an image of at most [`MIRROR_PIXELS`].
 fn mirror_buffer(scene: &Scene, vb: &VisibilityBuffer, targets: &[Target]) -> Option<Vec<Mirror>> {
-    let pixels = vb.width() as usize * vb.height() as usize;
+    // Chosen by the whole image's size, so that a tile of a frame takes the
+    // same path as the frame.
+    let image = vb.width() as usize * vb.height() as usize;
     let wanted = scene.environment.is_some()
         && scene.materials.iter().any(Material::reflects_environment)
         && targets.iter().any(|t| t.parts.contains(Component::Reflection))
-        && vb.scissor() == PixelRect::full(vb.width(), vb.height())
-        && pixels <= MIRROR_PIXELS;
+        && image <= MIRROR_PIXELS;
+    let held = vb.rect();
+    let pixels = held.width() as usize * held.height() as usize;
     wanted.then(|| {
         let mut buffer = Vec::new();
         (0..pixels).into_par_iter().map(|_| Mirror::NONE).collect_into_vec(&mut buffer);

@@ -29,17 +29,21 @@ use crate::visibility::VisibilityBuffer;
 /// Adds Km · Mape(R) to every target holding the reflection component, and the
 /// visible environment's background to every target holding the emission
 /// component (the first pass left those pixels black). `found`: each pixel's
-/// [`Mirror`], as the first shading pass found it (row by row, the whole
-/// frame); without it the pass finds them itself, a band of rows at a time.
+/// [`Mirror`], as the first shading pass found it (row by row, the pixels `vb`
+/// holds); without it the pass finds them itself, a band of rows at a time.
+/// The targets hold the pixels `vb` holds.
 pub fn add_reflection_map(scene: &Scene, vb: &VisibilityBuffer, targets: &mut [Target], found: Option<&[Mirror]>) {
     let Some(env) = &scene.environment else { return };
     let reflecting: Vec<bool> = scene.materials.iter().map(Material::reflects_environment).collect();
     if !env.visible && !reflecting.contains(&true) {
         return;
     }
-    let w = vb.width() as usize;
+    // Pixels are named by the image's coordinates, stored from the held
+    // rectangle's top left pixel.
+    let held = vb.rect();
+    let (w, x0, y0) = (held.width() as usize, i64::from(held.x0), held.y0 as usize);
     let frames = ObjectFrames::new(scene);
-    let rays = scene.camera.pixel_rays(Vec2::new(w as f32, vb.height() as f32));
+    let rays = scene.camera.pixel_rays(Vec2::new(vb.width() as f32, vb.height() as f32));
     let mirrors = Mirrors { scene, vb, frames: &frames, rays: &rays, reflecting: &reflecting };
     for t in targets {
         let (reflection, background) = (t.parts.contains(Component::Reflection), t.parts.contains(Component::Emission));
@@ -49,11 +53,11 @@ pub fn add_reflection_map(scene: &Scene, vb: &VisibilityBuffer, targets: &mut [T
         let bands = t.image.pixels_mut().par_chunks_mut(w * BAND).enumerate();
         let scratch = || (TriangleCache::new(512), Vec::new());
         bands.for_each_init(scratch, |(cache, band), (k, out)| {
-            let rows = k * BAND..k * BAND + out.len() / w;
+            let rows = y0 + k * BAND..y0 + k * BAND + out.len() / w;
             // Row y of the band is row y + 1 of `band` (it holds one more
-            // row above and below); of `found`, row y.
+            // row above and below); of `found`, row y − y0.
             let (source, top) = match found {
-                Some(all) => (all, 0),
+                Some(all) => (all, y0 as i64),
                 None => {
                     if reflection {
                         mirrors.fill(rows.clone(), cache, band);
@@ -62,12 +66,12 @@ pub fn add_reflection_map(scene: &Scene, vb: &VisibilityBuffer, targets: &mut [T
                 }
             };
             let at = |x: i64, y: i64| {
-                let (x, y) = (usize::try_from(x).ok().filter(|&x| x < w)?, usize::try_from(y - top).ok()?);
+                let (x, y) = (usize::try_from(x - x0).ok().filter(|&x| x < w)?, usize::try_from(y - top).ok()?);
                 source.get(y * w + x).copied().filter(Mirror::reflects)
             };
             for (y, row) in rows.clone().zip(out.chunks_mut(w)) {
-                let items = &vb.items()[y * w..(y + 1) * w];
-                for (x, (px, &item)) in row.iter_mut().zip(items).enumerate() {
+                let items = vb.item_row(y as u32);
+                for (x, (px, &item)) in (held.x0 as usize..).zip(row.iter_mut().zip(items)) {
                     if item.is_none() {
                         if background && env.visible {
                             let dir = |x: usize, y: usize| {
@@ -82,11 +86,8 @@ pub fn add_reflection_map(scene: &Scene, vb: &VisibilityBuffer, targets: &mut [T
                     // below, taken from the other side where they show another object.
                     let beside = |dx: i64, dy: i64| {
                         [1, -1].into_iter().map(|k| (x as i64 + k * dx, y as i64 + k * dy)).find(|&(nx, ny)| {
-                            nx >= 0
-                                && ny >= 0
-                                && (nx as u32) < vb.width()
-                                && (ny as u32) < vb.height()
-                                && vb.item(nx as u32, ny as u32).object == item.object
+                            let (Ok(nx), Ok(ny)) = (u32::try_from(nx), u32::try_from(ny)) else { return false };
+                            held.contains(nx, ny) && vb.item(nx, ny).object == item.object
                         })
                     };
                     let spread = |n: Option<(i64, i64)>| n.and_then(|(nx, ny)| at(nx, ny)).map_or(here.r, |m| m.r);
@@ -132,17 +133,20 @@ struct Mirrors<'a> {
 }
 
 impl Mirrors<'_> {
-    /// The mirrors of `rows` and of the rows above and below them, row by
-    /// row into `out` ([`Mirror::NONE`] where a pixel shows nothing that reflects).
+    /// The mirrors of `rows` and of the rows above and below them (those
+    /// held), row by row into `out`, the held columns of each
+    /// ([`Mirror::NONE`] where a pixel shows nothing that reflects).
     fn fill(&self, rows: Range<usize>, cache: &mut TriangleCache, out: &mut Vec<Mirror>) {
         let (scene, vb) = (self.scene, self.vb);
-        let w = vb.width() as usize;
-        let (first, last) = (rows.start.saturating_sub(1), (rows.end + 1).min(vb.height() as usize));
+        let held = vb.rect();
+        let w = held.width() as usize;
+        let first = rows.start.saturating_sub(1).max(held.y0 as usize);
+        let last = (rows.end + 1).min(held.y1 as usize);
         out.clear();
         out.resize((rows.len() + 2) * w, Mirror::NONE);
         for y in first..last {
             let row = &mut out[(y + 1 - rows.start) * w..][..w];
-            for (x, slot) in row.iter_mut().enumerate() {
+            for (x, slot) in (held.x0 as usize..).zip(row.iter_mut()) {
                 let item = vb.item(x as u32, y as u32);
                 if item.is_none() || !self.reflecting[item.material(scene)] {
                     continue;

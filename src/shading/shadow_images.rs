@@ -15,11 +15,13 @@ use crate::shadows::MapPool;
 use crate::visibility::VisibilityBuffer;
 
 /// Writes every light's shadow term at the pixels of `vb` into `images` (one
-/// grey image per light of `scene`, in the scene's order, resized to `vb`),
+/// grey image per light of `scene`, in the scene's order, resized to the
+/// pixels `vb` holds),
 /// with the terms this frame's shading used (kept in `pool`, or rendered
 /// again for lights whose maps the pool does not keep).
 pub fn shadow_term_images(scene: &Scene, vb: &VisibilityBuffer, pool: &mut MapPool, images: &mut Vec<LinearImage>) {
-    let (w, h) = (vb.width(), vb.height());
+    let held = vb.rect();
+    let (w, h) = (held.width(), held.height());
     images.resize_with(scene.lights.len(), LinearImage::default);
     let bounds = scene.caster_bounds().unwrap_or_default();
     let mut frame = ShadowFrame::within(scene, vb, bounds);
@@ -33,6 +35,7 @@ pub fn shadow_term_images(scene: &Scene, vb: &VisibilityBuffer, pool: &mut MapPo
                 let surfaces = frame.surfaces();
                 let rows = image.pixels_mut().par_chunks_mut(w.max(1) as usize).enumerate();
                 rows.for_each_init(Vec::new, |seen, (y, row)| {
+                    let y = y + held.y0 as usize;
                     surfaces.rows(y..y + 1, seen);
                     for (px, surface) in row.iter_mut().zip(seen.iter()) {
                         let lit = match surface {

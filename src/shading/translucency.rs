@@ -26,7 +26,7 @@ use super::reflection_map::reflection_map;
 use super::{frame_lights_within, Component, FrameLight, ObjectFrames, SurfacePoint, Target};
 use crate::scene::{Scene, TranslucencyOrder};
 use crate::shadows::{MapPool, Receiver, ShadowTerm};
-use crate::visibility::Fragment;
+use crate::visibility::{Fragment, VisibilityBuffer};
 
 /// One translucent fragment, ready to be added.
 struct Layer {
@@ -47,9 +47,12 @@ struct Layer {
 /// the scene's [`TranslucencyOrder`], lit by the frame's lights (their shadow
 /// maps taken from `pool`). Returns how many fragments were blended and, when
 /// there were some, each pixel's transmittance: the share of the opaque
-/// surface behind them that it still shows.
+/// surface behind them that it still shows. The targets, the fragments'
+/// pixels and the transmittance hold the pixels of the visibility buffer
+/// `opaque`, which the fragments were found in front of.
 pub fn composite(
     scene: &Scene,
+    opaque: &VisibilityBuffer,
     mut fragments: Vec<Fragment>,
     targets: &mut [Target],
     pool: &mut MapPool,
@@ -68,9 +71,8 @@ pub fn composite(
             fragments = indexed.into_iter().map(|(_, f)| f).collect();
         }
     }
-    let (w, h) = (targets[0].image.width(), targets[0].image.height());
-    let mut transmittance = vec![1.0f32; w as usize * h as usize];
-    let mut layers = prepare(scene, &fragments, w, h);
+    let mut transmittance = vec![1.0f32; opaque.depths().len()];
+    let mut layers = prepare(scene, &fragments, opaque);
     front_to_back_weights(&mut layers, &mut transmittance);
     // Where a texture's alpha is 0 the fragment adds nothing.
     layers.retain(|l| l.weight > 0.0);
@@ -110,14 +112,17 @@ fn front_to_back_weights(layers: &mut [Layer], transmittance: &mut [f32]) {
 }
 
 /// The surface, opacity (the material's, times its alpha map's),
-/// coefficients, emission and fog of every fragment.
-fn prepare(scene: &Scene, fragments: &[Fragment], w: u32, h: u32) -> Vec<Layer> {
+/// coefficients, emission and fog of every fragment (found in front of
+/// `opaque`).
+fn prepare(scene: &Scene, fragments: &[Fragment], opaque: &VisibilityBuffer) -> Vec<Layer> {
     let frames = ObjectFrames::new(scene);
-    let rays = scene.camera.pixel_rays(Vec2::new(w as f32, h as f32));
+    let rays = scene.camera.pixel_rays(Vec2::new(opaque.width() as f32, opaque.height() as f32));
+    let held = opaque.rect();
+    let stride = held.width().max(1);
     fragments
         .par_iter()
         .map(|f| {
-            let (x, y) = (f.pixel % w, f.pixel / w);
+            let (x, y) = (held.x0 + f.pixel % stride, held.y0 + f.pixel / stride);
             let mut surface = frames.surface(scene, f.item, &rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5)));
             let material = &scene.materials[surface.material];
             let (uv, duv) = surface.coords(material.alpha_set());

@@ -11,6 +11,7 @@ use super::lanes::{run_surfaces, RowRays};
 use super::surface::ObjectFrames;
 use super::{run_end, TriangleCache};
 use crate::camera::PixelRays;
+use crate::image::PixelRect;
 use crate::scene::Scene;
 use crate::shadows::{Receiver, ScreenSurfaces, SurfaceRows, VisibleSurface};
 use crate::visibility::VisibilityBuffer;
@@ -37,29 +38,33 @@ struct PixelSurfaces<'a> {
 impl SurfaceRows for PixelSurfaces<'_> {
     fn fill(&self, rows: Range<usize>, out: &mut Vec<Option<VisibleSurface>>) {
         let (scene, vb) = (self.scene, self.vb);
-        let w = vb.width() as usize;
+        // Rows and columns are the image's; `row` and `items` hold the
+        // columns `x0..x1` alone.
+        let held = vb.rect();
+        let (x0, w) = (held.x0 as usize, held.x1 as usize);
         out.clear();
-        out.resize(rows.len() * w, None);
+        out.resize(rows.len() * held.width() as usize, None);
         // A mesh triangle is prepared once for the pixels of the band that
         // show it (a solid's tangent plane is each pixel's own).
         let mut cache = TriangleCache::new(64);
-        for (y, row) in rows.zip(out.chunks_mut(w.max(1))) {
-            let items = &vb.items()[y * w..(y + 1) * w];
+        for (y, row) in rows.zip(out.chunks_mut((w - x0).max(1))) {
+            let items = vb.item_row(y as u32);
             let line = RowRays::new(&self.rays, y);
-            let mut x = 0;
+            let mut x = x0;
             while x < w {
-                let item = items[x];
+                let item = items[x - x0];
                 if item.is_none() {
                     x += 1;
                     continue;
                 }
-                let (receiver, end) = (|plane| Receiver { object: item.object, plane }, run_end(items, x));
+                let receiver = |plane| Receiver { object: item.object, plane };
+                let end = x0 + run_end(items, x - x0);
                 if item.primitive().is_some() {
                     // A solid: each pixel's own tangent plane.
                     let ray = self.rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
                     let tangent = self.frames.prepare_at(scene, vb, x as u32, y as u32, &ray);
                     let (position, normal) = tangent.position_normal(&ray);
-                    row[x] =
+                    row[x - x0] =
                         Some(VisibleSurface { position, normal, receiver: receiver(tangent.geometry().geometric) });
                     x += 1;
                     continue;
@@ -67,10 +72,14 @@ impl SurfaceRows for PixelSurfaces<'_> {
                 let triangle = cache.get(scene, &self.frames, item);
                 let plane = triangle.geometry().geometric;
                 run_surfaces(triangle, &line, x, end - x, |i, position, normal| {
-                    row[x + i] = Some(VisibleSurface { position, normal, receiver: receiver(plane) });
+                    row[x - x0 + i] = Some(VisibleSurface { position, normal, receiver: receiver(plane) });
                 });
                 x = end;
             }
         }
+    }
+
+    fn held(&self) -> PixelRect {
+        self.vb.rect()
     }
 }

@@ -14,6 +14,7 @@ use wide::f32x8;
 
 use super::Receiver;
 use crate::camera::{Camera, Projection};
+use crate::image::PixelRect;
 
 /// The surface one pixel shows, at its centre.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -31,9 +32,12 @@ pub struct VisibleSurface {
 /// which knows the frame's visibility buffer and the scene's geometry.
 pub trait SurfaceRows: Sync {
     /// Fills `out` (cleared first) with the surfaces of the frame's rows
-    /// `rows`, row by row, one entry per pixel; `None` where no object is
-    /// seen.
+    /// `rows` (of those [`SurfaceRows::held`] holds), row by row, one entry
+    /// per pixel held; `None` where no object is seen.
     fn fill(&self, rows: Range<usize>, out: &mut Vec<Option<VisibleSurface>>);
+
+    /// The pixels whose surfaces are known: the whole frame but for a tile.
+    fn held(&self) -> PixelRect;
 }
 
 /// The surfaces a frame's pixels show — found on demand, a band of rows at a
@@ -73,14 +77,23 @@ impl<'a> ScreenSurfaces<'a> {
         ScreenSurfaces { camera, width, height, source, pixel_scale, forward }
     }
 
-    /// The surfaces of rows `rows` (clamped to the frame), row by row, into
-    /// `out`.
+    /// The pixels whose surfaces are known ([`ScreenSurfaces::rows`]): the
+    /// whole frame but for a tile of it.
+    #[must_use]
+    pub fn held(&self) -> PixelRect {
+        self.source.held()
+    }
+
+    /// The surfaces of rows `rows` (clamped to those held), row by row, one
+    /// entry per column held, into `out`.
     pub fn rows(&self, rows: Range<usize>, out: &mut Vec<Option<VisibleSurface>>) {
-        let rows = rows.start.min(self.height as usize)..rows.end.min(self.height as usize);
+        let held = self.held();
+        let (y0, y1) = (held.y0 as usize, held.y1 as usize);
+        let rows = rows.start.clamp(y0, y1)..rows.end.clamp(y0, y1);
         self.source.fill(rows, out);
     }
 
-    /// The surfaces of every pixel, row by row.
+    /// The surfaces of every pixel held, row by row.
     #[must_use]
     pub fn all(&self) -> Vec<Option<VisibleSurface>> {
         let mut out = Vec::new();

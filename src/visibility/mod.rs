@@ -83,7 +83,11 @@ impl ItemId {
     }
 }
 
-/// Per-pixel depth and item id, rows top to bottom.
+/// Per-pixel depth and item id, rows top to bottom, of a rectangle of an
+/// image ([`VisibilityBuffer::rect`]: the whole image but for a tile of a
+/// frame). Pixels are named by the whole image's coordinates everywhere; only
+/// the storage is the rectangle's, row-major from its top left pixel
+/// ([`VisibilityBuffer::index`]).
 ///
 /// Depth is reversed: `1` at the near plane, falling towards `0` (perspective: at
 /// infinity, depth = near / distance along the view axis; orthographic: at the far
@@ -92,6 +96,8 @@ impl ItemId {
 pub struct VisibilityBuffer {
     width: u32,
     height: u32,
+    /// The pixels held (and drawn); the rest of the image is not stored.
+    rect: PixelRect,
     depth: Vec<f32>,
     items: Vec<ItemId>,
     /// World-space outward normals of the pixels that show a CSG solid (held
@@ -102,8 +108,6 @@ pub struct VisibilityBuffer {
     /// False for a buffer whose solids' normals are not wanted (every shadow
     /// map, even one that keeps items).
     with_normals: bool,
-    /// The pixels drawing fills in (`None`: all); the rest stay empty.
-    scissor: Option<PixelRect>,
 }
 
 impl VisibilityBuffer {
@@ -120,7 +124,7 @@ impl VisibilityBuffer {
             normals: Vec::new(),
             with_items: true,
             with_normals: true,
-            scissor: None,
+            rect: PixelRect::full(width, height),
         }
     }
 
@@ -138,32 +142,64 @@ impl VisibilityBuffer {
             normals: Vec::new(),
             with_items: false,
             with_normals: false,
-            scissor: None,
+            rect: PixelRect::full(width, height),
         }
     }
 
-    /// Width in pixels.
+    /// The whole image's width in pixels.
     #[must_use]
     pub fn width(&self) -> u32 {
         self.width
     }
 
-    /// Height in pixels.
+    /// The whole image's height in pixels.
     #[must_use]
     pub fn height(&self) -> u32 {
         self.height
     }
 
-    /// Depth of every pixel, row-major.
+    /// The pixels the buffer holds ([`VisibilityBuffer::resize_to`]).
+    #[must_use]
+    pub fn rect(&self) -> PixelRect {
+        self.rect
+    }
+
+    /// Where pixel (x, y) of the image is stored in [`VisibilityBuffer::depths`]
+    /// and [`VisibilityBuffer::items`]: `(y − y0) · rect width + x − x0`.
+    ///
+    /// # Panics
+    ///
+    /// May panic (in debug builds) for a pixel outside [`VisibilityBuffer::rect`].
+    #[inline]
+    #[must_use]
+    pub fn index(&self, x: u32, y: u32) -> usize {
+        debug_assert!(self.rect.contains(x, y), "({x}, {y}) outside {:?}", self.rect);
+        (y - self.rect.y0) as usize * self.rect.width() as usize + (x - self.rect.x0) as usize
+    }
+
+    /// Depth of every pixel held, row-major from the top left of
+    /// [`VisibilityBuffer::rect`].
     #[must_use]
     pub fn depths(&self) -> &[f32] {
         &self.depth
     }
 
-    /// Item of every pixel, row-major (empty for a depth-only buffer).
+    /// Item of every pixel held, as [`VisibilityBuffer::depths`] (empty for a
+    /// depth-only buffer).
     #[must_use]
     pub fn items(&self) -> &[ItemId] {
         &self.items
+    }
+
+    /// The items of row `y` held, columns `rect.x0..rect.x1`.
+    ///
+    /// # Panics
+    ///
+    /// On a depth-only buffer, or for a row outside [`VisibilityBuffer::rect`].
+    #[must_use]
+    pub fn item_row(&self, y: u32) -> &[ItemId] {
+        let start = self.index(self.rect.x0, y);
+        &self.items[start..start + self.rect.width() as usize]
     }
 
     /// Item at pixel (x, y).
@@ -173,7 +209,7 @@ impl VisibilityBuffer {
     /// On a depth-only buffer, or outside the buffer.
     #[must_use]
     pub fn item(&self, x: u32, y: u32) -> ItemId {
-        self.items[y as usize * self.width as usize + x as usize]
+        self.items[self.index(x, y)]
     }
 
     /// The solid's outward normal (world space) at pixel (x, y), meaningful
@@ -181,22 +217,38 @@ impl VisibilityBuffer {
     /// when no solid was drawn.
     #[must_use]
     pub fn normal(&self, x: u32, y: u32) -> Vec3 {
-        self.normals.get(y as usize * self.width as usize + x as usize).copied().unwrap_or(Vec3::ZERO)
+        self.normals.get(self.index(x, y)).copied().unwrap_or(Vec3::ZERO)
     }
 
     /// Depth at pixel (x, y).
     #[must_use]
     pub fn depth(&self, x: u32, y: u32) -> f32 {
-        self.depth[y as usize * self.width as usize + x as usize]
+        self.depth[self.index(x, y)]
     }
 
-    /// Makes the buffer `width` × `height`, reusing its memory when it can. The
-    /// contents are undefined until the next [`rasterize`].
+    /// Makes the buffer hold a whole `width` × `height` image, reusing its
+    /// memory when it can. The contents are undefined until the next
+    /// [`rasterize`].
     pub fn resize(&mut self, width: u32, height: u32) {
-        let n = width as usize * height as usize;
-        self.width = width;
-        self.height = height;
-        self.scissor = self.scissor.filter(|r| r.fits(width, height));
+        self.resize_to(width, height, None);
+    }
+
+    /// Makes the buffer hold the pixels of `rect` of a `width` × `height`
+    /// image (`None`: all of them), reusing its memory when it can; a
+    /// rectangle's buffer costs its area. [`rasterize`] and [`fragments`]
+    /// draw the pixels held exactly as they draw those pixels of the whole
+    /// image: coordinates stay the whole image's, so a tile of a frame is
+    /// computed by the same arithmetic as the frame. The contents are
+    /// undefined until the next [`rasterize`].
+    ///
+    /// # Panics
+    ///
+    /// If `rect` does not lie inside the image.
+    pub fn resize_to(&mut self, width: u32, height: u32, rect: Option<PixelRect>) {
+        let rect = rect.unwrap_or(PixelRect::full(width, height));
+        assert!(rect.fits(width, height), "{rect:?} outside a {width}x{height} image");
+        let n = rect.width() as usize * rect.height() as usize;
+        (self.width, self.height, self.rect) = (width, height, rect);
         self.depth.resize(n, 0.0);
         if self.with_items {
             self.items.resize(n, ItemId::NONE);
@@ -216,28 +268,6 @@ impl VisibilityBuffer {
             self.items = Vec::new();
             self.normals = Vec::new();
         }
-    }
-
-    /// Limits what [`rasterize`] and [`fragments`] draw to `rect` (`None`:
-    /// the whole buffer): every pixel inside holds exactly what a whole
-    /// frame's would, every pixel outside is left empty. Coordinates stay
-    /// the whole image's, so a tile of a frame is computed by the same
-    /// arithmetic as the frame.
-    ///
-    /// # Panics
-    ///
-    /// If `rect` does not lie inside the buffer.
-    pub fn set_scissor(&mut self, rect: Option<PixelRect>) {
-        if let Some(r) = rect {
-            assert!(r.fits(self.width, self.height), "{r:?} outside a {}x{} buffer", self.width, self.height);
-        }
-        self.scissor = rect;
-    }
-
-    /// The pixels drawing fills in ([`VisibilityBuffer::set_scissor`]).
-    #[must_use]
-    pub fn scissor(&self) -> PixelRect {
-        self.scissor.unwrap_or(PixelRect::full(self.width, self.height))
     }
 
     /// Forgets everything drawn.

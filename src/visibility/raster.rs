@@ -103,11 +103,13 @@ struct PolygonPass<'a> {
     projected: Vec<Projected>,
     planes: ClipPlanes,
     viewport: Viewport,
-    width: i64,
-    /// The rows and columns drawn (the buffer's scissor).
+    /// Pixels a stored row holds (the drawn columns).
+    stride: i64,
+    /// The rows and columns drawn (the buffer's rectangle); bands count from
+    /// its first row, stored rows and columns from its first.
     rows: Range<i64>,
     cols: Range<i64>,
-    /// Rows per band: [`BAND_ROWS`], or the whole image on one worker.
+    /// Rows per band: [`BAND_ROWS`], or all the rows drawn on one worker.
     band_rows: usize,
     bands: usize,
     workers: Workers,
@@ -144,7 +146,7 @@ pub enum Faces {
 /// material). Translucent meshes are left to [`fragments`].
 pub fn rasterize(scene: &Scene, vb: &mut VisibilityBuffer) -> RasterStats {
     let pass = PolygonPass::new(scene, &scene.camera, Faces::AsMaterials, Workers::All, vb.width(), vb.height())
-        .within(vb.scissor());
+        .within(vb.rect());
     let stats = pass.draw(&chunks(scene, |_, m| !m.translucent()), vb);
     RasterStats { solids: super::solids::draw_solids(scene, &scene.camera, |_| true, vb), ..stats }
 }
@@ -164,7 +166,7 @@ pub fn rasterize_casters(
     workers: Workers,
     vb: &mut VisibilityBuffer,
 ) -> RasterStats {
-    let pass = PolygonPass::new(scene, camera, Faces::All, workers, vb.width(), vb.height()).within(vb.scissor());
+    let pass = PolygonPass::new(scene, camera, Faces::All, workers, vb.width(), vb.height()).within(vb.rect());
     let stats = pass.draw(&chunks(scene, |i, _| casters[i]), vb);
     RasterStats { solids: super::solids::draw_solids(scene, camera, |i| casters[i], vb), ..stats }
 }
@@ -172,7 +174,8 @@ pub fn rasterize_casters(
 /// A sample of a translucent surface at a pixel centre.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Fragment {
-    /// Row-major pixel index.
+    /// The pixel's index among those the opaque buffer holds
+    /// ([`VisibilityBuffer::index`]).
     pub pixel: u32,
     /// Reversed depth (larger is nearer).
     pub depth: f32,
@@ -191,18 +194,18 @@ pub fn fragments(scene: &Scene, opaque: &VisibilityBuffer) -> Vec<Fragment> {
         return Vec::new();
     }
     let (w, h) = (opaque.width(), opaque.height());
-    let pass = PolygonPass::new(scene, &scene.camera, Faces::AsMaterials, Workers::All, w, h).within(opaque.scissor());
+    let pass = PolygonPass::new(scene, &scene.camera, Faces::AsMaterials, Workers::All, w, h).within(opaque.rect());
     let bins: Vec<ChunkBins> = chunks.par_iter().map(|c| pass.bin(c)).collect();
-    let band_len = w as usize * pass.band_rows;
+    let band_len = pass.stride as usize * pass.band_rows;
     let bands = opaque.depths().par_chunks(band_len).enumerate();
     let per_band: Vec<Vec<Fragment>> = bands
         .map(|(band, depth)| {
-            let row0 = (band * pass.band_rows) as i64;
             let mut sink = FragmentSink {
                 opaque: depth,
-                width: pass.width,
+                stride: pass.stride,
                 cols: pass.cols.clone(),
-                row0,
+                row0: pass.row0(band),
+                first_pixel: (band * band_len) as u32,
                 plane: LazyPlane::default(),
                 item: ItemId::NONE,
                 out: Vec::new(),
@@ -227,29 +230,42 @@ impl<'a> PolygonPass<'a> {
         let projected: Vec<Projected> =
             scene.objects.iter().map(|o| project(scene, o, view_proj, &planes, viewport, faces, workers)).collect();
         let cutouts = Cutouts::new(scene, |i| projected[i].to_clip, w, h);
-        let band_rows = match workers {
-            Workers::All => BAND_ROWS,
-            Workers::One => h.max(1),
-        };
         PolygonPass {
             scene,
             projected,
             planes,
             viewport,
-            width: w as i64,
-            rows: 0..h as i64,
-            cols: 0..w as i64,
-            band_rows,
-            bands: h.div_ceil(band_rows),
+            stride: 0,
+            rows: 0..0,
+            cols: 0..0,
+            band_rows: 1,
+            bands: 0,
             workers,
             cutouts,
         }
+        .within(PixelRect::full(width, height))
     }
 
-    /// The pass drawing only the pixels of `rect`.
+    /// The pass drawing only the pixels of `rect`, into a buffer that holds
+    /// them alone.
     fn within(self, rect: PixelRect) -> Self {
-        let rows = i64::from(rect.y0)..i64::from(rect.y1);
-        PolygonPass { rows, cols: i64::from(rect.x0)..i64::from(rect.x1), ..self }
+        let band_rows = match self.workers {
+            Workers::All => BAND_ROWS,
+            Workers::One => (rect.height() as usize).max(1),
+        };
+        PolygonPass {
+            stride: i64::from(rect.width()),
+            rows: i64::from(rect.y0)..i64::from(rect.y1),
+            cols: i64::from(rect.x0)..i64::from(rect.x1),
+            band_rows,
+            bands: (rect.height() as usize).div_ceil(band_rows),
+            ..self
+        }
+    }
+
+    /// The first image row of `band`.
+    fn row0(&self, band: usize) -> i64 {
+        self.rows.start + (band * self.band_rows) as i64
     }
 
     /// Bins `chunks` and draws them into `vb`, bands in parallel, each band
@@ -259,17 +275,17 @@ impl<'a> PolygonPass<'a> {
             Workers::All => chunks.par_iter().map(|c| self.bin(c)).collect(),
             Workers::One => chunks.iter().map(|c| self.bin(c)).collect(),
         };
-        let (w, row0) = (self.width, |band: usize| (band * self.band_rows) as i64);
+        let stride = self.stride;
         let (depth, items) = vb.parts_mut();
-        let band_len = w as usize * self.band_rows;
+        let band_len = stride as usize * self.band_rows;
         let draw = |band: usize, depth: &mut [f32], items: &mut [ItemId]| {
             depth.fill(0.0);
             items.fill(ItemId::NONE);
             let (plane, item) = (LazyPlane::default(), ItemId::NONE);
             let cols = self.cols.clone();
             let cutouts = (!self.cutouts.is_empty()).then_some(&self.cutouts);
-            let mut sink =
-                DepthSink { depth, items, width: w, cols, row0: row0(band), plane, item, cutouts, cutout: None };
+            let row0 = self.row0(band);
+            let mut sink = DepthSink { depth, items, stride, cols, row0, plane, item, cutouts, cutout: None };
             self.draw_band(band, &mut sink, chunks, &bins);
         };
         if self.workers == Workers::One {
@@ -393,12 +409,13 @@ impl PolygonPass<'_> {
         if rows.is_empty() || cols.is_empty() {
             return None;
         }
-        Some(rows.start as usize / self.band_rows..(rows.end as usize - 1) / self.band_rows + 1)
+        let band = |row: i64| (row - self.rows.start) as usize / self.band_rows;
+        Some(band(rows.start)..band(rows.end - 1) + 1)
     }
 
     /// Scan-converts the triangles binned into `band` into `sink`, in scene order.
     fn draw_band(&self, band: usize, sink: &mut impl BandSink, chunks: &[Chunk], bins: &[ChunkBins]) {
-        let row0 = (band * self.band_rows) as i64;
+        let row0 = self.row0(band);
         let rows = clamp(row0..row0 + self.band_rows as i64, &self.rows);
         if rows.is_empty() {
             return;
@@ -487,11 +504,14 @@ impl BandSink for DepthSink<'_> {
 
 /// Lists the samples of a band's spans that lie in front of the opaque depth.
 struct FragmentSink<'a> {
+    /// The band's stored depths.
     opaque: &'a [f32],
-    width: i64,
-    /// The columns drawn.
+    stride: i64,
+    /// The columns drawn (and stored).
     cols: Range<i64>,
     row0: i64,
+    /// The stored index of the band's first pixel.
+    first_pixel: u32,
     plane: LazyPlane,
     item: ItemId,
     out: Vec<Fragment>,
@@ -508,11 +528,11 @@ impl SpanSink for FragmentSink<'_> {
         let (x0, x1) = (x0.max(self.cols.start), x1.min(self.cols.end));
         let plane = self.plane.get();
         let row_z = plane.c + plane.dy * y as f64;
-        let base = (y - self.row0) * self.width;
+        let base = (y - self.row0) * self.stride - self.cols.start;
         for x in x0..x1 {
             let z = (row_z + plane.dx * x as f64) as f32;
             if z > self.opaque[(base + x) as usize] {
-                let pixel = (y * self.width + x) as u32;
+                let pixel = self.first_pixel + (base + x) as u32;
                 self.out.push(Fragment { pixel, depth: z, item: self.item });
             }
         }
@@ -524,8 +544,8 @@ impl SpanSink for FragmentSink<'_> {
 struct DepthSink<'a> {
     depth: &'a mut [f32],
     items: &'a mut [ItemId],
-    width: i64,
-    /// The columns drawn.
+    stride: i64,
+    /// The columns drawn (and stored).
     cols: Range<i64>,
     row0: i64,
     plane: LazyPlane,
@@ -542,14 +562,16 @@ impl SpanSink for DepthSink<'_> {
         if x0 >= x1 {
             return;
         }
-        let base = ((y - self.row0) * self.width) as usize;
+        // Where column 0 of row y would be stored (a column's place is this
+        // plus the column: the drawn columns alone are stored).
+        let base = (y - self.row0) * self.stride - self.cols.start;
         let plane = self.plane.get();
         let row_z = plane.c + plane.dy * y as f64;
         if let Some(cutout) = &self.cutout {
             // A cut-out triangle: the z-test, then the alpha test.
             for x in x0..x1 {
                 let z = (row_z + plane.dx * x as f64) as f32;
-                let at = base + x as usize;
+                let at = (base + x) as usize;
                 if z > self.depth[at] && cutout.covers(x, y) {
                     self.depth[at] = z;
                     if let Some(it) = self.items.get_mut(at) {
@@ -559,7 +581,7 @@ impl SpanSink for DepthSink<'_> {
             }
             return;
         }
-        let depth = &mut self.depth[base + x0 as usize..base + x1 as usize];
+        let depth = &mut self.depth[(base + x0) as usize..(base + x1) as usize];
         if self.items.is_empty() {
             for (k, d) in depth.iter_mut().enumerate() {
                 let z = (row_z + plane.dx * (x0 + k as i64) as f64) as f32;
@@ -567,7 +589,7 @@ impl SpanSink for DepthSink<'_> {
             }
             return;
         }
-        let items = &mut self.items[base + x0 as usize..base + x1 as usize];
+        let items = &mut self.items[(base + x0) as usize..(base + x1) as usize];
         for (k, (d, it)) in depth.iter_mut().zip(items.iter_mut()).enumerate() {
             let z = (row_z + plane.dx * (x0 + k as i64) as f64) as f32;
             if z > *d {

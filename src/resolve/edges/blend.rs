@@ -6,7 +6,8 @@ use glam::Vec2;
 /// One blend of the edge pass: pixel `c` moves towards pixel `o` by `alpha`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct EdgeBlend {
-    /// The pixel the edge crosses (row-major index).
+    /// The pixel the edge crosses: its index among the pixels the frame's
+    /// visibility buffer holds ([`crate::visibility::VisibilityBuffer::index`]).
     pub c: u32,
     /// The pixel across the edge.
     pub o: u32,

@@ -43,7 +43,7 @@ pub(super) struct WalkedPairs {
 }
 
 impl WalkedPairs {
-    /// The pairs `blends` join, on a `width` × `height` frame.
+    /// The pairs `blends` join, on a frame holding `width` × `height` pixels.
     pub(super) fn of(blends: &[EdgeBlend], width: u32, height: u32) -> Self {
         let mut bits = PixelSet::new(2 * width * height);
         for b in blends {
@@ -76,7 +76,7 @@ pub(super) fn find_intersection_blends(
     walked: &WalkedPairs,
     boxes: &[(Vec3, Vec3)],
 ) -> Vec<EdgeBlend> {
-    let (w, h) = (vb.width(), vb.height());
+    let (w, h, held) = (vb.width(), vb.height(), vb.rect());
     let screen = Screen::of(&scene.camera, w, h);
     let plane = |item: ItemId| -> Option<DepthPlane> {
         if item.is_none() || item.primitive().is_some() {
@@ -88,28 +88,30 @@ pub(super) fn find_intersection_blends(
         }
         screen.depth_plane(&clips[item.object as usize], object.triangles()?, item.triangle)
     };
-    let items = vb.items();
     let spans = overlap_spans(scene, &screen, boxes, (w, h));
-    let rows: Vec<Vec<EdgeBlend>> = (0..h)
+    // The pixels held alone are looked at (a tile's, with its guard band):
+    // rows and columns are the image's, `row` and `next` hold the columns
+    // from x0.
+    let x0 = held.x0 as usize;
+    let rows: Vec<Vec<EdgeBlend>> = (held.y0..held.y1)
         .into_par_iter()
         .map(|y| {
             let mut out = Vec::new();
             let span = &spans[y as usize];
+            // The span, and the pixel after it (its pair with the last one).
+            let span = span.start.max(held.x0) as usize..(span.end as usize + 1).min(held.x1 as usize);
             if span.is_empty() {
                 return out;
             }
-            // The span, and the pixel after it (its pair with the last one).
-            let span = span.start as usize..(span.end as usize + 1).min(w as usize);
-            let start = (y * w) as usize;
-            let row = &items[start..start + w as usize];
-            let next = items.get(start + w as usize..start + 2 * w as usize).unwrap_or_default();
-            let next = next.get(span.clone()).unwrap_or_default();
-            for_each_boundary(&row[span.clone()], next, |x, right, below| {
-                let x = span.start + x;
-                let (i, x) = (start + x, x as u32);
+            let row = vb.item_row(y);
+            let next = if y + 1 < held.y1 { vb.item_row(y + 1) } else { &[] };
+            let next = next.get(span.start - x0..span.end - x0).unwrap_or_default();
+            for_each_boundary(&row[span.start - x0..span.end - x0], next, |x, right, below| {
+                let x = (span.start + x) as u32;
+                let i = vb.index(x, y);
                 let pairs = [(right, (x + 1, y), RIGHT), (below, (x, y + 1), BELOW)];
                 for (_, o, _) in pairs.into_iter().filter(|p| p.0 && !walked.contains(i, p.2)) {
-                    out.extend(crossings(&plane, items, (x, y), o, w));
+                    out.extend(crossings(&plane, vb, (x, y), o));
                 }
             });
             out
@@ -210,26 +212,33 @@ fn for_each_boundary(row: &[ItemId], next: &[ItemId], mut f: impl FnMut(usize, b
     }
 }
 
-/// The blends of pixels `c` and `o`, neighbours showing different objects, if
-/// their surfaces cross between them; `plane` gives an item's depth plane.
-fn crossings(
+/// The blends of pixels `c` and `o` (both held by `vb`), neighbours showing
+/// different objects, if their surfaces cross between them; `plane` gives an
+/// item's depth plane.
+fn crossings<'a>(
     plane: impl Fn(ItemId) -> Option<DepthPlane>,
-    items: &[ItemId],
+    vb: &'a VisibilityBuffer,
     c: (u32, u32),
     o: (u32, u32),
-    width: u32,
-) -> impl Iterator<Item = EdgeBlend> {
-    let item = |(x, y): (u32, u32)| items[(y * width + x) as usize];
+) -> impl Iterator<Item = EdgeBlend> + 'a {
+    let item = |(x, y): (u32, u32)| vb.item(x, y);
+    let index = move |(x, y): (u32, u32)| vb.index(x, y) as u32;
     let planes = plane(item(c)).zip(plane(item(o)));
     planes
         .into_iter()
-        .flat_map(move |(pc, po)| crossing(c, o, &pc, &po, width).into_iter().chain(crossing(o, c, &po, &pc, width)))
+        .flat_map(move |(pc, po)| crossing(c, o, &pc, &po, index).into_iter().chain(crossing(o, c, &po, &pc, index)))
 }
 
 /// The blend of pixel `c` (showing plane `a`) towards its neighbour `o`
-/// (showing plane `b`) if the planes cross between their centres. Depths are
-/// reversed: greater is nearer.
-fn crossing(c: (u32, u32), o: (u32, u32), a: &DepthPlane, b: &DepthPlane, width: u32) -> Option<EdgeBlend> {
+/// (showing plane `b`) if the planes cross between their centres, its pixels
+/// named by `index`. Depths are reversed: greater is nearer.
+fn crossing(
+    c: (u32, u32),
+    o: (u32, u32),
+    a: &DepthPlane,
+    b: &DepthPlane,
+    index: impl Fn((u32, u32)) -> u32,
+) -> Option<EdgeBlend> {
     let centre = |(x, y): (u32, u32)| (f64::from(x) + 0.5, f64::from(y) + 0.5);
     // How far B's plane lies in front of A's.
     let ahead = |(x, y): (f64, f64)| b.at(x, y) - a.at(x, y);
@@ -239,8 +248,8 @@ fn crossing(c: (u32, u32), o: (u32, u32), a: &DepthPlane, b: &DepthPlane, width:
     let (x0, y0) = (f64::from(c.0), f64::from(c.1));
     let (alpha, (du, dv)) = square_part(|(u, v)| ahead((x0 + u, y0 + v)));
     (alpha > 1e-6).then(|| EdgeBlend {
-        c: c.1 * width + c.0,
-        o: o.1 * width + o.0,
+        c: index(c),
+        o: index(o),
         alpha: alpha as f32,
         inside: true,
         source: INTERSECTION,
@@ -316,13 +325,14 @@ mod tests {
         // pixel 10 (centre 10.5) shows A and pixel 9 shows B.
         let a = DepthPlane { z0: 0.5 - 0.01 * 10.3, gx: 0.01, gy: 0.0 };
         let b = DepthPlane { z0: 0.5, gx: 0.0, gy: 0.0 };
-        let blend = crossing((10, 4), (9, 4), &a, &b, 32).expect("the planes cross between the centres");
+        let blend =
+            crossing((10, 4), (9, 4), &a, &b, |(x, y)| y * 32 + x).expect("the planes cross between the centres");
         assert!((blend.alpha - 0.3).abs() < 1e-6, "the part of pixel 10 left of x = 10.3: {}", blend.alpha);
         assert!((blend.far - Vec2::new(-0.35, 0.0)).length() < 1e-6, "its centroid: {}", blend.far);
-        let back = crossing((9, 4), (10, 4), &b, &a, 32);
+        let back = crossing((9, 4), (10, 4), &b, &a, |(x, y)| y * 32 + x);
         assert!(back.is_none(), "pixel 9 lies wholly left of the line");
         // A plane in front at both centres ends between them: an edge, not this.
         let near = DepthPlane { z0: 0.9, gx: 0.0, gy: 0.0 };
-        assert!(crossing((10, 4), (9, 4), &near, &b, 32).is_none());
+        assert!(crossing((10, 4), (9, 4), &near, &b, |(x, y)| y * 32 + x).is_none());
     }
 }

@@ -133,7 +133,7 @@ impl EdgePass {
     ) {
         self.plan = options.map(|o| plan(scene, vb, o, &mut self.cache));
         (self.applied, self.blends) = (false, self.plan.as_ref().map_or(0, EdgePlan::len));
-        let samples = self.plan.as_ref().map_or_else(Vec::new, |p| p.samples(vb.width()));
+        let samples = self.plan.as_ref().map_or_else(Vec::new, |p| p.samples());
         subpixel.reset(scene, vb, samples);
     }
 
@@ -208,7 +208,7 @@ pub fn plan(scene: &Scene, vb: &VisibilityBuffer, options: &EdgeOptions, cache: 
     if options.mode.filter == EdgeFilter::Coverage {
         // Where an edge runs between two pixels it bounds what they show; an
         // intersection is only looked for where none does.
-        let walked = intersections::WalkedPairs::of(&blends, vb.width(), vb.height());
+        let walked = intersections::WalkedPairs::of(&blends, vb.rect().width(), vb.rect().height());
         let opaque = |o: &Object| !scene.materials[o.material].translucent();
         let objects = scene.objects.iter().zip(&edges);
         let boxes: Vec<(Vec3, Vec3)> =
@@ -221,7 +221,7 @@ pub fn plan(scene: &Scene, vb: &VisibilityBuffer, options: &EdgeOptions, cache: 
         EdgeFilter::Coverage => 0.5,
         EdgeFilter::Paper => 1.0,
     };
-    let blends = merge(blends, cap, vb.width());
+    let blends = merge(blends, cap, vb.rect().width());
     let flat = |item: ItemId| {
         let edges = edges.get(item.object as usize).and_then(Option::as_ref);
         item.primitive().is_none() && edges.is_some_and(|e| e.flat.get(item.triangle as usize) == Some(&true))

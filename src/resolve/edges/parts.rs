@@ -28,7 +28,7 @@ use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
 use super::blend::EdgeBlend;
-use crate::image::LinearImage;
+use crate::image::{LinearImage, PixelRect};
 use crate::shading::{ComponentSet, SubpixelSample, SubpixelShading, Target};
 use crate::visibility::{ItemId, VisibilityBuffer};
 
@@ -81,6 +81,9 @@ pub struct EdgePlan {
     /// its pixel's (the crossed pixels' own parts, then the re-shaded parts
     /// beyond edges), how far it moves, before fog ([`EdgePlan::record`]).
     moved: Vec<(ComponentSet, Vec<Vec3>)>,
+    /// The pixels the frame holds: blends name pixels by their index among
+    /// them, row-major from the top left one.
+    held: PixelRect,
 }
 
 impl EdgePlan {
@@ -110,7 +113,7 @@ impl EdgePlan {
             .map(|&(start, end, across_before)| {
                 let group = &blends[start as usize..end as usize];
                 let own = if reshade {
-                    own_part(group, vb.items(), vb.width(), &flat)
+                    own_part(group, vb.items(), vb.rect().width(), &flat)
                 } else {
                     OwnPart::Stepped([(group[0].c, 0.0); 2]) // the paper's: pixels as they are
                 };
@@ -122,7 +125,7 @@ impl EdgePlan {
             c.shaded_before = shaded;
             shaded += u32::from(c.own == OwnPart::Shaded);
         }
-        EdgePlan { blends, crossed, reshade, moved: Vec::new() }
+        EdgePlan { blends, crossed, reshade, moved: Vec::new(), held: vb.rect() }
     }
 
     /// The blends of crossed pixel `c`.
@@ -154,18 +157,18 @@ impl EdgePlan {
         self.blends.is_empty()
     }
 
-    /// The points the shading passes shade for [`EdgePlan::apply`] on a `width`
-    /// pixels wide frame (none under the paper's filter): per crossed pixel
+    /// The points the shading passes shade for [`EdgePlan::apply`] (none
+    /// under the paper's filter): per crossed pixel
     /// whose own part is shaded, its surface at that part's centroid; per blend
     /// that moves the pixel by at least [`RESHADED_SHARE`], the surface across
     /// at the centroid of the part beyond. (The pixels' centres, which they
     /// are compared with, are the passes' own pixels: [`EdgePlan::record`].)
     #[must_use]
-    pub fn samples(&self, width: u32) -> Vec<SubpixelSample> {
+    pub fn samples(&self) -> Vec<SubpixelSample> {
         if !self.reshade {
             return Vec::new();
         }
-        let pixel = |i: u32| (i % width, i / width);
+        let pixel = |i: u32| self.pixel(i);
         let at = |i: u32, offset: Vec2| {
             let p = pixel(i);
             SubpixelSample { pixel: p, at: Vec2::new(p.0 as f32 + 0.5, p.1 as f32 + 0.5) + offset }
@@ -191,8 +194,7 @@ impl EdgePlan {
         }
         let record = |t: &Target| {
             let moves = (0..self.moves()).into_par_iter();
-            let (px, width) = (t.image.pixels(), t.image.width() as usize);
-            moves.map(|k| self.part_move(k, px, width, t.parts, shaded)).collect()
+            moves.map(|k| self.part_move(k, t.image.pixels(), t.parts, shaded)).collect()
         };
         self.moved = targets.iter().map(|t| (t.parts, record(t))).collect();
     }
@@ -217,10 +219,10 @@ impl EdgePlan {
     pub fn record_and_apply(&self, targets: &mut [Target], shaded: &SubpixelShading) {
         let reshaded = self.matches(shaded);
         for t in targets {
-            let (parts, width) = (t.parts, t.image.width() as usize);
+            let parts = t.parts;
             let moved = |px: &[Vec3], _, k| {
                 if reshaded {
-                    self.part_move(k, px, width, parts, shaded)
+                    self.part_move(k, px, parts, shaded)
                 } else {
                     Vec3::ZERO
                 }
@@ -240,13 +242,20 @@ impl EdgePlan {
         self.crossed.len() + self.across()
     }
 
+    /// The image coordinates of the pixel of index `i` among those held.
+    fn pixel(&self, i: u32) -> (u32, u32) {
+        let w = self.held.width().max(1);
+        (self.held.x0 + i % w, self.held.y0 + i / w)
+    }
+
     /// How far part `k`'s colour moves from its pixel's in an image (its
-    /// pixels, its width) holding the components `parts`: a shaded part's
+    /// pixels: those held) holding the components `parts`: a shaded part's
     /// sample in `shaded` less its pixel, a stepped part by its neighbours.
-    fn part_move(&self, k: usize, px: &[Vec3], w: usize, parts: ComponentSet, shaded: &SubpixelShading) -> Vec3 {
+    fn part_move(&self, k: usize, px: &[Vec3], parts: ComponentSet, shaded: &SubpixelShading) -> Vec3 {
         let sampled = |s: usize| {
             let (x, y) = shaded.samples[s].pixel;
-            shaded.colour(s, parts).map_or(Vec3::ZERO, |colour| colour - px[y as usize * w + x as usize])
+            let i = (y - self.held.y0) as usize * self.held.width() as usize + (x - self.held.x0) as usize;
+            shaded.colour(s, parts).map_or(Vec3::ZERO, |colour| colour - px[i])
         };
         let Some(crossed) = self.crossed.get(k) else {
             return sampled(self.shaded() + k - self.crossed.len());

@@ -35,9 +35,10 @@ const CORNERS: [u32; 4] = [0, SAMPLES - 1, SAMPLES * (SAMPLES - 1), SAMPLES * SA
 /// One outline pixel's new colour as weights of itself and its neighbours.
 #[derive(Debug, Clone, PartialEq)]
 pub struct OutlineBlend {
-    /// The pixel (row-major index).
+    /// The pixel: its index among those the frame holds
+    /// ([`VisibilityBuffer::index`]).
     pub pixel: u32,
-    /// Source pixels (row-major) and their weights, summing to 1.
+    /// Source pixels (indexed as `pixel`) and their weights, summing to 1.
     pub weights: Vec<(u32, f32)>,
 }
 
@@ -90,10 +91,13 @@ fn corners_on_one_surface(me: ItemId, corners: &[Option<crate::raytrace::Hit>; 4
 /// `scene` as the visibility pass left it), with `trace` the scene's rays.
 #[must_use]
 pub fn find_outline_blends(scene: &Scene, vb: &VisibilityBuffer, trace: &TraceScene) -> Vec<OutlineBlend> {
-    let (w, h) = (vb.width() as i64, vb.height() as i64);
-    let rays = scene.camera.pixel_rays(Vec2::new(w as f32, h as f32));
+    let rays = scene.camera.pixel_rays(Vec2::new(vb.width() as f32, vb.height() as f32));
     let item = |x: i64, y: i64| vb.item(x as u32, y as u32);
-    let inside = |(nx, ny): (i64, i64)| (0..w).contains(&nx) && (0..h).contains(&ny);
+    // The pixels held alone are looked at (a tile's, with its guard band).
+    let held = vb.rect();
+    let (columns, rows) = (i64::from(held.x0)..i64::from(held.x1), i64::from(held.y0)..i64::from(held.y1));
+    let inside = |(nx, ny): (i64, i64)| columns.contains(&nx) && rows.contains(&ny);
+    let index = |x: i64, y: i64| vb.index(x as u32, y as u32) as u32;
     // A pixel lies on an outline when a side neighbour shows another item
     // across a solid's outline.
     let on_outline = |x: i64, y: i64| {
@@ -108,9 +112,10 @@ pub fn find_outline_blends(scene: &Scene, vb: &VisibilityBuffer, trace: &TraceSc
     // every worker (a row along a solid's top or bottom edge holds hundreds
     // of them, its neighbours a few: rows as the pieces left one worker
     // casting a long row's rays while the other waited).
-    let candidates: Vec<(i64, i64)> = (0..h)
+    let candidates: Vec<(i64, i64)> = rows
+        .clone()
         .into_par_iter()
-        .flat_map_iter(|y| (0..w).filter(move |&x| on_outline(x, y)).map(move |x| (x, y)))
+        .flat_map_iter(|y| columns.clone().filter(move |&x| on_outline(x, y)).map(move |x| (x, y)))
         .collect();
     candidates
         .par_iter()
@@ -154,13 +159,13 @@ pub fn find_outline_blends(scene: &Scene, vb: &VisibilityBuffer, trace: &TraceSc
                     .find(|&(nx, ny)| item(nx, ny) == seen)
                     .or_else(|| around().find(|&(nx, ny)| same_object(item(nx, ny))))
                     .unwrap_or((x, y));
-                let index = (source.1 * w + source.0) as u32;
+                let index = index(source.0, source.1);
                 match weights.iter_mut().find(|(p, _)| *p == index) {
                     Some((_, wgt)) => *wgt += share,
                     None => weights.push((index, share)),
                 }
             }
-            Some(OutlineBlend { pixel: (y * w + x) as u32, weights })
+            Some(OutlineBlend { pixel: index(x, y), weights })
         })
         .collect()
 }

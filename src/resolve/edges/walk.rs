@@ -106,25 +106,30 @@ impl Walker<'_> {
         // A column the edge crosses in two rows visits both pixels twice, each
         // as the other's neighbour.
         let mut sides = LastTwo::new();
-        let (w, h) = (self.vb.width(), self.vb.height());
-        let items = self.vb.items();
+        let (w, h, held) = (self.vb.width(), self.vb.height(), self.vb.rect());
+        let index = |(x, y): (u32, u32)| self.vb.index(x, y) as u32;
         let visit = |c: (u32, u32), other: (u32, u32), alpha, point: glam::DVec3, far: PartBeyond| {
+            // Pixels the buffer does not hold (outside a tile's guard band)
+            // are not blended.
+            if !held.contains(c.0, c.1) || !held.contains(other.0, other.1) {
+                return;
+            }
             // Only a pixel of the edge's own object can be its own surface, and
             // a blend needs one.
-            let ours = |(x, y): (u32, u32)| items[(y * w + x) as usize].object == object.index;
+            let ours = |(x, y): (u32, u32)| self.vb.item(x, y).object == object.index;
             if !ours(c) && !ours(other) {
                 return;
             }
             let mut side = |i: usize| sides.get((i, point), || self.side(&edge, &mut planes, i, point));
-            if let Some(blend) = depth_tested(w, &mut side, c, other, alpha, self.mode.filter) {
+            if let Some(blend) = depth_tested(index, &mut side, c, other, alpha, self.mode.filter) {
                 out.push(EdgeBlend { source, far: far.centroid(), ..blend });
             }
         };
         walk(a, b, visit, (w, h), self.mode.filter);
     }
 
-    /// How pixel `i` relates to `walked`, whose point there is `point`
-    /// (screen x, y, depth).
+    /// How pixel `i` (its index among those held) relates to `walked`, whose
+    /// point there is `point` (screen x, y, depth).
     fn side(
         &self,
         walked: &WalkedEdge,
@@ -215,8 +220,8 @@ pub(super) fn merge(blends: Vec<EdgeBlend>, cap: f32, width: u32) -> Vec<EdgeBle
 }
 
 /// `blends` sorted by pixel, neighbour, then (for a fixed order of the edges
-/// meeting there) outside first and by edge: bucketed by image row (a counting
-/// sort on a `width` pixels wide frame), then each row's few blends compared.
+/// meeting there) outside first and by edge: bucketed by row (a counting
+/// sort on pixels indexed `width` to a row), then each row's few blends compared.
 fn sorted_by_pixel(blends: Vec<EdgeBlend>, width: u32) -> Vec<EdgeBlend> {
     let rows: Vec<u32> = blends.iter().map(|b| b.c / width.max(1)).collect();
     let count = rows.iter().max().map_or(0, |&r| r as usize + 1);
@@ -344,16 +349,16 @@ enum Side {
 }
 
 /// The blend of `c` towards `o` if the depth test lets the edge show: neither pixel
-/// hides it, and one of them is its own surface.
+/// hides it, and one of them is its own surface; pixels are named in it by
+/// `index`.
 fn depth_tested(
-    width: u32,
+    index: impl Fn((u32, u32)) -> u32,
     side: &mut impl FnMut(usize) -> Side,
     c: (u32, u32),
     o: (u32, u32),
     alpha: f32,
     filter: EdgeFilter,
 ) -> Option<EdgeBlend> {
-    let index = |(x, y): (u32, u32)| y * width + x;
     // An occluder at `c` hides the edge whatever `o` shows (half the visits
     // along a hidden silhouette end here).
     let sc = side(index(c) as usize);

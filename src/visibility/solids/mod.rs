@@ -292,10 +292,12 @@ pub fn draw_solids(
     vb: &mut VisibilityBuffer,
 ) -> usize {
     let (width, height) = (vb.width(), vb.height());
-    let w = width as usize;
     let far = camera.far_plane_factor();
-    let scissor = vb.scissor();
-    let (rows, cols) = (scissor.y0 as usize..scissor.y1 as usize, scissor.x0 as usize..scissor.x1 as usize);
+    // The buffer holds the pixels of its rectangle alone, row-major from its
+    // top left pixel; bands count from its first row.
+    let held = vb.rect();
+    let (rows, cols) = (held.y0 as usize..held.y1 as usize, held.x0 as usize..held.x1 as usize);
+    let w = cols.len();
     let mut drawn = 0;
     for (object, o) in scene.objects.iter().enumerate().filter(|(i, _)| include(*i)) {
         let Some(solid) = o.solid() else { continue };
@@ -315,7 +317,7 @@ pub fn draw_solids(
             for (x, h) in row.hits().filter(|(x, _)| cols.contains(x)) {
                 // A hit's `t` along its row line is its distance along the view axis.
                 let z = camera.depth_at_view_distance(h.t);
-                let i = dy * w + x;
+                let i = dy * w + x - cols.start;
                 if z > depth[i] && z >= far && z <= 1.0 {
                     depth[i] = z;
                     // A depth map needs no item or normal.
@@ -412,10 +414,10 @@ impl ScannedRow<'_> {
     }
 }
 
-/// The walk itself: for each band of [`BAND_ROWS`] rows (in parallel, `bands`
-/// gives each its output), `visit(band, row_in_band, row)` with the row's
-/// visible hits ([`ScannedRow`]), for the rows in `rows` (the others are
-/// skipped).
+/// The walk itself: for each band of [`BAND_ROWS`] rows from the first of
+/// `rows` (in parallel, `bands` gives each its output), `visit(band,
+/// row_in_band, row)` with the row's visible hits ([`ScannedRow`]), for the
+/// rows in `rows`.
 fn scan_bands<B: Send>(
     prepared: &PreparedSolid,
     camera: &Camera,
@@ -440,14 +442,11 @@ fn scan_bands<B: Send>(
         bands.enumerate().with_max_len(1).for_each_init(
             || Lent::fitted(width as usize, prepared.caster.solid().primitives.len(), walker),
             |lent, (band, mut out)| {
-                let first = band * BAND_ROWS;
+                let first = rows.start + band * BAND_ROWS;
                 let mut occupancy = YOccupancy::at(&frame.entry, first as i64);
-                for dy in 0..BAND_ROWS.min(h - first) {
+                for dy in 0..BAND_ROWS.min(rows.end.min(h).saturating_sub(first)) {
                     let y = first + dy;
                     let occupied = occupancy.advance(y as i64);
-                    if !rows.contains(&y) {
-                        continue;
-                    }
                     frame.walk_row(y, occupied, &mut lent.0, |row| visit(&mut out, dy, row));
                 }
             },
