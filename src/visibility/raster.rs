@@ -5,11 +5,20 @@
 //! parallel and rasterization per band in parallel. A band draws its triangles in
 //! scene order (chunk by chunk), so the image does not depend on the number of
 //! threads: single- and multi-threaded renders are bit-identical.
+//!
+//! A span's z-test runs eight pixels at a time (`span_z_test`): their depths
+//! worked out in lanes, compared and blended at once. On the peers' spheres at
+//! 1920×1080 on one thread (`RAYON_NUM_THREADS=1 kage-bench raster`, two
+//! alternated rounds against the pixel-at-a-time loop) the visibility pass
+//! went from 4.5 to 3.9–4.0 ms on 10k triangles and from 8.3–8.9 to 7.9–8.1 ms
+//! on 100k; the million-triangle sphere's, bound by triangle set-up, did not
+//! move.
 
 use std::ops::Range;
 
 use glam::{DMat4, DVec4, Mat4, Vec4};
 use rayon::prelude::*;
+use wide::f32x8;
 
 use super::clip::{ClipPlanes, MAX_CLIPPED};
 use super::cutout::{CutoutTriangle, Cutouts};
@@ -18,6 +27,7 @@ use super::{ItemId, VisibilityBuffer};
 use crate::camera::Camera;
 use crate::image::PixelRect;
 use crate::scene::{Material, Scene};
+use crate::triangle::set_bits;
 
 /// Rows per band: the unit of parallel work and of binning.
 pub const BAND_ROWS: usize = 16;
@@ -582,20 +592,110 @@ impl SpanSink for DepthSink<'_> {
             return;
         }
         let depth = &mut self.depth[(base + x0) as usize..(base + x1) as usize];
-        if self.items.is_empty() {
-            for (k, d) in depth.iter_mut().enumerate() {
-                let z = (row_z + plane.dx * (x0 + k as i64) as f64) as f32;
-                *d = d.max(z);
-            }
-            return;
+        let items = match self.items.is_empty() {
+            true => None,
+            false => Some(&mut self.items[(base + x0) as usize..(base + x1) as usize]),
+        };
+        span_z_test(depth, items, self.item, row_z, plane.dx, x0);
+    }
+}
+
+/// The z-test of one span: each pixel from column `x0` on takes depth
+/// `row_z + dx · x` (in f64, then rounded to f32) where that is nearer than
+/// `depth` holds, and `item` with it (`items`: none for a depth-only buffer).
+/// Eight pixels at a time: their depths worked out in lanes (the same
+/// operations in the same order as one pixel's, so the same bits), compared
+/// and blended at once, items written only where a lane won; the span's last
+/// pixels one by one.
+#[inline]
+fn span_z_test(depth: &mut [f32], mut items: Option<&mut [ItemId]>, item: ItemId, row_z: f64, dx: f64, x0: i64) {
+    const LANES: usize = 8;
+    // Columns as f64 counted up from x0 (whole numbers, exact): no i64 to
+    // f64 conversion a pixel, which has no vector form before AVX-512.
+    let z_at = |x: f64| (row_z + dx * x) as f32;
+    let whole = depth.len() / LANES * LANES;
+    for k in (0..whole).step_by(LANES) {
+        let x = (x0 + k as i64) as f64;
+        let z = f32x8::new(std::array::from_fn(|j| z_at(x + j as f64)));
+        let block: &mut [f32; LANES] = (&mut depth[k..k + LANES]).try_into().expect("eight pixels");
+        let held = f32x8::new(*block);
+        let nearer = z.simd_gt(held);
+        let won = nearer.to_bitmask();
+        if won == 0 {
+            continue;
         }
-        let items = &mut self.items[(base + x0) as usize..(base + x1) as usize];
-        for (k, (d, it)) in depth.iter_mut().zip(items.iter_mut()).enumerate() {
-            let z = (row_z + plane.dx * (x0 + k as i64) as f64) as f32;
-            if z > *d {
-                *d = z;
-                *it = self.item;
+        *block = nearer.bitselect(z, held).to_array();
+        if let Some(items) = items.as_deref_mut() {
+            let items = &mut items[k..k + LANES];
+            if won == 0xff {
+                items.fill(item);
+            } else {
+                set_bits(won).for_each(|j| items[j] = item);
             }
+        }
+    }
+    for k in whole..depth.len() {
+        let z = z_at((x0 + k as i64) as f64);
+        if z > depth[k] {
+            depth[k] = z;
+            if let Some(items) = items.as_deref_mut() {
+                items[k] = item;
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use rand::rngs::StdRng;
+    use rand::{Rng, SeedableRng};
+
+    use super::{span_z_test, ItemId};
+
+    /// The span's z-test one pixel at a time, as the formula says: the
+    /// oracle of the eight-lane test.
+    fn one_by_one(depth: &mut [f32], items: &mut [ItemId], item: ItemId, row_z: f64, dx: f64, x0: i64) {
+        for (k, (d, it)) in depth.iter_mut().zip(items.iter_mut()).enumerate() {
+            let z = (row_z + dx * (x0 + k as i64) as f64) as f32;
+            if z > *d {
+                (*d, *it) = (z, item);
+            }
+        }
+    }
+
+    /// Spans of every length up to 40 from random columns, over held depths
+    /// drawn near the span's own (ties and lanes won in part included): the
+    /// same depth bits and items as one pixel at a time, with and without
+    /// items.
+    #[test]
+    fn eight_lane_spans_write_what_one_pixel_at_a_time_does() {
+        let mut rng = StdRng::seed_from_u64(11);
+        for round in 0..3000 {
+            let n = round % 41;
+            let (x0, row_z, dx) = (rng.gen_range(-20..5000), rng.gen_range(0.0..1.0), rng.gen_range(-1e-3..1e-3));
+            let item = ItemId { object: 7, triangle: round as u32 };
+            let held: Vec<f32> = (0..n)
+                .map(|k| {
+                    let own = (row_z + dx * (x0 + k as i64) as f64) as f32;
+                    match rng.gen_range(0..4) {
+                        0 => own,
+                        1 => own + rng.gen_range(-1e-4..1e-4),
+                        2 => 0.0,
+                        _ => rng.gen_range(0.0..1.0),
+                    }
+                })
+                .collect();
+            let before: Vec<ItemId> = (0..n).map(|k| ItemId { object: 1, triangle: k as u32 }).collect();
+            let (mut want, mut want_items) = (held.clone(), before.clone());
+            one_by_one(&mut want, &mut want_items, item, row_z, dx, x0);
+            let (mut got, mut got_items) = (held.clone(), before.clone());
+            span_z_test(&mut got, Some(&mut got_items), item, row_z, dx, x0);
+            let bits = |v: &[f32]| v.iter().map(|z| z.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&got), bits(&want), "round {round}: depths");
+            assert_eq!(got_items, want_items, "round {round}: items");
+            let mut depth_only = held.clone();
+            span_z_test(&mut depth_only, None, item, row_z, dx, x0);
+            assert_eq!(bits(&depth_only), bits(&want), "round {round}: a depth-only span");
         }
     }
 }
