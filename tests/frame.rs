@@ -256,3 +256,20 @@ fn subpixel_samples_match_the_passes_in(name: &str) {
         assert_eq!(beside.colour(k, ComponentSet::ALL), subpixel.colour(k, ComponentSet::ALL), "{name}: sample {k}");
     }
 }
+
+/// A renderer reused for a view that shows less (the camera turned half away)
+/// holds exactly a fresh renderer's items: pixels the new view leaves empty
+/// keep nothing of the frame before.
+#[test]
+fn a_reused_renderer_keeps_no_item_of_the_frame_before() {
+    let scene = kage::scene::demo::demo_scene().unwrap();
+    let mut aside = scene.clone();
+    aside.camera.target = aside.camera.eye + (aside.camera.target - aside.camera.eye).cross(Vec3::Y);
+    let mut renderer = kage::Renderer::new(&RenderOptions::default()).unwrap();
+    renderer.render(&scene).unwrap();
+    let reused = renderer.render(&aside).unwrap().visibility.items().to_vec();
+    let fresh = render(&aside, &RenderOptions::default()).unwrap();
+    let empty = fresh.visibility.items().iter().filter(|i| i.is_none()).count();
+    assert!(empty > reused.len() / 10, "the turned view leaves pixels empty ({empty})");
+    assert!(reused == fresh.visibility.items(), "items differ from a fresh renderer's");
+}
