@@ -547,6 +547,9 @@ impl BuildNode {
 
 #[cfg(test)]
 mod tests {
+    use rand::rngs::StdRng;
+    use rand::{Rng, SeedableRng};
+
     use super::*;
 
     /// The walk's stack gives back what it was given, last first, past its
@@ -593,11 +596,8 @@ mod tests {
     /// every primitive whose own box the ray enters.
     #[test]
     fn the_unordered_walk_reaches_what_the_ordered_one_does() {
-        let mut seed = 11u32;
-        let mut r = || {
-            seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
-            (seed >> 8) as f32 / (1u32 << 24) as f32 * 2.0 - 1.0
-        };
+        let mut rng = StdRng::seed_from_u64(11);
+        let mut r = || rng.gen_range(-1.0f32..1.0);
         let boxes: Vec<Aabb> = (0..3000)
             .map(|_| {
                 let p = Vec3::new(r(), r(), r()) * 4.0;

@@ -249,6 +249,9 @@ pub fn intersect_f64(ray: &Ray, p: &[Vec3; 3]) -> Option<(f64, [f64; 2])> {
 
 #[cfg(test)]
 mod tests {
+    use rand::rngs::StdRng;
+    use rand::{Rng, SeedableRng};
+
     use super::*;
 
     fn ray(o: [f32; 3], d: [f32; 3]) -> Ray {
@@ -270,11 +273,8 @@ mod tests {
     /// f64 decision may be taken), degenerate triangles, lanes past the count.
     #[test]
     fn eight_lanes_answer_as_one_triangle_tests_do() {
-        let mut seed = 7u32;
-        let mut r = || {
-            seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
-            (seed >> 8) as f32 / (1u32 << 24) as f32 * 2.0 - 1.0
-        };
+        let mut rng = StdRng::seed_from_u64(7);
+        let mut r = || rng.gen_range(-1.0f32..1.0);
         let mut hits = 0;
         for round in 0..4000 {
             let mut tris: Vec<[Vec3; 3]> =
