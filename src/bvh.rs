@@ -13,6 +13,20 @@
 //! [`crate::triangle::ShearedRay::intersect_lanes`]
 //! (`RAYON_NUM_THREADS=1 kage-bench rays --scenes sphere100k,sphere1m`).
 //!
+//! Coherent rays (a block of pixels' primary rays, a pixel's samples) walk
+//! it eight together ([`Bvh::intersect_packet_leaves`], as Embree's
+//! `rtcIntersect8`): a node's children are first tested against the whole
+//! packet at once in interval arithmetic (the slab test over the span of the
+//! rays' origins and reciprocal directions: one eight-lane test drops the
+//! children no ray can enter), then each child left against the eight rays,
+//! a ray a lane, with the one-ray test's operations; a leaf's triangles are
+//! tested once for all the rays that reach it
+//! ([`crate::triangle::RayLanes`]). Each ray gets the hit it finds alone.
+//! Primary rays of 4 × 2 pixel blocks, one thread, alternated with one ray
+//! at a time: 21.1–21.2 against 15.2–15.5 Mrays/s on a 9.8k-triangle
+//! sphere, 14.8–15.0 against 12.7 on a 998k one (at a million triangles
+//! each leaf is reached by fewer of the packet's rays).
+//!
 //! The hierarchy knows only boxes. Traversal hands each leaf to a closure that
 //! intersects it, so one walker serves the scene's triangles and solids (ray
 //! tracing, a leaf's triangles tested eight at a time) and a solid's primitives
@@ -23,7 +37,7 @@ use rayon::prelude::*;
 use wide::f32x8;
 
 use crate::camera::Ray;
-use crate::triangle::set_bits;
+use crate::triangle::{set_bits, RayLanes};
 
 /// An axis-aligned box.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -134,21 +148,21 @@ fn ray_lanes(ray: &Ray) -> ([f32x8; 3], [f32x8; 3]) {
 
 /// Postponed children of one walk: a fixed array, spilling to the heap only
 /// on trees deeper than a binned build makes.
-struct Stack {
-    fixed: [Postponed; 32],
+struct Stack<T: Copy, const N: usize> {
+    fixed: [T; N],
     len: usize,
-    spilled: Vec<Postponed>,
+    spilled: Vec<T>,
 }
 
-impl Stack {
+impl<T: Copy, const N: usize> Stack<T, N> {
     #[inline(always)]
-    fn new() -> Stack {
-        Stack { fixed: [0; 32], len: 0, spilled: Vec::new() }
+    fn new(zero: T) -> Self {
+        Stack { fixed: [zero; N], len: 0, spilled: Vec::new() }
     }
 
     #[inline(always)]
-    fn push(&mut self, p: Postponed) {
-        if self.len < self.fixed.len() {
+    fn push(&mut self, p: T) {
+        if self.len < N {
             self.fixed[self.len] = p;
             self.len += 1;
         } else {
@@ -157,12 +171,92 @@ impl Stack {
     }
 
     #[inline(always)]
-    fn pop(&mut self) -> Option<Postponed> {
+    fn pop(&mut self) -> Option<T> {
         if let Some(p) = self.spilled.pop() {
             return Some(p);
         }
         self.len = self.len.checked_sub(1)?;
         Some(self.fixed[self.len])
+    }
+}
+
+/// Rays walked together by [`Bvh::intersect_packet_leaves`], one a lane.
+pub const PACKET: usize = WIDTH;
+
+/// Eight rays walked together: origins and reciprocal directions, a ray a
+/// lane, and per axis the interval their origins and reciprocal
+/// directions span (`None` where the directions change sign along the axis
+/// or one is parallel to it), for the test that drops at once the children
+/// of a node no ray of the packet can enter.
+struct Packet {
+    origin: [f32x8; 3],
+    inv_dir: [f32x8; 3],
+    /// Per axis: smallest and largest origin, smallest and largest
+    /// reciprocal direction, of the rays in use.
+    span: [Option<[f32; 4]>; 3],
+}
+
+impl Packet {
+    fn new(rays: &RayLanes) -> Packet {
+        let (origin, dir) = rays.lanes();
+        let inv_dir = dir.map(|d| f32x8::splat(1.0) / d);
+        let span = |k: usize| {
+            let (o, d) = (origin[k].to_array(), inv_dir[k].to_array());
+            let (lo, hi) = (
+                |v: [f32; PACKET]| v.into_iter().fold(f32::INFINITY, f32::min),
+                |v: [f32; PACKET]| v.into_iter().fold(f32::NEG_INFINITY, f32::max),
+            );
+            let s = [lo(o), hi(o), lo(d), hi(d)];
+            let same_sign = s[2] > 0.0 || s[3] < 0.0;
+            (same_sign && s.iter().all(|v| v.is_finite())).then_some(s)
+        };
+        Packet { origin, inv_dir, span: std::array::from_fn(span) }
+    }
+}
+
+impl Node {
+    /// A bit per child that some ray of the packet may enter before `t_max`:
+    /// the slab test in interval arithmetic over the packet's spans, eight
+    /// children at once. Never drops a child that [`Node::packet_entries`]
+    /// finds a ray entering (rounding is monotonic, so the corner products
+    /// bound every ray's).
+    #[inline(always)]
+    fn packet_candidates(&self, p: &Packet, t_max: f32) -> u32 {
+        let (mut near, mut far) = (f32x8::ZERO, f32x8::splat(f32::INFINITY));
+        for (axis, span) in p.span.iter().enumerate() {
+            let Some([o_lo, o_hi, i_lo, i_hi]) = *span else { continue };
+            let (lo, hi) = (f32x8::from(self.bounds[axis]), f32x8::from(self.bounds[axis + 3]));
+            let (entry, exit) = if i_lo > 0.0 { (lo, hi) } else { (hi, lo) };
+            let (i_lo, i_hi) = (f32x8::splat(i_lo), f32x8::splat(i_hi));
+            let products = |plane: f32x8| {
+                let (a, b) = (plane - f32x8::splat(o_hi), plane - f32x8::splat(o_lo));
+                let (p, q, r, s) = (a * i_lo, a * i_hi, b * i_lo, b * i_hi);
+                (p.fast_min(q).fast_min(r).fast_min(s), p.fast_max(q).fast_max(r).fast_max(s))
+            };
+            near = near.fast_max(products(entry).0);
+            far = far.fast_min(products(exit).1);
+        }
+        let far = far * f32x8::splat(1.0 + 2.0 * f32::EPSILON * 2.0);
+        let may = near.simd_le(far) & near.simd_lt(f32x8::splat(t_max));
+        may.to_bitmask() & ((1u32 << self.children) - 1)
+    }
+
+    /// [`Node::entries`] of child `k` for the eight rays of a packet, a ray a
+    /// lane: the same operations, so each lane decides as its ray alone
+    /// would.
+    #[inline(always)]
+    fn packet_entries(&self, k: usize, p: &Packet, t_max: f32x8) -> (f32x8, u32) {
+        let b = &self.bounds;
+        let slab = |axis: usize| {
+            let (lo, hi) = (f32x8::splat(b[axis][k]), f32x8::splat(b[axis + 3][k]));
+            let (t0, t1) = ((lo - p.origin[axis]) * p.inv_dir[axis], (hi - p.origin[axis]) * p.inv_dir[axis]);
+            (t0.fast_min(t1), t0.fast_max(t1))
+        };
+        let ((nx, fx), (ny, fy), (nz, fz)) = (slab(0), slab(1), slab(2));
+        let near = nx.fast_max(ny).fast_max(nz).fast_max(f32x8::ZERO);
+        let far = fx.fast_min(fy).fast_min(fz) * f32x8::splat(1.0 + 2.0 * f32::EPSILON * 2.0);
+        let enters = near.simd_le(far) & near.simd_lt(t_max);
+        (near, enters.to_bitmask())
     }
 }
 
@@ -298,7 +392,7 @@ impl Bvh {
             return;
         }
         let (origin, inv) = ray_lanes(ray);
-        let mut stack = Stack::new();
+        let mut stack: Stack<Postponed, 32> = Stack::new(0);
         let mut at = 0usize;
         loop {
             let node = &self.nodes[at];
@@ -325,7 +419,7 @@ impl Bvh {
             return;
         }
         let (origin, inv) = ray_lanes(ray);
-        let mut stack = Stack::new();
+        let mut stack: Stack<Postponed, 32> = Stack::new(0);
         // The node walked now, or a leaf's primitives (`leaf` > 0 of them).
         let (mut at, mut leaf) = (0usize, 0u8);
         loop {
@@ -370,6 +464,82 @@ impl Bvh {
                 if t < *t_max {
                     let node = &self.nodes[parent];
                     (at, leaf) = (node.child[k] as usize, node.count[k]);
+                    break;
+                }
+            }
+        }
+    }
+
+    /// [`Bvh::intersect_leaves`] for up to eight rays walked together (a
+    /// packet: coherent rays, such as a block of pixels' primary rays, reach
+    /// mostly the same nodes). `lanes` has a bit per ray in use (the others
+    /// should repeat one of them: the packet's span covers every lane);
+    /// `t_max` is per ray. `hit(leaf, lanes,
+    /// t_max)` intersects the primitives `leaf` with the rays of `lanes`
+    /// (those that enter its box before their `t_max`) and lowers each one's
+    /// `t_max` to its nearest hit. Each ray reaches every leaf it would reach
+    /// alone before finding its nearest hit: its answer is its own.
+    pub fn intersect_packet_leaves(
+        &self,
+        rays: &RayLanes,
+        lanes: u32,
+        t_max: &mut [f32; PACKET],
+        mut hit: impl FnMut(&[u32], u32, &mut [f32; PACKET]),
+    ) {
+        if self.nodes.is_empty() || lanes == 0 {
+            return;
+        }
+        let p = Packet::new(rays);
+        let farthest = |t: &[f32; PACKET]| set_bits(lanes).map(|k| t[k]).fold(f32::NEG_INFINITY, f32::max);
+        let mut far = farthest(t_max);
+        let mut t = f32x8::from(*t_max);
+        let mut stack: Stack<(u32, f32x8), 48> = Stack::new((0, f32x8::ZERO));
+        // The node walked now, or a leaf's primitives (`leaf` > 0 of them),
+        // and the rays that entered it.
+        let (mut at, mut leaf, mut mask) = (0usize, 0u8, lanes);
+        loop {
+            if leaf > 0 {
+                hit(&self.order[at..at + leaf as usize], mask, t_max);
+                (t, far) = (f32x8::from(*t_max), farthest(t_max));
+            } else {
+                let node = &self.nodes[at];
+                let mut entered = [(0.0f32, 0usize, 0u32, f32x8::ZERO); WIDTH];
+                let mut n = 0;
+                for k in set_bits(node.packet_candidates(&p, far)) {
+                    let (near, m) = node.packet_entries(k, &p, t);
+                    let m = m & mask;
+                    if m == 0 {
+                        continue;
+                    }
+                    // Rays that do not enter it never reach it from the stack.
+                    let mut near = near.to_array();
+                    (0..PACKET).filter(|i| m >> i & 1 == 0).for_each(|i| near[i] = f32::INFINITY);
+                    let first = near.into_iter().fold(f32::INFINITY, f32::min);
+                    let near = f32x8::from(near);
+                    // Farthest first (ties: the later child first).
+                    let mut j = n;
+                    while j > 0 && entered[j - 1].0 <= first {
+                        entered[j] = entered[j - 1];
+                        j -= 1;
+                    }
+                    entered[j] = (first, k, m, near);
+                    n += 1;
+                }
+                if n > 0 {
+                    let slot = |k: usize| (at * WIDTH + k) as u32;
+                    entered[..n - 1].iter().for_each(|&(_, k, _, near)| stack.push((slot(k), near)));
+                    let (_, k, m, _) = entered[n - 1];
+                    (at, leaf, mask) = (node.child[k] as usize, node.count[k], m);
+                    continue;
+                }
+            }
+            loop {
+                let Some((slot, near)) = stack.pop() else { return };
+                let m = near.simd_lt(t).to_bitmask();
+                if m != 0 {
+                    let node = &self.nodes[slot as usize / WIDTH];
+                    let k = slot as usize % WIDTH;
+                    (at, leaf, mask) = (node.child[k] as usize, node.count[k], m);
                     break;
                 }
             }
@@ -556,7 +726,7 @@ mod tests {
     /// fixed part too (a tree deeper than a balanced build).
     #[test]
     fn the_stack_spills_and_stays_last_in_first_out() {
-        let mut stack = Stack::new();
+        let mut stack: Stack<Postponed, 32> = Stack::new(0);
         (0..100u32).for_each(|i| stack.push(postponed(i, i as f32 * 0.5)));
         for i in (0..100u32).rev() {
             let (parent, lane, t) = postponed_slot(stack.pop().expect("pushed"));

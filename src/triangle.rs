@@ -219,6 +219,126 @@ impl ShearedRay {
     }
 }
 
+/// Eight rays prepared for triangle tests together, one a lane
+/// ([`RayLanes::intersect_triangle`]): the rays of a packet walked through
+/// the BVH together test a leaf's triangles once for all of them. Each
+/// lane holds what [`ShearedRay::new`] computes for its ray, computed lane
+/// by lane with the same operations.
+#[derive(Debug, Clone, Copy)]
+pub struct RayLanes {
+    origin: [f32x8; 3],
+    dir: [f32x8; 3],
+    /// Each ray's rows ([`ShearedRay`]'s), entry by entry across the lanes.
+    rows: [[f32x8; 3]; 3],
+    inv_dz: f32x8,
+}
+
+impl RayLanes {
+    /// Prepares eight rays (a lane each).
+    #[must_use]
+    pub fn new(rays: &[Ray; LANES]) -> RayLanes {
+        let (mut origin, mut dir) = ([[0.0; LANES]; 3], [[0.0; LANES]; 3]);
+        for (lane, r) in rays.iter().enumerate() {
+            (0..3).for_each(|k| (origin[k][lane], dir[k][lane]) = (r.origin[k], r.dir[k]));
+        }
+        let (origin, d) = (origin.map(f32x8::from), dir.map(f32x8::from));
+        let a = d.map(f32x8::abs);
+        let one = f32x8::splat(1.0);
+        let on_x = a[0].simd_ge(a[1]) & a[0].simd_ge(a[2]);
+        let on_y = !on_x & a[1].simd_ge(a[2]);
+        let z = [on_x, on_y, !on_x & !on_y].map(|m| m & one);
+        let x = [z[2], z[0], z[1]];
+        let y = [x[2], x[0], x[1]];
+        let dot = |v: &[f32x8; 3]| d[0] * v[0] + d[1] * v[1] + d[2] * v[2];
+        let dz = dot(&z);
+        let down = dz.simd_lt(f32x8::ZERO);
+        let pick = |m: f32x8, t: f32x8, f: f32x8| (m & t) | (!m & f);
+        let (x, y) = (std::array::from_fn(|k| pick(down, y[k], x[k])), std::array::from_fn(|k| pick(down, x[k], y[k])));
+        let (sx, sy) = (dot(&x) / dz, dot(&y) / dz);
+        let rows = [std::array::from_fn(|k| x[k] - sx * z[k]), std::array::from_fn(|k| y[k] - sy * z[k]), z];
+        RayLanes { origin, dir: d, rows, inv_dz: one / dz }
+    }
+
+    /// The rays' origins and directions, axis by axis, a ray a lane.
+    #[must_use]
+    pub(crate) fn lanes(&self) -> ([f32x8; 3], [f32x8; 3]) {
+        (self.origin, self.dir)
+    }
+
+    /// Lane `lane`'s ray prepared alone: [`ShearedRay::new`] of it, read
+    /// from the lanes (the same values).
+    #[must_use]
+    pub fn lane(&self, lane: usize) -> ShearedRay {
+        let at = |v: f32x8| v.to_array()[lane];
+        let row = |r: &[f32x8; 3]| Vec3::new(at(r[0]), at(r[1]), at(r[2]));
+        ShearedRay {
+            origin: row(&self.origin),
+            rows: [row(&self.rows[0]), row(&self.rows[1]), row(&self.rows[2])],
+            inv_dz: at(self.inv_dz),
+        }
+    }
+
+    /// The ray of `lane`.
+    #[must_use]
+    fn ray(&self, lane: usize) -> Ray {
+        let axis = |v: &[f32x8; 3]| Vec3::new(v[0].to_array()[lane], v[1].to_array()[lane], v[2].to_array()[lane]);
+        Ray { origin: axis(&self.origin), dir: axis(&self.dir) }
+    }
+
+    /// [`ShearedRay::intersect`] of triangle `i` of `triangles` with the rays
+    /// of `lanes`, at once: every lane's answer is the one-ray test's, bit for
+    /// bit (the same operations in the same order; a lane on an edge is
+    /// decided by the one-ray test, in f64). `t_max` is per lane.
+    ///
+    /// # Panics
+    /// If `i` is out of range.
+    #[must_use]
+    #[inline]
+    pub fn intersect_triangle(
+        &self,
+        triangles: &TriangleColumns,
+        i: usize,
+        lanes: u32,
+        t_min: f32,
+        t_max: f32x8,
+    ) -> LaneHits {
+        assert!(i < triangles.len(), "triangle {i} of {}", triangles.len());
+        let [rx, ry, rz] = &self.rows;
+        let shear = |corner: usize| {
+            let axis = |k: usize| f32x8::splat(triangles.columns[3 * corner + k][i]) - self.origin[k];
+            let (x, y, z) = (axis(0), axis(1), axis(2));
+            let row = |r: &[f32x8; 3]| r[0] * x + r[1] * y + r[2] * z;
+            (row(rx), row(ry), row(rz))
+        };
+        let ((ax, ay, az), (bx, by, bz), (cx, cy, cz)) = (shear(0), shear(1), shear(2));
+        let (u, v, w) = (cx * by - cy * bx, ax * cy - ay * cx, bx * ay - by * ax);
+        let zero = f32x8::ZERO;
+        let on_edge = (u.simd_eq(zero) | v.simd_eq(zero) | w.simd_eq(zero)).to_bitmask() & lanes;
+        let negative = u.simd_lt(zero) | v.simd_lt(zero) | w.simd_lt(zero);
+        let positive = u.simd_gt(zero) | v.simd_gt(zero) | w.simd_gt(zero);
+        let det = u + v + w;
+        let t = self.inv_dz * (u * az + v * bz + w * cz) / det;
+        let inside = !(negative & positive) & !det.simd_eq(zero);
+        let within = t.simd_gt(f32x8::splat(t_min)) & t.simd_lt(t_max);
+        let mut out = LaneHits {
+            hits: (inside & within).to_bitmask() & lanes & !on_edge,
+            t: t.to_array(),
+            b1: (v / det).to_array(),
+            b2: (w / det).to_array(),
+        };
+        if on_edge != 0 {
+            let (p, t_max) = (triangles.get(i), t_max.to_array());
+            for k in set_bits(on_edge) {
+                if let Some((t, b)) = ShearedRay::new(&self.ray(k)).intersect(&p, t_min, t_max[k]) {
+                    out.hits |= 1 << k;
+                    (out.t[k], out.b1[k], out.b2[k]) = (t, b.x, b.y);
+                }
+            }
+        }
+        out
+    }
+}
+
 /// The edge functions of a ray on an edge in f32, decided in f64 so neighbours
 /// agree (rare: kept out of the inlined test).
 #[cold]
@@ -304,6 +424,53 @@ mod tests {
         }
         assert!(hits > 2000, "{hits} hits: the rays must hit often enough to mean anything");
         assert_eq!(TriangleColumns::new(&[]).len(), 0);
+    }
+
+    /// Eight rays in lanes answer what eight one-ray tests answer, bit for
+    /// bit: rays along every axis both ways (the shear's permutation differs
+    /// lane to lane) and with two axes of equal length, rays aimed at vertices and edges, a degenerate
+    /// triangle, a limit per lane, lanes left out.
+    #[test]
+    fn eight_rays_in_lanes_answer_as_one_ray_tests_do() {
+        let mut rng = StdRng::seed_from_u64(9);
+        let mut r = || rng.gen_range(-1.0f32..1.0);
+        let mut hits = 0;
+        for round in 0..3000 {
+            let mut tri = [(); 3].map(|_| Vec3::new(r(), r(), r()));
+            if round % 7 == 0 {
+                tri[2] = tri[1];
+            }
+            let rays: [Ray; LANES] = std::array::from_fn(|k| {
+                let origin = Vec3::new(r(), r(), r()) * 3.0;
+                let aim = match (round + k) % 3 {
+                    0 => tri[k % 3],
+                    1 => (tri[0] + tri[1]) * 0.5,
+                    _ => Vec3::new(r(), r(), r()) * 0.5,
+                };
+                if k == 7 && round % 2 == 0 {
+                    // Two axes of equal length: the dominant axis is chosen by a tie.
+                    let c = r();
+                    let dir = Vec3::new(c, -c, 0.4 * c * r());
+                    return Ray { origin: aim - dir * 2.0, dir };
+                }
+                Ray { origin, dir: aim - origin }
+            });
+            let t_max: [f32; LANES] = std::array::from_fn(|k| if k % 3 == 0 { 0.9 } else { f32::INFINITY });
+            let used = if round % 4 == 0 { 0b1011_0110 } else { 0xff };
+            let columns = TriangleColumns::new(&[tri]);
+            let lanes = RayLanes::new(&rays).intersect_triangle(&columns, 0, used, 0.0, f32x8::from(t_max));
+            for (k, ray) in rays.iter().enumerate() {
+                let one = ShearedRay::new(ray).intersect(&tri, 0.0, t_max[k]).filter(|_| used >> k & 1 == 1);
+                let lane = (lanes.hits >> k & 1 == 1).then(|| (lanes.t[k], Vec2::new(lanes.b1[k], lanes.b2[k])));
+                assert_eq!(
+                    one.map(|(t, b)| (t.to_bits(), b.x.to_bits(), b.y.to_bits())),
+                    lane.map(|(t, b)| (t.to_bits(), b.x.to_bits(), b.y.to_bits())),
+                    "round {round} lane {k}"
+                );
+                hits += usize::from(one.is_some());
+            }
+        }
+        assert!(hits > 5000, "{hits} hits: the rays must hit often enough to mean anything");
     }
 
     /// Rays through the shared edge of a quad split in two always hit one half.

@@ -94,6 +94,56 @@ fn crowded_leaves_match_brute_force() {
     assert!(hits > 300, "{hits}");
 }
 
+/// Packets of rays walked together find each ray's brute-force hit: coherent
+/// packets (eight rays from one eye through a small patch, as a pixel
+/// block's primary rays are), incoherent ones (random origins and
+/// directions), and packets of one to seven rays, with and without a
+/// distance limit.
+#[test]
+fn packets_find_each_rays_brute_force_hit() {
+    let mut rng = StdRng::seed_from_u64(17);
+    let (mut hits, mut rays) = (0, 0);
+    for n in [1, 30, 1000, 6000] {
+        let scene = soup(&mut rng, n);
+        for round in 0..400 {
+            let size = if round % 3 == 0 { rng.gen_range(1..=8) } else { 8 };
+            let packet: Vec<Ray> = if round % 2 == 0 {
+                let eye = random_ray(&mut rng).origin;
+                let aim = Vec3::new(rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0));
+                let step = rng.gen_range(0.001..0.2);
+                (0..size)
+                    .map(|k| {
+                        let p = aim + Vec3::new((k % 4) as f32, (k / 4) as f32, 0.0) * step;
+                        Ray { origin: eye, dir: (p - eye).normalize() }
+                    })
+                    .collect()
+            } else {
+                (0..size).map(|_| random_ray(&mut rng)).collect()
+            };
+            let t_max = if rng.gen_bool(0.3) { rng.gen_range(0.5..4.0) } else { f32::INFINITY };
+            let got = scene.intersect_packet(&packet, t_max);
+            assert!(got[size..].iter().all(Option::is_none), "lanes past the packet hit nothing");
+            for (ray, got) in packet.iter().zip(got) {
+                rays += 1;
+                match (brute(&scene, ray, t_max), got) {
+                    (None, None) => {}
+                    (Some((t, i)), Some(h)) => {
+                        hits += 1;
+                        assert_eq!(h.t.to_bits(), t.to_bits(), "n {n}: distance");
+                        if let Some(one) = scene.intersect(ray, t_max).filter(|one| one.item == h.item) {
+                            assert_eq!(one, h, "n {n}: the packet's hit is the ray's own");
+                        }
+                        let same = h.item.triangle as usize == i || brute(&scene, ray, t).is_none();
+                        assert!(same, "n {n}: triangle {} vs {i}", h.item.triangle);
+                    }
+                    (w, g) => panic!("n {n}, round {round}: brute force {w:?}, packet {g:?}"),
+                }
+            }
+        }
+    }
+    assert!(hits > rays / 4, "the rays must hit something often enough to mean anything: {hits}/{rays}");
+}
+
 #[test]
 fn empty_scene_hits_nothing() {
     let scene = TraceScene::from_triangles(Vec::new(), Vec::new());

@@ -154,6 +154,16 @@ fn tiles_of_an_environment_with_sparse_rays_and_every_image_equal_the_frame() {
     tiles_equal_the_frame_with(&edge, &RenderOptions { sparse_traced: false, ..options }, "environment, edge", 6, 2);
 }
 
+/// An OpenSCAD part whose solid holds closed meshes (its extrusions): a tile
+/// rasterizes the meshes' layers on its own rows alone and still draws what
+/// the whole frame draws there.
+#[test]
+fn tiles_of_an_openscad_part_with_closed_meshes_equal_the_frame() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/openscad/knob.csg");
+    let scene = kage::scene::model::scene_for_model(&path, 160, 120).expect("knob.csg");
+    tiles_equal_the_frame(&without_soft_shadows(scene), "knob.csg", 7, 3);
+}
+
 /// A tile's buffers hold its pixels and its guard band alone: the bytes of
 /// its buffers of one entry a pixel are the whole frame's per pixel times the
 /// pixels it draws, and a sixteenth of a frame draws well under a quarter of

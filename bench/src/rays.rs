@@ -40,13 +40,23 @@ pub struct HybridArgs {
     common: Common,
 }
 
-/// One row of the ray benchmark: (build ms, Mrays/s) for kage and Embree.
+/// One row of the ray benchmark: build ms and Mrays/s (one ray at a time,
+/// packets of eight) for kage and Embree.
 struct RayRow {
     name: String,
     triangles: usize,
     build_ms: f64,
     mrays: f64,
-    peer: Option<(f64, f64)>,
+    packet_mrays: f64,
+    peer: Option<Peer>,
+}
+
+/// Embree's build ms and Mrays/s (`rtcIntersect1`, `rtcIntersect8`).
+#[derive(Clone, Copy)]
+struct Peer {
+    build_ms: f64,
+    mrays: f64,
+    packet_mrays: f64,
 }
 
 /// Runs the ray table and prints it.
@@ -57,16 +67,22 @@ pub fn run(args: &RaysArgs) -> Result<()> {
         let (mesh, scene) = peer_scene_for_rays(common, &args.meshes, name)?;
         let mut best: Option<RayRow> = None;
         for _ in 0..args.rounds.max(1) {
-            let (build_ms, mrays) = time_rays(&scene, common.frames);
+            let (build_ms, mrays, packet_mrays) = time_rays(&scene, common.frames);
             let peer = args.embree.exists().then(|| run_embree(&args.embree, &mesh, common)).transpose()?;
-            let row = RayRow { name: name.to_string(), triangles: scene.triangle_count(), build_ms, mrays, peer };
+            let triangles = scene.triangle_count();
+            let row = RayRow { name: name.to_string(), triangles, build_ms, mrays, packet_mrays, peer };
             best = Some(match best {
                 None => row,
                 Some(b) => RayRow {
                     build_ms: b.build_ms.min(row.build_ms),
                     mrays: b.mrays.max(row.mrays),
+                    packet_mrays: b.packet_mrays.max(row.packet_mrays),
                     peer: match (b.peer, row.peer) {
-                        (Some(p), Some(q)) => Some((p.0.min(q.0), p.1.max(q.1))),
+                        (Some(p), Some(q)) => Some(Peer {
+                            build_ms: p.build_ms.min(q.build_ms),
+                            mrays: p.mrays.max(q.mrays),
+                            packet_mrays: p.packet_mrays.max(q.packet_mrays),
+                        }),
                         (p, q) => p.or(q),
                     },
                     ..row
@@ -76,22 +92,33 @@ pub fn run(args: &RaysArgs) -> Result<()> {
         rows.push(best.expect("one round"));
         eprintln!("{name}: done");
     }
-    println!("| scene | triangles | kage build ms | Embree build ms | build ratio | kage Mrays/s | Embree Mrays/s | rate ratio |");
-    println!("|---|---:|---:|---:|---:|---:|---:|---:|");
+    println!(
+        "| scene | triangles | kage build ms | Embree build ms | build ratio | kage Mrays/s | Embree Mrays/s | rate ratio | kage packets Mrays/s | Embree packets Mrays/s | packet rate ratio |"
+    );
+    println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
     for r in &rows {
-        let (pb, pr, bratio, rratio) = match r.peer {
-            Some((b, m)) => {
-                (format!("{b:.1}"), format!("{m:.2}"), format!("{:.2}", r.build_ms / b), format!("{:.2}", r.mrays / m))
-            }
-            None => ("not built".into(), "not built".into(), "n/a".into(), "n/a".into()),
+        let peer = |f: &dyn Fn(&Peer) -> f64, ours: Option<f64>| match (&r.peer, ours) {
+            (Some(p), Some(ours)) => format!("{:.2}", ours / f(p)),
+            (Some(p), None) => format!("{:.2}", f(p)),
+            (None, _) => "n/a".into(),
         };
         println!(
-            "| {} | {} | {:.1} | {pb} | {bratio} | {:.2} | {pr} | {rratio} |",
-            r.name, r.triangles, r.build_ms, r.mrays
+            "| {} | {} | {:.1} | {} | {} | {:.2} | {} | {} | {:.2} | {} | {} |",
+            r.name,
+            r.triangles,
+            r.build_ms,
+            r.peer.map_or("n/a".into(), |p| format!("{:.1}", p.build_ms)),
+            peer(&|p| p.build_ms, Some(r.build_ms)),
+            r.mrays,
+            peer(&|p| p.mrays, None),
+            peer(&|p| p.mrays, Some(r.mrays)),
+            r.packet_mrays,
+            peer(&|p| p.packet_mrays, None),
+            peer(&|p| p.packet_mrays, Some(r.packet_mrays)),
         );
     }
     println!(
-        "\n{}x{} primary rays (one per pixel centre, nearest hit, no shading), median of {} frames; build median of 5; best of {} rounds; {} threads.",
+        "\n{}x{} primary rays (one per pixel centre, nearest hit, no shading), one at a time and in packets of 4 x 2 pixels; median of {} frames; build median of 5; best of {} rounds; {} threads.",
         common.width,
         common.height,
         common.frames,
@@ -101,8 +128,9 @@ pub fn run(args: &RaysArgs) -> Result<()> {
     Ok(())
 }
 
-/// Median BVH build time (ms) and primary-ray throughput (Mrays/s).
-fn time_rays(scene: &Scene, frames: usize) -> (f64, f64) {
+/// Median BVH build time (ms) and primary-ray throughput (Mrays/s), one ray at
+/// a time and in packets of eight.
+fn time_rays(scene: &Scene, frames: usize) -> (f64, f64, f64) {
     let mut builds = Vec::new();
     let mut trace = TraceScene::new(scene);
     for _ in 0..5 {
@@ -112,31 +140,50 @@ fn time_rays(scene: &Scene, frames: usize) -> (f64, f64) {
     }
     let rays = scene.camera.pixel_rays(glam::Vec2::new(scene.width as f32, scene.height as f32));
     let (w, h) = (scene.width, scene.height);
-    let mut times = Vec::new();
-    for _ in 0..frames.max(1) + 1 {
-        let t = std::time::Instant::now();
-        let hits: usize = (0..h)
+    let ray = |x: u32, y: u32| rays.ray(glam::Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
+    let single = || -> usize {
+        (0..h)
             .into_par_iter()
-            .map(|y| {
-                (0..w)
-                    .filter(|&x| {
-                        let ray = rays.ray(glam::Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
-                        trace.intersect(&ray, f32::INFINITY).is_some()
-                    })
-                    .count()
+            .map(|y| (0..w).filter(|&x| trace.intersect(&ray(x, y), f32::INFINITY).is_some()).count())
+            .sum()
+    };
+    // Packets of 4 × 2 pixels, as Embree's peer forms its eight-ray packets.
+    let packets = || -> usize {
+        (0..h.div_ceil(2))
+            .into_par_iter()
+            .map(|row| {
+                let mut found = 0;
+                for x0 in (0..w).step_by(4) {
+                    let mut block = [ray(x0, 2 * row); 8];
+                    let mut n = 0;
+                    for (x, y) in (0..8).map(|k| (x0 + k % 4, 2 * row + k / 4)).filter(|&(x, y)| x < w && y < h) {
+                        (block[n], n) = (ray(x, y), n + 1);
+                    }
+                    found += trace.intersect_packet(&block[..n], f32::INFINITY).iter().flatten().count();
+                }
+                found
             })
-            .sum();
-        std::hint::black_box(hits);
-        times.push(t.elapsed().as_secs_f64());
+            .sum()
+    };
+    let (mut times, mut packet_times) = (Vec::new(), Vec::new());
+    for _ in 0..frames.max(1) + 1 {
+        for (f, out) in [(&single as &(dyn Fn() -> usize + Sync), &mut times), (&packets, &mut packet_times)] {
+            let t = std::time::Instant::now();
+            std::hint::black_box(f());
+            out.push(t.elapsed().as_secs_f64());
+        }
     }
     times.remove(0); // warm-up
-    (median(&mut builds), (w * h) as f64 / median(&mut times) / 1e6)
+    packet_times.remove(0);
+    let rate = |t: &mut Vec<f64>| (w * h) as f64 / median(t) / 1e6;
+    (median(&mut builds), rate(&mut times), rate(&mut packet_times))
 }
 
-/// Runs Embree's primary-ray benchmark (rtcIntersect1, no shading) on the same mesh.
-fn run_embree(bin: &Path, mesh: &Path, common: &Common) -> Result<(f64, f64)> {
+/// Runs Embree's primary-ray benchmark (no shading; `rtcIntersect1` and
+/// `rtcIntersect8` on 4 × 2 pixel blocks) on the same mesh.
+fn run_embree(bin: &Path, mesh: &Path, common: &Common) -> Result<Peer> {
     let out = Command::new(bin)
-        .args(["-t", "2", "-n", "-m", "primary", "-a", "1", "-f", &common.frames.to_string()])
+        .args(["-t", "2", "-n", "-m", "primary", "-a", "1,8", "-f", &common.frames.to_string()])
         .args(["-w", &common.width.to_string(), "-h", &common.height.to_string()])
         .arg(mesh)
         .output()
@@ -146,9 +193,12 @@ fn run_embree(bin: &Path, mesh: &Path, common: &Common) -> Result<(f64, f64)> {
         line.split_whitespace().find_map(|w| w.strip_prefix(key)).and_then(|v| v.parse().ok())
     };
     let build = text.lines().find(|l| l.contains("what=build")).and_then(|l| field(l, "median_ms="));
-    let rate = text.lines().find(|l| l.contains("mode=primary")).and_then(|l| field(l, "mrays_s="));
-    match (build, rate) {
-        (Some(b), Some(r)) => Ok((b, r)),
+    let rate = |api: &str| {
+        let key = format!("api={api} ");
+        text.lines().find(|l| l.contains("mode=primary") && l.contains(&key)).and_then(|l| field(l, "mrays_s="))
+    };
+    match (build, rate("1"), rate("8")) {
+        (Some(build_ms), Some(mrays), Some(packet_mrays)) => Ok(Peer { build_ms, mrays, packet_mrays }),
         _ => Err(miette!("Embree printed no build/primary results: {text}{}", String::from_utf8_lossy(&out.stderr))),
     }
 }
@@ -247,9 +297,18 @@ fn trace_everything(scene: &Scene, trace: &TraceScene, depth: u32) -> LinearImag
     let tracer = Tracer::new(scene, trace, &frames, ShadowRay);
     let rays = scene.camera.pixel_rays(glam::Vec2::new(scene.width as f32, scene.height as f32));
     let mut image = LinearImage::new(scene.width, scene.height);
-    image.pixels_mut().par_chunks_mut(scene.width as usize).enumerate().for_each(|(y, row)| {
-        for (x, px) in row.iter_mut().enumerate() {
-            *px = tracer.radiance(&rays.ray(glam::Vec2::new(x as f32 + 0.5, y as f32 + 0.5)), depth);
+    let w = scene.width as usize;
+    // Primary rays in packets of 4 × 2 pixels, as a ray tracer casts coherent rays.
+    image.pixels_mut().par_chunks_mut(2 * w).enumerate().for_each(|(pair, rows)| {
+        for x0 in (0..w).step_by(4) {
+            let pixels: Vec<(usize, usize)> =
+                (0..8).map(|k| (x0 + k % 4, k / 4)).filter(|&(x, dy)| x < w && dy * w < rows.len()).collect();
+            let packet: Vec<kage::camera::Ray> = pixels
+                .iter()
+                .map(|&(x, dy)| rays.ray(glam::Vec2::new(x as f32 + 0.5, (2 * pair + dy) as f32 + 0.5)))
+                .collect();
+            let (light, _) = tracer.radiance_packet(&packet, depth);
+            pixels.iter().zip(light).for_each(|(&(x, dy), l)| rows[dy * w + x] = l);
         }
     });
     image

@@ -6,7 +6,8 @@
 //! [`TraceScene`] puts a scene's triangles (in world space, with their item ids;
 //! [`crate::triangle`] is the watertight ray/triangle test) and its CSG solids (cast by
 //! [`crate::csg::CsgCaster`]) behind one [`crate::bvh`], and answers `intersect`
-//! (nearest hit) and `occluded` (anything before a distance?); [`TraceCache`]
+//! (nearest hit), `intersect_packet` (the nearest hits of up to eight coherent
+//! rays walked together) and `occluded` (anything before a distance?); [`TraceCache`]
 //! keeps it while the geometry stays. [`tracer`] shades what a ray sees, bounces
 //! included; [`traced`] is the raster frame's traced term, [`mod@reference`] the
 //! ray-traced oracle, both on top of it; [`shadow_truth`] holds a shadow
@@ -20,6 +21,7 @@ pub mod tracer;
 
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
+use wide::f32x8;
 
 use std::sync::Arc;
 
@@ -27,9 +29,9 @@ use crate::scene::{Material, Mesh, Scene};
 
 use crate::csg::{CsgCaster, CsgSolid};
 
-use crate::bvh::{Aabb, Bvh};
+use crate::bvh::{Aabb, Bvh, PACKET};
 use crate::camera::Ray;
-use crate::triangle::{ShearedRay, TriangleColumns, LANES};
+use crate::triangle::{set_bits, RayLanes, ShearedRay, TriangleColumns, LANES};
 use crate::visibility::ItemId;
 
 pub use cache::TraceCache;
@@ -213,6 +215,65 @@ impl TraceScene {
         })?;
         debug_assert_eq!(hit.item.object, self.items[i as usize].object);
         Some(Hit { t, ..hit })
+    }
+
+    /// [`TraceScene::intersect`] of up to [`PACKET`] rays walked through the
+    /// BVH together (coherent rays: a block of pixels' primary rays, a
+    /// mirror's reflections), each leaf's triangles tested once for all the
+    /// rays that reach it. Each ray's hit is the one it finds alone (on an
+    /// exact tie in distance between two triangles either may be named).
+    ///
+    /// # Panics
+    /// If `rays` is empty or longer than [`PACKET`].
+    #[must_use]
+    pub fn intersect_packet(&self, rays: &[Ray], t_max: f32) -> [Option<Hit>; PACKET] {
+        assert!((1..=PACKET).contains(&rays.len()), "{} rays in a packet", rays.len());
+        let padded: [Ray; PACKET] = std::array::from_fn(|i| rays[i.min(rays.len() - 1)]);
+        let lanes = (1u32 << rays.len()) - 1;
+        let sheared = RayLanes::new(&padded);
+        let mut hits = [None; PACKET];
+        let mut t = [t_max; PACKET];
+        self.bvh.intersect_packet_leaves(&sheared, lanes, &mut t, |leaf, mask, t| {
+            let leaves = Self::range(leaf);
+            let mut found = |k: usize, i: usize, d: f32, b: Vec2, t: &mut [f32; PACKET]| {
+                let item = self.items[i];
+                if d < t[k] && self.keeps(item, b) {
+                    t[k] = d;
+                    hits[k] = Some(Hit { t: d, item, barycentrics: b, normal: Vec3::ZERO });
+                }
+            };
+            if (mask.count_ones() as usize) < leaves.len() {
+                // Fewer rays than triangles: each ray tests the leaf's
+                // triangles eight at a time, as it would alone.
+                for k in set_bits(mask) {
+                    let sr = sheared.lane(k);
+                    for start in leaves.clone().step_by(LANES) {
+                        let count = (leaves.end - start).min(LANES);
+                        let lanes = sr.intersect_lanes(&self.triangles, start, count, 0.0, t[k]);
+                        for j in lanes.lanes() {
+                            found(k, start + j, lanes.t[j], Vec2::new(lanes.b1[j], lanes.b2[j]), t);
+                        }
+                    }
+                }
+            } else {
+                for i in leaves.clone() {
+                    let lanes = sheared.intersect_triangle(&self.triangles, i, mask, 0.0, f32x8::from(*t));
+                    for k in lanes.lanes() {
+                        found(k, i, lanes.t[k], Vec2::new(lanes.b1[k], lanes.b2[k]), t);
+                    }
+                }
+            }
+            for (_, object, caster) in self.solids_in(&leaves) {
+                for k in set_bits(mask) {
+                    if let Some(c) = caster.first_hit(&padded[k], 0.0, t[k]) {
+                        t[k] = c.t;
+                        let item = ItemId::primitive_of(*object, c.primitive);
+                        hits[k] = Some(Hit { t: c.t, item, barycentrics: Vec2::ZERO, normal: c.normal });
+                    }
+                }
+            }
+        });
+        hits
     }
 
     /// The leaves (triangles and solids) of a BVH leaf: consecutive numbers,

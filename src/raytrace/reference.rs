@@ -25,7 +25,8 @@ use rayon::prelude::*;
 
 use super::tracer::{occluded_towards, LightRays, ShadowRay, Tracer, Unshadowed};
 use super::TraceScene;
-use crate::camera::PixelRays;
+use crate::bvh::PACKET;
+use crate::camera::{PixelRays, Ray};
 use crate::image::LinearImage;
 use crate::sampling::{concentric_disc, hash3, stratified};
 use crate::scene::{Light, LightKind, Scene};
@@ -67,7 +68,7 @@ pub fn render_reference_until(
 ) -> (LinearImage, u32) {
     let trace = TraceScene::new(scene);
     let frames = ObjectFrames::new(scene);
-    let run = Run { scene, trace: &trace, opts, progress, stop };
+    let run = Run { scene, opts, progress, stop };
     if opts.shadows {
         run.with(Tracer::new(scene, &trace, &frames, AreaLights { per_axis: opts.light_samples.max(1) }))
     } else {
@@ -78,7 +79,6 @@ pub fn render_reference_until(
 /// One reference render's settings, before its tracer is chosen.
 struct Run<'a> {
     scene: &'a Scene,
-    trace: &'a TraceScene,
     opts: &'a ReferenceOptions,
     progress: &'a (dyn Fn(u32) + Sync),
     stop: &'a AtomicBool,
@@ -110,16 +110,17 @@ impl Run<'_> {
     fn pixel<L: LightRays>(&self, tracer: &Tracer<L>, rays: &PixelRays, (x, y): (u32, u32)) -> Vec3 {
         let n = self.opts.pixel_samples.max(1);
         let mut sum = Vec3::ZERO;
-        for k in 0..n * n {
-            let ray = rays.ray(Vec2::new(x as f32, y as f32) + stratified(k, n, hash3(x, y, k)));
-            let seen = tracer.radiance(&ray, self.opts.max_depth);
-            sum += match (
-                &self.scene.fog,
-                self.scene.fog.as_ref().and_then(|_| self.trace.intersect(&ray, f32::INFINITY)),
-            ) {
-                (Some(fog), Some(hit)) => seen.lerp(fog.color, fog.amount_at(&self.scene.camera, ray.at(hit.t))),
-                _ => seen,
-            };
+        let samples: Vec<Ray> =
+            (0..n * n).map(|k| rays.ray(Vec2::new(x as f32, y as f32) + stratified(k, n, hash3(x, y, k)))).collect();
+        // A pixel's samples are coherent: their first hits are found together.
+        for packet in samples.chunks(PACKET) {
+            let (light, hits) = tracer.radiance_packet(packet, self.opts.max_depth);
+            for ((ray, seen), hit) in packet.iter().zip(light).zip(hits) {
+                sum += match (&self.scene.fog, hit) {
+                    (Some(fog), Some(hit)) => seen.lerp(fog.color, fog.amount_at(&self.scene.camera, ray.at(hit.t))),
+                    _ => seen,
+                };
+            }
         }
         sum / (n * n) as f32
     }

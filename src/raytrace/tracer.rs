@@ -9,7 +9,8 @@ use std::cell::Cell;
 
 use glam::Vec3;
 
-use super::TraceScene;
+use super::{Hit, TraceScene};
+use crate::bvh::PACKET;
 use crate::camera::Ray;
 use crate::scene::{Light, LightKind, Scene};
 use crate::shading::phong::{self, Components};
@@ -115,7 +116,32 @@ impl<'a, L: LightRays> Tracer<'a, L> {
             return self.scene.background_along(ray.dir);
         }
         rays.set(rays.get() - 1);
-        let Some(hit) = self.trace.intersect(ray, f32::INFINITY) else { return self.scene.background_along(ray.dir) };
+        self.shade(ray, self.trace.intersect(ray, f32::INFINITY), seen, depth, layers, rays)
+    }
+
+    /// [`Tracer::radiance`] of up to [`PACKET`] coherent rays (a pixel's
+    /// samples, a block of pixels), their first hits found together
+    /// ([`TraceScene::intersect_packet`]); each lane's light is the one
+    /// [`Tracer::radiance`] finds for its ray. Also returns the first hits.
+    ///
+    /// # Panics
+    /// If `rays` is empty or longer than [`PACKET`].
+    #[must_use]
+    pub fn radiance_packet(&self, rays: &[Ray], depth: u32) -> ([Vec3; PACKET], [Option<Hit>; PACKET]) {
+        let hits = self.trace.intersect_packet(rays, f32::INFINITY);
+        let light = std::array::from_fn(|k| {
+            rays.get(k).map_or(Vec3::ZERO, |ray| {
+                self.shade(ray, hits[k], Seen::FromEye, depth, MAX_LAYERS, &Cell::new(MAX_RAYS - 1))
+            })
+        });
+        (light, hits)
+    }
+
+    /// The light leaving `hit` (the first surface along `ray`, if any) back
+    /// along the ray, with what lies behind a translucent surface and the
+    /// bounces.
+    fn shade(&self, ray: &Ray, hit: Option<Hit>, seen: Seen, depth: u32, layers: u32, rays: &Cell<u32>) -> Vec3 {
+        let Some(hit) = hit else { return self.scene.background_along(ray.dir) };
         let mut s = match hit.item.primitive() {
             // A solid: its tangent plane at the hit, which the ray meets there.
             Some(_) => ObjectFrames::tangent(self.scene, hit.item, ray.at(hit.t), hit.normal).surface(ray),

@@ -14,8 +14,10 @@
 //!
 //! Only whole frames of a mesh in front of the eye are rasterized: a mesh
 //! with a corner at or behind the eye plane, or round the eye, is left to the
-//! caster's rays (the same intervals, slower).
+//! caster's rays (the same intervals, slower). A tile rasterizes the rows it
+//! walks alone.
 
+use std::ops::Range;
 use std::sync::Arc;
 
 use glam::{DVec2, Mat4};
@@ -54,8 +56,15 @@ struct LayerView {
 
 impl MeshLayers {
     /// The layers of every mesh of `caster`'s solid seen through `vp` (its
-    /// pixel rays `rays`) in a `size` frame.
-    pub(super) fn new(caster: &CsgCaster, vp: Mat4, rays: &PixelRays, size: (usize, usize)) -> MeshLayers {
+    /// pixel rays `rays`) in a `size` frame, on the rows `rows` (a tile's
+    /// rasterizes its own rows alone).
+    pub(super) fn new(
+        caster: &CsgCaster,
+        vp: Mat4,
+        rays: &PixelRays,
+        size: (usize, usize),
+        rows: Range<usize>,
+    ) -> MeshLayers {
         let primitives = &caster.solid().primitives;
         let mut firsts: Vec<(usize, Arc<ClosedMesh>)> = Vec::new();
         for (i, p) in primitives.iter().enumerate() {
@@ -68,7 +77,7 @@ impl MeshLayers {
         }
         let mut out = MeshLayers { of: vec![None; primitives.len()], views: Vec::new() };
         for (first, mesh) in firsts {
-            let Some(view) = LayerView::new(caster, first, &mesh, vp, rays, size) else { continue };
+            let Some(view) = LayerView::new(caster, first, &mesh, vp, rays, size, rows.clone()) else { continue };
             let index = out.views.len() as u32;
             for layer in 0..mesh.layers() {
                 out.of[first + layer as usize] = Some((index, layer));
@@ -119,8 +128,8 @@ impl LayerView {
         pick_layer(&self.intervals[a..b], layer, self.layers)
     }
 
-    /// The mesh of primitive `first` (its first layer) rasterized, or
-    /// `None` when it reaches the eye plane or holds the eye.
+    /// The mesh of primitive `first` (its first layer) rasterized on the
+    /// rows `rows`, or `None` when it reaches the eye plane or holds the eye.
     fn new(
         caster: &CsgCaster,
         first: usize,
@@ -128,6 +137,7 @@ impl LayerView {
         vp: Mat4,
         rays: &PixelRays,
         (width, height): (usize, usize),
+        rows: Range<usize>,
     ) -> Option<LayerView> {
         let to_solid = caster.solid().primitives[first].transform;
         if !rays.ortho && mesh.contains(to_solid.inverse().transform_point3(rays.origin)) {
@@ -148,8 +158,8 @@ impl LayerView {
         let (lo, hi) = screen.iter().fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |(a, b), p| (a.min(*p), b.max(*p)));
         let x0 = (lo.x - 0.5).ceil().max(0.0) as usize;
         let x1 = ((hi.x - 0.5).floor().min(width as f64 - 1.0)).max(-1.0) as i64;
-        let y0 = (lo.y - 0.5).ceil().max(0.0) as usize;
-        let y1 = ((hi.y - 0.5).floor().min(height as f64 - 1.0)).max(-1.0) as i64;
+        let y0 = ((lo.y - 0.5).ceil().max(0.0) as usize).max(rows.start);
+        let y1 = ((hi.y - 0.5).floor().min(height as f64 - 1.0)).max(-1.0).min(rows.end as f64 - 1.0) as i64;
         if x1 < x0 as i64 || y1 < y0 as i64 {
             return None;
         }
@@ -369,7 +379,7 @@ mod tests {
             let (w, h) = (64usize, 48usize);
             let vp = camera.view_projection(w as f32 / h as f32);
             let rays = camera.pixel_rays(Vec2::new(w as f32, h as f32));
-            let layers = MeshLayers::new(&caster, vp, &rays, (w, h));
+            let layers = MeshLayers::new(&caster, vp, &rays, (w, h), 0..h);
             assert_eq!(layers.views.len(), 1, "{projection:?}: the mesh is rasterized");
             let (mut met, mut lanes) = (0, IntervalLanes::default());
             for y in 0..h {

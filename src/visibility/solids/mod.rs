@@ -433,7 +433,7 @@ fn scan_bands<B: Send>(
     // The whole frame in the pool: its preparation's parallel parts and
     // the bands start no second time from outside it.
     rayon::scope(|_| {
-        let frame = FrameWalk::new(prepared, camera, (width, height));
+        let frame = FrameWalk::new(prepared, camera, (width, height), rows.clone());
         let h = height as usize;
         // Each band its own piece of work: left to split only where stolen,
         // rayon hands each thread a quarter of the frame, and a thread done
@@ -485,8 +485,8 @@ impl<'a> FrameWalk<'a> {
     const PARALLEL_FROM: usize = 16;
 
     /// The frame of `solid` seen by `camera` at `width` x `height`, walked by
-    /// `walker`.
-    fn new(prepared: &'a PreparedSolid, camera: &Camera, (width, height): (u32, u32)) -> Self {
+    /// `walker` over the rows `rows`.
+    fn new(prepared: &'a PreparedSolid, camera: &Camera, (width, height): (u32, u32), rows: Range<usize>) -> Self {
         let (caster, solid) = (&prepared.caster, prepared.caster.solid());
         let vp = camera.view_projection(width as f32 / height as f32);
         let rays = camera.pixel_rays(Vec2::new(width as f32, height as f32));
@@ -512,7 +512,7 @@ impl<'a> FrameWalk<'a> {
         // Many primitives: each primitive's outline and faces at once.
         let (outlines, faces) = if many { rayon::join(outlines, faces) } else { (outlines(), faces()) };
         // A closed mesh's layers show where its rasterized pixels say.
-        let layers = MeshLayers::new(caster, vp, &rays, (width as usize, height as usize));
+        let layers = MeshLayers::new(caster, vp, &rays, (width as usize, height as usize), rows);
         let mut outlines: Vec<Option<Outline>> =
             outlines.into_iter().enumerate().map(|(i, o)| layers.narrow(i, o)).collect();
         if let Some(tree) = &solid.tree {
