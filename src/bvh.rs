@@ -23,9 +23,11 @@
 //! tested once for all the rays that reach it
 //! ([`crate::triangle::RayLanes`]). Each ray gets the hit it finds alone.
 //! Primary rays of 4 × 2 pixel blocks, one thread, alternated with one ray
-//! at a time: 21.1–21.2 against 15.2–15.5 Mrays/s on a 9.8k-triangle
-//! sphere, 14.8–15.0 against 12.7 on a 998k one (at a million triangles
-//! each leaf is reached by fewer of the packet's rays).
+//! at a time (`RAYON_NUM_THREADS=1 kage-bench rays --scenes
+//! sphere10k,sphere1m`, a 2-core AVX-512 EPYC VM): 21.8 against 16.1–16.3
+//! Mrays/s on a 9.8k-triangle sphere, 15.4–15.5 against 13.0–13.2 on a 998k
+//! one (at a million triangles each leaf is reached by fewer of the
+//! packet's rays).
 //!
 //! The hierarchy knows only boxes. Traversal hands each leaf to a closure that
 //! intersects it, so one walker serves the scene's triangles and solids (ray
