@@ -388,6 +388,16 @@ mod tests {
         assert!(ShearedRay::new(&ray([2.0, 2.0, 0.0], [0.0, 0.0, 1.0])).intersect(&tri, 0.0, 9.0).is_none());
     }
 
+    /// Lane `k`'s hit: its distance and barycentrics.
+    fn lane_hit(lanes: &LaneHits, k: usize) -> Option<(f32, Vec2)> {
+        (lanes.hits >> k & 1 == 1).then(|| (lanes.t[k], Vec2::new(lanes.b1[k], lanes.b2[k])))
+    }
+
+    /// A hit's bits, to compare answers exactly.
+    fn bits(hit: Option<(f32, Vec2)>) -> Option<[u32; 3]> {
+        hit.map(|(t, b)| [t.to_bits(), b.x.to_bits(), b.y.to_bits()])
+    }
+
     /// Eight lanes answer what eight one-triangle tests answer, bit for bit:
     /// random triangles and rays, rays aimed at vertices and edges (where the
     /// f64 decision may be taken), degenerate triangles, lanes past the count.
@@ -412,12 +422,7 @@ mod tests {
                 let lanes = sr.intersect_lanes(&columns, 0, count, t_min, t_max);
                 for (i, tri) in tris.iter().enumerate() {
                     let one = sr.intersect(tri, t_min, t_max).filter(|_| i < count);
-                    let lane = (lanes.hits >> i & 1 == 1).then(|| (lanes.t[i], Vec2::new(lanes.b1[i], lanes.b2[i])));
-                    assert_eq!(
-                        one.map(|(t, b)| (t.to_bits(), b.x.to_bits(), b.y.to_bits())),
-                        lane.map(|(t, b)| (t.to_bits(), b.x.to_bits(), b.y.to_bits())),
-                        "round {round} lane {i}"
-                    );
+                    assert_eq!(bits(one), bits(lane_hit(&lanes, i)), "round {round} lane {i}");
                     hits += usize::from(one.is_some());
                 }
             }
@@ -428,8 +433,9 @@ mod tests {
 
     /// Eight rays in lanes answer what eight one-ray tests answer, bit for
     /// bit: rays along every axis both ways (the shear's permutation differs
-    /// lane to lane) and with two axes of equal length, rays aimed at vertices and edges, a degenerate
-    /// triangle, a limit per lane, lanes left out.
+    /// lane to lane) and with two axes of equal length, rays aimed at
+    /// vertices and edges, a degenerate triangle, a limit per lane, lanes
+    /// left out.
     #[test]
     fn eight_rays_in_lanes_answer_as_one_ray_tests_do() {
         let mut rng = StdRng::seed_from_u64(9);
@@ -461,12 +467,7 @@ mod tests {
             let lanes = RayLanes::new(&rays).intersect_triangle(&columns, 0, used, 0.0, f32x8::from(t_max));
             for (k, ray) in rays.iter().enumerate() {
                 let one = ShearedRay::new(ray).intersect(&tri, 0.0, t_max[k]).filter(|_| used >> k & 1 == 1);
-                let lane = (lanes.hits >> k & 1 == 1).then(|| (lanes.t[k], Vec2::new(lanes.b1[k], lanes.b2[k])));
-                assert_eq!(
-                    one.map(|(t, b)| (t.to_bits(), b.x.to_bits(), b.y.to_bits())),
-                    lane.map(|(t, b)| (t.to_bits(), b.x.to_bits(), b.y.to_bits())),
-                    "round {round} lane {k}"
-                );
+                assert_eq!(bits(one), bits(lane_hit(&lanes, k)), "round {round} lane {k}");
                 hits += usize::from(one.is_some());
             }
         }
