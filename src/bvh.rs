@@ -111,19 +111,29 @@ impl Node {
     /// a ray grazing a face is not lost to rounding).
     #[inline(always)]
     fn entries(&self, origin: [f32x8; 3], inv_dir: [f32x8; 3], t_max: f32) -> (f32x8, u32) {
-        let b = &self.bounds;
-        let (lx, ly, lz) = (f32x8::from(b[0]), f32x8::from(b[1]), f32x8::from(b[2]));
-        let (hx, hy, hz) = (f32x8::from(b[3]), f32x8::from(b[4]), f32x8::from(b[5]));
-        let slab = |lo: f32x8, hi: f32x8, axis: usize| {
-            let (t0, t1) = ((lo - origin[axis]) * inv_dir[axis], (hi - origin[axis]) * inv_dir[axis]);
-            (t0.fast_min(t1), t0.fast_max(t1))
-        };
-        let ((nx, fx), (ny, fy), (nz, fz)) = (slab(lx, hx, 0), slab(ly, hy, 1), slab(lz, hz, 2));
-        let near = nx.fast_max(ny).fast_max(nz).fast_max(f32x8::ZERO);
-        let far = fx.fast_min(fy).fast_min(fz) * f32x8::splat(1.0 + 2.0 * f32::EPSILON * 2.0);
-        let enters = near.simd_le(far) & near.simd_lt(f32x8::splat(t_max));
-        (near, enters.to_bitmask() & ((1u32 << self.children) - 1))
+        let bounds = self.bounds.map(f32x8::from);
+        let (near, enters) = slab_test(&bounds, origin, inv_dir, f32x8::splat(t_max));
+        (near, enters & ((1u32 << self.children) - 1))
     }
+}
+
+/// The slab test, eight lanes at once (a box a lane, or a ray a lane): the
+/// distances at which the rays enter the boxes (`bounds`: smallest corners'
+/// x, y, z, then largest corners'), and a bit per lane entered before
+/// `t_max`; the far distance is widened by a few ulps so a ray grazing a
+/// face is not lost to rounding. One function for both walks, so a packet's
+/// lane decides as its ray alone does.
+#[inline(always)]
+fn slab_test(bounds: &[f32x8; 6], origin: [f32x8; 3], inv_dir: [f32x8; 3], t_max: f32x8) -> (f32x8, u32) {
+    let slab = |axis: usize| {
+        let (t0, t1) =
+            ((bounds[axis] - origin[axis]) * inv_dir[axis], (bounds[axis + 3] - origin[axis]) * inv_dir[axis]);
+        (t0.fast_min(t1), t0.fast_max(t1))
+    };
+    let ((nx, fx), (ny, fy), (nz, fz)) = (slab(0), slab(1), slab(2));
+    let near = nx.fast_max(ny).fast_max(nz).fast_max(f32x8::ZERO);
+    let far = fx.fast_min(fy).fast_min(fz) * f32x8::splat(1.0 + 2.0 * f32::EPSILON * 2.0);
+    (near, (near.simd_le(far) & near.simd_lt(t_max)).to_bitmask())
 }
 
 /// A postponed child: its parent node's index times [`WIDTH`] plus its lane
@@ -248,17 +258,8 @@ impl Node {
     /// would.
     #[inline(always)]
     fn packet_entries(&self, k: usize, p: &Packet, t_max: f32x8) -> (f32x8, u32) {
-        let b = &self.bounds;
-        let slab = |axis: usize| {
-            let (lo, hi) = (f32x8::splat(b[axis][k]), f32x8::splat(b[axis + 3][k]));
-            let (t0, t1) = ((lo - p.origin[axis]) * p.inv_dir[axis], (hi - p.origin[axis]) * p.inv_dir[axis]);
-            (t0.fast_min(t1), t0.fast_max(t1))
-        };
-        let ((nx, fx), (ny, fy), (nz, fz)) = (slab(0), slab(1), slab(2));
-        let near = nx.fast_max(ny).fast_max(nz).fast_max(f32x8::ZERO);
-        let far = fx.fast_min(fy).fast_min(fz) * f32x8::splat(1.0 + 2.0 * f32::EPSILON * 2.0);
-        let enters = near.simd_le(far) & near.simd_lt(t_max);
-        (near, enters.to_bitmask())
+        let bounds = self.bounds.map(|axis| f32x8::splat(axis[k]));
+        slab_test(&bounds, p.origin, p.inv_dir, t_max)
     }
 }
 
@@ -476,8 +477,7 @@ impl Bvh {
     /// packet: coherent rays, such as a block of pixels' primary rays, reach
     /// mostly the same nodes). `lanes` has a bit per ray in use (the others
     /// should repeat one of them: the packet's span covers every lane);
-    /// `t_max` is per ray. `hit(leaf, lanes,
-    /// t_max)` intersects the primitives `leaf` with the rays of `lanes`
+    /// `t_max` is per ray. `hit(leaf, lanes, t_max)` intersects the primitives `leaf` with the rays of `lanes`
     /// (those that enter its box before their `t_max`) and lowers each one's
     /// `t_max` to its nearest hit. Each ray reaches every leaf it would reach
     /// alone before finding its nearest hit: its answer is its own.
