@@ -5,6 +5,7 @@
 //! never slips between — which Möller–Trumbore does not promise.
 
 use glam::{DVec3, Vec2, Vec3};
+use rayon::prelude::*;
 use wide::f32x8;
 
 use crate::camera::Ray;
@@ -126,12 +127,37 @@ impl TriangleColumns {
     /// The columns of `triangles`, in their order.
     #[must_use]
     pub fn new(triangles: &[[Vec3; 3]]) -> TriangleColumns {
-        let column = |c: usize| {
-            let mut v: Vec<f32> = triangles.iter().map(|t| t[c / 3][c % 3]).collect();
-            v.resize(triangles.len() + LANES, 0.0);
-            v
-        };
-        TriangleColumns { columns: std::array::from_fn(column) }
+        Self::from_fn(triangles.len(), |j| triangles[j])
+    }
+
+    /// The columns of `triangles` taken in `order` (a BVH's leaf order): entry
+    /// `j` is triangle `order[j]`.
+    ///
+    /// # Panics
+    /// If `order` names a triangle out of range.
+    #[must_use]
+    pub fn in_order(triangles: &[[Vec3; 3]], order: &[u32]) -> TriangleColumns {
+        Self::from_fn(order.len(), |j| triangles[order[j] as usize])
+    }
+
+    /// The columns of `n` triangles, entry `j` being `triangle(j)`: blocks of
+    /// entries filled in parallel, each triangle asked once.
+    fn from_fn(n: usize, triangle: impl Fn(usize) -> [Vec3; 3] + Sync) -> TriangleColumns {
+        const BLOCK: usize = 1 << 12;
+        let mut columns: [Vec<f32>; 9] = std::array::from_fn(|_| vec![0.0; n + LANES]);
+        let mut chunks = columns.each_mut().map(|c| c[..n].chunks_mut(BLOCK));
+        let blocks: Vec<[&mut [f32]; 9]> = (0..n.div_ceil(BLOCK))
+            .map(|_| std::array::from_fn(|c| chunks[c].next().expect("as many blocks")))
+            .collect();
+        blocks.into_par_iter().enumerate().for_each(|(b, mut block)| {
+            for k in 0..block[0].len() {
+                let t = triangle(b * BLOCK + k);
+                for (c, column) in block.iter_mut().enumerate() {
+                    column[k] = t[c / 3][c % 3];
+                }
+            }
+        });
+        TriangleColumns { columns }
     }
 
     /// Triangles stored.
@@ -396,6 +422,23 @@ mod tests {
     /// A hit's bits, to compare answers exactly.
     fn bits(hit: Option<(f32, Vec2)>) -> Option<[u32; 3]> {
         hit.map(|(t, b)| [t.to_bits(), b.x.to_bits(), b.y.to_bits()])
+    }
+
+    /// Columns taken in an order hold, at entry `j`, triangle `order[j]`,
+    /// across several of the blocks filled in parallel, and zeros past the end.
+    #[test]
+    fn columns_in_order_hold_the_ordered_triangles() {
+        let mut rng = StdRng::seed_from_u64(3);
+        let n = 10_007;
+        let tris: Vec<[Vec3; 3]> =
+            (0..n).map(|_| [(); 3].map(|_| Vec3::new(rng.gen(), rng.gen(), rng.gen()))).collect();
+        let mut order: Vec<u32> = (0..n as u32).collect();
+        (0..n).for_each(|i| order.swap(i, rng.gen_range(0..n)));
+        let columns = TriangleColumns::in_order(&tris, &order);
+        assert_eq!(columns.len(), n);
+        assert!((0..n).all(|j| columns.get(j) == tris[order[j] as usize]));
+        assert!((0..9).all(|c| columns.lanes(c, n) == f32x8::ZERO));
+        assert!((0..n).all(|j| TriangleColumns::new(&tris).get(j) == tris[j]));
     }
 
     /// Eight lanes answer what eight one-triangle tests answer, bit for bit:

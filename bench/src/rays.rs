@@ -134,6 +134,7 @@ fn time_rays(scene: &Scene, frames: usize) -> (f64, f64, f64) {
     let mut builds = Vec::new();
     let mut trace = TraceScene::new(scene);
     for _ in 0..5 {
+        drop(trace); // freed outside the timing, as the peer releases its scene
         let t = std::time::Instant::now();
         trace = TraceScene::new(scene);
         builds.push(t.elapsed().as_secs_f64() * 1e3);

@@ -154,30 +154,30 @@ impl TraceScene {
 
     /// The mesh objects' triangles in world space, with their ids.
     fn mesh_triangles(scene: &Scene) -> (Vec<[Vec3; 3]>, Vec<ItemId>) {
-        let (triangles, items): (Vec<[Vec3; 3]>, Vec<ItemId>) = scene
+        let meshes: Vec<_> = scene
             .objects
-            .par_iter()
+            .iter()
             .enumerate()
-            .filter_map(|(o, obj)| Some((o, obj.triangles()?, obj.transform)))
-            .flat_map_iter(|(o, mesh, m)| {
-                mesh.triangles.iter().enumerate().map(move |(t, tri)| {
-                    let p = tri.map(|i| m.transform_point3(mesh.positions[i as usize]));
-                    (p, ItemId { object: o as u32, triangle: t as u32 })
-                })
-            })
-            .unzip();
+            .filter_map(|(o, obj)| Some((o as u32, obj.triangles()?, obj.transform)))
+            .collect();
+        let total = meshes.iter().map(|m| m.1.triangles.len()).sum();
+        let (mut triangles, mut items) = (Vec::with_capacity(total), Vec::with_capacity(total));
+        for (object, mesh, m) in meshes {
+            let world = |tri: &[u32; 3]| tri.map(|i| m.transform_point3(mesh.positions[i as usize]));
+            triangles.par_extend(mesh.triangles.par_iter().with_min_len(1 << 12).map(world));
+            let n = mesh.triangles.len() as u32;
+            items.par_extend((0..n).into_par_iter().map(|triangle| ItemId { object, triangle }));
+        }
         (triangles, items)
     }
 
     /// A trace scene over explicit world-space triangles and their ids.
     #[must_use]
     pub fn from_triangles(triangles: Vec<[Vec3; 3]>, items: Vec<ItemId>) -> TraceScene {
-        let bounds: Vec<Aabb> = triangles.par_iter().map(|t| Aabb::around(t)).collect();
-        let mut bvh = Bvh::build(&bounds);
+        let mut bvh = Bvh::build_by(triangles.len(), |i| Aabb::around(&triangles[i]));
         let order = bvh.renumber();
-        let triangles: Vec<[Vec3; 3]> = order.iter().map(|&i| triangles[i as usize]).collect();
-        let triangles = TriangleColumns::new(&triangles);
-        let items = order.iter().map(|&i| items[i as usize]).collect();
+        let items = order.par_iter().map(|&i| items[i as usize]).collect();
+        let triangles = TriangleColumns::in_order(&triangles, &order);
         TraceScene { triangles, items, solids: Vec::new(), bvh, casters: Vec::new(), cutouts: Vec::new() }
     }
 
