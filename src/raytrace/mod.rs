@@ -124,7 +124,7 @@ impl TraceScene {
         let n = triangles.len();
         let mut bounds: Vec<Aabb> = triangles.par_iter().map(|t| Aabb::around(t)).collect();
         bounds.extend(solids.iter().map(|s| s.2));
-        let mut bvh = Bvh::build(&bounds);
+        let mut bvh = Bvh::build_lanes(bounds.len(), |i| bounds[i]);
         let order = bvh.renumber();
         let mut solids: Vec<Option<(u32, CsgSolid)>> = solids.into_iter().map(|(o, s, _)| Some((o, s))).collect();
         let mut leaves = Vec::with_capacity(order.len());
@@ -174,7 +174,7 @@ impl TraceScene {
     /// A trace scene over explicit world-space triangles and their ids.
     #[must_use]
     pub fn from_triangles(triangles: Vec<[Vec3; 3]>, items: Vec<ItemId>) -> TraceScene {
-        let mut bvh = Bvh::build_by(triangles.len(), |i| Aabb::around(&triangles[i]));
+        let mut bvh = Bvh::build_lanes(triangles.len(), |i| Aabb::around(&triangles[i]));
         let order = bvh.renumber();
         let items = order.par_iter().map(|&i| items[i as usize]).collect();
         let triangles = TriangleColumns::in_order(&triangles, &order);
