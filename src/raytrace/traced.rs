@@ -20,6 +20,15 @@
 //! ray-traced truth falls from 0.037 to 0.013 RMSE (at 320×180: the test
 //! `reflections_are_refined_where_what_they_show_has_edges`).
 //!
+//! Neighbouring traced pixels of a row are traced eight at a time: their
+//! mirror rays, then their refracted rays, walk the BVH together
+//! ([`Tracer::bounces_packet`]), each pixel getting the light it gets alone.
+//! The traced term at 1920×1080 (`kage-bench hybrid --frames 5`, one run,
+//! alternated with pixels traced one at a time, 2-core EPYC VM): 72 → 69.5
+//! ms on `showroom.toml`, 89 → 77 ms on `reflections.toml`, 154 → 130 ms
+//! with its eye at 0.8× (shading and shadow rays, one ray at a time, are
+//! the rest).
+//!
 //! The other way, for a preview whose camera moves: [`Refine::Sparse`]
 //! traces one pixel of each 2 × 2 block and gives the others the mean of
 //! the nearest traced pixels that show the same object (a bilinear
@@ -38,6 +47,7 @@ use rayon::prelude::*;
 
 use super::tracer::{ShadowRay, Tracer};
 use super::TraceCache;
+use crate::bvh::PACKET;
 use crate::image::LinearImage;
 use crate::scene::Scene;
 use crate::shading::subpixel::SampleSurface;
@@ -93,11 +103,30 @@ pub fn add_traced(
         let item = vb.item(x as u32, y as u32);
         !item.is_none() && scene.materials[item.material(scene)].traces()
     };
-    let sample = |x: usize, y: usize, offset: Vec2| {
+    let surface = |x: usize, y: usize, offset: Vec2| {
         let ray = rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5) + offset);
         let mut s = frames.surface_at(scene, vb, x as u32, y as u32, &ray);
         normal_map::apply(&scene.materials[s.material], &mut s);
+        (ray, s)
+    };
+    let sample = |x: usize, y: usize, offset: Vec2| {
+        let (ray, s) = surface(x, y, offset);
         tracer.bounces(&ray, &s, depth)
+    };
+    // The centre samples of pixels `xs` of row `y`, handed to `put(i, light)`
+    // (`i` indexing `xs`): up to eight neighbours' secondary rays walked
+    // together (coherent where they leave one mirror).
+    let samples_in_row = |y: usize, xs: &[usize], put: &mut dyn FnMut(usize, Vec3)| {
+        for (c, chunk) in xs.chunks(PACKET).enumerate() {
+            let (mut rays, mut surfaces) = (Vec::with_capacity(PACKET), Vec::with_capacity(PACKET));
+            for &x in chunk {
+                let (ray, s) = surface(x, y, Vec2::ZERO);
+                rays.push(ray);
+                surfaces.push(s);
+            }
+            let light = tracer.bounces_packet(&rays, &surfaces, depth);
+            (0..chunk.len()).for_each(|k| put(c * PACKET + k, light[k]));
+        }
     };
     // The pixels the buffer holds are traced (the whole image but for a
     // tile), into `image`, which holds them too.
@@ -115,15 +144,10 @@ pub fn add_traced(
      -> usize {
         let rows = out.par_chunks_mut(stride).enumerate();
         rows.map(|(y, row)| {
-            let (mut count, y) = (0, y + origin.1);
-            for (x, px) in row[cols.clone()].iter_mut().enumerate() {
-                let x = x + cols.start + origin.0;
-                if traces(x, y) {
-                    put(px, sample(x, y, Vec2::ZERO));
-                    count += 1;
-                }
-            }
-            count
+            let y = y + origin.1;
+            let xs: Vec<usize> = cols.clone().map(|x| x + origin.0).filter(|&x| traces(x, y)).collect();
+            samples_in_row(y, &xs, &mut |i, light| put(&mut row[xs[i] - origin.0], light));
+            xs.len()
         })
         .sum()
     };
@@ -155,12 +179,11 @@ pub fn add_traced(
                 .par_chunks_mut(cw.max(1))
                 .enumerate()
                 .map(|(cy, row)| {
-                    let (mut count, y) = (0, 2 * (cy + cy0));
-                    for (x, c) in (2 * cx0..).step_by(2).zip(row).filter(|&(x, _)| held(x, y) && traces(x, y)) {
-                        *c = sample(x, y, Vec2::ZERO);
-                        count += 1;
-                    }
-                    count
+                    let y = 2 * (cy + cy0);
+                    let xs: Vec<usize> =
+                        (2 * cx0..).step_by(2).take(row.len()).filter(|&x| held(x, y) && traces(x, y)).collect();
+                    samples_in_row(y, &xs, &mut |i, light| row[xs[i] / 2 - cx0] = light);
+                    xs.len()
                 })
                 .sum();
             let object = |x: usize, y: usize| vb.item(x as u32, y as u32).object;

@@ -196,29 +196,80 @@ impl<'a, L: LightRays> Tracer<'a, L> {
 
     /// [`Tracer::bounces`] with at most `rays` left of the call's budget.
     fn bounces_within(&self, ray: &Ray, s: &SurfacePoint, depth: u32, rays: &Cell<u32>) -> Vec3 {
+        let mut out = Vec3::ZERO;
+        for (next, weight) in self.secondary(ray, s, depth).into_iter().flatten() {
+            out += weight * self.through_layers(&next, Seen::Bounced, depth - 1, MAX_LAYERS, rays);
+        }
+        out
+    }
+
+    /// [`Tracer::bounces`] at up to [`PACKET`] surfaces seen along coherent
+    /// rays (neighbouring pixels of a mirror): their mirror rays are walked
+    /// together, then their refracted rays
+    /// ([`TraceScene::intersect_packet`]); each lane's light is the one
+    /// [`Tracer::bounces`] finds for it.
+    ///
+    /// # Panics
+    /// If `rays` is empty, longer than [`PACKET`], or not as long as
+    /// `surfaces`.
+    #[must_use]
+    pub fn bounces_packet(&self, rays: &[Ray], surfaces: &[SurfacePoint], depth: u32) -> [Vec3; PACKET] {
+        assert!((1..=PACKET).contains(&rays.len()), "{} rays in a packet", rays.len());
+        assert_eq!(rays.len(), surfaces.len(), "a surface a ray");
+        let mut out = [Vec3::ZERO; PACKET];
+        let budgets: [Cell<u32>; PACKET] = std::array::from_fn(|_| Cell::new(MAX_RAYS));
+        let secondary: [[Option<(Ray, Vec3)>; 2]; PACKET] =
+            std::array::from_fn(|k| rays.get(k).map_or([None, None], |ray| self.secondary(ray, &surfaces[k], depth)));
+        // The mirror rays first, then the refracted ones, as one lane's
+        // bounces spend its budget.
+        for which in 0..2 {
+            let (mut lanes, mut packet, mut n) = ([(0, Vec3::ZERO); PACKET], [rays[0]; PACKET], 0);
+            for (k, (next, weight)) in secondary.iter().enumerate().filter_map(|(k, pair)| Some((k, pair[which]?))) {
+                (lanes[n], packet[n], n) = ((k, weight), next, n + 1);
+            }
+            if n == 0 {
+                continue;
+            }
+            let hits = self.trace.intersect_packet(&packet[..n], f32::INFINITY);
+            for (((k, weight), next), hit) in lanes.into_iter().zip(packet).zip(hits).take(n) {
+                // As `through_layers`, with the hit found for the packet.
+                let budget = &budgets[k];
+                let light = if budget.get() == 0 {
+                    self.scene.background_along(next.dir)
+                } else {
+                    budget.set(budget.get() - 1);
+                    self.shade(&next, hit, Seen::Bounced, depth - 1, MAX_LAYERS, budget)
+                };
+                out[k] += weight * light;
+            }
+        }
+        out
+    }
+
+    /// The rays IrayTracing follows from `s` (seen along `ray`) with their
+    /// weights: the mirror ray (Kr) and the refracted one (Kt; total
+    /// internal reflection sends it back in). None when `depth` is 0 or the
+    /// material neither reflects nor refracts.
+    fn secondary(&self, ray: &Ray, s: &SurfacePoint, depth: u32) -> [Option<(Ray, Vec3)>; 2] {
         let m = &self.scene.materials[s.material];
         if depth == 0 || !m.traces() {
-            return Vec3::ZERO;
+            return [None, None];
         }
         let d = ray.dir;
-        let mut out = Vec3::ZERO;
-        if m.kr.max_element() > 0.0 {
+        let mirror = (m.kr.max_element() > 0.0).then(|| {
             let n = facing(d, s.normal);
-            let r = reflect(d, n);
-            let mirror = Ray { origin: s.position + n * self.epsilon, dir: r };
-            out += m.kr * self.through_layers(&mirror, Seen::Bounced, depth - 1, MAX_LAYERS, rays);
-        }
-        if m.kt.max_element() > 0.0 {
+            (Ray { origin: s.position + n * self.epsilon, dir: reflect(d, n) }, m.kr)
+        });
+        let refracted = (m.kt.max_element() > 0.0).then(|| {
             // Entering when the ray meets the front (outward) side of the surface.
             let eta = if s.front { 1.0 / m.ior } else { m.ior };
             let (dir, sign) = match refract(d, s.normal, eta) {
                 Some(t) => (t, -1.0),
                 None => (reflect(d, s.normal), 1.0),
             };
-            let origin = s.position + s.normal * (sign * self.epsilon);
-            out += m.kt * self.through_layers(&Ray { origin, dir }, Seen::Bounced, depth - 1, MAX_LAYERS, rays);
-        }
-        out
+            (Ray { origin: s.position + s.normal * (sign * self.epsilon), dir }, m.kt)
+        });
+        [mirror, refracted]
     }
 }
 
@@ -273,6 +324,69 @@ mod tests {
         assert!(reflect(d, away).dot(away) < 0.0, "about the untilted normal it would enter the surface");
         let towards = Vec3::new(-0.6, 0.8, 0.0);
         assert_eq!(facing(d, towards), towards, "a normal that faces the ray is kept");
+    }
+
+    /// Eight neighbours' bounces walked together equal each one's bounces
+    /// alone, bit for bit: a mirror floor, a glass sphere (mirror and
+    /// refracted rays, total internal reflection), a diffuse box (no
+    /// secondary ray), packets of 1 to 8 rays, at depths 0 to 3.
+    #[test]
+    fn bounces_in_packets_equal_bounces_one_at_a_time() {
+        use crate::scene::mesh::shapes;
+        use crate::scene::{Light, Material, Object};
+        use glam::{Affine3A, Vec2};
+        use std::sync::Arc;
+        let camera = crate::camera::Camera {
+            eye: Vec3::new(0.3, 2.0, 5.0),
+            target: Vec3::ZERO,
+            up: Vec3::Y,
+            near: 0.1,
+            far: 40.0,
+            projection: crate::camera::Projection::Perspective { fov_y_deg: 50.0 },
+            shift: Vec2::ZERO,
+        };
+        let mut scene = Scene::new(64, 48, camera);
+        let mirror = Material { kr: Vec3::splat(0.8), ..Material::default() };
+        let glass = Material { kr: Vec3::splat(0.1), kt: Vec3::splat(0.9), ior: 1.5, ..Material::default() };
+        scene.materials = vec![mirror, glass, Material::default()];
+        let floor = Affine3A::from_translation(Vec3::new(0.0, -1.0, 0.0)) * Affine3A::from_scale(Vec3::splat(8.0));
+        scene.objects.push(Object::mesh("floor", Arc::new(shapes::plane()), floor, 0));
+        scene.objects.push(Object::mesh("ball", Arc::new(shapes::sphere(24)), Affine3A::IDENTITY, 1));
+        let at = Affine3A::from_translation(Vec3::new(1.8, -0.5, -1.0)) * Affine3A::from_scale(Vec3::splat(0.5));
+        scene.objects.push(Object::mesh("box", Arc::new(shapes::cube()), at, 2));
+        let lamp = LightKind::Point { position: Vec3::new(2.0, 5.0, 3.0) };
+        scene.lights = vec![Light { kind: lamp, ambient: 0.1, ..Light::default() }];
+        let trace = TraceScene::new(&scene);
+        let frames = ObjectFrames::new(&scene);
+        let tracer = Tracer::new(&scene, &trace, &frames, ShadowRay);
+        let pixel_rays = scene.camera.pixel_rays(Vec2::new(64.0, 48.0));
+        let (mut packets, mut traced) = (0, 0);
+        for y in 0..48 {
+            for x0 in (0..64).step_by(PACKET) {
+                let n = 1 + (x0 / PACKET + y) % PACKET;
+                let (mut rays, mut surfaces) = (Vec::new(), Vec::new());
+                for x in x0..x0 + n {
+                    let ray = pixel_rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
+                    let Some(hit) = trace.intersect(&ray, f32::INFINITY) else { continue };
+                    surfaces.push(frames.prepare(&scene, hit.item).surface(&ray));
+                    rays.push(ray);
+                }
+                if rays.is_empty() {
+                    continue;
+                }
+                for depth in 0..4 {
+                    let together = tracer.bounces_packet(&rays, &surfaces, depth);
+                    for k in 0..rays.len() {
+                        let alone = tracer.bounces(&rays[k], &surfaces[k], depth);
+                        assert_eq!(together[k].to_array().map(f32::to_bits), alone.to_array().map(f32::to_bits));
+                        traced += usize::from(depth > 0 && alone != Vec3::ZERO);
+                    }
+                    assert!(together[rays.len()..].iter().all(|&c| c == Vec3::ZERO), "lanes past the rays stay dark");
+                }
+                packets += 1;
+            }
+        }
+        assert!(packets > 100 && traced > 1000, "{packets} packets, {traced} lanes with light bounced");
     }
 
     /// Five nested mirror-glass translucent spheres: each layer a ray
