@@ -318,59 +318,6 @@ impl TraceScene {
         })
     }
 
-    /// [`TraceScene::occluded`] of up to [`PACKET`] rays walked through the
-    /// BVH together (shadow rays from neighbouring points towards one
-    /// light), ray `k` looking as far as `t_max[k]`, for the bits `k` of
-    /// `lanes` (the other lanes' rays should repeat one of them, as a
-    /// packet's span covers every lane). Returns a bit per ray that something
-    /// stops: each the answer the ray gets alone. A limit must not be NaN.
-    #[must_use]
-    pub fn occluded_packet(&self, rays: &[Ray; PACKET], t_max: [f32; PACKET], lanes: u32) -> u32 {
-        let casts = |object: u32| self.casters.is_empty() || self.casters[object as usize];
-        let sheared = RayLanes::new(rays);
-        let mut t = t_max;
-        // A stopped ray's limit becomes NaN: no box is entered before it, and
-        // it tells the stopped rays apart.
-        let stop = |k: usize, t: &mut [f32; PACKET]| t[k] = f32::NAN;
-        let stopped = |t: &[f32; PACKET]| (0..PACKET).filter(|&k| t[k].is_nan()).fold(0u32, |m, k| m | 1 << k);
-        self.bvh.intersect_packet_leaves(&sheared, lanes, &mut t, |leaf, mask, t| {
-            let leaves = Self::range(leaf);
-            let stops = |i: usize, b: Vec2| casts(self.items[i].object) && self.keeps(self.items[i], b);
-            if (mask.count_ones() as usize) < leaves.len() {
-                for k in set_bits(mask) {
-                    let sr = sheared.lane(k);
-                    let hit = leaves.clone().step_by(LANES).any(|start| {
-                        let count = (leaves.end - start).min(LANES);
-                        let lanes = sr.intersect_lanes(&self.triangles, start, count, 0.0, t[k]);
-                        lanes.lanes().any(|j| stops(start + j, Vec2::new(lanes.b1[j], lanes.b2[j])))
-                    });
-                    if hit {
-                        stop(k, t);
-                    }
-                }
-            } else {
-                for i in leaves.clone() {
-                    let live = mask & !stopped(t);
-                    if live == 0 {
-                        break;
-                    }
-                    let lanes = sheared.intersect_triangle(&self.triangles, i, live, 0.0, f32x8::from(*t));
-                    for k in lanes.lanes().filter(|&k| stops(i, Vec2::new(lanes.b1[k], lanes.b2[k]))) {
-                        stop(k, t);
-                    }
-                }
-            }
-            for (_, object, caster) in self.solids_in(&leaves) {
-                for k in set_bits(mask & !stopped(t)) {
-                    if casts(*object) && caster.first_hit(&rays[k], 0.0, t[k]).is_some() {
-                        stop(k, t);
-                    }
-                }
-            }
-        });
-        stopped(&t) & lanes
-    }
-
     /// Number of leaves (triangles and solids).
     #[must_use]
     pub fn len(&self) -> usize {

@@ -33,21 +33,6 @@ pub trait LightRays: Sync {
     /// The share of `light` seen from `origin` (the surface point `at`, nudged
     /// off its surface) through `trace`; `salt` tells sample patterns apart.
     fn lit(&self, trace: &TraceScene, light: &Light, origin: Vec3, at: Vec3, salt: u32) -> f32;
-
-    /// [`LightRays::lit`] at up to [`PACKET`] points at once: lane `k`,
-    /// for each bit `k` of `lanes`, from `origins[k]` at `at[k]` (the other
-    /// lanes answer 1). Unless a tracer knows better, one point at a time.
-    fn lit_packet(
-        &self,
-        trace: &TraceScene,
-        light: &Light,
-        origins: &[Vec3; PACKET],
-        at: &[Vec3; PACKET],
-        salt: u32,
-        lanes: u32,
-    ) -> [f32; PACKET] {
-        std::array::from_fn(|k| if lanes >> k & 1 == 1 { self.lit(trace, light, origins[k], at[k], salt) } else { 1.0 })
-    }
 }
 
 /// One shadow ray to each light: to its centre, or along a directional light.
@@ -56,42 +41,15 @@ pub struct ShadowRay;
 
 impl LightRays for ShadowRay {
     fn lit(&self, trace: &TraceScene, light: &Light, origin: Vec3, _at: Vec3, _salt: u32) -> f32 {
-        let (ray, t_max) = shadow_ray(light, origin);
-        f32::from(u8::from(!trace.occluded(&ray, t_max)))
+        match light.kind {
+            LightKind::Directional { direction } => {
+                f32::from(u8::from(!trace.occluded(&Ray { origin, dir: -direction }, f32::INFINITY)))
+            }
+            LightKind::Point { position } | LightKind::Spot { position, .. } => {
+                f32::from(u8::from(!occluded_towards(trace, origin, position)))
+            }
+        }
     }
-
-    /// The eight shadow rays walked together
-    /// ([`TraceScene::occluded_packet`]).
-    fn lit_packet(
-        &self,
-        trace: &TraceScene,
-        light: &Light,
-        origins: &[Vec3; PACKET],
-        _at: &[Vec3; PACKET],
-        _salt: u32,
-        lanes: u32,
-    ) -> [f32; PACKET] {
-        let rays = origins.map(|o| shadow_ray(light, o));
-        let blocked = trace.occluded_packet(&rays.map(|r| r.0), rays.map(|r| r.1), lanes);
-        std::array::from_fn(|k| f32::from(u8::from(blocked >> k & 1 == 0)))
-    }
-}
-
-/// The shadow ray from `origin` to `light` and how far it looks: to a
-/// point or spot light's position (short of it by a relative hair, so the
-/// light itself does not count), or along a directional light without end.
-fn shadow_ray(light: &Light, origin: Vec3) -> (Ray, f32) {
-    match light.kind {
-        LightKind::Directional { direction } => (Ray { origin, dir: -direction }, f32::INFINITY),
-        LightKind::Point { position } | LightKind::Spot { position, .. } => towards(origin, position),
-    }
-}
-
-/// The ray from `origin` to `target` and its length, less a relative hair.
-fn towards(origin: Vec3, target: Vec3) -> (Ray, f32) {
-    let to = target - origin;
-    let dist = to.length();
-    (Ray { origin, dir: to / dist }, dist * (1.0 - 1e-4))
 }
 
 /// Every light reaches every point (no shadow rays).
@@ -108,22 +66,9 @@ impl LightRays for Unshadowed {
 /// relative hair, so the light's own position does not count).
 #[must_use]
 pub fn occluded_towards(trace: &TraceScene, origin: Vec3, target: Vec3) -> bool {
-    let (ray, t_max) = towards(origin, target);
-    trace.occluded(&ray, t_max)
-}
-
-/// A surface a ray meets, ready to be lit.
-struct Met {
-    s: SurfacePoint,
-    k: phong::Coefficients,
-    /// Its opacity there (material and alpha map).
-    alpha: f32,
-    object: u32,
-}
-
-/// Whether `light` reaches `object` (selective lighting, seed 002 §3.3).
-fn reaches(light: &Light, object: u32) -> bool {
-    light.only.as_ref().is_none_or(|o| o.contains(&(object as usize)))
+    let to = target - origin;
+    let dist = to.length();
+    trace.occluded(&Ray { origin, dir: to / dist }, dist * (1.0 - 1e-4))
 }
 
 /// Where a ray comes from, which decides whether single-sided back faces
@@ -184,9 +129,12 @@ impl<'a, L: LightRays> Tracer<'a, L> {
     #[must_use]
     pub fn radiance_packet(&self, rays: &[Ray], depth: u32) -> ([Vec3; PACKET], [Option<Hit>; PACKET]) {
         let hits = self.trace.intersect_packet(rays, f32::INFINITY);
-        let budgets: [Cell<u32>; PACKET] = std::array::from_fn(|_| Cell::new(MAX_RAYS - 1));
-        let live = (1u32 << rays.len()) - 1;
-        (self.shade_packet(rays, &hits, live, Seen::FromEye, depth, budgets.each_ref()), hits)
+        let light = std::array::from_fn(|k| {
+            rays.get(k).map_or(Vec3::ZERO, |ray| {
+                self.shade(ray, hits[k], Seen::FromEye, depth, MAX_LAYERS, &Cell::new(MAX_RAYS - 1))
+            })
+        });
+        (light, hits)
     }
 
     /// The light leaving `hit` (the first surface along `ray`, if any) back
@@ -194,56 +142,6 @@ impl<'a, L: LightRays> Tracer<'a, L> {
     /// bounces.
     fn shade(&self, ray: &Ray, hit: Option<Hit>, seen: Seen, depth: u32, layers: u32, rays: &Cell<u32>) -> Vec3 {
         let Some(hit) = hit else { return self.scene.background_along(ray.dir) };
-        let met = self.meet(ray, hit);
-        let lit = |i: usize, light: &Light| {
-            self.lights.lit(self.trace, light, self.shadow_origin(&met.s), met.s.position, i as u32)
-        };
-        self.light_met(ray, &met, seen, depth, layers, rays, lit)
-    }
-
-    /// [`Tracer::shade`] of up to [`PACKET`] coherent rays and their hits,
-    /// the lanes of `live` (the others come back black): each light's shadow
-    /// rays from the lanes' surfaces asked together
-    /// ([`LightRays::lit_packet`]); each lane's light is the one
-    /// [`Tracer::shade`] finds, `budgets[k]` being lane `k`'s.
-    fn shade_packet(
-        &self,
-        rays: &[Ray],
-        hits: &[Option<Hit>; PACKET],
-        live: u32,
-        seen: Seen,
-        depth: u32,
-        budgets: [&Cell<u32>; PACKET],
-    ) -> [Vec3; PACKET] {
-        let mets: [Option<Met>; PACKET] =
-            std::array::from_fn(|k| (live >> k & 1 == 1).then(|| Some(self.meet(rays.get(k)?, hits[k]?))).flatten());
-        let shadows: Vec<[f32; PACKET]> = (self.scene.lights.iter().enumerate())
-            .map(|(i, light)| {
-                let (mut wanted, mut origins, mut at) = (0u32, [Vec3::ZERO; PACKET], [Vec3::ZERO; PACKET]);
-                for (k, met) in mets.iter().enumerate() {
-                    let Some(met) = met else { continue };
-                    if light.casts_shadows() && reaches(light, met.object) && !self.passes_through(met, seen) {
-                        (wanted, origins[k], at[k]) = (wanted | 1 << k, self.shadow_origin(&met.s), met.s.position);
-                    }
-                }
-                if wanted == 0 {
-                    [1.0; PACKET]
-                } else {
-                    self.lights.lit_packet(self.trace, light, &origins, &at, i as u32, wanted)
-                }
-            })
-            .collect();
-        std::array::from_fn(|k| match (rays.get(k), &mets[k]) {
-            (Some(ray), Some(met)) => {
-                self.light_met(ray, met, seen, depth, MAX_LAYERS, budgets[k], |i, _| shadows[i][k])
-            }
-            (Some(ray), None) if live >> k & 1 == 1 => self.scene.background_along(ray.dir),
-            _ => Vec3::ZERO,
-        })
-    }
-
-    /// The surface `hit` is, seen along `ray`, its maps sampled.
-    fn meet(&self, ray: &Ray, hit: Hit) -> Met {
         let mut s = match hit.item.primitive() {
             // A solid: its tangent plane at the hit, which the ray meets there.
             Some(_) => ObjectFrames::tangent(self.scene, hit.item, ray.at(hit.t), hit.normal).surface(ray),
@@ -253,40 +151,6 @@ impl<'a, L: LightRays> Tracer<'a, L> {
         let (uv, duv) = s.coords(material.alpha_set());
         let alpha = material.alpha_at(uv, duv);
         let k = phong::sample_maps(material, &mut s);
-        Met { s, k, alpha, object: hit.item.object }
-    }
-
-    /// Whether a ray passes through `met` to what lies behind: a back face
-    /// the eye's pass culls; a bounced ray meets the inside of a glass it is
-    /// in, but not a translucent back face, which the polygon pass never
-    /// draws.
-    fn passes_through(&self, met: &Met, seen: Seen) -> bool {
-        let material = &self.scene.materials[met.s.material];
-        !material.two_sided && !met.s.front && (seen == Seen::FromEye || material.translucent())
-    }
-
-    /// Where the shadow rays from `s` start: nudged off the surface.
-    fn shadow_origin(&self, s: &SurfacePoint) -> Vec3 {
-        s.position + s.normal * self.epsilon
-    }
-
-    /// The light leaving `met` (met along `ray`) back along the ray, with what
-    /// lies behind a translucent surface and the bounces; `lit(i, light)` is
-    /// the share of light `i` reaching it (asked only for a light that casts
-    /// shadows and reaches it).
-    #[expect(clippy::too_many_arguments, reason = "shade's state, passed down as it is")]
-    fn light_met(
-        &self,
-        ray: &Ray,
-        met: &Met,
-        seen: Seen,
-        depth: u32,
-        layers: u32,
-        rays: &Cell<u32>,
-        lit: impl Fn(usize, &Light) -> f32,
-    ) -> Vec3 {
-        let Met { s, k, alpha, object } = met;
-        let material = &self.scene.materials[s.material];
         let behind = || {
             let next = Ray { origin: s.position + ray.dir * self.epsilon, dir: ray.dir };
             if layers > 0 {
@@ -295,18 +159,26 @@ impl<'a, L: LightRays> Tracer<'a, L> {
                 self.scene.background_along(ray.dir)
             }
         };
-        if self.passes_through(met, seen) {
+        if !material.two_sided && !s.front && (seen == Seen::FromEye || material.translucent()) {
+            // A back face the eye's pass culls; a bounced ray meets the
+            // inside of a glass it is in, but not a translucent back face,
+            // which the polygon pass never draws.
             return behind();
         }
         let mut acc = Components { emission: k.parts().3, ..Default::default() };
         for (i, light) in self.scene.lights.iter().enumerate() {
-            if !reaches(light, *object) {
+            if light.only.as_ref().is_some_and(|o| !o.contains(&(hit.item.object as usize))) {
                 continue; // selective lighting (seed 002 §3.3)
             }
-            let shadow = if light.casts_shadows() { lit(i, light) } else { 1.0 };
-            phong::add_light(&mut acc, light, k, s, shadow);
+            let origin = s.position + s.normal * self.epsilon;
+            let shadow = if light.casts_shadows() {
+                self.lights.lit(self.trace, light, origin, s.position, i as u32)
+            } else {
+                1.0
+            };
+            phong::add_light(&mut acc, light, &k, &s, shadow);
         }
-        let own = acc.total() + reflection_map(self.scene, s) + self.bounces_within(ray, s, depth, rays);
+        let own = acc.total() + reflection_map(self.scene, &s) + self.bounces_within(ray, &s, depth, rays);
         if material.translucent() {
             alpha * own + (1.0 - alpha) * behind()
         } else {
@@ -359,20 +231,15 @@ impl<'a, L: LightRays> Tracer<'a, L> {
                 continue;
             }
             let hits = self.trace.intersect_packet(&packet[..n], f32::INFINITY);
-            // As `through_layers`: a lane whose budget is spent sees the
-            // background.
-            let mut live = 0u32;
-            for (j, &(k, _)) in lanes[..n].iter().enumerate() {
+            for (((k, weight), next), hit) in lanes.into_iter().zip(packet).zip(hits).take(n) {
+                // As `through_layers`, with the hit found for the packet.
                 let budget = &budgets[k];
-                if budget.get() > 0 {
+                let light = if budget.get() == 0 {
+                    self.scene.background_along(next.dir)
+                } else {
                     budget.set(budget.get() - 1);
-                    live |= 1 << j;
-                }
-            }
-            let lane_budgets = std::array::from_fn(|j| &budgets[lanes[j].0]);
-            let light = self.shade_packet(&packet[..n], &hits, live, Seen::Bounced, depth - 1, lane_budgets);
-            for (j, &(k, weight)) in lanes[..n].iter().enumerate() {
-                let light = if live >> j & 1 == 1 { light[j] } else { self.scene.background_along(packet[j].dir) };
+                    self.shade(&next, hit, Seen::Bounced, depth - 1, MAX_LAYERS, budget)
+                };
                 out[k] += weight * light;
             }
         }
@@ -445,7 +312,6 @@ pub fn refract(d: Vec3, n: Vec3, eta: f32) -> Option<Vec3> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::triangle::set_bits;
 
     #[test]
     fn a_normal_facing_away_is_tilted_until_the_mirror_ray_leaves_the_surface() {
@@ -460,13 +326,14 @@ mod tests {
         assert_eq!(facing(d, towards), towards, "a normal that faces the ray is kept");
     }
 
-    /// A mirror floor, a glass ball (mirror and refracted rays, total
-    /// internal reflection), a diffuse box that casts no shadow, a
-    /// translucent pane, a point light and a directional one reaching all
-    /// but the box.
-    fn packet_scene() -> Scene {
+    /// Eight neighbours' bounces walked together equal each one's bounces
+    /// alone, bit for bit: a mirror floor, a glass sphere (mirror and
+    /// refracted rays, total internal reflection), a diffuse box (no
+    /// secondary ray), packets of 1 to 8 rays, at depths 0 to 3.
+    #[test]
+    fn bounces_in_packets_equal_bounces_one_at_a_time() {
         use crate::scene::mesh::shapes;
-        use crate::scene::{Material, Object};
+        use crate::scene::{Light, Material, Object};
         use glam::{Affine3A, Vec2};
         use std::sync::Arc;
         let camera = crate::camera::Camera {
@@ -481,34 +348,14 @@ mod tests {
         let mut scene = Scene::new(64, 48, camera);
         let mirror = Material { kr: Vec3::splat(0.8), ..Material::default() };
         let glass = Material { kr: Vec3::splat(0.1), kt: Vec3::splat(0.9), ior: 1.5, ..Material::default() };
-        let pane = Material { opacity: 0.4, two_sided: true, ..Material::default() };
-        scene.materials = vec![mirror, glass, Material::default(), pane];
+        scene.materials = vec![mirror, glass, Material::default()];
         let floor = Affine3A::from_translation(Vec3::new(0.0, -1.0, 0.0)) * Affine3A::from_scale(Vec3::splat(8.0));
         scene.objects.push(Object::mesh("floor", Arc::new(shapes::plane()), floor, 0));
         scene.objects.push(Object::mesh("ball", Arc::new(shapes::sphere(24)), Affine3A::IDENTITY, 1));
         let at = Affine3A::from_translation(Vec3::new(1.8, -0.5, -1.0)) * Affine3A::from_scale(Vec3::splat(0.5));
-        let mut cube = Object::mesh("box", Arc::new(shapes::cube()), at, 2);
-        cube.casts_shadows = false;
-        scene.objects.push(cube);
-        let at =
-            Affine3A::from_translation(Vec3::new(-1.5, 0.5, 0.5)) * Affine3A::from_scale(Vec3::new(0.8, 1.2, 0.05));
-        scene.objects.push(Object::mesh("pane", Arc::new(shapes::cube()), at, 3));
+        scene.objects.push(Object::mesh("box", Arc::new(shapes::cube()), at, 2));
         let lamp = LightKind::Point { position: Vec3::new(2.0, 5.0, 3.0) };
-        let sun = LightKind::Directional { direction: Vec3::new(-0.3, -1.0, -0.4).normalize() };
-        scene.lights = vec![
-            Light { kind: lamp, ambient: 0.1, ..Light::default() },
-            Light { kind: sun, intensity: 0.5, only: Some(vec![0, 1, 3]), ..Light::default() },
-        ];
-        scene
-    }
-
-    /// Eight neighbours' bounces walked together equal each one's bounces
-    /// alone, bit for bit (their shadow rays asked together too), packets of
-    /// 1 to 8 rays, at depths 0 to 3.
-    #[test]
-    fn bounces_in_packets_equal_bounces_one_at_a_time() {
-        use glam::Vec2;
-        let scene = packet_scene();
+        scene.lights = vec![Light { kind: lamp, ambient: 0.1, ..Light::default() }];
         let trace = TraceScene::new(&scene);
         let frames = ObjectFrames::new(&scene);
         let tracer = Tracer::new(&scene, &trace, &frames, ShadowRay);
@@ -540,49 +387,6 @@ mod tests {
             }
         }
         assert!(packets > 100 && traced > 1000, "{packets} packets, {traced} lanes with light bounced");
-    }
-
-    /// Eight primary rays shaded together (first hits and each light's
-    /// shadow rays walked as packets) see what each sees alone, bit for bit,
-    /// and shadow rays walked together are stopped as each alone is.
-    #[test]
-    fn radiance_and_shadows_in_packets_equal_one_ray_at_a_time() {
-        use glam::Vec2;
-        let scene = packet_scene();
-        let trace = TraceScene::new(&scene);
-        let frames = ObjectFrames::new(&scene);
-        let tracer = Tracer::new(&scene, &trace, &frames, ShadowRay);
-        let pixel_rays = scene.camera.pixel_rays(Vec2::new(64.0, 48.0));
-        let (mut shadowed, mut lit) = (0, 0);
-        for y in (0..48).step_by(2) {
-            for x0 in (0..64).step_by(4) {
-                let n = 1 + (x0 / 4 + y) % PACKET;
-                let rays: Vec<Ray> = (0..n)
-                    .map(|k| pixel_rays.ray(Vec2::new((x0 + k % 4) as f32 + 0.5, (y + k / 4) as f32 + 0.5)))
-                    .collect();
-                let (together, hits) = tracer.radiance_packet(&rays, 2);
-                for (k, ray) in rays.iter().enumerate() {
-                    let alone = tracer.radiance(ray, 2);
-                    assert_eq!(together[k].to_array().map(f32::to_bits), alone.to_array().map(f32::to_bits));
-                }
-                // The shadow rays from the hits, towards each light.
-                for light in &scene.lights {
-                    let origins: [Vec3; PACKET] = std::array::from_fn(|k| {
-                        hits[k.min(n - 1)].map_or(Vec3::ZERO, |h| rays[k.min(n - 1)].at(h.t * 0.999))
-                    });
-                    let shadow = origins.map(|o| shadow_ray(light, o));
-                    let lanes = (0..n).filter(|&k| hits[k].is_some()).fold(0u32, |m, k| m | 1 << k);
-                    let blocked = trace.occluded_packet(&shadow.map(|r| r.0), shadow.map(|r| r.1), lanes);
-                    for k in set_bits(lanes) {
-                        let alone = trace.occluded(&shadow[k].0, shadow[k].1);
-                        assert_eq!(blocked >> k & 1 == 1, alone, "lane {k} of {n}");
-                        (shadowed, lit) = (shadowed + usize::from(alone), lit + usize::from(!alone));
-                    }
-                    assert_eq!(blocked & !lanes, 0, "only the lanes asked");
-                }
-            }
-        }
-        assert!(shadowed > 100 && lit > 100, "{shadowed} shadowed, {lit} lit");
     }
 
     /// Five nested mirror-glass translucent spheres: each layer a ray
