@@ -162,11 +162,20 @@ impl TraceScene {
             .collect();
         let total = meshes.iter().map(|m| m.1.triangles.len()).sum();
         let (mut triangles, mut items) = (Vec::with_capacity(total), Vec::with_capacity(total));
+        // A large mesh's triangles in parallel; small ones (a scene of many
+        // parts) one after another, where starting parallel work would cost
+        // more than the work.
         for (object, mesh, m) in meshes {
             let world = |tri: &[u32; 3]| tri.map(|i| m.transform_point3(mesh.positions[i as usize]));
-            triangles.par_extend(mesh.triangles.par_iter().with_min_len(1 << 12).map(world));
             let n = mesh.triangles.len() as u32;
-            items.par_extend((0..n).into_par_iter().map(|triangle| ItemId { object, triangle }));
+            let id = |triangle| ItemId { object, triangle };
+            if n < 1 << 14 {
+                triangles.extend(mesh.triangles.iter().map(world));
+                items.extend((0..n).map(id));
+            } else {
+                triangles.par_extend(mesh.triangles.par_iter().with_min_len(1 << 12).map(world));
+                items.par_extend((0..n).into_par_iter().map(id));
+            }
         }
         (triangles, items)
     }
