@@ -17,7 +17,6 @@
 //! caster's rays (the same intervals, slower). A tile rasterizes the rows it
 //! walks alone.
 
-use std::ops::Range;
 use std::sync::Arc;
 
 use glam::{DVec2, Mat4};
@@ -26,6 +25,7 @@ use rayon::prelude::*;
 use crate::camera::PixelRays;
 use crate::csg::outline::{Extent, Outline};
 use crate::csg::{pick_layer, ClosedMesh, CsgCaster, Hit, Interval, IntervalLanes, MeshInterval, Shape, MESH_FLIP};
+use crate::image::PixelRect;
 
 /// Rows of a band rasterized by one task.
 const BAND: usize = 16;
@@ -56,14 +56,14 @@ struct LayerView {
 
 impl MeshLayers {
     /// The layers of every mesh of `caster`'s solid seen through `vp` (its
-    /// pixel rays `rays`) in a `size` frame, on the rows `rows` (a tile's
-    /// rasterizes its own rows alone).
+    /// pixel rays `rays`) in a `size` frame, on the pixels of `window` (a
+    /// tile's rasterizes its own alone).
     pub(super) fn new(
         caster: &CsgCaster,
         vp: Mat4,
         rays: &PixelRays,
         size: (usize, usize),
-        rows: Range<usize>,
+        window: PixelRect,
     ) -> MeshLayers {
         let primitives = &caster.solid().primitives;
         let mut firsts: Vec<(usize, Arc<ClosedMesh>)> = Vec::new();
@@ -77,7 +77,7 @@ impl MeshLayers {
         }
         let mut out = MeshLayers { of: vec![None; primitives.len()], views: Vec::new() };
         for (first, mesh) in firsts {
-            let Some(view) = LayerView::new(caster, first, &mesh, vp, rays, size, rows.clone()) else { continue };
+            let Some(view) = LayerView::new(caster, first, &mesh, vp, rays, size, window) else { continue };
             let index = out.views.len() as u32;
             for layer in 0..mesh.layers() {
                 out.of[first + layer as usize] = Some((index, layer));
@@ -129,7 +129,8 @@ impl LayerView {
     }
 
     /// The mesh of primitive `first` (its first layer) rasterized on the
-    /// rows `rows`, or `None` when it reaches the eye plane or holds the eye.
+    /// pixels of `window`, or `None` when it reaches the eye plane or holds
+    /// the eye.
     fn new(
         caster: &CsgCaster,
         first: usize,
@@ -137,7 +138,7 @@ impl LayerView {
         vp: Mat4,
         rays: &PixelRays,
         (width, height): (usize, usize),
-        rows: Range<usize>,
+        window: PixelRect,
     ) -> Option<LayerView> {
         let to_solid = caster.solid().primitives[first].transform;
         if !rays.ortho && mesh.contains(to_solid.inverse().transform_point3(rays.origin)) {
@@ -156,10 +157,10 @@ impl LayerView {
             })
             .collect::<Option<_>>()?;
         let (lo, hi) = screen.iter().fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |(a, b), p| (a.min(*p), b.max(*p)));
-        let x0 = (lo.x - 0.5).ceil().max(0.0) as usize;
-        let x1 = ((hi.x - 0.5).floor().min(width as f64 - 1.0)).max(-1.0) as i64;
-        let y0 = ((lo.y - 0.5).ceil().max(0.0) as usize).max(rows.start);
-        let y1 = ((hi.y - 0.5).floor().min(height as f64 - 1.0)).max(-1.0).min(rows.end as f64 - 1.0) as i64;
+        let x0 = ((lo.x - 0.5).ceil().max(0.0) as usize).max(window.x0 as usize);
+        let x1 = ((hi.x - 0.5).floor().min(width as f64 - 1.0)).max(-1.0).min(f64::from(window.x1) - 1.0) as i64;
+        let y0 = ((lo.y - 0.5).ceil().max(0.0) as usize).max(window.y0 as usize);
+        let y1 = ((hi.y - 0.5).floor().min(height as f64 - 1.0)).max(-1.0).min(f64::from(window.y1) - 1.0) as i64;
         if x1 < x0 as i64 || y1 < y0 as i64 {
             return None;
         }
@@ -379,7 +380,7 @@ mod tests {
             let (w, h) = (64usize, 48usize);
             let vp = camera.view_projection(w as f32 / h as f32);
             let rays = camera.pixel_rays(Vec2::new(w as f32, h as f32));
-            let layers = MeshLayers::new(&caster, vp, &rays, (w, h), 0..h);
+            let layers = MeshLayers::new(&caster, vp, &rays, (w, h), PixelRect::full(w as u32, h as u32));
             assert_eq!(layers.views.len(), 1, "{projection:?}: the mesh is rasterized");
             let (mut met, mut lanes) = (0, IntervalLanes::default());
             for y in 0..h {

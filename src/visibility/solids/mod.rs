@@ -53,6 +53,10 @@
 //! Anything with a corner at or behind the eye, and spheres under an
 //! orthographic camera, fall back to their box. A too-wide extent only costs
 //! time: where a primitive does not reach, its interval is empty.
+//!
+//! A tile of a frame walks its own pixels alone: its rows, and on each row
+//! each occupant's ends cut to its columns (closed meshes are rasterized on
+//! its rectangle alone too); what it draws equals the whole frame's there.
 
 mod block;
 mod bounds;
@@ -67,7 +71,6 @@ mod zbuffer;
 pub use surface_frame::SurfaceFrame;
 
 use std::cell::{Cell, RefCell};
-use std::ops::Range;
 
 use glam::{Vec2, Vec3};
 use rayon::iter::IndexedParallelIterator;
@@ -77,6 +80,7 @@ use crate::camera::{Camera, PixelRays, RowLine};
 use crate::csg::occupancy::{OccupancyTree, Occupied};
 use crate::csg::outline::{screen_point, Extent, Outline};
 use crate::csg::{Crossing, CsgCaster, CsgSolid, FacesOnScreen, Hit, Primitive, SpanScratch};
+use crate::image::PixelRect;
 use crate::scene::Scene;
 use crate::visibility::{ItemId, VisibilityBuffer};
 use block::BlockOrder;
@@ -207,8 +211,8 @@ impl PreparedSolid {
             return;
         }
         let bands = out.bands_mut(BAND_ROWS);
-        let rows = 0..height as usize;
-        scan_bands(self, camera, (width, height), rows, bands, |(pixels, written), dy, row| {
+        let whole = PixelRect::full(width, height);
+        scan_bands(self, camera, (width, height), whole, bands, |(pixels, written), dy, row| {
             let out = row_to_write(&mut pixels[dy * w..(dy + 1) * w], &mut written[dy], row.blocks());
             row.unit_crossings_into(out);
         });
@@ -296,7 +300,7 @@ pub fn draw_solids(
     // The buffer holds the pixels of its rectangle alone, row-major from its
     // top left pixel; bands count from its first row.
     let held = vb.rect();
-    let (rows, cols) = (held.y0 as usize..held.y1 as usize, held.x0 as usize..held.x1 as usize);
+    let cols = held.x0 as usize..held.x1 as usize;
     let w = cols.len();
     let mut drawn = 0;
     for (object, o) in scene.objects.iter().enumerate().filter(|(i, _)| include(*i)) {
@@ -313,7 +317,7 @@ pub fn draw_solids(
             .collect();
         let bands = bands.into_par_iter().enumerate();
         let prepared = PreparedSolid::new(&world, CsgMethod::Segments).expect("segments need no expansion");
-        scan_bands(&prepared, camera, (width, height), rows.clone(), bands, |(_, (depth, items, normals)), dy, row| {
+        scan_bands(&prepared, camera, (width, height), held, bands, |(_, (depth, items, normals)), dy, row| {
             for (x, h) in row.hits().filter(|(x, _)| cols.contains(x)) {
                 // A hit's `t` along its row line is its distance along the view axis.
                 let z = camera.depth_at_view_distance(h.t);
@@ -415,14 +419,14 @@ impl ScannedRow<'_> {
 }
 
 /// The walk itself: for each band of [`BAND_ROWS`] rows from the first of
-/// `rows` (in parallel, `bands` gives each its output), `visit(band,
+/// `window` (in parallel, `bands` gives each its output), `visit(band,
 /// row_in_band, row)` with the row's visible hits ([`ScannedRow`]), for the
-/// rows in `rows`.
+/// rows of `window`, each row walked over the columns of `window` alone.
 fn scan_bands<B: Send>(
     prepared: &PreparedSolid,
     camera: &Camera,
     (width, height): (u32, u32),
-    rows: Range<usize>,
+    window: PixelRect,
     bands: impl IndexedParallelIterator<Item = B>,
     visit: impl Fn(&mut B, usize, &ScannedRow) + Sync,
 ) {
@@ -433,7 +437,8 @@ fn scan_bands<B: Send>(
     // The whole frame in the pool: its preparation's parallel parts and
     // the bands start no second time from outside it.
     rayon::scope(|_| {
-        let frame = FrameWalk::new(prepared, camera, (width, height), rows.clone());
+        let rows = window.y0 as usize..window.y1 as usize;
+        let frame = FrameWalk::new(prepared, camera, (width, height), window);
         let h = height as usize;
         // Each band its own piece of work: left to split only where stolen,
         // rayon hands each thread a quarter of the frame, and a thread done
@@ -477,6 +482,8 @@ struct FrameWalk<'a> {
     /// the near plane lies at t = near, under either projection.
     near: f32,
     width: usize,
+    /// The columns walked (a tile's own; the others are left empty).
+    columns: (i64, i64),
 }
 
 impl<'a> FrameWalk<'a> {
@@ -485,8 +492,8 @@ impl<'a> FrameWalk<'a> {
     const PARALLEL_FROM: usize = 16;
 
     /// The frame of `solid` seen by `camera` at `width` x `height`, walked by
-    /// `walker` over the rows `rows`.
-    fn new(prepared: &'a PreparedSolid, camera: &Camera, (width, height): (u32, u32), rows: Range<usize>) -> Self {
+    /// `walker` over the pixels of `window`.
+    fn new(prepared: &'a PreparedSolid, camera: &Camera, (width, height): (u32, u32), window: PixelRect) -> Self {
         let (caster, solid) = (&prepared.caster, prepared.caster.solid());
         let vp = camera.view_projection(width as f32 / height as f32);
         let rays = camera.pixel_rays(Vec2::new(width as f32, height as f32));
@@ -512,7 +519,7 @@ impl<'a> FrameWalk<'a> {
         // Many primitives: each primitive's outline and faces at once.
         let (outlines, faces) = if many { rayon::join(outlines, faces) } else { (outlines(), faces()) };
         // A closed mesh's layers show where its rasterized pixels say.
-        let layers = MeshLayers::new(caster, vp, &rays, (width as usize, height as usize), rows);
+        let layers = MeshLayers::new(caster, vp, &rays, (width as usize, height as usize), window);
         let mut outlines: Vec<Option<Outline>> =
             outlines.into_iter().enumerate().map(|(i, o)| layers.narrow(i, o)).collect();
         if let Some(tree) = &solid.tree {
@@ -542,6 +549,7 @@ impl<'a> FrameWalk<'a> {
             rays,
             near: camera.near,
             width: width as usize,
+            columns: (i64::from(window.x0), i64::from(window.x1) - 1),
         }
     }
 
@@ -560,6 +568,8 @@ impl<'a> FrameWalk<'a> {
                 let (c, d) = ends.filter(|_| row == y)?;
                 (a, b) = (a.max(c), b.min(d));
             }
+            // Only the window's columns.
+            (a, b) = (a.max(self.columns.0), b.min(self.columns.1));
             (a <= b).then_some((i, a, b))
         };
         ends.clear();
