@@ -1,4 +1,4 @@
-//! `kage-bench rays`: the BVH (binned SAH) beside Embree — build time and
+//! `kage-bench rays`: the BVH (binned SAH) beside Embree and the obvhs crate — build time and
 //! primary-ray throughput on the peers' meshes. `kage-bench hybrid`: seed 002
 //! §4's item-buffer hybrid beside the same image traced entirely by rays.
 
@@ -49,6 +49,15 @@ struct RayRow {
     mrays: f64,
     packet_mrays: f64,
     peer: Option<Peer>,
+    crate_bvh: CrateBvh,
+}
+
+/// The obvhs crate's compressed wide BVH (CWBVH from a PLOC tree, its
+/// `medium_build` preset): build ms and Mrays/s, one ray at a time.
+#[derive(Clone, Copy)]
+struct CrateBvh {
+    build_ms: f64,
+    mrays: f64,
 }
 
 /// Embree's build ms and Mrays/s (`rtcIntersect1`, `rtcIntersect8`).
@@ -65,12 +74,14 @@ pub fn run(args: &RaysArgs) -> Result<()> {
     let mut rows = Vec::new();
     for name in args.meshes.scenes.split(',').map(str::trim) {
         let (mesh, scene) = peer_scene_for_rays(common, &args.meshes, name)?;
+        let triangles = crate_triangles(&scene);
         let mut best: Option<RayRow> = None;
         for _ in 0..args.rounds.max(1) {
             let (build_ms, mrays, packet_mrays) = time_rays(&scene, common.frames);
+            let crate_bvh = time_obvhs(&scene, &triangles, common.frames);
             let peer = args.embree.exists().then(|| run_embree(&args.embree, &mesh, common)).transpose()?;
             let triangles = scene.triangle_count();
-            let row = RayRow { name: name.to_string(), triangles, build_ms, mrays, packet_mrays, peer };
+            let row = RayRow { name: name.to_string(), triangles, build_ms, mrays, packet_mrays, peer, crate_bvh };
             best = Some(match best {
                 None => row,
                 Some(b) => RayRow {
@@ -84,6 +95,10 @@ pub fn run(args: &RaysArgs) -> Result<()> {
                             packet_mrays: p.packet_mrays.max(q.packet_mrays),
                         }),
                         (p, q) => p.or(q),
+                    },
+                    crate_bvh: CrateBvh {
+                        build_ms: b.crate_bvh.build_ms.min(row.crate_bvh.build_ms),
+                        mrays: b.crate_bvh.mrays.max(row.crate_bvh.mrays),
                     },
                     ..row
                 },
@@ -118,7 +133,23 @@ pub fn run(args: &RaysArgs) -> Result<()> {
         );
     }
     println!(
-        "\n{}x{} primary rays (one per pixel centre, nearest hit, no shading), one at a time and in packets of 4 x 2 pixels; median of {} frames; build median of 5; best of {} rounds; {} threads.",
+        "\n| scene | obvhs build ms | kage build / obvhs | obvhs Mrays/s | kage rate / obvhs | kage packets / obvhs |"
+    );
+    println!("|---|---:|---:|---:|---:|---:|");
+    for r in &rows {
+        let c = r.crate_bvh;
+        println!(
+            "| {} | {:.1} | {:.2} | {:.2} | {:.2} | {:.2} |",
+            r.name,
+            c.build_ms,
+            r.build_ms / c.build_ms,
+            c.mrays,
+            r.mrays / c.mrays,
+            r.packet_mrays / c.mrays
+        );
+    }
+    println!(
+        "\n{}x{} primary rays (one per pixel centre, nearest hit, no shading), one at a time and in packets of 4 x 2 pixels; obvhs one at a time; median of {} frames; build median of 5; best of {} rounds; {} threads.",
         common.width,
         common.height,
         common.frames,
@@ -178,6 +209,67 @@ fn time_rays(scene: &Scene, frames: usize) -> (f64, f64, f64) {
     packet_times.remove(0);
     let rate = |t: &mut Vec<f64>| (w * h) as f64 / median(t) / 1e6;
     (median(&mut builds), rate(&mut times), rate(&mut packet_times))
+}
+
+/// The scene's world triangles as obvhs takes them (any order: obvhs builds its own).
+fn crate_triangles(scene: &Scene) -> Vec<obvhs::triangle::Triangle> {
+    let trace = TraceScene::new(scene);
+    (0..trace.len())
+        .map(|i| {
+            let [v0, v1, v2] = trace.triangle(i).map(glam::Vec3A::from);
+            obvhs::triangle::Triangle { v0, v1, v2 }
+        })
+        .collect()
+}
+
+/// Median obvhs build time (ms: the compressed wide BVH and its triangles put in
+/// leaf order, as kage's build gathers its triangle columns) and its primary-ray
+/// throughput (Mrays/s), one ray at a time, on the same rays as kage's.
+fn time_obvhs(scene: &Scene, triangles: &[obvhs::triangle::Triangle], frames: usize) -> CrateBvh {
+    use obvhs::ray::{Ray, RayHit};
+    let build = || {
+        let bvh = obvhs::cwbvh::builder::build_cwbvh_from_tris(
+            triangles,
+            obvhs::BvhBuildParams::medium_build(),
+            &mut std::time::Duration::default(),
+        );
+        let ordered: Vec<_> = bvh.primitive_indices.par_iter().map(|&i| triangles[i as usize]).collect();
+        (bvh, ordered)
+    };
+    let mut builds = Vec::new();
+    let mut built = build();
+    for _ in 0..5 {
+        drop(built);
+        let t = std::time::Instant::now();
+        built = build();
+        builds.push(t.elapsed().as_secs_f64() * 1e3);
+    }
+    let (bvh, ordered) = &built;
+    let rays = scene.camera.pixel_rays(glam::Vec2::new(scene.width as f32, scene.height as f32));
+    let (w, h) = (scene.width, scene.height);
+    let single = || -> usize {
+        (0..h)
+            .into_par_iter()
+            .map(|y| {
+                (0..w)
+                    .filter(|&x| {
+                        let r = rays.ray(glam::Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
+                        let ray = Ray::new(r.origin.into(), r.dir.into(), 0.0, f32::INFINITY);
+                        let mut hit = RayHit::none();
+                        bvh.ray_traverse(ray, &mut hit, |ray, id| ordered[id].intersect(ray))
+                    })
+                    .count()
+            })
+            .sum()
+    };
+    let mut times = Vec::new();
+    for _ in 0..frames.max(1) + 1 {
+        let t = std::time::Instant::now();
+        std::hint::black_box(single());
+        times.push(t.elapsed().as_secs_f64());
+    }
+    times.remove(0); // warm-up
+    CrateBvh { build_ms: median(&mut builds), mrays: (w * h) as f64 / median(&mut times) / 1e6 }
 }
 
 /// Runs Embree's primary-ray benchmark (no shading; `rtcIntersect1` and
