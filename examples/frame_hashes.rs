@@ -94,7 +94,13 @@ fn print_frame(name: &str, variant: &str, scene: &Scene) {
 fn print_reference(name: &str, scene: &Scene) {
     use kage::raytrace::reference::{render_reference, ReferenceOptions};
     let small = Scene { width: scene.width.div_ceil(4), height: scene.height.div_ceil(4), ..scene.clone() };
-    let options = ReferenceOptions { pixel_samples: 2, light_samples: 2, shadows: true, max_depth: 4 };
+    let options = ReferenceOptions {
+        pixel_samples: 2,
+        light_samples: 2,
+        shadows: true,
+        max_depth: 4,
+        ..ReferenceOptions::default()
+    };
     println!("{name} reference image {:016x}", image_hash(&render_reference(&small, &options, &|_| {})));
 }
 

@@ -77,7 +77,13 @@ fn mirror_scene() -> Scene {
 #[test]
 fn jittered_item_buffers_approach_the_supersampled_reference() {
     let mut scene = mirror_scene();
-    let opts = ReferenceOptions { pixel_samples: 8, light_samples: 1, shadows: false, max_depth: 4 };
+    let opts = ReferenceOptions {
+        pixel_samples: 8,
+        light_samples: 1,
+        shadows: false,
+        max_depth: 4,
+        ..ReferenceOptions::default()
+    };
     let truth = render_reference(&scene, &opts, &|_| {});
     let aliased = render(&scene, &RenderOptions::default()).expect("render");
     scene.antialias = Antialias::Jitter(16);

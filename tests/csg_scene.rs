@@ -117,7 +117,13 @@ fn solids_and_meshes_hide_each_other_as_rays_see_them() {
 fn a_solid_is_shaded_and_reflected_as_the_reference_sees_it() {
     let scene = without_shadows(scene(200, 130));
     let frame = render(&scene, &RenderOptions { ray_depth: 2, ..Default::default() }).unwrap();
-    let opts = ReferenceOptions { pixel_samples: 1, light_samples: 1, shadows: false, max_depth: 2 };
+    let opts = ReferenceOptions {
+        pixel_samples: 1,
+        light_samples: 1,
+        shadows: false,
+        max_depth: 2,
+        ..ReferenceOptions::default()
+    };
     let reference = render_reference(&scene, &opts, &|_| {});
     let trace = TraceScene::new(&scene);
     let rays = scene.camera.pixel_rays(Vec2::new(200.0, 130.0));
@@ -159,12 +165,24 @@ fn a_solid_casts_shadows_where_shadow_rays_find_it() {
     let (shadowed, unshadowed) = (render(&lit, &opts).unwrap(), render(&plain, &opts).unwrap());
     let reference = render_reference(
         &lit,
-        &ReferenceOptions { pixel_samples: 1, light_samples: 1, shadows: true, max_depth: 0 },
+        &ReferenceOptions {
+            pixel_samples: 1,
+            light_samples: 1,
+            shadows: true,
+            max_depth: 0,
+            ..ReferenceOptions::default()
+        },
         &|_| {},
     );
     let unlit = render_reference(
         &plain,
-        &ReferenceOptions { pixel_samples: 1, light_samples: 1, shadows: false, max_depth: 0 },
+        &ReferenceOptions {
+            pixel_samples: 1,
+            light_samples: 1,
+            shadows: false,
+            max_depth: 0,
+            ..ReferenceOptions::default()
+        },
         &|_| {},
     );
     let (mut floor, mut both, mut either) = (0, 0, 0);

@@ -43,7 +43,13 @@ fn the_reflection_map_pass_matches_the_reference() {
     let mut scene = scene();
     scene.lights.iter_mut().for_each(|l| l.shadow = kage::scene::ShadowSettings::NONE);
     let frame = render(&scene, &RenderOptions::default()).unwrap();
-    let opts = ReferenceOptions { pixel_samples: 6, light_samples: 1, shadows: false, max_depth: 4 };
+    let opts = ReferenceOptions {
+        pixel_samples: 6,
+        light_samples: 1,
+        shadows: false,
+        max_depth: 4,
+        ..ReferenceOptions::default()
+    };
     let truth = render_reference(&scene, &opts, &|_| {});
     // Pixels inside the reflection-mapped ball (object 1).
     let vb = &frame.visibility;
@@ -74,7 +80,13 @@ fn the_reflection_map_is_filtered_not_aliased() {
     // Only the mapped ball's reflection: no lights' share to compare.
     scene.lights.iter_mut().for_each(|l| (l.intensity, l.ambient) = (0.0, 0.0));
     let frame = render(&scene, &RenderOptions::default()).unwrap();
-    let opts = ReferenceOptions { pixel_samples: 8, light_samples: 1, shadows: false, max_depth: 0 };
+    let opts = ReferenceOptions {
+        pixel_samples: 8,
+        light_samples: 1,
+        shadows: false,
+        max_depth: 0,
+        ..ReferenceOptions::default()
+    };
     let truth = render_reference(&scene, &opts, &|_| {});
     let env = scene.environment.clone().unwrap();
     let frames = kage::shading::ObjectFrames::new(&scene);

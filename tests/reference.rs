@@ -25,7 +25,13 @@ fn one_ray_per_pixel_without_shadows_matches_the_rasterizer() {
     let frame = render(&scene, &RenderOptions::default()).unwrap();
     let mut scalar = LinearImage::new(scene.width, scene.height);
     kage::shading::shade_into_scalar(&scene, &frame.visibility, &mut scalar);
-    let opts = ReferenceOptions { pixel_samples: 1, light_samples: 1, shadows: false, max_depth: 0 };
+    let opts = ReferenceOptions {
+        pixel_samples: 1,
+        light_samples: 1,
+        shadows: false,
+        max_depth: 0,
+        ..ReferenceOptions::default()
+    };
     let reference = render_reference(&scene, &opts, &|_| {});
     let trace = TraceScene::new(&scene);
     let rays = scene.camera.pixel_rays(glam::Vec2::new(scene.width as f32, scene.height as f32));
@@ -71,7 +77,13 @@ fn rays_pass_back_faces_the_rasterizer_culls() {
     let wall = std::sync::Arc::new(kage::scene::mesh::shapes::plane());
     scene.objects.push(kage::scene::Object::mesh("wall", wall, place, material));
     let raster = render(&scene, &RenderOptions::default()).unwrap().image;
-    let opts = ReferenceOptions { pixel_samples: 1, light_samples: 1, shadows: false, max_depth: 0 };
+    let opts = ReferenceOptions {
+        pixel_samples: 1,
+        light_samples: 1,
+        shadows: false,
+        max_depth: 0,
+        ..ReferenceOptions::default()
+    };
     let reference = render_reference(&scene, &opts, &|_| {});
     let c = kage::compare::compare(&raster, &reference, 0.05).unwrap();
     assert!(c.share_over < 0.02, "the reference sees the wall's back the raster culls: {c:?}");
@@ -84,12 +96,24 @@ fn shadows_only_darken_and_antialiasing_stays_close() {
     scene.height = 68;
     let plain = render_reference(
         &scene,
-        &ReferenceOptions { pixel_samples: 1, light_samples: 1, shadows: false, max_depth: 0 },
+        &ReferenceOptions {
+            pixel_samples: 1,
+            light_samples: 1,
+            shadows: false,
+            max_depth: 0,
+            ..ReferenceOptions::default()
+        },
         &|_| {},
     );
     let shadowed = render_reference(
         &scene,
-        &ReferenceOptions { pixel_samples: 1, light_samples: 3, shadows: true, max_depth: 0 },
+        &ReferenceOptions {
+            pixel_samples: 1,
+            light_samples: 3,
+            shadows: true,
+            max_depth: 0,
+            ..ReferenceOptions::default()
+        },
         &|_| {},
     );
     let mut darker = 0;
@@ -100,7 +124,13 @@ fn shadows_only_darken_and_antialiasing_stays_close() {
     assert!(darker > 200, "the demo's objects must cast visible shadows ({darker} pixels)");
     let aa = render_reference(
         &scene,
-        &ReferenceOptions { pixel_samples: 3, light_samples: 1, shadows: false, max_depth: 0 },
+        &ReferenceOptions {
+            pixel_samples: 3,
+            light_samples: 1,
+            shadows: false,
+            max_depth: 0,
+            ..ReferenceOptions::default()
+        },
         &|_| {},
     );
     let c = kage::compare::compare(&aa, &plain, 0.05).unwrap();
@@ -114,7 +144,13 @@ fn an_interrupted_reference_keeps_the_rows_already_traced() {
     let mut scene = kage::scene::demo::demo_scene().unwrap();
     scene.width = 64;
     scene.height = 48;
-    let opts = ReferenceOptions { pixel_samples: 1, light_samples: 1, shadows: false, max_depth: 0 };
+    let opts = ReferenceOptions {
+        pixel_samples: 1,
+        light_samples: 1,
+        shadows: false,
+        max_depth: 0,
+        ..ReferenceOptions::default()
+    };
     let full = render_reference(&scene, &opts, &|_| {});
     let stop = AtomicBool::new(false);
     // Stop after ten rows have been reported finished.
@@ -198,7 +234,13 @@ fn every_example_scene_renders_as_its_reference() {
         scene.width = (72.0 * aspect).round() as u32;
         scene.antialias = kage::scene::Antialias::Jitter(16);
         let raster = render(&scene, &RenderOptions::default()).unwrap().image;
-        let opts = ReferenceOptions { pixel_samples: 4, light_samples: 4, shadows: true, max_depth: 4 };
+        let opts = ReferenceOptions {
+            pixel_samples: 4,
+            light_samples: 4,
+            shadows: true,
+            max_depth: 4,
+            ..ReferenceOptions::default()
+        };
         let reference = render_reference(&scene, &opts, &|_| {});
         let c = kage::compare::compare(&clip(&raster), &clip(&reference), 0.05).unwrap();
         println!("{name:<28} rmse {:.4} (bound {bound}), {:.1}% of pixels off by > 0.05", c.rmse, 100.0 * c.share_over);

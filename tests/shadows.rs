@@ -177,7 +177,13 @@ fn jittered_area_lights_approach_the_reference_penumbra() {
                               // The reference filters textures by supersampling (finest level): so here too.
     scene.materials.iter_mut().for_each(|m| m.maps.filter = kage::scene::material::Filter::Bilinear);
     assert!(scene.lights[0].size > 0.0);
-    let opts = ReferenceOptions { pixel_samples: 1, light_samples: 6, shadows: true, max_depth: 0 };
+    let opts = ReferenceOptions {
+        pixel_samples: 1,
+        light_samples: 6,
+        shadows: true,
+        max_depth: 0,
+        ..ReferenceOptions::default()
+    };
     let truth = render_reference(&scene, &opts, &|_| {});
     let mut errors = Vec::new();
     for samples in [1, 16] {

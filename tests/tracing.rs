@@ -52,6 +52,7 @@ fn mirror_scene() -> Scene {
         exposure: Default::default(),
         antialias: Default::default(),
         fog: None,
+        ambient_occlusion: None,
         environment: None,
         translucency: Default::default(),
         tone: Default::default(),
@@ -102,7 +103,13 @@ fn a_plane_mirror_shows_the_sphere_at_its_mirror_image() {
     assert!(at(opposite).max_element() < 0.01, "nothing to reflect at {:?}: {}", opposite, at(opposite));
     assert!(at(direct).x > 0.99, "the ball itself at {direct:?}");
     // The reference renderer agrees.
-    let opts = ReferenceOptions { pixel_samples: 1, light_samples: 1, shadows: true, max_depth: 2 };
+    let opts = ReferenceOptions {
+        pixel_samples: 1,
+        light_samples: 1,
+        shadows: true,
+        max_depth: 2,
+        ..ReferenceOptions::default()
+    };
     let reference = render_reference(&scene, &opts, &|_| {});
     assert!((reference.get(seen.0, seen.1) - at(seen)).abs().max_element() < 1e-3);
     assert!((reference.get(opposite.0, opposite.1) - at(opposite)).abs().max_element() < 1e-3);
@@ -188,7 +195,13 @@ fn a_glass_slab_shifts_a_line_by_the_snell_offset() {
         let (ti, tt) = (deg.to_radians(), (deg.to_radians().sin() / 1.5).asin());
         let expected = t * (ti - tt).sin() / tt.cos();
         let raster = render(&scene, &RenderOptions::default()).expect("render");
-        let opts = ReferenceOptions { pixel_samples: 4, light_samples: 1, shadows: false, max_depth: 4 };
+        let opts = ReferenceOptions {
+            pixel_samples: 4,
+            light_samples: 1,
+            shadows: false,
+            max_depth: 4,
+            ..ReferenceOptions::default()
+        };
         let traced = render_reference(&scene, &opts, &|_| {});
         for (what, image) in [("item buffer", &raster.image), ("reference", &traced)] {
             let x = line_x(&scene, image);

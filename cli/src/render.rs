@@ -99,7 +99,8 @@ pub struct RenderArgs {
     /// traced (ray-traced reflections and refraction), fog; or `all` (these
     /// seven, which add up to the image). `shadow` writes each light's shadow
     /// term as NAME.shadow.N.exr (N: the light's number from 0, in the
-    /// scene's order; 1 lit, 0 in shadow).
+    /// scene's order; 1 lit, 0 in shadow); `occlusion` writes ambient
+    /// occlusion's open share as NAME.occlusion.EXT (with --ao; 1 open).
     #[arg(long, value_parser = parse_aovs)]
     aov: Option<Aovs>,
     /// Brightness of 8-bit output: stops (e.g. 1.5, -1) or `auto`.
@@ -118,6 +119,19 @@ pub struct RenderArgs {
     /// other shadow settings.
     #[arg(long, value_parser = parse_shadow_method)]
     shadows: Option<ShadowMethod>,
+    /// Ambient occlusion: darkens the ambient light in creases, at the foot
+    /// of parts and inside holes, by rays from each pixel's surface point
+    /// (the scene file's `[ambient_occlusion]`, or these defaults).
+    #[arg(long)]
+    ao: bool,
+    /// Ambient occlusion: how far away (world units) a surface still darkens
+    /// (default: a tenth of the model's diagonal). Implies --ao.
+    #[arg(long, value_name = "DISTANCE", value_parser = parse_positive)]
+    ao_radius: Option<f32>,
+    /// Ambient occlusion: rays per pixel (default 16; more: less grain, more
+    /// time). Implies --ao.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=4096))]
+    ao_rays: Option<u32>,
     /// An OpenSCAD .csg model's spheres and cylinders: `exact` (true curved
     /// surfaces) or `faceted` as OpenSCAD's own mesh ($fn, $fa, $fs), to compare
     /// with OpenSCAD pixel for pixel.
@@ -223,23 +237,28 @@ fn aov_path(output: &Path, name: &str) -> PathBuf {
 }
 
 /// What `--aov` asks for: components of the image, and whether the lights'
-/// shadow terms.
+/// shadow terms and ambient occlusion's open share.
 #[derive(Debug, Clone, Copy)]
 struct Aovs {
     components: ComponentSet,
     shadow: bool,
+    occlusion: bool,
 }
 
 fn parse_aovs(s: &str) -> Result<Aovs, String> {
-    let mut aovs = Aovs { components: ComponentSet::EMPTY, shadow: false };
+    let mut aovs = Aovs { components: ComponentSet::EMPTY, shadow: false, occlusion: false };
     let mut list = Vec::new();
     for name in s.split(',').map(str::trim) {
         match name {
             "all" => aovs.components = ComponentSet::ALL,
             "shadow" => aovs.shadow = true,
+            "occlusion" => aovs.occlusion = true,
             _ => list.push(Component::from_name(name).ok_or_else(|| {
                 let known: Vec<&str> = Component::ALL.iter().map(|c| c.name()).collect();
-                format!("'{name}' is not a component (expected 'all', 'shadow' or some of {})", known.join(", "))
+                format!(
+                    "'{name}' is not a component (expected 'all', 'shadow', 'occlusion' or some of {})",
+                    known.join(", ")
+                )
             })?),
         }
     }
@@ -320,6 +339,13 @@ fn parse_fov(s: &str) -> Result<f32, String> {
     match s.parse::<f32>() {
         Ok(v) if v > 0.0 && v < 180.0 => Ok(v),
         _ => Err(format!("'{s}' is not a field of view between 0 and 180 degrees")),
+    }
+}
+
+fn parse_positive(s: &str) -> Result<f32, String> {
+    match s.parse::<f32>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+        _ => Err(format!("'{s}' is not a distance above 0")),
     }
 }
 
@@ -484,6 +510,11 @@ pub fn render_command(args: &RenderArgs) -> miette::Result<()> {
     if let Some(method) = args.shadows {
         scene.lights.iter_mut().for_each(|l| l.shadow = l.shadow.with_method(method));
     }
+    if args.ao || args.ao_radius.is_some() || args.ao_rays.is_some() {
+        let ao = scene.ambient_occlusion.get_or_insert_with(Default::default);
+        ao.radius = args.ao_radius.or(ao.radius);
+        ao.rays = args.ao_rays.unwrap_or(ao.rays);
+    }
     let extra = scene.shadow_warnings();
     scene.warnings.extend(extra);
     for w in &scene.warnings {
@@ -496,7 +527,12 @@ pub fn render_command(args: &RenderArgs) -> miette::Result<()> {
         }
         return reference_command(args, &scene).map_err(report::to_report);
     }
-    let wanted = args.aov.unwrap_or(Aovs { components: ComponentSet::EMPTY, shadow: false });
+    let wanted = args.aov.unwrap_or(Aovs { components: ComponentSet::EMPTY, shadow: false, occlusion: false });
+    if wanted.occlusion && scene.ambient_occlusion.is_none() {
+        miette::bail!(
+            "--aov occlusion writes ambient occlusion's open share, but this render has none: add --ao (or an [ambient_occlusion] table in the scene file)"
+        );
+    }
     let options = RenderOptions {
         threads: args.threads,
         ray_depth: args.ray_depth,
@@ -570,6 +606,14 @@ fn write_frame(
             eprintln!("wrote {} ({} component)", aov.display(), c.name());
         }
     }
+    if args.aov.is_some_and(|a| a.occlusion) {
+        // Grey, unexposed: 1 open, 0 closed.
+        let occlusion = aov_path(path, "occlusion");
+        write(&frame.occlusion, &occlusion, 1.0, ToneCurve::Clip)?;
+        if !args.quiet {
+            eprintln!("wrote {} (ambient occlusion's open share)", occlusion.display());
+        }
+    }
     for (i, image) in frame.shadows.iter().enumerate() {
         // Linear floats, unexposed: 1 is lit, 0 in shadow.
         let shadow = aov_path(&path.with_extension("exr"), &format!("shadow.{i}"));
@@ -607,6 +651,9 @@ fn print_stats(path: &Path, scene: &Scene, frame: &kage::Frame, quiet: bool) {
         s.traced_pixels,
         s.traced_refined
     );
+    if scene.ambient_occlusion.is_some() {
+        eprintln!("ambient occlusion: {:.1} ms", s.occlusion_ms);
+    }
     if let Antialias::Edge(_) = scene.antialias {
         eprintln!("antialiased edges: {:.1} ms, {} pixels blended", s.edge_ms, s.edge_blends);
     }
@@ -648,6 +695,7 @@ fn reference_command(args: &RenderArgs, scene: &Scene) -> kage::error::Result<()
         light_samples: args.light_samples,
         shadows: !args.no_shadows,
         max_depth: args.ray_depth,
+        ..ReferenceOptions::default()
     };
     let bar = indicatif::ProgressBar::new(scene.height as u64);
     bar.set_style(

@@ -25,7 +25,7 @@ use crate::error::{Error, Result};
 use crate::idle::{IdleClock, IdleTime};
 use crate::image::{LinearImage, PixelRect};
 use crate::raytrace::traced::Refine;
-use crate::raytrace::{traced, TraceCache};
+use crate::raytrace::{occlusion, traced, TraceCache};
 use crate::resolve::edges::{EdgeOptions, EdgePass};
 use crate::resolve::jitter;
 use crate::scene::{Antialias, Scene};
@@ -140,6 +140,8 @@ pub struct FrameStats {
     pub shading_ms: f64,
     /// Milliseconds tracing reflections and refraction from the item buffer.
     pub traced_ms: f64,
+    /// Milliseconds finding ambient occlusion (0 without it).
+    pub occlusion_ms: f64,
     /// Pixels that spawned secondary rays, summed over passes.
     pub traced_pixels: usize,
     /// Traced pixels traced again at sub-pixel points where what they show
@@ -185,7 +187,8 @@ pub struct StageIdle {
     pub shadows: IdleTime,
     /// Shading, fog and translucency, the shadow stage aside.
     pub shading: IdleTime,
-    /// Reflections and refraction traced from the item buffer.
+    /// Rays from the item buffer: reflections and refraction, ambient
+    /// occlusion.
     pub traced: IdleTime,
     /// The edge pass's recording and blending.
     pub edges: IdleTime,
@@ -207,6 +210,7 @@ enum Stage {
     Visibility,
     Shading,
     Traced,
+    Occlusion,
     Edges,
 }
 
@@ -221,7 +225,7 @@ impl FrameStats {
             let idle = match stage {
                 Stage::Visibility => &mut self.idle.visibility,
                 Stage::Shading => &mut self.idle.shading,
-                Stage::Traced => &mut self.idle.traced,
+                Stage::Traced | Stage::Occlusion => &mut self.idle.traced,
                 Stage::Edges => &mut self.idle.edges,
             };
             *idle = idle.plus(clock.stop());
@@ -236,6 +240,7 @@ impl FrameStats {
             Stage::Visibility => self.visibility_ms += ms,
             Stage::Shading => self.shading_ms += ms,
             Stage::Traced => self.traced_ms += ms,
+            Stage::Occlusion => self.occlusion_ms += ms,
             Stage::Edges => self.edge_ms += ms,
         }
     }
@@ -270,6 +275,10 @@ pub struct Frame {
     /// lights (grey: 1 lit, 0 in shadow or facing away from the light; 1
     /// where no object is seen). The mean of the passes, when jittered.
     pub shadows: Vec<LinearImage>,
+    /// With the scene's ambient occlusion, the open share of each pixel's
+    /// hemisphere (grey: 1 open, 0 closed; 1 where no object is seen), the
+    /// mean of the passes when jittered; empty (0 × 0) without.
+    pub occlusion: LinearImage,
     /// Timings and counts.
     pub stats: FrameStats,
 }
@@ -321,6 +330,11 @@ struct Scratch {
     aovs: Vec<LinearImage>,
     /// One pass's shadow terms (when requested), in `Frame::shadows`' order.
     shadows: Vec<LinearImage>,
+    /// One pass's ambient component, for ambient occlusion to darken when no
+    /// ambient image is requested.
+    ambient: LinearImage,
+    /// One pass's open shares (ambient occlusion).
+    occlusion: LinearImage,
     /// Shadow-map buffers, reused from light to light and frame to frame.
     maps: MapPool,
     /// The BVH of the traced term, rebuilt only when the geometry changes.
@@ -346,6 +360,7 @@ impl Renderer {
             stats: FrameStats::default(),
             aovs: Vec::new(),
             shadows: Vec::new(),
+            occlusion: LinearImage::new(0, 0),
         };
         Ok(Renderer { pool, frame, options: *options, scratch: Scratch::default() })
     }
@@ -494,6 +509,7 @@ fn render_into(
         render_pass(scene, frame, scratch, options, edges.as_ref(), stop)?;
         frame.aovs.iter_mut().zip(&mut scratch.aovs).for_each(|((_, a), s)| std::mem::swap(a, s));
         std::mem::swap(&mut frame.shadows, &mut scratch.shadows);
+        std::mem::swap(&mut frame.occlusion, &mut scratch.occlusion);
         progress(1, 1);
     } else {
         render_jittered(scene, &offsets, frame, scratch, options, progress, stop)?;
@@ -529,6 +545,9 @@ fn fit_component_images(
     let lights = if options.shadow_images { scene.lights.len() } else { 0 };
     frame.shadows.resize_with(lights, LinearImage::default);
     frame.shadows.iter_mut().for_each(|a| a.resize(w, h));
+    let (ow, oh) = if scene.ambient_occlusion.is_some() { (w, h) } else { (0, 0) };
+    frame.occlusion.resize(ow, oh);
+    scratch.occlusion.resize(ow, oh);
 }
 
 /// Seed 002 §4's accumulation buffer: one pass per sub-pixel `offsets`, each
@@ -548,6 +567,7 @@ fn render_jittered(
     scratch.accum.pixels_mut().fill(Vec3::ZERO);
     frame.aovs.iter_mut().for_each(|(_, a)| a.pixels_mut().fill(Vec3::ZERO));
     frame.shadows.iter_mut().for_each(|a| a.pixels_mut().fill(Vec3::ZERO));
+    frame.occlusion.pixels_mut().fill(Vec3::ZERO);
     // Directional lights' maps are fitted to the unshifted view: the passes
     // share them (and the next frame may reuse them).
     scratch.maps.fit_to(Some(scene.camera));
@@ -556,10 +576,15 @@ fn render_jittered(
     let mut passes = || {
         for (done, &offset) in (1..).zip(offsets) {
             pass.camera = scene.camera.shifted(offset, (scene.width, scene.height));
+            if let (Some(ao), Some(base)) = (&mut pass.ambient_occlusion, &scene.ambient_occlusion) {
+                // Each pass casts new rays of each point's sequence.
+                ao.pass = base.pass.saturating_mul(offsets.len() as u32).saturating_add(done - 1);
+            }
             render_pass(&pass, frame, scratch, options, None, stop)?;
             jitter::accumulate(&mut scratch.accum, &frame.image, weight);
             frame.aovs.iter_mut().zip(&scratch.aovs).for_each(|((_, a), s)| jitter::accumulate(a, s, weight));
             frame.shadows.iter_mut().zip(&scratch.shadows).for_each(|(a, s)| jitter::accumulate(a, s, weight));
+            jitter::accumulate(&mut frame.occlusion, &scratch.occlusion, weight);
             progress(done, offsets.len() as u32);
         }
         Ok(())
@@ -586,14 +611,17 @@ fn render_pass(
     stop.check()?;
     let ray_depth = options.ray_depth;
     let Frame { image, visibility, aovs, stats, .. } = frame;
-    let Scratch { aovs: component_images, maps, trace, edges: edge_pass, subpixel, shadows, .. } = scratch;
+    let Scratch {
+        aovs: component_images, maps, trace, edges: edge_pass, subpixel, shadows, ambient, occlusion, ..
+    } = scratch;
     visibility.resize_to(scene.width, scene.height, Some(drawn(scene, options.region)));
     stats.raster = stats.timed(Stage::Visibility, || visibility::rasterize(scene, visibility));
     stop.check()?;
     let vb = &*visibility;
     let held = visibility.rect();
     image.resize(held.width(), held.height());
-    let mut images = PassImages::new(image, aovs, component_images);
+    let darkened = scene.ambient_occlusion.is_some().then_some(ambient);
+    let mut images = PassImages::new(image, aovs, component_images, darkened);
     let targets = &mut images.targets;
     let beside = |s: &mut SubpixelShading| {
         let start = Instant::now();
@@ -608,6 +636,10 @@ fn render_pass(
     }
     stop.check()?;
     let builds = trace.builds();
+    if scene.ambient_occlusion.is_some() {
+        let open = occlusion;
+        stats.timed(Stage::Occlusion, || occlusion_term(scene, vb, &mut images, subpixel, trace, open));
+    }
     let refine = match (edges, options.sparse_traced) {
         (Some(_), _) => Refine::Contrast,
         (None, true) => Refine::Sparse,
@@ -665,16 +697,27 @@ fn shade<T: Send>(
 /// The images one pass writes.
 struct PassImages<'a> {
     /// The frame's image (every component) first, then the image of each
-    /// requested component.
+    /// requested component, then (with ambient occlusion and no ambient image
+    /// requested) the pass's own ambient image.
     targets: Vec<Target<'a>>,
+    /// Whether the last target is the pass's own ambient image.
+    own_ambient: bool,
     /// The traced component's image, when it is requested: written by the
     /// traced term alone, it joins `targets` then.
     traced: Option<&'a mut LinearImage>,
 }
 
 impl<'a> PassImages<'a> {
-    /// `image` and the `components`' own `images` (same order).
-    fn new(image: &'a mut LinearImage, components: &[(Component, LinearImage)], images: &'a mut [LinearImage]) -> Self {
+    /// `image` and the `components`' own `images` (same order), and
+    /// `ambient` (cleared to `image`'s size) when given and no ambient image
+    /// is requested: what ambient occlusion darkens.
+    fn new(
+        image: &'a mut LinearImage,
+        components: &[(Component, LinearImage)],
+        images: &'a mut [LinearImage],
+        ambient: Option<&'a mut LinearImage>,
+    ) -> Self {
+        let (w, h) = (image.width(), image.height());
         let mut targets = vec![Target { parts: ComponentSet::ALL, image }];
         let mut traced = None;
         for ((c, _), image) in components.iter().zip(images) {
@@ -683,7 +726,36 @@ impl<'a> PassImages<'a> {
                 c => targets.push(Target { parts: ComponentSet::only(*c), image }),
             }
         }
-        PassImages { targets, traced }
+        let requested = components.iter().any(|(c, _)| *c == Component::Ambient);
+        let own_ambient = ambient.is_some() && !requested;
+        if let Some(image) = ambient.filter(|_| own_ambient) {
+            image.resize(w, h);
+            image.pixels_mut().fill(Vec3::ZERO);
+            targets.push(Target { parts: ComponentSet::only(Component::Ambient), image });
+        }
+        PassImages { targets, traced, own_ambient }
+    }
+}
+
+/// Ambient occlusion ([`crate::raytrace::occlusion`]): the pass's ambient
+/// darkened in its image and its ambient image, each pixel's open share into
+/// `open`; the pass's own ambient image then leaves the targets.
+fn occlusion_term(
+    scene: &Scene,
+    vb: &VisibilityBuffer,
+    images: &mut PassImages,
+    subpixel: &mut SubpixelShading,
+    trace: &mut TraceCache,
+    open: &mut LinearImage,
+) {
+    let ambient = ComponentSet::only(Component::Ambient);
+    let Some(k) = images.targets.iter().position(|t| t.parts == ambient) else { return };
+    let (image, rest) = images.targets.split_at_mut(1);
+    let trace = trace.get(scene);
+    occlusion::darken_ambient(scene, vb, trace, image[0].image, rest[k - 1].image, subpixel, open);
+    if images.own_ambient {
+        images.targets.remove(k);
+        images.own_ambient = false;
     }
 }
 

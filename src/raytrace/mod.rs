@@ -10,10 +10,12 @@
 //! rays walked together) and `occluded` (anything before a distance?); [`TraceCache`]
 //! keeps it while the geometry stays. [`tracer`] shades what a ray sees, bounces
 //! included; [`traced`] is the raster frame's traced term, [`mod@reference`] the
-//! ray-traced oracle, both on top of it; [`shadow_truth`] holds a shadow
+//! ray-traced oracle, both on top of it; [`occlusion`] is ambient occlusion,
+//! by rays from the item buffer's exact hits; [`shadow_truth`] holds a shadow
 //! method's decisions and antialiased terms to shadow rays.
 
 mod cache;
+pub mod occlusion;
 pub mod reference;
 pub mod shadow_truth;
 pub mod traced;
@@ -35,6 +37,13 @@ use crate::triangle::{set_bits, RayLanes, ShearedRay, TriangleColumns, LANES};
 use crate::visibility::ItemId;
 
 pub use cache::TraceCache;
+
+/// How far off its surface a ray leaving a point starts (along the normal),
+/// so it does not meet the surface it leaves: a hair of the scene's size.
+#[must_use]
+pub fn ray_epsilon(scene: &Scene) -> f32 {
+    scene.bounds().map_or(1e-4, |(lo, hi)| (hi - lo).length() * 1e-5)
+}
 
 /// The nearest surface along a ray.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -44,11 +44,14 @@ pub struct ReferenceOptions {
     pub shadows: bool,
     /// Reflection/refraction bounces followed from a surface (0: none).
     pub max_depth: u32,
+    /// Ambient-occlusion rays at each point shaded, where the scene has
+    /// ambient occlusion ([`crate::raytrace::occlusion`]): its truth.
+    pub occlusion_rays: u32,
 }
 
 impl Default for ReferenceOptions {
     fn default() -> Self {
-        ReferenceOptions { pixel_samples: 4, light_samples: 4, shadows: true, max_depth: 4 }
+        ReferenceOptions { pixel_samples: 4, light_samples: 4, shadows: true, max_depth: 4, occlusion_rays: 64 }
     }
 }
 
@@ -69,10 +72,12 @@ pub fn render_reference_until(
     let trace = TraceScene::new(scene);
     let frames = ObjectFrames::new(scene);
     let run = Run { scene, opts, progress, stop };
+    let ao = opts.occlusion_rays;
     if opts.shadows {
-        run.with(Tracer::new(scene, &trace, &frames, AreaLights { per_axis: opts.light_samples.max(1) }))
+        let lights = AreaLights { per_axis: opts.light_samples.max(1) };
+        run.with(Tracer::new(scene, &trace, &frames, lights).with_occlusion_rays(ao))
     } else {
-        run.with(Tracer::new(scene, &trace, &frames, Unshadowed))
+        run.with(Tracer::new(scene, &trace, &frames, Unshadowed).with_occlusion_rays(ao))
     }
 }
 

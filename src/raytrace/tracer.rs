@@ -9,7 +9,8 @@ use std::cell::Cell;
 
 use glam::Vec3;
 
-use super::{Hit, TraceScene};
+use super::occlusion::Occlusion;
+use super::{ray_epsilon, Hit, TraceScene};
 use crate::bvh::PACKET;
 use crate::camera::Ray;
 use crate::scene::{Light, LightKind, Scene};
@@ -90,14 +91,23 @@ pub struct Tracer<'a, L: LightRays = ShadowRay> {
     frames: &'a ObjectFrames,
     lights: L,
     epsilon: f32,
+    /// The scene's ambient occlusion, if any.
+    occlusion: Option<Occlusion<'a>>,
 }
 
 impl<'a, L: LightRays> Tracer<'a, L> {
     /// A tracer over `trace` (built from `scene`), its shadow rays cast by `lights`.
     #[must_use]
     pub fn new(scene: &'a Scene, trace: &'a TraceScene, frames: &'a ObjectFrames, lights: L) -> Self {
-        let epsilon = scene.bounds().map_or(1e-4, |(lo, hi)| (hi - lo).length() * 1e-5);
-        Tracer { scene, trace, frames, lights, epsilon }
+        let occlusion = Occlusion::new(scene, trace);
+        Tracer { scene, trace, frames, lights, epsilon: ray_epsilon(scene), occlusion }
+    }
+
+    /// The same tracer with `rays` ambient-occlusion rays at each point it
+    /// shades (the reference's many), where the scene has ambient occlusion.
+    #[must_use]
+    pub fn with_occlusion_rays(self, rays: u32) -> Self {
+        Tracer { occlusion: self.occlusion.map(|o| o.with_rays(rays)), ..self }
     }
 
     /// Light arriving along `ray` (unit direction), following `depth` bounces.
@@ -177,6 +187,9 @@ impl<'a, L: LightRays> Tracer<'a, L> {
                 1.0
             };
             phong::add_light(&mut acc, light, &k, &s, shadow);
+        }
+        if let Some(occlusion) = &self.occlusion {
+            acc.ambient *= occlusion.open(s.position, s.normal);
         }
         let own = acc.total() + reflection_map(self.scene, &s) + self.bounces_within(ray, &s, depth, rays);
         if material.translucent() {

@@ -26,7 +26,9 @@ pub use light::{
 };
 pub use material::{phong_exponent, ComponentMaps, Material, NormalMap};
 pub use mesh::Mesh;
-pub use settings::{Antialias, EdgeFilter, EdgeMode, EdgeSelection, Exposure, Fog, FogMode, TranslucencyOrder, Up};
+pub use settings::{
+    AmbientOcclusion, Antialias, EdgeFilter, EdgeMode, EdgeSelection, Exposure, Fog, FogMode, TranslucencyOrder, Up,
+};
 pub use texture::{SharedFootprint, Texture};
 
 use crate::camera::Camera;
@@ -201,6 +203,9 @@ pub struct Scene {
     pub antialias: Antialias,
     /// Fog (seed 002 §3.5), if any.
     pub fog: Option<Fog>,
+    /// Ambient occlusion, if any: the ambient term darkened where nearby
+    /// surfaces hide the sky.
+    pub ambient_occlusion: Option<AmbientOcclusion>,
     /// The environment map (reflection map of eq. 4 and optional background).
     pub environment: Option<Environment>,
     /// How translucent surfaces are ordered (seed 002 §3.4).
@@ -260,6 +265,7 @@ impl Scene {
             tone: ToneCurve::default(),
             antialias: Antialias::default(),
             fog: None,
+            ambient_occlusion: None,
             environment: None,
             translucency: TranslucencyOrder::default(),
             camera,
@@ -290,6 +296,20 @@ impl Scene {
             return Err(Error::Scene(format!("object '{}' has a non-finite transform", o.name)));
         }
         Ok(())
+    }
+
+    /// The ambient-occlusion radius: the scene's own, or
+    /// [`AmbientOcclusion::RADIUS_OF_SIZE`] of the diagonal of the shadow
+    /// casters' box (the model, not its floor; all objects' without casters).
+    /// `None` without ambient occlusion.
+    #[must_use]
+    pub fn occlusion_radius(&self) -> Option<f32> {
+        let ao = self.ambient_occlusion?;
+        let size = || {
+            let (lo, hi) = self.caster_bounds().or_else(|| self.bounds()).unwrap_or((Vec3::ZERO, Vec3::ONE));
+            AmbientOcclusion::RADIUS_OF_SIZE * (hi - lo).length()
+        };
+        Some(ao.radius.unwrap_or_else(size))
     }
 
     /// World-space bounds `(min, max)` of all objects (`None` if there are none).

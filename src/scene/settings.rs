@@ -206,6 +206,37 @@ pub enum TranslucencyOrder {
     Unsorted,
 }
 
+/// Ambient occlusion: the ambient term at a point scaled by the share of the
+/// hemisphere above it that is open within `radius` (cosine-weighted), found by
+/// rays ([`crate::raytrace::occlusion`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AmbientOcclusion {
+    /// How far away an occluder still darkens, in world units (`None`:
+    /// [`AmbientOcclusion::RADIUS_OF_SIZE`] of the diagonal of the objects' box).
+    pub radius: Option<f32>,
+    /// Rays a point casts in one pass.
+    pub rays: u32,
+    /// Which of each point's rays a pass casts: pass `p` casts rays
+    /// `p · rays .. (p + 1) · rays` of the point's sequence, so the passes of a
+    /// progressive preview (or of jittered antialiasing) add new rays, not the
+    /// same ones again.
+    pub pass: u32,
+}
+
+impl AmbientOcclusion {
+    /// The default radius's share of the diagonal of the objects' box.
+    pub const RADIUS_OF_SIZE: f32 = 0.1;
+    /// Most rays a point may cast in one pass.
+    pub const MAX_RAYS: u32 = 4096;
+}
+
+impl Default for AmbientOcclusion {
+    /// The radius from the model's size, 16 rays a point, the first pass.
+    fn default() -> Self {
+        AmbientOcclusion { radius: None, rays: 16, pass: 0 }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -38,6 +38,7 @@ pub fn scene_with(mesh: Mesh, camera: Camera, width: u32, height: u32, two_sided
         exposure: Default::default(),
         antialias: Antialias::None,
         fog: None,
+        ambient_occlusion: None,
         environment: None,
         translucency: Default::default(),
         tone: Default::default(),

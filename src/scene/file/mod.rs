@@ -29,7 +29,8 @@ use crate::limits::{Limit, LimitSetting, Limits};
 use crate::scene::camera_path::{CameraPath, Interpolation, Key};
 use crate::scene::material::Filter;
 use crate::scene::settings::{
-    Antialias, EdgeFilter, EdgeMode, EdgeSelection, Exposure, Fog, FogMode, TranslucencyOrder, MAX_JITTER_SAMPLES,
+    AmbientOcclusion, Antialias, EdgeFilter, EdgeMode, EdgeSelection, Exposure, Fog, FogMode, TranslucencyOrder,
+    MAX_JITTER_SAMPLES,
 };
 use crate::scene::texture::Wrap;
 
@@ -52,6 +53,7 @@ pub struct SceneFile {
     #[serde(default, rename = "object")]
     objects: Vec<Spanned<ObjectRec>>,
     fog: Option<Spanned<FogRec>>,
+    ambient_occlusion: Option<Spanned<OcclusionRec>>,
     environment: Option<Spanned<EnvironmentRec>>,
     /// `[limits]`: limit name → value.
     #[serde(default)]
@@ -132,6 +134,15 @@ struct FogRec {
     start: Option<f32>,
     end: Option<f32>,
     density: Option<f32>,
+}
+
+/// `[ambient_occlusion]`: `radius` (world units; default from the model's
+/// size), `rays` a point (default 16).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct OcclusionRec {
+    radius: Option<f32>,
+    rays: Option<i64>,
 }
 
 fn fog_color() -> V3 {
@@ -642,6 +653,7 @@ impl SceneFile {
             tone: self.image.tonemap.into(),
             antialias: self.antialias()?,
             fog: self.fog()?,
+            ambient_occlusion: self.ambient_occlusion()?,
             environment: self.environment(&from)?,
             translucency: self.image.translucency.into(),
             limits: from.limits,

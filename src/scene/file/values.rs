@@ -46,6 +46,23 @@ impl SceneFile {
         Ok(Some(Fog { mode, color: r.color.into() }))
     }
 
+    pub(super) fn ambient_occlusion(&self) -> Result<Option<AmbientOcclusion>> {
+        let Some(rec) = &self.ambient_occlusion else { return Ok(None) };
+        let r = rec.get_ref();
+        if r.radius.is_some_and(|r| !(r.is_finite() && r > 0.0)) {
+            return Err(self.invalid(rec.span(), "ambient_occlusion `radius` must be finite and > 0"));
+        }
+        let max = AmbientOcclusion::MAX_RAYS;
+        let rays = match r.rays {
+            None => AmbientOcclusion::default().rays,
+            Some(n) if (1..=i64::from(max)).contains(&n) => n as u32,
+            Some(n) => {
+                return Err(self.invalid(rec.span(), format!("ambient_occlusion `rays` must be 1 to {max}, not {n}")))
+            }
+        };
+        Ok(Some(AmbientOcclusion { radius: r.radius, rays, pass: 0 }))
+    }
+
     pub(super) fn antialias(&self) -> Result<Antialias> {
         let Some(rec) = &self.image.antialias else { return Ok(Antialias::default()) };
         let rec = rec.get_ref();
