@@ -8,6 +8,7 @@
 //! criterion benchmarks: `cargo bench -p kage-bench`.
 
 mod aa;
+mod ao;
 mod csg;
 mod openscad;
 mod raster;
@@ -48,6 +49,9 @@ enum Command {
     /// Antialiasing: the edge pass (seed 004) and jittered passes against a
     /// 256-pass supersampled truth.
     Aa(aa::AaArgs),
+    /// Ambient occlusion after the viewer's 64 passes against the reference
+    /// renderer's, and what it costs a frame.
+    Ao(ao::AoArgs),
     /// CSG solids (seed 003): the scanline walk's visible surfaces beside a ray
     /// per pixel cast at every primitive (the paper's baseline) and BVH rays,
     /// on the OpenSCAD corpus.
@@ -188,6 +192,7 @@ fn main() -> miette::Result<()> {
         Command::Rays(args) => rays::run(&args),
         Command::Hybrid(args) => rays::run_hybrid(&args),
         Command::Aa(args) => aa::run(&args),
+        Command::Ao(args) => ao::run(&args),
         Command::Csg(args) => csg::run(&args),
         Command::CsgRandom(args) => csg::run_random(&args),
         Command::CsgPreview(args) => csg::run_preview(&args),

@@ -119,6 +119,11 @@ pub struct RenderArgs {
     /// other shadow settings.
     #[arg(long, value_parser = parse_shadow_method)]
     shadows: Option<ShadowMethod>,
+    /// X-ray: every object drawn see-through (its front and back faces
+    /// blended in depth order, whatever order the file lists them in), so
+    /// parts inside others show; shadows off.
+    #[arg(long)]
+    xray: bool,
     /// Ambient occlusion: darkens the ambient light in creases, at the foot
     /// of parts and inside holes, by rays from each pixel's surface point
     /// (the scene file's `[ambient_occlusion]`, or these defaults).
@@ -509,6 +514,9 @@ pub fn render_command(args: &RenderArgs) -> miette::Result<()> {
     scene.tone = args.tonemap.unwrap_or(scene.tone);
     if let Some(method) = args.shadows {
         scene.lights.iter_mut().for_each(|l| l.shadow = l.shadow.with_method(method));
+    }
+    if args.xray {
+        scene.xray(kage::scene::XRAY_OPACITY);
     }
     if args.ao || args.ao_radius.is_some() || args.ao_rays.is_some() {
         let ao = scene.ambient_occlusion.get_or_insert_with(Default::default);

@@ -186,6 +186,9 @@ pub fn box_corners((lo, hi): (Vec3, Vec3)) -> [Vec3; 8] {
     })
 }
 
+/// The opacity of every material in an x-ray view ([`Scene::xray`]).
+pub const XRAY_OPACITY: f32 = 0.3;
+
 /// A complete scene.
 #[derive(Debug, Clone)]
 pub struct Scene {
@@ -296,6 +299,22 @@ impl Scene {
             return Err(Error::Scene(format!("object '{}' has a non-finite transform", o.name)));
         }
         Ok(())
+    }
+
+    /// Makes the scene an x-ray view: every material translucent with
+    /// `opacity` and two-sided (back faces drawn too), blended in depth order
+    /// ([`TranslucencyOrder::Sorted`]: each pixel's fragments sorted, so the
+    /// image does not depend on the order of the objects), no shadows (a
+    /// see-through part would darken what lies behind it), no mirrors or glass
+    /// traced.
+    pub fn xray(&mut self, opacity: f32) {
+        for m in &mut self.materials {
+            m.opacity = opacity;
+            m.two_sided = true;
+            (m.kr, m.kt) = (Vec3::ZERO, Vec3::ZERO);
+        }
+        self.translucency = TranslucencyOrder::Sorted;
+        self.lights.iter_mut().for_each(|l| l.shadow = ShadowSettings::NONE);
     }
 
     /// The ambient-occlusion radius: the scene's own, or

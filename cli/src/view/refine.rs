@@ -9,7 +9,7 @@ use std::sync::{Mutex, MutexGuard, PoisonError};
 use glam::Vec3;
 use kage::image::{LinearImage, ToneCurve};
 use kage::scene::material::Filter;
-use kage::scene::{Antialias, Light, Scene, ShadowMethod, ShadowSettings};
+use kage::scene::{AmbientOcclusion, Antialias, Light, Scene, ShadowMethod, ShadowSettings};
 use kage::ComponentSet;
 use kage::{FrameStats, RenderOptions, Renderer};
 use rayon::prelude::*;
@@ -19,6 +19,10 @@ use super::state::{Display, Shadows, Smoothing, Step, Viewer, MAX_PASSES};
 /// Jittered passes averaged before the average replaces the full frame on
 /// screen (fewer look noisier than the edge pass's frame).
 pub const SHOWN_FROM_PASS: u32 = 4;
+
+/// Ambient-occlusion rays a pixel casts in each jittered pass (new ones each
+/// pass): the full frame casts the scene's (16 by default), 64 passes 256.
+pub const PASS_OCCLUSION_RAYS: u32 = 4;
 
 /// What the window shows: linear colour, how to map it to the screen, and
 /// the frame it came from. The rendering thread writes it in place (its
@@ -172,7 +176,8 @@ fn publish(
 }
 
 /// `base` as `viewer` and `step` set it up: the orbit's camera at the
-/// window's size, the toggles' shadows, smoothing, fog; a quick step with
+/// window's size, the toggles' shadows, smoothing, fog, ambient occlusion
+/// (none in a quick step, new rays each jittered pass); a quick step with
 /// plain maps in place of costlier shadows and no edge pass; a jittered pass
 /// shifted to its sub-pixel point (those of `--antialias jitter:64`), each
 /// jittered light shadowed from that pass's own point of its disc.
@@ -209,6 +214,22 @@ pub fn scene_for(base: &Scene, viewer: &Viewer, step: Step) -> Scene {
     if !t.fog {
         scene.fog = None;
     }
+    if t.xray {
+        scene.xray(kage::scene::XRAY_OPACITY);
+    }
+    scene.ambient_occlusion = match step {
+        // A moving camera: no ambient occlusion (its rays cost several
+        // frames' time).
+        _ if !t.ao => None,
+        Step::Quick => None,
+        Step::Full => Some(scene.ambient_occlusion.unwrap_or_default()),
+        // Each pass casts PASS_OCCLUSION_RAYS new rays a pixel: 64 passes, 256.
+        Step::Pass(n) => Some(AmbientOcclusion {
+            rays: PASS_OCCLUSION_RAYS,
+            pass: n.clamp(1, MAX_PASSES) - 1,
+            ..scene.ambient_occlusion.unwrap_or_default()
+        }),
+    };
     if !t.ghosts {
         scene.objects.retain(|o| !o.ghost);
     }
@@ -265,6 +286,8 @@ fn display_image(scene: &Scene, frame: &kage::Frame, display: Display, out: &mut
                 None => out.pixels_mut().fill(Vec3::ONE),
             }
         }
+        Display::Occlusion if frame.occlusion.pixels().len() == out.pixels().len() => copy(out, &frame.occlusion),
+        Display::Occlusion => out.pixels_mut().fill(Vec3::ONE),
         Display::Depth => {
             let seen = vb.depths().iter().copied().filter(|d| d.is_finite());
             let (near, far) = seen.fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), d| (a.min(d), b.max(d)));
@@ -291,4 +314,28 @@ fn false_colour(id: u32) -> Vec3 {
     let h = id.wrapping_mul(0x9E37_79B9).rotate_left(7) ^ 0x5bd1_e995;
     let c = |s: u32| 0.25 + 0.75 * ((h >> s) & 0xff) as f32 / 255.0;
     Vec3::new(c(0), c(8), c(16))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::view::orbit::Orbit;
+    use glam::Vec3;
+
+    #[test]
+    fn ambient_occlusion_is_off_in_quick_frames_and_casts_new_rays_each_pass() {
+        let base = kage::scene::demo::demo_scene().expect("the demo");
+        let orbit = Orbit::from_camera(&base.camera);
+        let mut viewer = Viewer::new(orbit, (Vec3::splat(-1.0), Vec3::ONE), (320, 180));
+        let ao = |viewer: &Viewer, step| scene_for(&base, viewer, step).ambient_occlusion;
+        let off = [ao(&viewer, Step::Quick), ao(&viewer, Step::Full), ao(&viewer, Step::Pass(3))];
+        assert_eq!(off, [None; 3], "off until O");
+        viewer.toggles.ao = true;
+        let ao = |step| ao(&viewer, step);
+        assert_eq!(ao(Step::Quick), None);
+        assert_eq!(ao(Step::Full), Some(AmbientOcclusion::default()));
+        let passes: Vec<(u32, u32)> =
+            (1..=MAX_PASSES).map(|n| ao(Step::Pass(n)).map(|a| (a.pass, a.rays)).expect("on")).collect();
+        assert!(passes.iter().enumerate().all(|(k, &p)| p == (k as u32, PASS_OCCLUSION_RAYS)), "{passes:?}");
+    }
 }

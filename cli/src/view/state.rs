@@ -146,6 +146,8 @@ pub enum Display {
     Component(Component),
     /// The first shadowed light's shadow term.
     Shadow,
+    /// Ambient occlusion's open share (white where it is off).
+    Occlusion,
     /// Eye depth, near white to far black.
     Depth,
     /// Shading normals as colours.
@@ -160,7 +162,7 @@ impl Display {
     pub fn cycle() -> Vec<Display> {
         let mut all = vec![Display::Image];
         all.extend(Component::ALL.map(Display::Component));
-        all.extend([Display::Shadow, Display::Depth, Display::Normals, Display::Items]);
+        all.extend([Display::Shadow, Display::Occlusion, Display::Depth, Display::Normals, Display::Items]);
         all
     }
 
@@ -171,6 +173,7 @@ impl Display {
             Display::Image => "image".to_string(),
             Display::Component(c) => c.name().to_string(),
             Display::Shadow => "shadow term".to_string(),
+            Display::Occlusion => "ambient occlusion".to_string(),
             Display::Depth => "depth".to_string(),
             Display::Normals => "normals".to_string(),
             Display::Items => "items".to_string(),
@@ -196,6 +199,10 @@ pub struct Toggles {
     pub exact_csg: bool,
     /// OpenSCAD's `#` and `%` parts drawn see-through (M).
     pub ghosts: bool,
+    /// Ambient occlusion (O): the scene's, or the defaults.
+    pub ao: bool,
+    /// Every object see-through (X).
+    pub xray: bool,
 }
 
 impl Default for Toggles {
@@ -208,6 +215,8 @@ impl Default for Toggles {
             ground: true,
             exact_csg: true,
             ghosts: true,
+            ao: false,
+            xray: false,
         }
     }
 }
@@ -345,6 +354,8 @@ impl Viewer {
             Key::Char('r') => t.traced = !t.traced,
             Key::Char('g') => t.fog = !t.fog,
             Key::Char('m') => t.ghosts = !t.ghosts,
+            Key::Char('o') => t.ao = !t.ao,
+            Key::Char('x') => t.xray = !t.xray,
             Key::Char('p') => {
                 t.ground = !t.ground;
                 return Request::Reload;
@@ -421,10 +432,11 @@ impl Viewer {
     }
 
     /// Whether the quick frame would render the same as the full one (no
-    /// edge pass wanted, no costlier shadows).
+    /// edge pass wanted, no costlier shadows, no ambient occlusion).
     fn quick_is_full(&self) -> bool {
         let scene_costly = self.toggles.shadows == Shadows::Scene && self.costly_scene;
-        self.toggles.smoothing == Smoothing::None && !self.toggles.shadows.costly() && !scene_costly
+        let t = &self.toggles;
+        t.smoothing == Smoothing::None && !t.shadows.costly() && !scene_costly && !t.ao
     }
 
     fn after_full(&self) -> Option<Step> {
@@ -510,7 +522,7 @@ mod tests {
         assert_eq!(v.apply(drag(Button::Left, 5.0, 0.0, false)), Request::Render);
         assert_eq!(next(&mut v), Some(Step::Quick));
         assert_eq!(next(&mut v), Some(Step::Full));
-        assert_eq!(v.apply(Input::Key(Key::Char('x'))), Request::Nothing);
+        assert_eq!(v.apply(Input::Key(Key::Char('j'))), Request::Nothing);
         assert_eq!(next(&mut v), Some(Step::Pass(1)));
         assert_eq!(v.apply(Input::Key(Key::Char('z'))), Request::Redraw, "the HUD is drawn over the frame");
         assert_eq!(next(&mut v), Some(Step::Pass(2)));
@@ -537,6 +549,11 @@ mod tests {
         assert_eq!((next(&mut v), next(&mut v)), (Some(Step::Quick), None));
         v.costly_scene = true;
         v.apply(Input::Wheel(1.0));
+        assert_eq!((next(&mut v), next(&mut v), next(&mut v)), (Some(Step::Quick), Some(Step::Full), None));
+        // Ambient occlusion is left out of quick frames: the full frame follows.
+        v.costly_scene = false;
+        assert_eq!(v.apply(Input::Key(Key::Char('o'))), Request::Render);
+        assert!(v.toggles.ao);
         assert_eq!((next(&mut v), next(&mut v), next(&mut v)), (Some(Step::Quick), Some(Step::Full), None));
     }
 
@@ -619,6 +636,8 @@ mod tests {
         assert_eq!(v.apply(Input::Key(Key::Char('m'))), Request::Render);
         assert!(!v.toggles.ghosts);
         assert!(!v.toggles.traced && !v.toggles.fog, "R and G turn them off");
+        assert_eq!(v.apply(Input::Key(Key::Char('x'))), Request::Render);
+        assert!(v.toggles.xray, "X turns x-ray on");
         assert_eq!(v.apply(Input::Key(Key::Escape)), Request::Quit);
         assert_eq!(v.apply(Input::Key(Key::Char('q'))), Request::Quit);
         assert_eq!(v.apply(Input::Key(Key::F12)), Request::Screenshot);

@@ -577,6 +577,7 @@ fn viewer_for(scene: Option<&Scene>, size: (u32, u32)) -> Viewer {
     let mut viewer = Viewer::new(orbit, bounds, size);
     viewer.framed = scene.and_then(Scene::caster_bounds).unwrap_or(bounds);
     viewer.costly_scene = costly;
+    viewer.toggles.ao = scene.is_some_and(|s| s.ambient_occlusion.is_some());
     viewer
 }
 
@@ -602,8 +603,8 @@ fn hud_lines(viewer: &Viewer, shown: &Shown, step: Option<Step>, times: &VecDequ
             format!("{:.1} fps  {}x{}  {stage}", 1.0 / mean, viewer.size.0, viewer.size.1)
         },
         format!(
-            "ms: visibility {:.1}  shadows {:.1}  shading {:.1}  traced {:.1}  edges {:.1}",
-            st.visibility_ms, st.shadow_ms, st.shading_ms, st.traced_ms, st.edge_ms
+            "ms: visibility {:.1}  shadows {:.1}  shading {:.1}  traced {:.1}  ao {:.1}  edges {:.1}",
+            st.visibility_ms, st.shadow_ms, st.shading_ms, st.traced_ms, st.occlusion_ms, st.edge_ms
         ),
         format!("{} triangles  {} solids  {} passes averaged", st.raster.triangles, st.raster.solids, shown.passes),
         match skipped(&viewer.warnings) {
@@ -611,8 +612,14 @@ fn hud_lines(viewer: &Viewer, shown: &Shown, step: Option<Step>, times: &VecDequ
             n => format!("INCOMPLETE: {n} part(s) not drawn"),
         },
         format!(
-            "shadows {}  smoothing {smoothing}  show {}{}",
+            "shadows {}  smoothing {smoothing}{}  show {}{}",
             viewer.toggles.shadows.name(),
+            match (viewer.toggles.ao, viewer.toggles.xray) {
+                (false, false) => "",
+                (true, false) => "  ao",
+                (false, true) => "  x-ray",
+                (true, true) => "  ao  x-ray",
+            },
             viewer.display.name(),
             if viewer.display == Display::Image { "" } else { " (V: next)" }
         ),
@@ -668,6 +675,8 @@ pub fn cheat_sheet() -> Vec<String> {
         "A           antialiasing",
         "R           traced reflections",
         "G           fog",
+        "O           ambient occlusion",
+        "X           x-ray",
         "P           ground plane",
         "C           CSG exact/faceted",
         "M           OpenSCAD # and % parts",
