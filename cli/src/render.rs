@@ -119,6 +119,12 @@ pub struct RenderArgs {
     /// other shadow settings.
     #[arg(long, value_parser = parse_shadow_method)]
     shadows: Option<ShadowMethod>,
+    /// Section: everything beyond a plane removed and the cut faces of closed
+    /// parts drawn (red). `x=VALUE` removes x > VALUE, `-x=VALUE` removes
+    /// x < VALUE (likewise y, z), in the model file's own coordinates (a
+    /// scene file's world; its `[section]` takes any plane).
+    #[arg(long, value_parser = parse_section, allow_hyphen_values = true, value_name = "[-]AXIS=VALUE")]
+    section: Option<kage::scene::section::SectionPlane>,
     /// X-ray: every object drawn see-through (its front and back faces
     /// blended in depth order, whatever order the file lists them in), so
     /// parts inside others show; shadows off.
@@ -347,6 +353,20 @@ fn parse_fov(s: &str) -> Result<f32, String> {
     }
 }
 
+fn parse_section(s: &str) -> Result<kage::scene::section::SectionPlane, String> {
+    let bad = || format!("'{s}' is not a section (expected AXIS=VALUE or -AXIS=VALUE, AXIS x, y or z: e.g. z=5)");
+    let (axis, value) = s.split_once('=').ok_or_else(bad)?;
+    let value: f32 = value.trim().parse().ok().filter(|v: &f32| v.is_finite()).ok_or_else(bad)?;
+    let (sign, axis) = axis.trim().strip_prefix('-').map_or((1.0, axis.trim()), |a| (-1.0, a));
+    let normal = match axis {
+        "x" | "X" => Vec3::X,
+        "y" | "Y" => Vec3::Y,
+        "z" | "Z" => Vec3::Z,
+        _ => return Err(bad()),
+    } * sign;
+    kage::scene::section::SectionPlane::through(normal * value * sign, normal).ok_or_else(bad)
+}
+
 fn parse_positive(s: &str) -> Result<f32, String> {
     match s.parse::<f32>() {
         Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
@@ -390,6 +410,7 @@ fn load(args: &RenderArgs) -> kage::error::Result<Scene> {
         file_camera: args.camera == CameraArg::File,
         camera: camera_override(args),
         limits: Limits::default().with_settings(&args.limits),
+        section: args.section,
     };
     let (width, height) = (args.width, args.height);
     let (w, h) = (width.unwrap_or(960), height.unwrap_or(540));
@@ -404,6 +425,9 @@ fn load(args: &RenderArgs) -> kage::error::Result<Scene> {
     };
     if args.input.is_none() {
         scene.limits = scene.limits.with_settings(&args.limits);
+    }
+    if let Some(plane) = args.section {
+        scene.section(plane);
     }
     scene.width = width.unwrap_or(scene.width);
     scene.height = height.unwrap_or(scene.height);

@@ -12,6 +12,7 @@ pub mod load;
 pub mod material;
 pub mod mesh;
 pub mod model;
+pub mod section;
 pub mod settings;
 pub mod texture;
 

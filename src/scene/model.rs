@@ -11,6 +11,7 @@ use super::file::add_model;
 use super::framing::{fit_depth, framed_camera, key_light, light_rig, CameraOverride, View, FRAMING_FOV_DEG};
 use super::load;
 use super::mesh::shapes;
+use super::section::SectionPlane;
 use super::{Environment, Exposure, Light, Material, Object, Scene, ShadowSettings, Up};
 use crate::bvh::{Aabb, Bvh};
 use crate::camera::{Camera, Projection, Ray};
@@ -97,6 +98,11 @@ pub struct ModelOptions {
     pub camera: CameraOverride,
     /// What the model may ask for.
     pub limits: Limits,
+    /// A section plane in the model file's own coordinates (before its up
+    /// axis is turned): what lies beyond it is removed
+    /// ([`Scene::section`]); the camera and lights still frame the whole
+    /// model, and the ground is not cut.
+    pub section: Option<SectionPlane>,
 }
 
 impl Default for ModelOptions {
@@ -108,6 +114,7 @@ impl Default for ModelOptions {
             file_camera: false,
             camera: CameraOverride::default(),
             limits: Limits::default(),
+            section: None,
         }
     }
 }
@@ -204,6 +211,11 @@ pub fn scene_for_loaded_model(
         // more than the rest of the frame.
         lights[0].shadow.resolution = 512;
         lights.iter_mut().skip(1).for_each(|l| l.shadow = ShadowSettings::NONE);
+    }
+    if let Some(plane) = options.section {
+        let normal = turn.transform_vector3(plane.normal);
+        let world = SectionPlane::through(normal * plane.offset, normal).expect("a turn keeps a unit normal");
+        scene.section(world);
     }
     if options.ground && interior.is_none() {
         add_ground(&mut scene, bounds);

@@ -72,6 +72,7 @@ fn model_scene(path: &Path, toggles: &Toggles) -> Result<Scene, String> {
         file_camera: false,
         camera: CameraOverride::default(),
         limits: Limits::default(),
+        section: None,
     };
     let (w, h) = DEFAULT_SIZE;
     let scene = if InputFormat::from_path(path) == Some(InputFormat::Scad) {

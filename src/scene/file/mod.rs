@@ -54,6 +54,7 @@ pub struct SceneFile {
     objects: Vec<Spanned<ObjectRec>>,
     fog: Option<Spanned<FogRec>>,
     ambient_occlusion: Option<Spanned<OcclusionRec>>,
+    section: Option<Spanned<SectionRec>>,
     environment: Option<Spanned<EnvironmentRec>>,
     /// `[limits]`: limit name → value.
     #[serde(default)]
@@ -143,6 +144,15 @@ struct FogRec {
 struct OcclusionRec {
     radius: Option<f32>,
     rays: Option<i64>,
+}
+
+/// `[section]`: the plane through `point` with `normal` (pointing into the
+/// half removed).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SectionRec {
+    point: V3,
+    normal: V3,
 }
 
 fn fog_color() -> V3 {
@@ -679,6 +689,13 @@ impl SceneFile {
         self.resolve_only(&mut scene, &produced)?;
         if scene.objects.is_empty() {
             return Err(self.invalid(0..0, "the scene has no [[object]]: there is nothing to draw"));
+        }
+        if let Some(rec) = &self.section {
+            let r = rec.get_ref();
+            let plane = super::section::SectionPlane::through(Vec3::from(r.point), Vec3::from(r.normal));
+            let plane = plane
+                .ok_or_else(|| self.invalid(rec.span(), "section `point` must be finite and `normal` not zero"))?;
+            scene.section(plane);
         }
         self.place_camera_and_lights(&mut scene, &models)?;
         scene.camera_path = self.camera_path(&scene.camera)?;
