@@ -109,3 +109,41 @@ fn a_scene_files_section_cuts_its_objects_and_a_bad_one_says_where() {
     let e = SceneFile::parse(bad, std::path::Path::new("bad.toml")).and_then(|f| f.build(&fs)).err().expect("refused");
     assert!(e.to_string().starts_with("bad.toml:4:") && e.to_string().contains("normal"), "{e}");
 }
+
+#[test]
+fn a_section_of_an_openscad_part_is_the_part_intersected_with_a_cube() {
+    use kage::scene::model::{scene_for_model_with, ModelOptions};
+    let knob = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/openscad/knob.csg");
+    let text = std::fs::read_to_string(&knob).expect("the example");
+    // The same cut written in OpenSCAD: keep z ≤ 12 of the file's z-up
+    // coordinates (the part stands 0 to 21 high).
+    let cube = "multmatrix([[1, 0, 0, -100], [0, 1, 0, -100], [0, 0, 1, -88], [0, 0, 0, 1]]) { cube(size = [200, 200, 100], center = false); }";
+    let wrapped = format!("intersection() {{\n group() {{\n{text}\n }}\n {cube}\n}}\n");
+    let path = std::env::temp_dir().join(format!("kage-section-{}.csg", std::process::id()));
+    std::fs::write(&path, wrapped).expect("a scratch file");
+    let plane = SectionPlane::through(Vec3::Z * 12.0, Vec3::Z);
+    let options = ModelOptions { section: plane, ..ModelOptions::default() };
+    let mut cut = scene_for_model_with(&knob, 240, 180, &options).expect("the section loads");
+    let mut intersected =
+        scene_for_model_with(&path, 240, 180, &ModelOptions::default()).expect("the intersection loads");
+    std::fs::remove_file(&path).ok();
+    cut.antialias = Antialias::None;
+    (intersected.camera, intersected.antialias) = (cut.camera, Antialias::None);
+    let (a, b) =
+        (render(&cut, &RenderOptions::default()).unwrap(), render(&intersected, &RenderOptions::default()).unwrap());
+    let solid = |s: &Scene, o: u32| s.objects.get(o as usize).is_some_and(|o| o.solid().is_some());
+    let (ia, ib) = (a.visibility.items(), b.visibility.items());
+    let (da, db) = (a.visibility.depths(), b.visibility.depths());
+    let mut part = 0;
+    let agree = (0..ia.len())
+        .filter(|&i| {
+            let (pa, pb) =
+                (!ia[i].is_none() && solid(&cut, ia[i].object), !ib[i].is_none() && solid(&intersected, ib[i].object));
+            part += usize::from(pa || pb);
+            pa == pb && (!pa || (da[i] - db[i]).abs() <= 1e-3 * da[i].abs().max(1.0))
+        })
+        .count();
+    let share = agree as f64 / ia.len() as f64;
+    assert!(part > 5000, "the part covers {part} pixels");
+    assert!(share >= 0.995, "section and intersection agree on {:.3}% of pixels", 100.0 * share);
+}
