@@ -106,7 +106,7 @@ fn a_scene_files_section_cuts_its_objects_and_a_bad_one_says_where() {
     let (_, hi) = scene.bounds().expect("bounds");
     assert!((hi.y - 0.2).abs() < 1e-5, "nothing above the plane: top at {}", hi.y);
     let bad = "[[object]]\nshape = \"sphere\"\n\n[section]\npoint = [0, 0, 0]\nnormal = [0, 0, 0]\n";
-    let e = SceneFile::parse(bad, std::path::Path::new("bad.toml")).and_then(|f| f.build(&fs)).err().expect("refused");
+    let e = SceneFile::parse(bad, std::path::Path::new("bad.toml")).and_then(|f| f.build(&fs)).expect_err("refused");
     assert!(e.to_string().starts_with("bad.toml:4:") && e.to_string().contains("normal"), "{e}");
 }
 

@@ -85,9 +85,9 @@ impl Scene {
             match &object.body {
                 Body::Mesh(mesh) => self.cut_mesh(object.clone(), mesh, (n, d), cap, &mut out, &mut report),
                 Body::Solid { solid, materials } => match cut_solid(solid, (n, d)) {
-                    Cut::Kept => out.push(object),
-                    Cut::Removed => report.removed += 1,
-                    Cut::Cut(solid) => {
+                    Sectioned::Kept => out.push(object),
+                    Sectioned::Removed => report.removed += 1,
+                    Sectioned::Cut(solid) => {
                         let materials = materials.iter().copied().chain([cap]).collect();
                         out.push(Object { body: Body::Solid { solid: Arc::new(solid), materials }, ..object });
                         report.capped += 1;
@@ -114,9 +114,9 @@ impl Scene {
         report: &mut SectionReport,
     ) {
         match clip_mesh(mesh, plane) {
-            Cut::Kept => out.push(object),
-            Cut::Removed => report.removed += 1,
-            Cut::Cut((kept, loops)) => {
+            Sectioned::Kept => out.push(object),
+            Sectioned::Removed => report.removed += 1,
+            Sectioned::Cut((kept, loops)) => {
                 let name = object.name.clone();
                 let mut cut = Object { body: Body::Mesh(Arc::new(kept.clone())), ..object.clone() };
                 match loops.and_then(|loops| cap_mesh(&kept, &loops, plane.0)) {
@@ -142,7 +142,7 @@ impl Scene {
 }
 
 /// What cutting a body left.
-enum Cut<T> {
+enum Sectioned<T> {
     /// All of it (nothing beyond the plane).
     Kept,
     /// None of it.
@@ -156,13 +156,13 @@ enum Cut<T> {
 type Loops = Option<Vec<Vec<u32>>>;
 
 /// The part of `mesh` on the kept side of `(n, d)`, and its cut's loops.
-fn clip_mesh(mesh: &Mesh, (n, d): (DVec3, f64)) -> Cut<(Mesh, Loops)> {
+fn clip_mesh(mesh: &Mesh, (n, d): (DVec3, f64)) -> Sectioned<(Mesh, Loops)> {
     let side: Vec<f64> = mesh.positions.iter().map(|p| n.dot(p.as_dvec3()) - d).collect();
     if side.iter().all(|&s| s <= 0.0) {
-        return Cut::Kept;
+        return Sectioned::Kept;
     }
     if side.iter().all(|&s| s >= 0.0) {
-        return Cut::Removed;
+        return Sectioned::Removed;
     }
     // A vertex on the plane counts as beyond it (a crossing at its very
     // point stands for it): each edge along the plane is then met once, from
@@ -197,7 +197,7 @@ fn clip_mesh(mesh: &Mesh, (n, d): (DVec3, f64)) -> Cut<(Mesh, Loops)> {
         }
     }
     if kept.out.triangles.is_empty() {
-        return Cut::Removed;
+        return Sectioned::Removed;
     }
     // A mesh with split vertices (hard edges, seams) meets one crossing
     // point as several vertices: loops are joined by position.
@@ -207,7 +207,7 @@ fn clip_mesh(mesh: &Mesh, (n, d): (DVec3, f64)) -> Cut<(Mesh, Loops)> {
     // the edges between them have no length and are left out.
     let edges: Vec<(u32, u32)> = edges.iter().map(|&(a, b)| (one(a), one(b))).filter(|(a, b)| a != b).collect();
     let loops = close_loops(&edges);
-    Cut::Cut((kept.out, loops))
+    Sectioned::Cut((kept.out, loops))
 }
 
 /// A point's bits, −0 and +0 alike: one key for one place.
@@ -349,18 +349,18 @@ fn cap_mesh(kept: &Mesh, loops: &[Vec<u32>], n: DVec3) -> Option<Mesh> {
 }
 
 /// `solid` intersected with its bounding box cut by `(n, d)`.
-fn cut_solid(solid: &CsgSolid, (n, d): (DVec3, f64)) -> Cut<CsgSolid> {
-    let (Some((lo, hi)), Some(tree)) = (solid.bounds(), &solid.tree) else { return Cut::Kept };
+fn cut_solid(solid: &CsgSolid, (n, d): (DVec3, f64)) -> Sectioned<CsgSolid> {
+    let (Some((lo, hi)), Some(tree)) = (solid.bounds(), &solid.tree) else { return Sectioned::Kept };
     let grow = (hi - lo).max_element().max(1e-3) * 0.01;
     let (lo, hi) = ((lo - grow).as_dvec3(), (hi + grow).as_dvec3());
     let corners: Vec<DVec3> =
         (0..8).map(|i| DVec3::new([lo.x, hi.x][i & 1], [lo.y, hi.y][i >> 1 & 1], [lo.z, hi.z][i >> 2 & 1])).collect();
     let side: Vec<f64> = corners.iter().map(|c| n.dot(*c) - d).collect();
     if side.iter().all(|&s| s <= 0.0) {
-        return Cut::Kept;
+        return Sectioned::Kept;
     }
     if side.iter().all(|&s| s > 0.0) {
-        return Cut::Removed;
+        return Sectioned::Removed;
     }
     let mut vertices: Vec<Vec3> =
         corners.iter().zip(&side).filter(|(_, &s)| s <= 0.0).map(|(c, _)| c.as_vec3()).collect();
@@ -391,7 +391,7 @@ fn cut_solid(solid: &CsgSolid, (n, d): (DVec3, f64)) -> Cut<CsgSolid> {
     });
     let leaf = CsgTree::Leaf(cut.primitives.len() - 1);
     cut.tree = Some(CsgTree::Intersection(vec![tree.clone(), leaf]));
-    Cut::Cut(cut)
+    Sectioned::Cut(cut)
 }
 
 #[cfg(test)]
@@ -428,7 +428,7 @@ mod tests {
     }
 
     fn cut(mesh: &Mesh, n: Vec3, d: f32) -> (Mesh, Option<Mesh>) {
-        let Cut::Cut((kept, loops)) = clip_mesh(mesh, (n.as_dvec3(), f64::from(d))) else { panic!("not cut") };
+        let Sectioned::Cut((kept, loops)) = clip_mesh(mesh, (n.as_dvec3(), f64::from(d))) else { panic!("not cut") };
         let lid = loops.and_then(|l| cap_mesh(&kept, &l, n.as_dvec3()));
         (kept, lid)
     }
