@@ -411,6 +411,7 @@ fn load(args: &RenderArgs) -> kage::error::Result<Scene> {
         camera: camera_override(args),
         limits: Limits::default().with_settings(&args.limits),
         section: args.section,
+        section_across: None,
     };
     let (width, height) = (args.width, args.height);
     let (w, h) = (width.unwrap_or(960), height.unwrap_or(540));

@@ -185,6 +185,34 @@ fn the_refined_image_equals_64_jittered_passes() {
     assert!(e < 1e-3, "RMSE {e}");
 }
 
+/// O turns ambient occlusion on; refined, the viewer's 64 passes cast 4 new
+/// rays a pixel each, as `kage render --ao --ao-rays 4 --antialias
+/// jitter:64` does; X (x-ray) then changes the image.
+#[test]
+fn ambient_occlusion_refines_as_64_jittered_passes_do() {
+    if !have_xvfb() {
+        return;
+    }
+    let dir = scratch("occlusion");
+    let file = dir.join("scene.toml");
+    // A cube standing on the floor (the helper's floats over it), a strong ambient light.
+    let lit = scene("cube", "[0.3, 0.7, 0.3]")
+        .replace("position = [3.0, 5.0, 2.0]", "position = [3.0, 5.0, 2.0]\nambient = 0.6")
+        .replace("translate = [0.0, 0.6, 0.0]", "translate = [0.0, 0.3, 0.0]");
+    std::fs::write(&file, lit).unwrap();
+    let script = "key o\nwait\nscreenshot ao.png\nkey x\nwait 4\nscreenshot xray.png\nquit\n";
+    let (ok, out) = scripted(&dir, script, &[file.to_str().unwrap()]);
+    assert!(ok, "{out}");
+    let (with, plain) = (dir.join("render-ao.png"), dir.join("render.png"));
+    let file = file.to_str().unwrap();
+    kage(&["render", file, "--ao", "--ao-rays", "4", "--antialias", "jitter:64", "-o", with.to_str().unwrap()]);
+    kage(&["render", file, "--antialias", "jitter:64", "-o", plain.to_str().unwrap()]);
+    let shot = read(&dir.join("ao.png"));
+    let (e, darker) = (rmse(&shot, &read(&with)), rmse(&shot, &read(&plain)));
+    assert!(e < 1e-3 && darker > 2e-3, "RMSE {e} to the render with ambient occlusion, {darker} to the one without");
+    assert!(rmse(&read(&dir.join("xray.png")), &shot) > 1e-2, "x-ray changes the image");
+}
+
 /// A file dropped on the window opens with its own camera, the toggles
 /// kept (here the edge pass): the screenshot is `kage render` of that file.
 #[test]

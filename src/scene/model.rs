@@ -12,7 +12,7 @@ use super::framing::{fit_depth, framed_camera, key_light, light_rig, CameraOverr
 use super::load;
 use super::mesh::shapes;
 use super::section::SectionPlane;
-use super::{Environment, Exposure, Light, Material, Object, Scene, ShadowSettings, Up};
+use super::{box_corners, Environment, Exposure, Light, Material, Object, Scene, ShadowSettings, Up};
 use crate::bvh::{Aabb, Bvh};
 use crate::camera::{Camera, Projection, Ray};
 use crate::csg::openscad::CsgOptions;
@@ -103,6 +103,10 @@ pub struct ModelOptions {
     /// ([`Scene::section`]); the camera and lights still frame the whole
     /// model, and the ground is not cut.
     pub section: Option<SectionPlane>,
+    /// A section plane across the model (as a viewer places one): its normal
+    /// in the model file's coordinates, and where it crosses the model's box
+    /// along that normal (0: the box's near end, 1: its far end).
+    pub section_across: Option<(Vec3, f32)>,
 }
 
 impl Default for ModelOptions {
@@ -115,6 +119,7 @@ impl Default for ModelOptions {
             camera: CameraOverride::default(),
             limits: Limits::default(),
             section: None,
+            section_across: None,
         }
     }
 }
@@ -216,6 +221,15 @@ pub fn scene_for_loaded_model(
         let normal = turn.transform_vector3(plane.normal);
         let world = SectionPlane::through(normal * plane.offset, normal).expect("a turn keeps a unit normal");
         scene.section(world);
+    }
+    if let Some((normal, at)) = options.section_across {
+        let normal = turn.transform_vector3(normal);
+        let ends = box_corners(bounds).map(|c| c.dot(normal.normalize_or_zero()));
+        let (near, far) = ends.iter().fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), &e| (a.min(e), b.max(e)));
+        let point = normal.normalize_or_zero() * (near + at.clamp(0.0, 1.0) * (far - near));
+        if let Some(world) = SectionPlane::through(point, normal) {
+            scene.section(world);
+        }
     }
     if options.ground && interior.is_none() {
         add_ground(&mut scene, bounds);

@@ -14,7 +14,7 @@ use kage::scene::model::{self, ModelOptions};
 use kage::scene::{file, Scene};
 use kage::Limits;
 
-use super::state::Toggles;
+use super::state::{Toggles, SECTION_STEP};
 use crate::render::extension;
 
 /// Window size when neither the command line nor the scene file gives one.
@@ -36,9 +36,13 @@ impl Source {
     /// The library's message (with file, line and column for a scene or
     /// `.csg` file) when the file cannot be read or understood.
     pub fn load(&self, toggles: &Toggles) -> Result<Scene, String> {
-        let Some(path) = &self.path else { return demo_scene().map_err(|e| e.to_string()) };
+        let Some(path) = &self.path else {
+            return demo_scene().map(|s| cut_across(s, toggles)).map_err(|e| e.to_string());
+        };
         match InputFormat::from_path(path) {
-            Some(InputFormat::Scene) => file::load_scene(path).map_err(|e| e.to_string()),
+            Some(InputFormat::Scene) => {
+                file::load_scene(path).map(|s| cut_across(s, toggles)).map_err(|e| e.to_string())
+            }
             Some(_) => model_scene(path, toggles),
             None => Err(format!("{}: kage view opens {}", path.display(), InputFormat::described())),
         }
@@ -59,6 +63,19 @@ impl Source {
     }
 }
 
+/// A scene (the demo, a scene file) cut by the toggles' section plane, placed
+/// across its shadow casters' box along a world axis.
+fn cut_across(mut scene: Scene, toggles: &Toggles) -> Scene {
+    let Some((axis, at)) = toggles.section else { return scene };
+    let Some((lo, hi)) = scene.caster_bounds().or_else(|| scene.bounds()) else { return scene };
+    let normal = glam::Vec3::AXES[axis];
+    let point = lo.lerp(hi, f32::from(at) * SECTION_STEP);
+    if let Some(plane) = kage::scene::section::SectionPlane::through(point, normal) {
+        scene.section(plane);
+    }
+    scene
+}
+
 /// A model file framed on its ground, as `kage render FILE` sets it up,
 /// with the toggles' ground and CSG geometry.
 fn model_scene(path: &Path, toggles: &Toggles) -> Result<Scene, String> {
@@ -73,6 +90,7 @@ fn model_scene(path: &Path, toggles: &Toggles) -> Result<Scene, String> {
         camera: CameraOverride::default(),
         limits: Limits::default(),
         section: None,
+        section_across: toggles.section.map(|(axis, at)| (glam::Vec3::AXES[axis], f32::from(at) * SECTION_STEP)),
     };
     let (w, h) = DEFAULT_SIZE;
     let scene = if InputFormat::from_path(path) == Some(InputFormat::Scad) {

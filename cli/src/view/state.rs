@@ -181,6 +181,12 @@ impl Display {
     }
 }
 
+/// How far [ and ] move a section plane: a share of the model's extent.
+pub const SECTION_STEP: f32 = 0.05;
+
+/// Steps of [`SECTION_STEP`] across the model.
+pub const SECTION_STEPS: u8 = 20;
+
 /// The settings the toggles change.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Toggles {
@@ -203,6 +209,11 @@ pub struct Toggles {
     pub ao: bool,
     /// Every object see-through (X).
     pub xray: bool,
+    /// A section plane across a model (K: along x, y, z, off; [ and ]
+    /// move it): the axis (0, 1, 2 of the model file's coordinates) and
+    /// where it crosses the model, in steps of [`SECTION_STEP`] of its
+    /// extent.
+    pub section: Option<(usize, u8)>,
 }
 
 impl Default for Toggles {
@@ -217,6 +228,7 @@ impl Default for Toggles {
             ghosts: true,
             ao: false,
             xray: false,
+            section: None,
         }
     }
 }
@@ -356,6 +368,20 @@ impl Viewer {
             Key::Char('m') => t.ghosts = !t.ghosts,
             Key::Char('o') => t.ao = !t.ao,
             Key::Char('x') => t.xray = !t.xray,
+            Key::Char('k') => {
+                t.section = match t.section {
+                    None => Some((0, SECTION_STEPS / 2)),
+                    Some((axis, at)) if axis < 2 => Some((axis + 1, at)),
+                    Some(_) => None,
+                };
+                return Request::Reload;
+            }
+            Key::Char(c @ ('[' | ']')) => {
+                let Some((axis, at)) = t.section else { return Request::Nothing };
+                let at = if c == ']' { (at + 1).min(SECTION_STEPS) } else { at.saturating_sub(1) };
+                t.section = Some((axis, at));
+                return Request::Reload;
+            }
             Key::Char('p') => {
                 t.ground = !t.ground;
                 return Request::Reload;
@@ -638,6 +664,14 @@ mod tests {
         assert!(!v.toggles.traced && !v.toggles.fog, "R and G turn them off");
         assert_eq!(v.apply(Input::Key(Key::Char('x'))), Request::Render);
         assert!(v.toggles.xray, "X turns x-ray on");
+        assert_eq!(v.apply(Input::Key(Key::Char('['))), Request::Nothing, "no section to move");
+        let mut sections = Vec::new();
+        for key in ['k', ']', ']', 'k', '[', 'k', 'k'] {
+            assert_eq!(v.apply(Input::Key(Key::Char(key))), Request::Reload);
+            sections.push(v.toggles.section);
+        }
+        let want = [Some((0, 10)), Some((0, 11)), Some((0, 12)), Some((1, 12)), Some((1, 11)), Some((2, 11)), None];
+        assert_eq!(sections, want);
         assert_eq!(v.apply(Input::Key(Key::Escape)), Request::Quit);
         assert_eq!(v.apply(Input::Key(Key::Char('q'))), Request::Quit);
         assert_eq!(v.apply(Input::Key(Key::F12)), Request::Screenshot);

@@ -612,8 +612,13 @@ fn hud_lines(viewer: &Viewer, shown: &Shown, step: Option<Step>, times: &VecDequ
             n => format!("INCOMPLETE: {n} part(s) not drawn"),
         },
         format!(
-            "shadows {}  smoothing {smoothing}{}  show {}{}",
+            "shadows {}  smoothing {smoothing}{}{}  show {}{}",
             viewer.toggles.shadows.name(),
+            viewer.toggles.section.map_or(String::new(), |(axis, at)| format!(
+                "  section {} {:.0}%",
+                ["x", "y", "z"][axis],
+                f32::from(at) * super::state::SECTION_STEP * 100.0
+            )),
             match (viewer.toggles.ao, viewer.toggles.xray) {
                 (false, false) => "",
                 (true, false) => "  ao",
@@ -677,6 +682,7 @@ pub fn cheat_sheet() -> Vec<String> {
         "G           fog",
         "O           ambient occlusion",
         "X           x-ray",
+        "K  [  ]     section x/y/z/off, move",
         "P           ground plane",
         "C           CSG exact/faceted",
         "M           OpenSCAD # and % parts",
