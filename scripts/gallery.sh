@@ -3,7 +3,8 @@
 # glTF, an OBJ and an OpenSCAD .csg from the shared corpus, and two OpenSCAD
 # parts from this repository (a revolved knob, a label plate made with
 # BOSL2's text3d) — each with plain `kage render FILE` (no options but the size),
-# into docs/gallery/.
+# then a row of the looks a designer asks for (ambient occlusion, a section,
+# x-ray), each one option on the same command, into docs/gallery/.
 #
 #   scripts/gallery.sh            # after a change that alters how models come out
 #
@@ -32,4 +33,19 @@ for entry in "${models[@]}"; do
   fi
   "$kage" render "$model" --width 480 --height 270 -o "$out/$name" 2>/dev/null
   echo "$out/$name  <-  kage render $model"
+done
+# The looks: one option each.
+looks=(
+  "examples/openscad/knob.csg|ao.png|--ao"
+  "examples/openscad/knob.csg|section.png|--section=-y=0"
+  "$assets/gltf/CesiumMilkTruck/CesiumMilkTruck.glb|xray.png|--xray"
+)
+for entry in "${looks[@]}"; do
+  IFS='|' read -r model name option <<<"$entry"
+  if [ ! -f "$model" ]; then
+    echo "skipped $model: not there" >&2
+    continue
+  fi
+  "$kage" render "$model" "$option" --width 480 --height 270 -o "$out/$name" 2>/dev/null
+  echo "$out/$name  <-  kage render $model $option"
 done

@@ -1,5 +1,6 @@
 //! `kage-bench ao`: ambient occlusion after the viewer's refinement passes
-//! against the reference renderer's, and what it costs a frame.
+//! against the reference renderer's, and what it costs a frame; beside it
+//! what the x-ray view costs a frame and a section plane its one cut.
 //!
 //! Each scene is rendered as ambient occlusion alone (every material a white
 //! ambient reflector, one white ambient light, a black background), so the
@@ -92,10 +93,10 @@ fn scenes(c: &Common) -> Result<Vec<(String, Scene)>> {
 pub fn run(args: &AoArgs) -> Result<()> {
     let c = &args.common;
     println!(
-        "| scene | size | radius | full frame ms (no AO) | AO ms, 16 rays | AO ms a pass ({} rays) | quick frame ms | RMSE after the full frame | RMSE after {} passes | reference s |",
+        "| scene | size | radius | full frame ms (no AO) | AO ms, 16 rays | AO ms a pass ({} rays) | quick frame ms | RMSE after the full frame | RMSE after {} passes | reference s | x-ray frame ms | section ms (once) |",
         args.pass_rays, args.passes
     );
-    println!("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|");
+    println!("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
     for (name, scene) in scenes(c)? {
         // The radius the scene itself gets (its floor left out of the model's size).
         let with_ao = Scene { ambient_occlusion: Some(AmbientOcclusion::default()), ..scene.clone() };
@@ -116,6 +117,19 @@ pub fn run(args: &AoArgs) -> Result<()> {
         let plain = timed(&scene)?.0;
         let with = timed(&with_ao)?.1;
         let quick = timed(&Scene { antialias: Antialias::None, ..scene.clone() })?.0;
+        let mut xray = scene.clone();
+        xray.xray(kage::scene::XRAY_OPACITY);
+        let xray_ms = timed(&xray)?.0;
+        // A section through the middle of the model's box, across its longest side.
+        let section_ms = {
+            let (lo, hi) = scene.caster_bounds().or_else(|| scene.bounds()).unwrap_or_default();
+            let axis = Vec3::AXES[(hi - lo).max_position()];
+            let plane = kage::scene::section::SectionPlane::through((lo + hi) * 0.5, axis).expect("a plane");
+            let mut cut = scene.clone();
+            let t = std::time::Instant::now();
+            cut.section(plane);
+            t.elapsed().as_secs_f64() * 1e3
+        };
         // The open share: the full frame, then the passes, against the reference.
         let full = occlusion_only(&scene, full_ao);
         let first = kage::render(&full, &RenderOptions::default()).map_err(|e| miette!("{e}"))?.image;
@@ -135,11 +149,12 @@ pub fn run(args: &AoArgs) -> Result<()> {
         let reference_s = t.elapsed().as_secs_f64();
         let rmse = |image| kage::compare::compare(image, &truth, 0.05).map(|e| e.rmse).map_err(|e| miette!("{e}"));
         println!(
-            "| {name} | {}x{} | {radius:.3} | {plain:.1} | {with:.1} | {pass_ms:.1} | {quick:.1} | {:.4} | {:.4} | {reference_s:.1} |",
+            "| {name} | {}x{} | {radius:.3} | {plain:.1} | {with:.1} | {pass_ms:.1} | {quick:.1} | {:.4} | {:.4} | {reference_s:.1} | {xray_ms:.1} ({:.2}x) | {section_ms:.1} |",
             c.width,
             c.height,
             rmse(&first)?,
             rmse(&refined.image)?,
+            xray_ms / plain,
         );
     }
     println!(
