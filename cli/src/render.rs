@@ -125,7 +125,7 @@ pub struct RenderArgs {
     /// scene file's world; its `[section]` takes any plane).
     #[arg(long, value_parser = parse_section, allow_hyphen_values = true, value_name = "[-]AXIS=VALUE")]
     section: Option<kage::scene::section::SectionPlane>,
-    /// X-ray: every object drawn see-through (its front and back faces
+    /// X-ray: every part but the ground drawn see-through (front and back faces
     /// blended in depth order, whatever order the file lists them in), so
     /// parts inside others show; shadows off.
     #[arg(long)]

@@ -302,20 +302,48 @@ impl Scene {
         Ok(())
     }
 
-    /// Makes the scene an x-ray view: every material translucent with
-    /// `opacity` and two-sided (back faces drawn too), blended in depth order
+    /// Makes the scene an x-ray view: every object but a floor under them
+    /// all (which stays as it is, the ground the parts stand on) drawn in a
+    /// see-through copy of its material, with `opacity` and two-sided (back
+    /// faces drawn too), blended in depth order
     /// ([`TranslucencyOrder::Sorted`]: each pixel's fragments sorted, so the
-    /// image does not depend on the order of the objects), no shadows (a
-    /// see-through part would darken what lies behind it), no mirrors or glass
-    /// traced.
+    /// image does not depend on the order of the objects); no shadows (a
+    /// see-through part would darken what lies behind it), no mirrors or
+    /// glass traced.
     pub fn xray(&mut self, opacity: f32) {
-        for m in &mut self.materials {
-            m.opacity = opacity;
-            m.two_sided = true;
-            (m.kr, m.kt) = (Vec3::ZERO, Vec3::ZERO);
+        let floors = self.grounds();
+        let mut see_through: std::collections::HashMap<usize, usize> = std::collections::HashMap::new();
+        let materials = &mut self.materials;
+        let mut copy = |m: usize| {
+            *see_through.entry(m).or_insert_with(|| {
+                let base = &materials[m];
+                let (kr, kt) = (Vec3::ZERO, Vec3::ZERO);
+                materials.push(Material { opacity, two_sided: true, kr, kt, ..base.clone() });
+                materials.len() - 1
+            })
+        };
+        let parts = self.objects.iter_mut().enumerate().filter(|(i, _)| !floors.contains(i));
+        for (_, object) in parts {
+            object.material = copy(object.material);
+            if let Body::Solid { materials: own, .. } = &mut object.body {
+                *own = own.iter().map(|&m| copy(m)).collect();
+            }
         }
         self.translucency = TranslucencyOrder::Sorted;
         self.lights.iter_mut().for_each(|l| l.shadow = ShadowSettings::NONE);
+    }
+
+    /// The objects that are a ground: flat and horizontal, under every other
+    /// object (a model's ground, a scene's floor), whether they cast shadows
+    /// or not.
+    fn grounds(&self) -> Vec<usize> {
+        let boxes: Vec<Option<Bounds>> = self.objects.iter().map(Object::world_bounds).collect();
+        let Some((lo, hi)) = self.bounds() else { return Vec::new() };
+        let eps = 1e-4 * (hi - lo).max_element().max(f32::MIN_POSITIVE);
+        let flat_under = |i: usize, (b0, b1): Bounds| {
+            b1.y - b0.y <= eps && boxes.iter().enumerate().all(|(j, c)| j == i || c.is_none_or(|c| c.0.y >= b1.y - eps))
+        };
+        (0..boxes.len()).filter(|&i| boxes[i].is_some_and(|b| flat_under(i, b))).collect()
     }
 
     /// The ambient-occlusion radius: the scene's own, or
