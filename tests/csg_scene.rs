@@ -174,17 +174,7 @@ fn a_solid_casts_shadows_where_shadow_rays_find_it() {
         },
         &|_| {},
     );
-    let unlit = render_reference(
-        &plain,
-        &ReferenceOptions {
-            pixel_samples: 1,
-            light_samples: 1,
-            shadows: false,
-            max_depth: 0,
-            ..ReferenceOptions::default()
-        },
-        &|_| {},
-    );
+    let unlit = render_reference(&plain, &ReferenceOptions::CENTRES, &|_| {});
     let (mut floor, mut both, mut either) = (0, 0, 0);
     for y in 0..130 {
         for x in 0..200 {

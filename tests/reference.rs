@@ -25,13 +25,7 @@ fn one_ray_per_pixel_without_shadows_matches_the_rasterizer() {
     let frame = render(&scene, &RenderOptions::default()).unwrap();
     let mut scalar = LinearImage::new(scene.width, scene.height);
     kage::shading::shade_into_scalar(&scene, &frame.visibility, &mut scalar);
-    let opts = ReferenceOptions {
-        pixel_samples: 1,
-        light_samples: 1,
-        shadows: false,
-        max_depth: 0,
-        ..ReferenceOptions::default()
-    };
+    let opts = ReferenceOptions::CENTRES;
     let reference = render_reference(&scene, &opts, &|_| {});
     let trace = TraceScene::new(&scene);
     let rays = scene.camera.pixel_rays(glam::Vec2::new(scene.width as f32, scene.height as f32));
@@ -77,13 +71,7 @@ fn rays_pass_back_faces_the_rasterizer_culls() {
     let wall = std::sync::Arc::new(kage::scene::mesh::shapes::plane());
     scene.objects.push(kage::scene::Object::mesh("wall", wall, place, material));
     let raster = render(&scene, &RenderOptions::default()).unwrap().image;
-    let opts = ReferenceOptions {
-        pixel_samples: 1,
-        light_samples: 1,
-        shadows: false,
-        max_depth: 0,
-        ..ReferenceOptions::default()
-    };
+    let opts = ReferenceOptions::CENTRES;
     let reference = render_reference(&scene, &opts, &|_| {});
     let c = kage::compare::compare(&raster, &reference, 0.05).unwrap();
     assert!(c.share_over < 0.02, "the reference sees the wall's back the raster culls: {c:?}");
@@ -94,17 +82,7 @@ fn shadows_only_darken_and_antialiasing_stays_close() {
     let mut scene = kage::scene::demo::demo_scene().unwrap();
     scene.width = 120;
     scene.height = 68;
-    let plain = render_reference(
-        &scene,
-        &ReferenceOptions {
-            pixel_samples: 1,
-            light_samples: 1,
-            shadows: false,
-            max_depth: 0,
-            ..ReferenceOptions::default()
-        },
-        &|_| {},
-    );
+    let plain = render_reference(&scene, &ReferenceOptions::CENTRES, &|_| {});
     let shadowed = render_reference(
         &scene,
         &ReferenceOptions {
@@ -144,13 +122,7 @@ fn an_interrupted_reference_keeps_the_rows_already_traced() {
     let mut scene = kage::scene::demo::demo_scene().unwrap();
     scene.width = 64;
     scene.height = 48;
-    let opts = ReferenceOptions {
-        pixel_samples: 1,
-        light_samples: 1,
-        shadows: false,
-        max_depth: 0,
-        ..ReferenceOptions::default()
-    };
+    let opts = ReferenceOptions::CENTRES;
     let full = render_reference(&scene, &opts, &|_| {});
     let stop = AtomicBool::new(false);
     // Stop after ten rows have been reported finished.

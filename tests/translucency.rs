@@ -116,13 +116,7 @@ fn the_reference_blends_translucent_layers_as_the_raster_does() {
     (scene.width, scene.height) = (240, 135);
     scene.lights.iter_mut().for_each(|l| l.shadow = kage::scene::ShadowSettings::NONE);
     let frame = render(&scene, &RenderOptions::default()).unwrap();
-    let opts = ReferenceOptions {
-        pixel_samples: 1,
-        light_samples: 1,
-        shadows: false,
-        max_depth: 0,
-        ..ReferenceOptions::default()
-    };
+    let opts = ReferenceOptions::CENTRES;
     let truth = render_reference(&scene, &opts, &|_| {});
     let c = kage::compare::compare(&frame.image, &truth, 2e-3).unwrap();
     assert!(frame.stats.translucent_fragments > 5000);

@@ -49,6 +49,13 @@ pub struct ReferenceOptions {
     pub occlusion_rays: u32,
 }
 
+impl ReferenceOptions {
+    /// One ray through each pixel centre, no shadows, no bounces: what the
+    /// raster frame's visibility and unshadowed shading equal pixel for pixel.
+    pub const CENTRES: ReferenceOptions =
+        ReferenceOptions { pixel_samples: 1, light_samples: 1, shadows: false, max_depth: 0, occlusion_rays: 64 };
+}
+
 impl Default for ReferenceOptions {
     fn default() -> Self {
         ReferenceOptions { pixel_samples: 4, light_samples: 4, shadows: true, max_depth: 4, occlusion_rays: 64 }
