@@ -79,6 +79,7 @@ fn a_plane_beyond_everything_removes_it_and_one_behind_keeps_it() {
     let mut gone = ball(false);
     let report = gone.section(SectionPlane::through(Vec3::Z * -2.0, Vec3::Z).expect("a plane"));
     assert_eq!((report.removed, gone.objects.len()), (1, 0));
+    assert!(gone.warnings.iter().any(|w| w.contains("nothing is left")), "{:?}", gone.warnings);
     let mut kept = ball(true);
     let report = kept.section(SectionPlane::through(Vec3::Z * 2.0, Vec3::Z).expect("a plane"));
     assert_eq!((report.removed, report.capped, kept.objects.len()), (0, 0, 1));

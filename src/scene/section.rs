@@ -95,6 +95,9 @@ impl Scene {
                 },
             }
         }
+        if out.is_empty() && report.removed > 0 {
+            self.warnings.push("section: every object lies beyond the plane: nothing is left to draw".to_string());
+        }
         self.objects = out;
         if !report.open.is_empty() {
             let names = report.open.join(", ");
