@@ -25,7 +25,7 @@
 //! Measured (`kage-bench ao`, 960×540, 2-core EPYC VM): after 64 passes of 4
 //! rays the open share is within 0.005–0.009 RMSE of the reference's (128 rays
 //! at each of 4 × 4 hits a pixel) on the demo, the bunny, the glTF truck and
-//! a corpus OpenSCAD part; 16 rays a pixel cost 12–26× a frame.
+//! a corpus OpenSCAD part; 16 rays a pixel cost 11–22× a frame.
 
 use std::ops::Range;
 
