@@ -181,7 +181,7 @@ impl Display {
     }
 }
 
-/// How far [ and ] move a section plane: a share of the model's extent.
+/// How far `[` and `]` move a section plane: a share of the model's extent.
 pub const SECTION_STEP: f32 = 0.05;
 
 /// Steps of [`SECTION_STEP`] across the model.
@@ -209,7 +209,7 @@ pub struct Toggles {
     pub ao: bool,
     /// Every object see-through (X).
     pub xray: bool,
-    /// A section plane across a model (K: along x, y, z, off; [ and ]
+    /// A section plane across a model (K: along x, y, z, off; `[` and `]`
     /// move it): the axis (0, 1, 2 of the model file's coordinates) and
     /// where it crosses the model, in steps of [`SECTION_STEP`] of its
     /// extent.
