@@ -121,8 +121,9 @@ impl Scene {
             Sectioned::Removed => report.removed += 1,
             Sectioned::Cut((kept, loops)) => {
                 let name = object.name.clone();
-                let mut cut = Object { body: Body::Mesh(Arc::new(kept.clone())), ..object.clone() };
-                match loops.and_then(|loops| cap_mesh(&kept, &loops, plane.0)) {
+                let lid = loops.and_then(|loops| cap_mesh(&kept, &loops, plane.0));
+                let mut cut = Object { body: Body::Mesh(Arc::new(kept)), ..object.clone() };
+                match lid {
                     Some(lid) => {
                         out.push(cut);
                         let name = format!("{name} (section)");
