@@ -11,9 +11,8 @@
 use std::path::PathBuf;
 
 use glam::Vec3;
-use kage::raytrace::reference::{render_reference, ReferenceOptions};
 use kage::scene::{AmbientOcclusion, Antialias, Light, Material, Scene, ShadowSettings};
-use kage::{RenderOptions, Renderer};
+use kage::{render_reference, ReferenceOptions, RenderOptions, Renderer};
 use miette::{miette, Result};
 
 use crate::share::median_csg;
