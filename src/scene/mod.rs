@@ -337,13 +337,9 @@ impl Scene {
     /// object (a model's ground, a scene's floor), whether they cast shadows
     /// or not.
     fn grounds(&self) -> Vec<usize> {
-        let boxes: Vec<Option<Bounds>> = self.objects.iter().map(Object::world_bounds).collect();
-        let Some((lo, hi)) = self.bounds() else { return Vec::new() };
-        let eps = 1e-4 * (hi - lo).max_element().max(f32::MIN_POSITIVE);
-        let flat_under = |i: usize, (b0, b1): Bounds| {
-            b1.y - b0.y <= eps && boxes.iter().enumerate().all(|(j, c)| j == i || c.is_none_or(|c| c.0.y >= b1.y - eps))
-        };
-        (0..boxes.len()).filter(|&i| boxes[i].is_some_and(|b| flat_under(i, b))).collect()
+        let boxes: Vec<(usize, Bounds)> =
+            self.objects.iter().enumerate().filter_map(|(i, o)| Some((i, o.world_bounds()?))).collect();
+        flat_under(&boxes, |_| true)
     }
 
     /// The ambient-occlusion radius: the scene's own, or
@@ -424,20 +420,13 @@ impl Scene {
             .filter(|(_, o)| o.casts_shadows)
             .filter_map(|(i, o)| Some((i, o.world_bounds()?)))
             .collect();
-        let Some((lo, hi)) = casters.iter().map(|&(_, b)| b).reduce(|(a, b), (c, d)| (a.min(c), b.max(d))) else {
-            return (casters, Vec::new());
+        let lit_from_above = |top: f32, eps: f32| {
+            self.lights.iter().all(|l| match l.kind {
+                LightKind::Point { position } | LightKind::Spot { position, .. } => position.y > top + eps,
+                LightKind::Directional { direction } => direction.y < 0.0,
+            })
         };
-        let eps = 1e-4 * (hi - lo).max_element().max(f32::MIN_POSITIVE);
-        let flat_floor = |&(i, b): &(usize, Bounds)| {
-            let top = b.1.y;
-            b.1.y - b.0.y <= eps
-                && casters.iter().all(|&(j, c)| j == i || c.0.y >= top - eps)
-                && self.lights.iter().all(|l| match l.kind {
-                    LightKind::Point { position } | LightKind::Spot { position, .. } => position.y > top + eps,
-                    LightKind::Directional { direction } => direction.y < 0.0,
-                })
-        };
-        let floors = casters.iter().filter(|c| flat_floor(c)).map(|&(i, _)| i).collect();
+        let floors = flat_under(&casters, |(top, eps)| lit_from_above(top, eps));
         (casters, floors)
     }
 
@@ -460,4 +449,17 @@ impl Scene {
     pub fn triangle_count(&self) -> usize {
         self.objects.iter().filter_map(Object::triangles).map(|m| m.triangles.len()).sum()
     }
+}
+
+/// Of the `boxes` (object index, world bounds), the flat, horizontal ones lying
+/// under every other (within a hair of their union's size) whose top and
+/// hair `also(top, hair)` accepts.
+fn flat_under(boxes: &[(usize, Bounds)], also: impl Fn((f32, f32)) -> bool) -> Vec<usize> {
+    let Some((lo, hi)) = boxes.iter().map(|&(_, b)| b).reduce(|(a, b), (c, d)| (a.min(c), b.max(d))) else {
+        return Vec::new();
+    };
+    let eps = 1e-4 * (hi - lo).max_element().max(f32::MIN_POSITIVE);
+    let under = |i: usize, top: f32| boxes.iter().all(|&(j, c)| j == i || c.0.y >= top - eps);
+    let flat = |&&(i, b): &&(usize, Bounds)| b.1.y - b.0.y <= eps && under(i, b.1.y) && also((b.1.y, eps));
+    boxes.iter().filter(flat).map(|&(i, _)| i).collect()
 }
