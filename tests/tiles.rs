@@ -2,14 +2,14 @@
 //! the whole frame, bit for bit, with every technique on (edge antialiasing
 //! and jittered passes, every shadow method, a mirror, glass, translucent
 //! surfaces, fog, a CSG solid, a texture; an environment, the viewer's sparse
-//! rays, every component and shadow term on its own), for random tilings on 1,
+//! rays, every component and shadow term on its own, feature lines), for random tilings on 1,
 //! 5, 16 and 2 workers; and a tile's buffers cost its area.
 
 use std::path::Path;
 
 use kage::image::{LinearImage, PixelRect};
 use kage::scene::file::load_scene;
-use kage::scene::{Antialias, Scene, ShadowMethod};
+use kage::scene::{Antialias, FeatureLines, Scene, ShadowMethod};
 use kage::shading::{Component, ComponentSet};
 use kage::{render, Frame, RenderOptions, Renderer};
 use rand::rngs::StdRng;
@@ -162,6 +162,19 @@ fn tiles_of_an_openscad_part_with_closed_meshes_equal_the_frame() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/openscad/knob.csg");
     let scene = kage::scene::model::scene_for_model(&path, 160, 120).expect("knob.csg");
     tiles_equal_the_frame(&without_soft_shadows(scene), "knob.csg", 7, 3);
+}
+
+/// Feature lines, hidden ones dashed, over meshes and CSG solids: a mesh
+/// edge's strokes are steps counted from its start and a solid's come from
+/// pixel pairs, so a tile draws the strokes the frame draws there.
+#[test]
+fn tiles_of_a_frame_with_feature_lines_equal_the_frame() {
+    let lines = Some(FeatureLines { hidden: true, ..FeatureLines::default() });
+    let scene = Scene { lines, ..without_soft_shadows(everything()) };
+    tiles_equal_the_frame(&scene, "lines", 8, 3);
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/openscad/knob.csg");
+    let knob = kage::scene::model::scene_for_model(&path, 160, 120).expect("knob.csg");
+    tiles_equal_the_frame(&Scene { lines, ..without_soft_shadows(knob) }, "knob.csg, lines", 9, 2);
 }
 
 /// A tile's buffers hold its pixels and its guard band alone: the bytes of

@@ -53,6 +53,7 @@ fn mirror_scene() -> Scene {
         antialias: Default::default(),
         fog: None,
         ambient_occlusion: None,
+        lines: None,
         environment: None,
         translucency: Default::default(),
         tone: Default::default(),

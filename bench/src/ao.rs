@@ -1,6 +1,7 @@
 //! `kage-bench ao`: ambient occlusion after the viewer's refinement passes
 //! against the reference renderer's, and what it costs a frame; beside it
-//! what the x-ray view costs a frame and a section plane its one cut.
+//! what the x-ray view and feature lines cost a frame and a section plane
+//! its one cut.
 //!
 //! Each scene is rendered as ambient occlusion alone (every material a white
 //! ambient reflector, one white ambient light, a black background), so the
@@ -11,7 +12,7 @@
 use std::path::PathBuf;
 
 use glam::Vec3;
-use kage::scene::{AmbientOcclusion, Antialias, Light, Material, Scene, ShadowSettings};
+use kage::scene::{AmbientOcclusion, Antialias, FeatureLines, Light, Material, Scene, ShadowSettings};
 use kage::{render_reference, ReferenceOptions, RenderOptions, Renderer};
 use miette::{miette, Result};
 
@@ -92,10 +93,10 @@ fn scenes(c: &Common) -> Result<Vec<(String, Scene)>> {
 pub fn run(args: &AoArgs) -> Result<()> {
     let c = &args.common;
     println!(
-        "| scene | size | radius | full frame ms (no AO) | AO ms, 16 rays | AO ms a pass ({} rays) | quick frame ms | RMSE after the full frame | RMSE after {} passes | reference s | x-ray frame ms | section ms (once) |",
+        "| scene | size | radius | full frame ms (no AO) | AO ms, 16 rays | AO ms a pass ({} rays) | quick frame ms | RMSE after the full frame | RMSE after {} passes | reference s | x-ray frame ms | lines: frame ms, with lines ms | section ms (once) |",
         args.pass_rays, args.passes
     );
-    println!("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    println!("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
     for (name, scene) in scenes(c)? {
         // The radius the scene itself gets (its floor left out of the model's size).
         let with_ao = Scene { ambient_occlusion: Some(AmbientOcclusion::default()), ..scene.clone() };
@@ -119,6 +120,17 @@ pub fn run(args: &AoArgs) -> Result<()> {
         let mut xray = scene.clone();
         xray.xray(kage::scene::XRAY_OPACITY);
         let xray_ms = timed(&xray)?.0;
+        // Feature lines: frames with and without them, one after the other.
+        let lined = Scene { lines: Some(FeatureLines::default()), ..scene.clone() };
+        let (mut without, mut with_lines) = (Vec::new(), Vec::new());
+        for _ in 0..c.frames.max(1) {
+            for (s, out) in [(&scene, &mut without), (&lined, &mut with_lines)] {
+                let t = std::time::Instant::now();
+                renderer.render(s).map_err(|e| miette!("{e}"))?;
+                out.push(t.elapsed().as_secs_f64() * 1e3);
+            }
+        }
+        let (without, with_lines) = (median(&mut without), median(&mut with_lines));
         // A section through the middle of the model's box, across its longest side.
         let section_ms = {
             let (lo, hi) = scene.caster_bounds().or_else(|| scene.bounds()).unwrap_or_default();
@@ -148,16 +160,17 @@ pub fn run(args: &AoArgs) -> Result<()> {
         let reference_s = t.elapsed().as_secs_f64();
         let rmse = |image| kage::compare::compare(image, &truth, 0.05).map(|e| e.rmse).map_err(|e| miette!("{e}"));
         println!(
-            "| {name} | {}x{} | {radius:.3} | {plain:.1} | {with:.1} | {pass_ms:.1} | {quick:.1} | {:.4} | {:.4} | {reference_s:.1} | {xray_ms:.1} ({:.2}x) | {section_ms:.1} |",
+            "| {name} | {}x{} | {radius:.3} | {plain:.1} | {with:.1} | {pass_ms:.1} | {quick:.1} | {:.4} | {:.4} | {reference_s:.1} | {xray_ms:.1} ({:.2}x) | {without:.1}, {with_lines:.1} ({:.2}x) | {section_ms:.1} |",
             c.width,
             c.height,
             rmse(&first)?,
             rmse(&refined.image)?,
             xray_ms / plain,
+            with_lines / without,
         );
     }
     println!(
-        "\nOpen share alone (white ambient reflectors, one white ambient light): the full frame (edge pass, {} rays a pixel), {} jittered passes of {} rays (the viewer's refinement), and the reference ({} x {} rays a pixel, {} AO rays at each hit); frame times of the scene as it is, median of {} frames; {} threads.",
+        "\nOpen share alone (white ambient reflectors, one white ambient light): the full frame (edge pass, {} rays a pixel), {} jittered passes of {} rays (the viewer's refinement), and the reference ({} x {} rays a pixel, {} AO rays at each hit); frame times of the scene as it is, median of {} frames (with and without feature lines: one frame of each in turn, the median of each); {} threads.",
         AmbientOcclusion::default().rays,
         args.passes,
         args.pass_rays,

@@ -130,6 +130,21 @@ pub struct RenderArgs {
     /// parts inside others show; shadows off.
     #[arg(long)]
     xray: bool,
+    /// Feature lines: silhouettes, boundaries and creases drawn as dark
+    /// antialiased lines over the image (the scene file's `[lines]`, or these
+    /// defaults).
+    #[arg(long)]
+    lines: bool,
+    /// Feature lines hidden behind surfaces drawn too, dashed. Implies --lines.
+    #[arg(long)]
+    hidden_lines: bool,
+    /// Feature lines' width in pixels (default 1.5). Implies --lines.
+    #[arg(long, value_name = "PIXELS", value_parser = parse_line_width)]
+    line_width: Option<f32>,
+    /// A technical drawing: white surfaces with flat light, no ground, no
+    /// shadows, feature lines with the hidden ones dashed.
+    #[arg(long)]
+    drawing: bool,
     /// Ambient occlusion: darkens the ambient light in creases, at the foot
     /// of parts and inside holes, by rays from each pixel's surface point
     /// (the scene file's `[ambient_occlusion]`, or these defaults).
@@ -374,6 +389,27 @@ fn parse_positive(s: &str) -> Result<f32, String> {
     }
 }
 
+fn parse_line_width(s: &str) -> Result<f32, String> {
+    let widths = kage::scene::FeatureLines::WIDTHS;
+    match s.parse::<f32>() {
+        Ok(v) if widths.contains(&v) => Ok(v),
+        _ => Err(format!("'{s}' is not a line width of {} to {} pixels", widths.start(), widths.end())),
+    }
+}
+
+/// The feature lines and drawing look the arguments ask for, over the
+/// scene file's `[lines]`.
+fn apply_lines(args: &RenderArgs, scene: &mut Scene) {
+    if args.drawing {
+        scene.drawing();
+    }
+    if args.lines || args.hidden_lines || args.line_width.is_some() {
+        let lines = scene.lines.get_or_insert_with(Default::default);
+        lines.hidden |= args.hidden_lines;
+        lines.width = args.line_width.unwrap_or(lines.width);
+    }
+}
+
 fn parse_exposure(s: &str) -> Result<Exposure, String> {
     match s {
         "auto" => Ok(Exposure::Auto),
@@ -543,6 +579,7 @@ pub fn render_command(args: &RenderArgs) -> miette::Result<()> {
     if args.xray {
         scene.xray(kage::scene::XRAY_OPACITY);
     }
+    apply_lines(args, &mut scene);
     if args.ao || args.ao_radius.is_some() || args.ao_rays.is_some() {
         let ao = scene.ambient_occlusion.get_or_insert_with(Default::default);
         ao.radius = args.ao_radius.or(ao.radius);
@@ -561,6 +598,9 @@ pub fn render_command(args: &RenderArgs) -> miette::Result<()> {
         return reference_command(args, &scene).map_err(report::to_report);
     }
     let wanted = args.aov.unwrap_or(Aovs { components: ComponentSet::EMPTY, shadow: false, occlusion: false });
+    if scene.lines.is_some() && args.aov.is_some() {
+        eprintln!("warning: feature lines are drawn over the image only; the --aov images have none");
+    }
     if wanted.occlusion && scene.ambient_occlusion.is_none() {
         miette::bail!(
             "--aov occlusion writes ambient occlusion's open share, but this render has none: add --ao (or an [ambient_occlusion] table in the scene file)"
@@ -687,6 +727,9 @@ fn print_stats(path: &Path, scene: &Scene, frame: &kage::Frame, quiet: bool) {
     if scene.ambient_occlusion.is_some() {
         eprintln!("ambient occlusion: {:.1} ms", s.occlusion_ms);
     }
+    if scene.lines.is_some() {
+        eprintln!("feature lines: {:.1} ms, {} pixels drawn", s.lines_ms, s.line_pixels);
+    }
     if let Antialias::Edge(_) = scene.antialias {
         eprintln!("antialiased edges: {:.1} ms, {} pixels blended", s.edge_ms, s.edge_blends);
     }
@@ -723,6 +766,9 @@ impl Progress {
 fn reference_command(args: &RenderArgs, scene: &Scene) -> kage::error::Result<()> {
     use kage::{render_reference_until, ReferenceOptions};
     scene.validate()?;
+    if scene.lines.is_some() {
+        eprintln!("warning: the reference renderer draws no feature lines");
+    }
     let opts = ReferenceOptions {
         pixel_samples: args.spp,
         light_samples: args.light_samples,

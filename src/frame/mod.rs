@@ -142,6 +142,10 @@ pub struct FrameStats {
     pub traced_ms: f64,
     /// Milliseconds finding ambient occlusion (0 without it).
     pub occlusion_ms: f64,
+    /// Milliseconds drawing feature lines (0 without them).
+    pub lines_ms: f64,
+    /// Pixels feature lines were drawn on, summed over passes.
+    pub line_pixels: usize,
     /// Pixels that spawned secondary rays, summed over passes.
     pub traced_pixels: usize,
     /// Traced pixels traced again at sub-pixel points where what they show
@@ -212,6 +216,7 @@ enum Stage {
     Traced,
     Occlusion,
     Edges,
+    Lines,
 }
 
 impl FrameStats {
@@ -226,7 +231,7 @@ impl FrameStats {
                 Stage::Visibility => &mut self.idle.visibility,
                 Stage::Shading => &mut self.idle.shading,
                 Stage::Traced | Stage::Occlusion => &mut self.idle.traced,
-                Stage::Edges => &mut self.idle.edges,
+                Stage::Edges | Stage::Lines => &mut self.idle.edges,
             };
             *idle = idle.plus(clock.stop());
         }
@@ -242,6 +247,7 @@ impl FrameStats {
             Stage::Traced => self.traced_ms += ms,
             Stage::Occlusion => self.occlusion_ms += ms,
             Stage::Edges => self.edge_ms += ms,
+            Stage::Lines => self.lines_ms += ms,
         }
     }
 
@@ -662,6 +668,10 @@ fn render_pass(
     let seen = seen_through(fog.as_deref(), transmittance.as_deref());
     stats.timed(Stage::Edges, || edge_pass.apply(scene, vb, targets, seen.as_deref(), trace));
     stats.edge_blends = edge_pass.blends();
+    if scene.lines.is_some() {
+        let image = &mut *images.targets[0].image;
+        stats.line_pixels += stats.timed(Stage::Lines, || edge_pass.draw_lines(scene, vb, image, trace));
+    }
     stats.passes += 1;
     Ok(())
 }

@@ -28,7 +28,8 @@ pub use light::{
 pub use material::{phong_exponent, ComponentMaps, Material, NormalMap};
 pub use mesh::Mesh;
 pub use settings::{
-    AmbientOcclusion, Antialias, EdgeFilter, EdgeMode, EdgeSelection, Exposure, Fog, FogMode, TranslucencyOrder, Up,
+    AmbientOcclusion, Antialias, EdgeFilter, EdgeMode, EdgeSelection, Exposure, FeatureLines, Fog, FogMode,
+    TranslucencyOrder, Up,
 };
 pub use texture::{SharedFootprint, Texture};
 
@@ -190,6 +191,10 @@ pub fn box_corners((lo, hi): (Vec3, Vec3)) -> [Vec3; 8] {
 /// The opacity of every material in an x-ray view ([`Scene::xray`]).
 pub const XRAY_OPACITY: f32 = 0.3;
 
+/// The diffuse share of a surface's white in a technical drawing
+/// ([`Scene::drawing`]); the rest is its own flat light.
+pub const DRAWING_DIFFUSE: f32 = 0.2;
+
 /// A complete scene.
 #[derive(Debug, Clone)]
 pub struct Scene {
@@ -210,6 +215,8 @@ pub struct Scene {
     /// Ambient occlusion, if any: the ambient term darkened where nearby
     /// surfaces hide the sky.
     pub ambient_occlusion: Option<AmbientOcclusion>,
+    /// Feature lines drawn over the image, if any.
+    pub lines: Option<FeatureLines>,
     /// The environment map (reflection map of eq. 4 and optional background).
     pub environment: Option<Environment>,
     /// How translucent surfaces are ordered (seed 002 §3.4).
@@ -270,6 +277,7 @@ impl Scene {
             antialias: Antialias::default(),
             fog: None,
             ambient_occlusion: None,
+            lines: None,
             environment: None,
             translucency: TranslucencyOrder::default(),
             camera,
@@ -331,6 +339,33 @@ impl Scene {
         }
         self.translucency = TranslucencyOrder::Sorted;
         self.lights.iter_mut().for_each(|l| l.shadow = ShadowSettings::NONE);
+    }
+
+    /// Makes the scene a technical drawing: every surface white, lit mostly
+    /// by its own flat light (a fifth of it diffuse, so faces at different
+    /// angles stay apart), nothing glossy, mirrored or textured (alpha kept);
+    /// a white background, no ground (the objects [`Scene::xray`] keeps
+    /// opaque), no shadows, no fog, colours clipped at white rather than
+    /// rolled off; dark feature lines with the hidden ones dashed.
+    pub fn drawing(&mut self) {
+        for m in &mut self.materials {
+            let maps = ComponentMaps { alpha: m.maps.alpha.take(), filter: m.maps.filter, ..ComponentMaps::default() };
+            let (ka, ks, kr, kt, km) = (Vec3::ZERO, Vec3::ZERO, Vec3::ZERO, Vec3::ZERO, Vec3::ZERO);
+            let (kd, ke) = (Vec3::splat(DRAWING_DIFFUSE), Vec3::splat(1.0 - DRAWING_DIFFUSE));
+            *m = Material { ka, kd, ks, ke, kr, kt, km, maps, ..m.clone() };
+        }
+        let grounds = self.grounds();
+        let mut index = 0;
+        self.objects.retain(|_| {
+            index += 1;
+            !grounds.contains(&(index - 1))
+        });
+        self.background = Vec3::ONE;
+        // White stays white: no roll-off towards it.
+        (self.exposure, self.tone) = (Exposure::default(), ToneCurve::Clip);
+        self.fog = None;
+        self.lights.iter_mut().for_each(|l| l.shadow = ShadowSettings::NONE);
+        self.lines = Some(FeatureLines { hidden: true, ..self.lines.unwrap_or_default() });
     }
 
     /// The objects that are a ground: flat and horizontal, under every other

@@ -237,6 +237,35 @@ impl Default for AmbientOcclusion {
     }
 }
 
+/// Feature lines: silhouettes, creases and boundaries drawn over the image as
+/// antialiased lines of one width and colour ([`crate::resolve::edges::lines`]),
+/// and, if asked, the hidden ones dashed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FeatureLines {
+    /// Line width in pixels.
+    pub width: f32,
+    /// Linear RGB colour of the lines.
+    pub colour: Vec3,
+    /// Draw the lines hidden behind surfaces too, dashed and fainter.
+    pub hidden: bool,
+    /// Two faces meeting at more than this angle (degrees between their
+    /// normals) meet at a crease, which is drawn.
+    pub crease_deg: f32,
+}
+
+impl FeatureLines {
+    /// The thinnest and widest lines, in pixels.
+    pub const WIDTHS: std::ops::RangeInclusive<f32> = 0.5..=16.0;
+}
+
+impl Default for FeatureLines {
+    /// Near-black lines 1.5 pixels wide at creases of over 30°, hidden lines
+    /// not drawn.
+    fn default() -> Self {
+        FeatureLines { width: 1.5, colour: Vec3::splat(0.01), hidden: false, crease_deg: 30.0 }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

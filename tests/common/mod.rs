@@ -39,6 +39,7 @@ pub fn scene_with(mesh: Mesh, camera: Camera, width: u32, height: u32, two_sided
         antialias: Antialias::None,
         fog: None,
         ambient_occlusion: None,
+        lines: None,
         environment: None,
         translucency: Default::default(),
         tone: Default::default(),

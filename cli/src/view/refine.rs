@@ -14,7 +14,7 @@ use kage::ComponentSet;
 use kage::{FrameStats, RenderOptions, Renderer};
 use rayon::prelude::*;
 
-use super::state::{Display, Shadows, Smoothing, Step, Viewer, MAX_PASSES};
+use super::state::{Display, LineStyle, Shadows, Smoothing, Step, Viewer, MAX_PASSES};
 
 /// Jittered passes averaged before the average replaces the full frame on
 /// screen (fewer look noisier than the edge pass's frame).
@@ -217,6 +217,11 @@ pub fn scene_for(base: &Scene, viewer: &Viewer, step: Step) -> Scene {
     if t.xray {
         scene.xray(kage::scene::XRAY_OPACITY);
     }
+    match t.lines {
+        LineStyle::Off => scene.lines = None,
+        LineStyle::Lines => scene.lines = Some(scene.lines.unwrap_or_default()),
+        LineStyle::Drawing => scene.drawing(),
+    }
     scene.ambient_occlusion = match step {
         // A moving camera: no ambient occlusion (its rays cost several
         // frames' time).
@@ -337,5 +342,25 @@ mod tests {
         let passes: Vec<(u32, u32)> =
             (1..=MAX_PASSES).map(|n| ao(Step::Pass(n)).map(|a| (a.pass, a.rays)).expect("on")).collect();
         assert!(passes.iter().enumerate().all(|(k, &p)| p == (k as u32, PASS_OCCLUSION_RAYS)), "{passes:?}");
+    }
+
+    #[test]
+    fn l_draws_the_scenes_lines_then_a_technical_drawing_in_every_step() {
+        let base = kage::scene::demo::demo_scene().expect("the demo");
+        let orbit = Orbit::from_camera(&base.camera);
+        let mut viewer = Viewer::new(orbit, (Vec3::splat(-1.0), Vec3::ONE), (320, 180));
+        let with_lines =
+            Scene { lines: Some(kage::scene::FeatureLines { width: 3.0, ..Default::default() }), ..base.clone() };
+        assert_eq!(scene_for(&with_lines, &viewer, Step::Full).lines, None, "L off leaves even the scene's lines out");
+        viewer.toggles.lines = LineStyle::Lines;
+        for step in [Step::Quick, Step::Full, Step::Pass(5)] {
+            assert_eq!(scene_for(&base, &viewer, step).lines, Some(Default::default()));
+            assert_eq!(scene_for(&with_lines, &viewer, step).lines.map(|l| l.width), Some(3.0), "the scene's own");
+        }
+        viewer.toggles.lines = LineStyle::Drawing;
+        let drawing = scene_for(&base, &viewer, Step::Quick);
+        assert!(drawing.lines.is_some_and(|l| l.hidden), "hidden lines dashed");
+        assert_eq!(drawing.background, Vec3::ONE);
+        assert_eq!(drawing.objects.len(), base.objects.len() - 1, "the ground left out");
     }
 }

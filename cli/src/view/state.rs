@@ -137,6 +137,30 @@ pub enum Smoothing {
     Progressive,
 }
 
+/// Feature lines (L cycles).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LineStyle {
+    /// None (the scene's own `[lines]` left out too).
+    Off,
+    /// Silhouettes, boundaries and creases over the shaded image.
+    Lines,
+    /// A technical drawing: white surfaces in flat light, hidden lines
+    /// dashed ([`kage::Scene::drawing`]).
+    Drawing,
+}
+
+impl LineStyle {
+    /// Its name, for the HUD ("" when off).
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            LineStyle::Off => "",
+            LineStyle::Lines => "  lines",
+            LineStyle::Drawing => "  drawing",
+        }
+    }
+}
+
 /// What the window shows (V cycles).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Display {
@@ -209,6 +233,8 @@ pub struct Toggles {
     pub ao: bool,
     /// Every object see-through (X).
     pub xray: bool,
+    /// Feature lines (L).
+    pub lines: LineStyle,
     /// A section plane across a model (K: along x, y, z, off; `[` and `]`
     /// move it): the axis (0, 1, 2 of the model file's coordinates) and
     /// where it crosses the model, in steps of [`SECTION_STEP`] of its
@@ -228,6 +254,7 @@ impl Default for Toggles {
             ghosts: true,
             ao: false,
             xray: false,
+            lines: LineStyle::Off,
             section: None,
         }
     }
@@ -368,6 +395,7 @@ impl Viewer {
             Key::Char('m') => t.ghosts = !t.ghosts,
             Key::Char('o') => t.ao = !t.ao,
             Key::Char('x') => t.xray = !t.xray,
+            Key::Char('l') => t.lines = next_of(&[LineStyle::Off, LineStyle::Lines, LineStyle::Drawing], t.lines),
             Key::Char('k') => {
                 t.section = match t.section {
                     None => Some((0, SECTION_STEPS / 2)),
@@ -664,6 +692,12 @@ mod tests {
         assert!(!v.toggles.traced && !v.toggles.fog, "R and G turn them off");
         assert_eq!(v.apply(Input::Key(Key::Char('x'))), Request::Render);
         assert!(v.toggles.xray, "X turns x-ray on");
+        let mut styles = Vec::new();
+        for _ in 0..3 {
+            assert_eq!(v.apply(Input::Key(Key::Char('l'))), Request::Render);
+            styles.push(v.toggles.lines);
+        }
+        assert_eq!(styles, [LineStyle::Lines, LineStyle::Drawing, LineStyle::Off], "L cycles the line styles");
         assert_eq!(v.apply(Input::Key(Key::Char('['))), Request::Nothing, "no section to move");
         let mut sections = Vec::new();
         for key in ['k', ']', ']', 'k', '[', 'k', 'k'] {

@@ -578,6 +578,9 @@ fn viewer_for(scene: Option<&Scene>, size: (u32, u32)) -> Viewer {
     viewer.framed = scene.and_then(Scene::caster_bounds).unwrap_or(bounds);
     viewer.costly_scene = costly;
     viewer.toggles.ao = scene.is_some_and(|s| s.ambient_occlusion.is_some());
+    if scene.is_some_and(|s| s.lines.is_some()) {
+        viewer.toggles.lines = super::state::LineStyle::Lines;
+    }
     viewer
 }
 
@@ -603,8 +606,8 @@ fn hud_lines(viewer: &Viewer, shown: &Shown, step: Option<Step>, times: &VecDequ
             format!("{:.1} fps  {}x{}  {stage}", 1.0 / mean, viewer.size.0, viewer.size.1)
         },
         format!(
-            "ms: visibility {:.1}  shadows {:.1}  shading {:.1}  traced {:.1}  ao {:.1}  edges {:.1}",
-            st.visibility_ms, st.shadow_ms, st.shading_ms, st.traced_ms, st.occlusion_ms, st.edge_ms
+            "ms: visibility {:.1}  shadows {:.1}  shading {:.1}  traced {:.1}  ao {:.1}  edges {:.1}  lines {:.1}",
+            st.visibility_ms, st.shadow_ms, st.shading_ms, st.traced_ms, st.occlusion_ms, st.edge_ms, st.lines_ms
         ),
         format!("{} triangles  {} solids  {} passes averaged", st.raster.triangles, st.raster.solids, shown.passes),
         match skipped(&viewer.warnings) {
@@ -612,7 +615,7 @@ fn hud_lines(viewer: &Viewer, shown: &Shown, step: Option<Step>, times: &VecDequ
             n => format!("INCOMPLETE: {n} part(s) not drawn"),
         },
         format!(
-            "shadows {}  smoothing {smoothing}{}{}  show {}{}",
+            "shadows {}  smoothing {smoothing}{}{}{}  show {}{}",
             viewer.toggles.shadows.name(),
             viewer.toggles.section.map_or(String::new(), |(axis, at)| format!(
                 "  section {} {:.0}%",
@@ -625,6 +628,7 @@ fn hud_lines(viewer: &Viewer, shown: &Shown, step: Option<Step>, times: &VecDequ
                 (false, true) => "  x-ray",
                 (true, true) => "  ao  x-ray",
             },
+            viewer.toggles.lines.name(),
             viewer.display.name(),
             if viewer.display == Display::Image { "" } else { " (V: next)" }
         ),
@@ -682,6 +686,7 @@ pub fn cheat_sheet() -> Vec<String> {
         "G           fog",
         "O           ambient occlusion",
         "X           x-ray",
+        "L           lines, drawing, off",
         "K  [  ]     section x/y/z/off, move",
         "P           ground plane",
         "C           CSG exact/faceted",

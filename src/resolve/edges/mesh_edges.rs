@@ -144,6 +144,15 @@ pub struct EdgeCache {
 }
 
 impl EdgeCache {
+    /// The edges of every object's mesh, as [`EdgeCache::edges_of`], with the
+    /// crease angle the cache was last asked for (the edge pass's default
+    /// before that): feature lines read the faces beside each edge, not its
+    /// crease flag.
+    pub(super) fn edges_as_kept(&mut self, scene: &Scene) -> Vec<Option<Arc<MeshEdges>>> {
+        let crease_deg = if self.crease_deg > 0.0 { self.crease_deg } else { super::EdgeOptions::default().crease_deg };
+        self.edges_of(scene, crease_deg)
+    }
+
     /// The edges of every object's mesh (index = object), found for the meshes not
     /// seen last frame; entries of meshes no longer drawn are dropped.
     pub(super) fn edges_of(&mut self, scene: &Scene, crease_deg: f32) -> Vec<Option<Arc<MeshEdges>>> {

@@ -74,6 +74,7 @@
 mod blend;
 mod dda;
 mod intersections;
+pub mod lines;
 mod mesh_edges;
 mod parts;
 mod screen;
@@ -174,6 +175,24 @@ impl EdgePass {
             targets.iter_mut().for_each(|t| apply_outline_blends(t.image, &blends));
             self.blends += blends.len();
         }
+    }
+
+    /// Draws the scene's feature lines ([`crate::scene::FeatureLines`]) into
+    /// `image` (the pixels `vb` holds), from the edge lists this pass keeps
+    /// and, where the scene has solids, rays through `trace`. Returns the
+    /// pixels drawn on (0 without lines).
+    pub fn draw_lines(
+        &mut self,
+        scene: &Scene,
+        vb: &VisibilityBuffer,
+        image: &mut crate::image::LinearImage,
+        trace: &mut TraceCache,
+    ) -> usize {
+        let Some(lines) = &scene.lines else { return 0 };
+        let edges = self.cache.edges_as_kept(scene);
+        let solids = scene.objects.iter().any(|o| o.solid().is_some());
+        let trace = solids.then(|| trace.get(scene));
+        lines::draw_lines(scene, vb, image, &edges, trace, lines)
     }
 
     /// The pixels this frame's pass blended (0 without one).

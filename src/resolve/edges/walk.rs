@@ -247,14 +247,14 @@ fn sorted_by_pixel(blends: Vec<EdgeBlend>, width: u32) -> Vec<EdgeBlend> {
 
 /// Which faces look at the eye, tested in the object's own space (the sign of a
 /// point's side of a plane survives any affine map).
-struct Facing {
+pub(super) struct Facing {
     /// Perspective: the eye in object space; orthographic: the direction towards
     /// the eye in object space, with w = 0.
     eye: Vec4,
 }
 
 impl Facing {
-    fn new(camera: &Camera, world_to_object: glam::Affine3A) -> Facing {
+    pub(super) fn new(camera: &Camera, world_to_object: glam::Affine3A) -> Facing {
         let eye = match camera.projection {
             Projection::Perspective { .. } => world_to_object.transform_point3(camera.eye).extend(1.0),
             Projection::Orthographic { .. } => {
@@ -265,7 +265,7 @@ impl Facing {
     }
 
     /// Whether face `plane` (n, n·p) has the eye on its front side.
-    fn front(&self, plane: Vec4) -> bool {
+    pub(super) fn front(&self, plane: Vec4) -> bool {
         plane.truncate().dot(self.eye.truncate()) - plane.w * self.eye.w > 0.0
     }
 }
@@ -288,7 +288,7 @@ fn selected(e: &MeshEdge, front: &[bool], two_sided: bool, selection: EdgeSelect
 
 /// View distance from stored depth, and the size of a pixel there, to compare
 /// depths on the scale of the image.
-struct DepthScale {
+pub(super) struct DepthScale {
     projection: Projection,
     near: f64,
     far: f64,
@@ -297,7 +297,7 @@ struct DepthScale {
 }
 
 impl DepthScale {
-    fn of(camera: &Camera, height: u32) -> DepthScale {
+    pub(super) fn of(camera: &Camera, height: u32) -> DepthScale {
         let pixel = match camera.projection {
             Projection::Perspective { fov_y_deg } => 2.0 * (f64::from(fov_y_deg).to_radians() * 0.5).tan(),
             Projection::Orthographic { height } => f64::from(height),
@@ -305,7 +305,7 @@ impl DepthScale {
         DepthScale { projection: camera.projection, near: f64::from(camera.near), far: f64::from(camera.far), pixel }
     }
 
-    fn distance(&self, z: f64) -> f64 {
+    pub(super) fn distance(&self, z: f64) -> f64 {
         match self.projection {
             Projection::Perspective { .. } => self.near / z.max(f64::MIN_POSITIVE),
             Projection::Orthographic { .. } => self.far - z * (self.far - self.near),
@@ -329,7 +329,7 @@ impl DepthScale {
     }
 
     /// A pixel's size at view distance `d`.
-    fn pixel_at(&self, d: f64) -> f64 {
+    pub(super) fn pixel_at(&self, d: f64) -> f64 {
         match self.projection {
             Projection::Perspective { .. } => self.pixel * d,
             Projection::Orthographic { .. } => self.pixel,

@@ -29,8 +29,8 @@ use crate::limits::{Limit, LimitSetting, Limits};
 use crate::scene::camera_path::{CameraPath, Interpolation, Key};
 use crate::scene::material::Filter;
 use crate::scene::settings::{
-    AmbientOcclusion, Antialias, EdgeFilter, EdgeMode, EdgeSelection, Exposure, Fog, FogMode, TranslucencyOrder,
-    MAX_JITTER_SAMPLES,
+    AmbientOcclusion, Antialias, EdgeFilter, EdgeMode, EdgeSelection, Exposure, FeatureLines, Fog, FogMode,
+    TranslucencyOrder, MAX_JITTER_SAMPLES,
 };
 use crate::scene::texture::Wrap;
 
@@ -54,6 +54,7 @@ pub struct SceneFile {
     objects: Vec<Spanned<ObjectRec>>,
     fog: Option<Spanned<FogRec>>,
     ambient_occlusion: Option<Spanned<OcclusionRec>>,
+    lines: Option<Spanned<LinesRec>>,
     section: Option<Spanned<SectionRec>>,
     environment: Option<Spanned<EnvironmentRec>>,
     /// `[limits]`: limit name → value.
@@ -144,6 +145,19 @@ struct FogRec {
 struct OcclusionRec {
     radius: Option<f32>,
     rays: Option<i64>,
+}
+
+/// `[lines]`: feature lines' `width` (pixels, default 1.5), `color`
+/// (linear RGB, default near-black), `hidden` (dashed hidden lines, default
+/// false) and `crease` (degrees between two faces' normals that make a
+/// crease, default 30).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct LinesRec {
+    width: Option<f32>,
+    color: Option<V3>,
+    hidden: Option<bool>,
+    crease: Option<f32>,
 }
 
 /// `[section]`: the plane through `point` with `normal` (pointing into the
@@ -664,6 +678,7 @@ impl SceneFile {
             antialias: self.antialias()?,
             fog: self.fog()?,
             ambient_occlusion: self.ambient_occlusion()?,
+            lines: self.lines()?,
             environment: self.environment(&from)?,
             translucency: self.image.translucency.into(),
             limits: from.limits,

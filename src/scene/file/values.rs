@@ -63,6 +63,29 @@ impl SceneFile {
         Ok(Some(AmbientOcclusion { radius: r.radius, rays, pass: 0 }))
     }
 
+    pub(super) fn lines(&self) -> Result<Option<FeatureLines>> {
+        let Some(rec) = &self.lines else { return Ok(None) };
+        let r = rec.get_ref();
+        let base = FeatureLines::default();
+        let widths = FeatureLines::WIDTHS;
+        if r.width.is_some_and(|w| !widths.contains(&w)) {
+            let (lo, hi) = (widths.start(), widths.end());
+            return Err(self.invalid(rec.span(), format!("lines `width` must be {lo} to {hi} pixels")));
+        }
+        if r.crease.is_some_and(|c| !(0.0..=180.0).contains(&c)) {
+            return Err(self.invalid(rec.span(), "lines `crease` must be 0 to 180 degrees"));
+        }
+        if r.color.is_some_and(|c| !c.iter().all(|v| v.is_finite() && *v >= 0.0)) {
+            return Err(self.invalid(rec.span(), "lines `color` must be finite and >= 0"));
+        }
+        Ok(Some(FeatureLines {
+            width: r.width.unwrap_or(base.width),
+            colour: r.color.map_or(base.colour, Vec3::from),
+            hidden: r.hidden.unwrap_or(base.hidden),
+            crease_deg: r.crease.unwrap_or(base.crease_deg),
+        }))
+    }
+
     pub(super) fn antialias(&self) -> Result<Antialias> {
         let Some(rec) = &self.image.antialias else { return Ok(Antialias::default()) };
         let rec = rec.get_ref();
