@@ -13,6 +13,7 @@ mod csg;
 mod openscad;
 mod raster;
 mod rays;
+mod section;
 mod share;
 mod slb;
 mod soft;
@@ -52,6 +53,9 @@ enum Command {
     /// Ambient occlusion after the viewer's 64 passes against the reference
     /// renderer's, and what it costs a frame.
     Ao(ao::AoArgs),
+    /// Section planes through the OpenSCAD corpus beside OpenSCAD's own
+    /// intersection of each part with a box, meshed exactly.
+    Section(section::SectionArgs),
     /// CSG solids (seed 003): the scanline walk's visible surfaces beside a ray
     /// per pixel cast at every primitive (the paper's baseline) and BVH rays,
     /// on the OpenSCAD corpus.
@@ -193,6 +197,7 @@ fn main() -> miette::Result<()> {
         Command::Hybrid(args) => rays::run_hybrid(&args),
         Command::Aa(args) => aa::run(&args),
         Command::Ao(args) => ao::run(&args),
+        Command::Section(args) => section::run(&args),
         Command::Csg(args) => csg::run(&args),
         Command::CsgRandom(args) => csg::run_random(&args),
         Command::CsgPreview(args) => csg::run_preview(&args),
