@@ -105,7 +105,7 @@ fn compare(path: &Path, args: &SectionArgs) -> Result<Outcome> {
     let cut = 0.5 * (lo.z + hi.z);
     let plane = SectionPlane::through(Vec3::new(0.0, 0.0, cut), Vec3::Z).expect("a plane");
     let start = Instant::now();
-    let options = ModelOptions { section: Some(plane), ..as_written.clone() };
+    let options = ModelOptions { section: Some(plane), ..as_written };
     let sectioned = scene_for_model_with(path, w, h, &options).map_err(|e| miette!("{e}"))?;
     let kage_ms = start.elapsed().as_secs_f64() * 1e3;
     // OpenSCAD: the tree intersected with a box from below the part to the
