@@ -39,7 +39,7 @@ fn floor_scene(with_box: bool, ao: Option<AmbientOcclusion>) -> Scene {
 }
 
 fn ao(rays: u32) -> Option<AmbientOcclusion> {
-    Some(AmbientOcclusion { radius: Some(1.0), rays, pass: 0 })
+    Some(AmbientOcclusion { radius: Some(1.0), rays, ..AmbientOcclusion::default() })
 }
 
 fn frame(scene: &Scene) -> Frame {
@@ -105,6 +105,35 @@ fn sixty_four_preview_passes_match_the_references_ambient_occlusion() {
     assert!(
         e.rmse < 0.02 && e.rmse < 0.25 * effect.rmse,
         "raster against the reference's ambient occlusion: rmse {:.4}; the occlusion itself: {:.4}",
+        e.rmse,
+        effect.rmse
+    );
+}
+
+/// The quick form: the same radius, estimated from the frame's depth buffer.
+fn screen(rays: u32) -> Option<AmbientOcclusion> {
+    ao(rays).map(|a| AmbientOcclusion { screen_space: true, ..a })
+}
+
+#[test]
+fn the_screen_space_form_leaves_a_floor_open_darkens_a_boxs_foot_and_nears_the_reference() {
+    let alone = frame(&floor_scene(false, screen(16)));
+    assert!(alone.occlusion.pixels().iter().all(|&p| p == Vec3::ONE), "a floor alone closes nothing");
+    let scene = floor_scene(true, screen(16));
+    let quick = frame(&scene);
+    let plain = frame(&floor_scene(true, None));
+    let darkened = quick.image.pixels().iter().zip(plain.image.pixels()).filter(|(q, p)| q.x < p.x - 1e-4).count();
+    assert!(darkened > 300, "{darkened} pixels darkened");
+    // Against the traced open share of the same pixels (256 rays each):
+    // far nearer than no occlusion at all.
+    let traced = frame(&floor_scene(true, ao(256))).occlusion;
+    let mut open = kage::image::LinearImage::new(traced.width(), traced.height());
+    open.pixels_mut().fill(Vec3::ONE);
+    let e = compare(&quick.occlusion, &traced, 0.05).expect("same size");
+    let effect = compare(&open, &traced, 0.05).expect("same size");
+    assert!(
+        e.rmse < 0.5 * effect.rmse,
+        "screen-space open share against the traced: rmse {:.4}; the occlusion itself: {:.4}",
         e.rmse,
         effect.rmse
     );

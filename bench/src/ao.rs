@@ -93,10 +93,10 @@ fn scenes(c: &Common) -> Result<Vec<(String, Scene)>> {
 pub fn run(args: &AoArgs) -> Result<()> {
     let c = &args.common;
     println!(
-        "| scene | size | radius | full frame ms (no AO) | AO ms, 16 rays | AO ms a pass ({} rays) | quick frame ms | RMSE after the full frame | RMSE after {} passes | reference s | x-ray frame ms | lines: frame ms, with lines ms | section ms (once) |",
+        "| scene | size | radius | full frame ms (no AO) | AO ms, 16 rays | AO ms a pass ({} rays) | quick frame ms | quick AO ms (screen space) | RMSE after the full frame | RMSE after {} passes | RMSE of quick AO | reference s | x-ray frame ms | lines: frame ms, with lines ms | section ms (once) |",
         args.pass_rays, args.passes
     );
-    println!("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    println!("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
     for (name, scene) in scenes(c)? {
         // The radius the scene itself gets (its floor left out of the model's size).
         let with_ao = Scene { ambient_occlusion: Some(AmbientOcclusion::default()), ..scene.clone() };
@@ -116,7 +116,10 @@ pub fn run(args: &AoArgs) -> Result<()> {
         };
         let plain = timed(&scene)?.0;
         let with = timed(&with_ao)?.1;
-        let quick = timed(&Scene { antialias: Antialias::None, ..scene.clone() })?.0;
+        let quick_scene = Scene { antialias: Antialias::None, ..scene.clone() };
+        let quick = timed(&quick_scene)?.0;
+        let screen_ao = AmbientOcclusion { screen_space: true, ..full_ao };
+        let quick_ao = timed(&Scene { ambient_occlusion: Some(screen_ao), ..quick_scene })?.1;
         let mut xray = scene.clone();
         xray.xray(kage::scene::XRAY_OPACITY);
         let xray_ms = timed(&xray)?.0;
@@ -148,6 +151,8 @@ pub fn run(args: &AoArgs) -> Result<()> {
         let passes = Scene { antialias: Antialias::Jitter(args.passes), ..occlusion_only(&scene, pass_ao) };
         let refined = kage::render(&passes, &RenderOptions::default()).map_err(|e| miette!("{e}"))?;
         let pass_ms = refined.stats.occlusion_ms / f64::from(args.passes);
+        let screen = Scene { antialias: Antialias::None, ..occlusion_only(&scene, screen_ao) };
+        let screen = kage::render(&screen, &RenderOptions::default()).map_err(|e| miette!("{e}"))?.image;
         let opts = ReferenceOptions {
             pixel_samples: args.reference_spp,
             shadows: false,
@@ -160,17 +165,19 @@ pub fn run(args: &AoArgs) -> Result<()> {
         let reference_s = t.elapsed().as_secs_f64();
         let rmse = |image| kage::compare::compare(image, &truth, 0.05).map(|e| e.rmse).map_err(|e| miette!("{e}"));
         println!(
-            "| {name} | {}x{} | {radius:.3} | {plain:.1} | {with:.1} | {pass_ms:.1} | {quick:.1} | {:.4} | {:.4} | {reference_s:.1} | {xray_ms:.1} ({:.2}x) | {without:.1}, {with_lines:.1} ({:.2}x) | {section_ms:.1} |",
+            "| {name} | {}x{} | {radius:.3} | {plain:.1} | {with:.1} | {pass_ms:.1} | {quick:.1} | {quick_ao:.1} ({:.0}%) | {:.4} | {:.4} | {:.4} | {reference_s:.1} | {xray_ms:.1} ({:.2}x) | {without:.1}, {with_lines:.1} ({:.2}x) | {section_ms:.1} |",
             c.width,
             c.height,
+            100.0 * quick_ao / quick,
             rmse(&first)?,
             rmse(&refined.image)?,
+            rmse(&screen)?,
             xray_ms / plain,
             with_lines / without,
         );
     }
     println!(
-        "\nOpen share alone (white ambient reflectors, one white ambient light): the full frame (edge pass, {} rays a pixel), {} jittered passes of {} rays (the viewer's refinement), and the reference ({} x {} rays a pixel, {} AO rays at each hit); frame times of the scene as it is, median of {} frames (with and without feature lines: one frame of each in turn, the median of each); {} threads.",
+        "\nOpen share alone (white ambient reflectors, one white ambient light): the full frame (edge pass, {} rays a pixel), {} jittered passes of {} rays (the viewer's refinement), the quick frame's screen-space estimate (no antialiasing, the viewer's while the camera moves), and the reference ({} x {} rays a pixel, {} AO rays at each hit); frame times of the scene as it is, median of {} frames (with and without feature lines: one frame of each in turn, the median of each); {} threads.",
         AmbientOcclusion::default().rays,
         args.passes,
         args.pass_rays,

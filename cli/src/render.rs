@@ -158,6 +158,11 @@ pub struct RenderArgs {
     /// time). Implies --ao.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=4096))]
     ao_rays: Option<u32>,
+    /// Ambient occlusion estimated from the frame's depth buffer instead of
+    /// rays (the viewer's form while the camera moves): a fraction of the
+    /// cost, blind to surfaces the image does not show. Implies --ao.
+    #[arg(long)]
+    ao_screen: bool,
     /// An OpenSCAD .csg model's spheres and cylinders: `exact` (true curved
     /// surfaces) or `faceted` as OpenSCAD's own mesh ($fn, $fa, $fs), to compare
     /// with OpenSCAD pixel for pixel.
@@ -580,10 +585,11 @@ pub fn render_command(args: &RenderArgs) -> miette::Result<()> {
         scene.xray(kage::scene::XRAY_OPACITY);
     }
     apply_lines(args, &mut scene);
-    if args.ao || args.ao_radius.is_some() || args.ao_rays.is_some() {
+    if args.ao || args.ao_screen || args.ao_radius.is_some() || args.ao_rays.is_some() {
         let ao = scene.ambient_occlusion.get_or_insert_with(Default::default);
         ao.radius = args.ao_radius.or(ao.radius);
         ao.rays = args.ao_rays.unwrap_or(ao.rays);
+        ao.screen_space |= args.ao_screen;
     }
     let extra = scene.shadow_warnings();
     scene.warnings.extend(extra);

@@ -761,8 +761,12 @@ fn occlusion_term(
     let ambient = ComponentSet::only(Component::Ambient);
     let Some(k) = images.targets.iter().position(|t| t.parts == ambient) else { return };
     let (image, rest) = images.targets.split_at_mut(1);
-    let trace = trace.get(scene);
-    occlusion::darken_ambient(scene, vb, trace, image[0].image, rest[k - 1].image, subpixel, open);
+    let (image, ambient) = (&mut *image[0].image, &mut *rest[k - 1].image);
+    if scene.ambient_occlusion.is_some_and(|a| a.screen_space) {
+        shading::screen_occlusion::darken_ambient(scene, vb, image, ambient, subpixel, open);
+    } else {
+        occlusion::darken_ambient(scene, vb, trace.get(scene), image, ambient, subpixel, open);
+    }
     if images.own_ambient {
         images.targets.remove(k);
         images.own_ambient = false;

@@ -221,6 +221,10 @@ pub struct AmbientOcclusion {
     /// progressive preview (or of jittered antialiasing) add new rays, not the
     /// same ones again.
     pub pass: u32,
+    /// Estimate the share from the frame's depth buffer instead of casting
+    /// rays ([`crate::shading::screen_occlusion`]): far cheaper, blind to what
+    /// the frame does not show; the viewer's form while the camera moves.
+    pub screen_space: bool,
 }
 
 impl AmbientOcclusion {
@@ -231,9 +235,10 @@ impl AmbientOcclusion {
 }
 
 impl Default for AmbientOcclusion {
-    /// The radius from the model's size, 16 rays a point, the first pass.
+    /// The radius from the model's size, 16 rays a point, the first pass,
+    /// traced.
     fn default() -> Self {
-        AmbientOcclusion { radius: None, rays: 16, pass: 0 }
+        AmbientOcclusion { radius: None, rays: 16, pass: 0, screen_space: false }
     }
 }
 

@@ -19,6 +19,7 @@ pub(crate) mod normal_map;
 pub(crate) mod passes;
 pub(crate) mod phong;
 pub(crate) mod reflection_map;
+pub mod screen_occlusion;
 pub(crate) mod shadow_images;
 pub(crate) mod subpixel;
 pub(crate) mod surface;

@@ -223,10 +223,10 @@ pub fn scene_for(base: &Scene, viewer: &Viewer, step: Step) -> Scene {
         LineStyle::Drawing => scene.drawing(),
     }
     scene.ambient_occlusion = match step {
-        // A moving camera: no ambient occlusion (its rays cost several
-        // frames' time).
         _ if !t.ao => None,
-        Step::Quick => None,
+        // A moving camera: the screen-space estimate (rays cost several
+        // frames' time).
+        Step::Quick => Some(AmbientOcclusion { screen_space: true, ..scene.ambient_occlusion.unwrap_or_default() }),
         Step::Full => Some(scene.ambient_occlusion.unwrap_or_default()),
         // Each pass casts PASS_OCCLUSION_RAYS new rays a pixel: 64 passes, 256.
         Step::Pass(n) => Some(AmbientOcclusion {
@@ -328,7 +328,7 @@ mod tests {
     use glam::Vec3;
 
     #[test]
-    fn ambient_occlusion_is_off_in_quick_frames_and_casts_new_rays_each_pass() {
+    fn ambient_occlusion_is_screen_space_in_quick_frames_and_casts_new_rays_each_pass() {
         let base = kage::scene::demo::demo_scene().expect("the demo");
         let orbit = Orbit::from_camera(&base.camera);
         let mut viewer = Viewer::new(orbit, (Vec3::splat(-1.0), Vec3::ONE), (320, 180));
@@ -337,7 +337,7 @@ mod tests {
         assert_eq!(off, [None; 3], "off until O");
         viewer.toggles.ao = true;
         let ao = |step| ao(&viewer, step);
-        assert_eq!(ao(Step::Quick), None);
+        assert!(ao(Step::Quick).is_some_and(|a| a.screen_space), "quick frames: from the depth buffer");
         assert_eq!(ao(Step::Full), Some(AmbientOcclusion::default()));
         let passes: Vec<(u32, u32)> =
             (1..=MAX_PASSES).map(|n| ao(Step::Pass(n)).map(|a| (a.pass, a.rays)).expect("on")).collect();

@@ -60,7 +60,7 @@ impl SceneFile {
                 return Err(self.invalid(rec.span(), format!("ambient_occlusion `rays` must be 1 to {max}, not {n}")))
             }
         };
-        Ok(Some(AmbientOcclusion { radius: r.radius, rays, pass: 0 }))
+        Ok(Some(AmbientOcclusion { radius: r.radius, rays, ..AmbientOcclusion::default() }))
     }
 
     pub(super) fn lines(&self) -> Result<Option<FeatureLines>> {
