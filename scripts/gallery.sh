@@ -3,8 +3,9 @@
 # glTF, an OBJ and an OpenSCAD .csg from the shared corpus, and two OpenSCAD
 # parts from this repository (a revolved knob, a label plate made with
 # BOSL2's text3d) — each with plain `kage render FILE` (no options but the size),
-# then a row of the looks a designer asks for (ambient occlusion, a section,
-# x-ray), each one option on the same command, into docs/gallery/.
+# then rows of the looks a designer asks for (ambient occlusion, a section,
+# x-ray, feature lines, a technical drawing), each one option on the same
+# command, into docs/gallery/.
 #
 #   scripts/gallery.sh            # after a change that alters how models come out
 #
@@ -39,6 +40,9 @@ looks=(
   "examples/openscad/knob.csg|ao.png|--ao"
   "examples/openscad/knob.csg|section.png|--section=-y=0"
   "$assets/gltf/CesiumMilkTruck/CesiumMilkTruck.glb|xray.png|--xray"
+  "examples/openscad/knob.csg|lines.png|--lines"
+  "$assets/csg/ex003_cross_cubes.stl|drawing.png|--drawing"
+  "bench/corpus/openscad/mk3_x_end_idler.csg|drawing_part.png|--drawing"
 )
 for entry in "${looks[@]}"; do
   IFS='|' read -r model name option <<<"$entry"

@@ -139,12 +139,13 @@ struct FogRec {
 }
 
 /// `[ambient_occlusion]`: `radius` (world units; default from the model's
-/// size), `rays` a point (default 16).
+/// size), `rays` a point (default 16), `screen_space` (default false).
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct OcclusionRec {
     radius: Option<f32>,
     rays: Option<i64>,
+    screen_space: Option<bool>,
 }
 
 /// `[lines]`: feature lines' `width` (pixels, default 1.5), `color`

@@ -60,7 +60,8 @@ impl SceneFile {
                 return Err(self.invalid(rec.span(), format!("ambient_occlusion `rays` must be 1 to {max}, not {n}")))
             }
         };
-        Ok(Some(AmbientOcclusion { radius: r.radius, rays, ..AmbientOcclusion::default() }))
+        let screen_space = r.screen_space.unwrap_or(false);
+        Ok(Some(AmbientOcclusion { radius: r.radius, rays, screen_space, ..AmbientOcclusion::default() }))
     }
 
     pub(super) fn lines(&self) -> Result<Option<FeatureLines>> {
