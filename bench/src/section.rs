@@ -3,7 +3,7 @@
 //! large cube, rendered by OpenSCAD 2021.01 to an exact mesh (CGAL).
 //!
 //! Each part is cut at the middle of its height (the file's z), the lower
-//! half kept: kage cuts its solid with the plane ([`kage::Scene::section`]);
+//! half kept, its spheres and cylinders faceted as OpenSCAD facets them: kage cuts its solid with the plane ([`kage::Scene::section`]);
 //! OpenSCAD intersects the file's tree with a box reaching from below the
 //! part to the plane. Both are drawn from one camera (framing the whole
 //! part), and each pixel agrees when both show the part at the same depth
@@ -14,6 +14,7 @@ use std::process::Command;
 use std::time::{Duration, Instant};
 
 use glam::Vec3;
+use kage::csg::openscad::{CsgOptions, Geometry};
 use kage::scene::model::{scene_for_model_with, ModelOptions};
 use kage::scene::section::SectionPlane;
 use kage::scene::{Scene, Up};
@@ -95,8 +96,10 @@ enum Outcome {
 /// Cuts the part in `path` both ways and compares the images.
 fn compare(path: &Path, args: &SectionArgs) -> Result<Outcome> {
     let (w, h) = (args.width, args.height);
-    // As written: OpenSCAD's z up, no ground.
-    let as_written = ModelOptions { up: Some(Up::Y), ground: false, ..ModelOptions::default() };
+    // As written: OpenSCAD's z up, no ground; spheres and cylinders as
+    // OpenSCAD's own facets ($fn, $fa, $fs), like for like with its mesh.
+    let csg = CsgOptions { geometry: Geometry::Faceted, ..CsgOptions::default() };
+    let as_written = ModelOptions { up: Some(Up::Y), ground: false, csg, ..ModelOptions::default() };
     let whole = match scene_for_model_with(path, w, h, &as_written) {
         Ok(s) => s,
         Err(e) => return Ok(Outcome::Skipped(format!("kage: {e}"))),

@@ -21,9 +21,10 @@ use crate::raytrace::TraceScene;
 use crate::scene::Scene;
 use crate::visibility::{ItemId, VisibilityBuffer};
 
-/// Bisection steps placing a crossing: within an eighth of a pixel (the
-/// middle of the last quarter).
-const BISECTIONS: u32 = 2;
+/// Bisection steps placing a crossing: within a quarter of a pixel (the
+/// middle of the half the one ray picks). A second ray (an eighth) changed
+/// the knob's lines by a PSNR of 49 dB for half again the lines' time.
+const BISECTIONS: u32 = 1;
 
 /// The largest relative difference of two neighbouring pixels' depths on one
 /// surface of a solid.
@@ -51,10 +52,21 @@ pub(super) fn outline_strokes(
     let rows: Vec<[Vec<(u32, f32)>; 2]> = (held.y0..held.y1)
         .into_par_iter()
         .map(|y| {
-            let right = (held.x0..held.x1 - 1).filter_map(|x| Some((x, finder.crossing((x, y), (x + 1, y))?)));
-            let below = (y + 1 < held.y1).then_some(held.x0..held.x1).into_iter().flatten();
-            let down = below.filter_map(|x| Some((x, finder.crossing((x, y), (x, y + 1))?)));
-            [right.collect(), down.collect()]
+            // Only pairs with a solid's pixel are looked at (most of a
+            // frame's pixels are a mesh's or the background's).
+            let solid = |i: &ItemId| i.primitive().is_some();
+            let (row, next) = (vb.item_row(y), (y + 1 < held.y1).then(|| vb.item_row(y + 1)));
+            let at = |x: u32| (x - held.x0) as usize;
+            let finder = &finder;
+            let right = (held.x0..held.x1 - 1)
+                .filter(|&x| solid(&row[at(x)]) || solid(&row[at(x) + 1]))
+                .filter_map(|x| Some((x, finder.crossing((x, y), (x + 1, y))?)));
+            let below = next.map(|next| {
+                (held.x0..held.x1)
+                    .filter(move |&x| solid(&row[at(x)]) || solid(&next[at(x)]))
+                    .filter_map(move |x| Some((x, finder.crossing((x, y), (x, y + 1))?)))
+            });
+            [right.collect(), below.into_iter().flatten().collect()]
         })
         .collect();
     let find = |list: &[(u32, f32)], x: u32| list.binary_search_by_key(&x, |c| c.0).ok().map(|i| list[i].1);
