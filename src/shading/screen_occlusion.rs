@@ -15,11 +15,14 @@
 //! in front closes what lies behind it.
 //!
 //! To cost a fraction of a quick frame it runs on cells of [`CELL`] ×
-//! [`CELL`] pixels (one surface point each, [`SAMPLES`] samples), each cell
-//! of a 4 × 4 block taking other directions of one sequence, then averages
-//! each cell with its 4 × 4 neighbours of like depth: 128 directions reach
-//! every cell's value, and each pixel takes its cell's.
-//! Measured in `kage-bench ao` ("quick AO" columns) against the reference.
+//! [`CELL`] pixels (one surface point each, [`SAMPLES`] directions of
+//! [`STEPS`] points), each cell of a 4 × 4 block taking other directions of
+//! one sequence, then averages each cell with its 4 × 4 neighbours of like
+//! depth: 64 directions reach
+//! every cell's value, and each pixel takes the four nearest cells' of like
+//! depth, bilinearly. Measured (`kage-bench ao`, 960×540, 2-core EPYC VM):
+//! 7.5–9.3 ms a frame, 0.03–0.04 RMSE from the reference's traced share
+//! (the traced form's 64 passes: 0.005–0.009).
 
 use glam::{DVec2, Vec2, Vec3};
 use rayon::prelude::*;

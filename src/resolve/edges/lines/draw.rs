@@ -53,23 +53,38 @@ impl Dashes {
 /// if given) cover, with their coverage: pixel indices row-major from
 /// `held`'s top left, ascending, each once.
 pub(super) fn coverage(strokes: &[Stroke], held: PixelRect, width: f32, dashes: Option<Dashes>) -> Vec<(u32, f32)> {
-    let dashed: Vec<Stroke> = match dashes {
-        Some(d) => strokes.par_iter().flat_map_iter(|s| d.split(s)).collect(),
-        None => strokes.to_vec(),
+    let dashed: Vec<Stroke>;
+    let strokes = match dashes {
+        Some(d) => {
+            dashed = strokes.par_iter().flat_map_iter(|s| d.split(s)).collect();
+            &dashed[..]
+        }
+        None => strokes,
     };
-    let mut spots: Vec<(u32, f32)> = dashed
-        .par_iter()
-        .with_min_len(64)
-        .fold(Vec::new, |mut spots, s| {
-            stroke_spots(s, held, width, &mut spots);
+    let mut spots: Vec<(u32, f32)> = strokes
+        .par_chunks(256)
+        .map(|chunk| {
+            let mut spots = Vec::with_capacity(chunk.len() * 16);
+            chunk.iter().for_each(|s| stroke_spots(s, held, width, &mut spots));
             spots
         })
-        .flatten_iter()
-        .collect();
-    // A pixel keeps its largest coverage: sorted by pixel, largest first.
-    spots.par_sort_unstable_by(|a, b| a.0.cmp(&b.0).then(b.1.total_cmp(&a.1)));
-    spots.dedup_by_key(|s| s.0);
+        .collect::<Vec<_>>()
+        .concat();
+    largest_each(&mut spots);
     spots
+}
+
+/// Leaves `spots` (pixel, coverage in 0..=1) sorted by pixel, each pixel once
+/// with its largest coverage: sorted as one number each (pixel above, the
+/// coverage's bits turned around below: a non-negative float's bits order
+/// as its value), which sorts several times faster than comparing pairs.
+pub(super) fn largest_each(spots: &mut Vec<(u32, f32)>) {
+    let mut keys: Vec<u64> =
+        spots.par_iter().map(|&(i, c)| (u64::from(i) << 32) | u64::from(u32::MAX - c.max(0.0).to_bits())).collect();
+    keys.par_sort_unstable();
+    keys.dedup_by_key(|k| *k >> 32);
+    spots.clear();
+    spots.extend(keys.iter().map(|&k| ((k >> 32) as u32, f32::from_bits(u32::MAX - (k as u32)))));
 }
 
 /// The pixels `stroke` covers among those `held`, with their coverage.
