@@ -26,8 +26,8 @@
 //! Lines are drawn over the image only: the component images (`--aov`) are
 //! left without them.
 //!
-//! Measured (`kage-bench ao`, 960×540, 2-core EPYC VM): lines cost 1.08–1.15×
-//! a frame on the demo, the bunny and the glTF truck, about 1.3× on a corpus
+//! Measured (`kage-bench ao`, 960×540, 2-core EPYC VM): lines cost 1.07–1.14×
+//! a frame on the demo, the bunny and the glTF truck, 1.22× on a corpus
 //! OpenSCAD part (its outline's crossings each cast a ray).
 
 mod draw;
