@@ -44,6 +44,25 @@ fn corpus() -> PathBuf {
     crate::repository().join("bench/corpus/openscad")
 }
 
+/// The corpus's `.csg` models, by name; only those `only` names (file stems)
+/// when it names any.
+///
+/// # Errors
+///
+/// When the corpus folder cannot be read.
+pub(crate) fn corpus_models(only: &[String]) -> Result<Vec<PathBuf>> {
+    let dir = corpus();
+    let mut models: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .map_err(|e| miette!("{}: {e}", dir.display()))?
+        .flatten()
+        .map(|e| e.path())
+        .filter(|p| p.extension().is_some_and(|e| e == "csg"))
+        .filter(|p| only.is_empty() || only.iter().any(|o| p.file_stem().is_some_and(|s| s == o.as_str())))
+        .collect();
+    models.sort();
+    Ok(models)
+}
+
 /// The nodes whose presence the table names (a model "uses" them).
 const CONSTRUCTS: [(&str, &str); 14] = [
     ("linear_extrude(", "linear"),
@@ -82,14 +101,7 @@ pub fn run(args: &OpenscadArgs) -> Result<()> {
     if !exe.exists() {
         return Err(miette!("{} is not built: `cargo build --release` builds it beside kage-bench", exe.display()));
     }
-    let mut models: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .map_err(|e| miette!("{}: {e}", dir.display()))?
-        .flatten()
-        .map(|e| e.path())
-        .filter(|p| p.extension().is_some_and(|e| e == "csg"))
-        .filter(|p| args.only.is_empty() || args.only.iter().any(|o| p.file_stem().is_some_and(|s| s == o.as_str())))
-        .collect();
-    models.sort();
+    let models = corpus_models(&args.only)?;
     let display = Xvfb::start();
     println!("| model | uses | kage | agrees with OpenSCAD's mesh | kage first image s | peak MB | OpenSCAD preview s | Manifold booleans s | Manifold way to image s | Manifold peak MB |");
     println!("|---|---|---|---:|---:|---:|---:|---:|---:|---:|");

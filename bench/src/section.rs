@@ -9,7 +9,7 @@
 //! part), and each pixel agrees when both show the part at the same depth
 //! (within a thousandth) or both miss it.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
 use std::time::{Duration, Instant};
 
@@ -47,18 +47,10 @@ const TARGET: f64 = 0.995;
 ///
 /// When the corpus cannot be read or `openscad` is not installed.
 pub fn run(args: &SectionArgs) -> Result<()> {
-    let dir = crate::repository().join("bench/corpus/openscad");
     if Command::new("openscad").arg("--version").output().is_err() {
         return Err(miette!("openscad is not installed (Debian: apt-get install openscad)"));
     }
-    let mut models: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .map_err(|e| miette!("{}: {e}", dir.display()))?
-        .flatten()
-        .map(|e| e.path())
-        .filter(|p| p.extension().is_some_and(|e| e == "csg"))
-        .filter(|p| args.only.is_empty() || args.only.iter().any(|o| p.file_stem().is_some_and(|s| s == o.as_str())))
-        .collect();
-    models.sort();
+    let models = crate::openscad::corpus_models(&args.only)?;
     println!("| model | cut at z | pixels of the part | agree | OpenSCAD intersection s | kage section ms |");
     println!("|---|---:|---:|---:|---:|---:|");
     let (mut measured, mut met, mut skipped) = (0, 0, Vec::new());

@@ -117,6 +117,21 @@ impl MeshEdges {
     }
 }
 
+/// The objects of `scene` that are meshes, with their edges (`edges`, per
+/// object, as [`EdgeCache::edges_of`] gives them): (index, object, mesh,
+/// edges), in parallel.
+pub(super) fn meshes_with_edges<'a>(
+    scene: &'a Scene,
+    edges: &'a [Option<Arc<MeshEdges>>],
+) -> impl ParallelIterator<Item = (usize, &'a crate::scene::Object, &'a Mesh, &'a MeshEdges)> {
+    scene
+        .objects
+        .par_iter()
+        .zip(edges)
+        .enumerate()
+        .filter_map(|(index, (object, edges))| Some((index, object, object.triangles()?.as_ref(), edges.as_deref()?)))
+}
+
 /// Per vertex, the index of the first vertex at the same position, to a millionth
 /// of the mesh's size (a seam's two copies of a vertex are often computed by
 /// different formulas: sin 0 and sin 2π).

@@ -10,7 +10,7 @@ use rayon::prelude::*;
 
 use super::blend::{EdgeBlend, PixelSet};
 use super::dda::{walk, PartBeyond};
-use super::mesh_edges::{MeshEdge, MeshEdges, NO_FACE};
+use super::mesh_edges::{meshes_with_edges, MeshEdge, MeshEdges, NO_FACE};
 use super::screen::{ClipMap, DepthPlane, Screen};
 use crate::camera::{Camera, Projection};
 use crate::scene::{EdgeFilter, EdgeMode, EdgeSelection, Mesh, Scene};
@@ -27,20 +27,14 @@ pub(super) fn find_blends(
     let camera = &scene.camera;
     let (w, h) = (vb.width(), vb.height());
     let walker = Walker { scene, vb, clips, mode, depth: DepthScale::of(camera, h), screen: Screen::of(camera, w, h) };
-    let objects: Vec<WalkedObject> = scene
-        .objects
-        .par_iter()
-        .zip(edges)
-        .enumerate()
-        .filter_map(|(index, (o, edges))| {
-            // Solids' outlines are not mesh edges: they keep their aliased edges.
-            let (mesh, edges) = (o.triangles()?, edges.as_deref()?);
+    // Solids' outlines are not mesh edges: they keep their aliased edges.
+    let objects: Vec<WalkedObject> = meshes_with_edges(scene, edges)
+        .filter_map(|(index, o, mesh, edges)| {
             let material = &scene.materials[o.material];
             // A translucent surface is blended over the opaque frame later; its
             // edges are not walked.
             (!material.translucent()).then(|| {
-                let facing = Facing::new(camera, o.transform.inverse());
-                let front = edges.planes.par_iter().map(|&plane| facing.front(plane)).collect();
+                let front = Facing::faces(camera, o, edges);
                 WalkedObject { index: index as u32, mesh, edges, front, two_sided: material.two_sided }
             })
         })
@@ -254,7 +248,7 @@ pub(super) struct Facing {
 }
 
 impl Facing {
-    pub(super) fn new(camera: &Camera, world_to_object: glam::Affine3A) -> Facing {
+    fn new(camera: &Camera, world_to_object: glam::Affine3A) -> Facing {
         let eye = match camera.projection {
             Projection::Perspective { .. } => world_to_object.transform_point3(camera.eye).extend(1.0),
             Projection::Orthographic { .. } => {
@@ -264,8 +258,15 @@ impl Facing {
         Facing { eye }
     }
 
+    /// Per face of `edges` (the mesh of `object`), whether it looks at the
+    /// eye of `camera`.
+    pub(super) fn faces(camera: &Camera, object: &crate::scene::Object, edges: &MeshEdges) -> Vec<bool> {
+        let facing = Facing::new(camera, object.transform.inverse());
+        edges.planes.par_iter().map(|&plane| facing.front(plane)).collect()
+    }
+
     /// Whether face `plane` (n, n·p) has the eye on its front side.
-    pub(super) fn front(&self, plane: Vec4) -> bool {
+    fn front(&self, plane: Vec4) -> bool {
         plane.truncate().dot(self.eye.truncate()) - plane.w * self.eye.w > 0.0
     }
 }

@@ -7,7 +7,7 @@ use std::sync::Arc;
 use glam::{DVec2, DVec3, Vec4};
 use rayon::prelude::*;
 
-use super::super::mesh_edges::{MeshEdge, MeshEdges, NO_FACE};
+use super::super::mesh_edges::{meshes_with_edges, MeshEdge, MeshEdges, NO_FACE};
 use super::super::screen::{ClipMap, Screen};
 use super::super::walk::{DepthScale, Facing};
 use super::{Stroke, Strokes};
@@ -43,15 +43,9 @@ pub(super) fn mesh_strokes(
         hidden: lines.hidden,
     };
     let cos_crease = lines.crease_deg.to_radians().cos();
-    let per_object: Vec<Strokes> = scene
-        .objects
-        .par_iter()
-        .zip(edges)
-        .enumerate()
-        .filter_map(|(index, (o, edges))| {
-            let (mesh, edges) = (o.triangles()?, edges.as_deref()?);
-            let facing = Facing::new(camera, o.transform.inverse());
-            let front: Vec<bool> = edges.planes.iter().map(|&p| facing.front(p)).collect();
+    let per_object: Vec<Strokes> = meshes_with_edges(scene, edges)
+        .map(|(index, o, mesh, edges)| {
+            let front = Facing::faces(camera, o, edges);
             let two_sided = scene.materials[o.material].two_sided;
             let feature = |e: &&MeshEdge| is_feature(e, &front, two_sided, &edges.planes, cos_crease, lines.hidden);
             // The few lines first, then walked in chunks (folding the walk
@@ -65,8 +59,7 @@ pub(super) fn mesh_strokes(
                     out
                 })
                 .collect();
-            let strokes = chunks.into_iter().fold(Strokes::default(), join);
-            Some(strokes)
+            chunks.into_iter().fold(Strokes::default(), join)
         })
         .collect();
     per_object.into_iter().fold(Strokes::default(), join)
