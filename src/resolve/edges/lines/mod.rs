@@ -8,16 +8,20 @@
 //!   where the two faces' normals differ by more than the lines'
 //!   `crease_deg` (the surface's own fold, not the shading's: a smooth-shaded
 //!   box still has its edges drawn, a finely tessellated sphere none inside).
-//!   Each edge is projected as the edge pass projects it, and every pixel
-//!   along it is depth-tested against the visibility buffer: the edge is
-//!   hidden where the surface the pixel shows lies nearer than the edge even
-//!   a pixel to either side (`visible.rs`). Hidden stretches are dropped, or
-//!   dashed when the lines ask for hidden lines.
+//!   Each edge is projected as the edge pass projects it and stepped along a
+//!   pixel at a time, each step depth-tested against the visibility buffer:
+//!   hidden where the surface its pixel shows lies nearer than the edge even
+//!   a pixel to either side (`visible.rs`). Hidden steps are dropped, or
+//!   dashed when the lines ask for hidden lines (then the creases between
+//!   faces turned away are drawn too). A step is a stroke of its own,
+//!   counted from the edge's projected start, so a tile draws the strokes
+//!   the whole frame draws there.
 //! - CSG solids have no edge lists: their outlines are found in the image
 //!   (`solids.rs`), between neighbouring pixels where a solid meets another
 //!   object, the background, or itself across a fold or a step in depth, the
-//!   crossing placed along the two pixels' centres by rays; the crossings are
-//!   joined cell by cell (marching squares). They have no hidden lines.
+//!   crossing placed between the two pixels' centres by the two surfaces'
+//!   planes (a fold) or a ray; the crossings are joined cell by cell
+//!   (marching squares). They have no hidden lines.
 //! - The lines are drawn as round-capped strokes (`draw.rs`): each pixel
 //!   takes the largest coverage any stroke gives it, so where strokes meet
 //!   (a polygon's corner, a dash's overlap) nothing is drawn twice darker,
