@@ -169,11 +169,18 @@ impl Camera {
     /// reversed depth `depth` lies (see [`crate::visibility::VisibilityBuffer`]).
     #[must_use]
     pub fn distance_at_depth(&self, ray: &Ray, depth: f32) -> f32 {
-        let along_view = match self.projection {
+        self.view_distance_at_depth(depth) / ray.dir.dot((self.target - self.eye).normalize()).max(1e-6)
+    }
+
+    /// How far along the view axis, from the eye (perspective) or the eye
+    /// plane (orthographic), the point of reversed depth `depth` lies: the
+    /// inverse of [`Camera::depth_at_view_distance`].
+    #[must_use]
+    pub fn view_distance_at_depth(&self, depth: f32) -> f32 {
+        match self.projection {
             Projection::Perspective { .. } => self.near / depth,
             Projection::Orthographic { .. } => self.far - depth * (self.far - self.near),
-        };
-        along_view / ray.dir.dot((self.target - self.eye).normalize()).max(1e-6)
+        }
     }
 
     /// The reversed depth (see [`crate::visibility::VisibilityBuffer`]) of a

@@ -28,7 +28,7 @@ use glam::{DVec2, Vec2, Vec3};
 use rayon::prelude::*;
 
 use super::subpixel::SubpixelShading;
-use crate::camera::{PixelRays, Projection};
+use crate::camera::PixelRays;
 use crate::image::LinearImage;
 use crate::sampling::concentric_disc;
 use crate::scene::Scene;
@@ -288,10 +288,6 @@ impl<'a> Probe<'a> {
 
     /// View distance of stored depth `depth`.
     fn view_distance(&self, depth: f32) -> f32 {
-        let c = &self.scene.camera;
-        match c.projection {
-            Projection::Perspective { .. } => c.near / depth.max(f32::MIN_POSITIVE),
-            Projection::Orthographic { .. } => c.far - depth * (c.far - c.near),
-        }
+        self.scene.camera.view_distance_at_depth(depth)
     }
 }
