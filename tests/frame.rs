@@ -251,7 +251,7 @@ fn subpixel_samples_match_the_passes_in(name: &str) {
     let mut targets = [Target { parts: ComponentSet::ALL, image: &mut image }];
     let mut pool = kage::shadows::MapPool::default();
     let prepare = |s: &mut SubpixelShading| s.reset(&scene, vb, subpixel.samples.clone());
-    kage::shading::shade_lit_beside(&scene, vb, &mut targets, &mut pool, &mut beside, prepare);
+    kage::shading::shade_lit_beside(&scene, vb, &mut targets, &mut pool, &mut beside, None, prepare);
     for k in 0..pixels.len() {
         assert_eq!(beside.colour(k, ComponentSet::ALL), subpixel.colour(k, ComponentSet::ALL), "{name}: sample {k}");
     }

@@ -93,10 +93,10 @@ fn scenes(c: &Common) -> Result<Vec<(String, Scene)>> {
 pub fn run(args: &AoArgs) -> Result<()> {
     let c = &args.common;
     println!(
-        "| scene | size | radius | full frame ms (no AO) | AO ms, 16 rays | AO ms a pass ({} rays) | quick frame ms | quick AO ms (screen space) | RMSE after the full frame | RMSE after {} passes | RMSE of quick AO | reference s | x-ray frame ms | lines: frame ms, with lines ms | section ms (once) |",
+        "| scene | size | radius | full frame ms (no AO) | AO ms, 16 rays | AO ms a pass ({} rays) | quick frame ms | quick AO ms (screen space) | quick frame with it ms | RMSE after the full frame | RMSE after {} passes | RMSE of quick AO | reference s | x-ray frame ms | lines: frame ms, with lines ms | section ms (once) |",
         args.pass_rays, args.passes
     );
-    println!("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    println!("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
     for (name, scene) in scenes(c)? {
         // The radius the scene itself gets (its floor left out of the model's size).
         let with_ao = Scene { ambient_occlusion: Some(AmbientOcclusion::default()), ..scene.clone() };
@@ -116,13 +116,25 @@ pub fn run(args: &AoArgs) -> Result<()> {
         };
         let plain = timed(&scene)?.0;
         let with = timed(&with_ao)?.1;
-        let quick_scene = Scene { antialias: Antialias::None, ..scene.clone() };
-        let quick = timed(&quick_scene)?.0;
-        let screen_ao = AmbientOcclusion { screen_space: true, ..full_ao };
-        let quick_ao = timed(&Scene { ambient_occlusion: Some(screen_ao), ..quick_scene })?.1;
         let mut xray = scene.clone();
         xray.xray(kage::scene::XRAY_OPACITY);
         let xray_ms = timed(&xray)?.0;
+        let quick_scene = Scene { antialias: Antialias::None, ..scene.clone() };
+        let screen_ao = AmbientOcclusion { screen_space: true, ..full_ao };
+        let quick_with = Scene { ambient_occlusion: Some(screen_ao), ..quick_scene.clone() };
+        // Quick frames with and without it, one after the other: its own
+        // stage, and what the whole frame gains.
+        let (mut quick, mut quick_with_ms, mut quick_ao) = (Vec::new(), Vec::new(), Vec::new());
+        for _ in 0..c.frames.max(1) {
+            let t = std::time::Instant::now();
+            renderer.render(&quick_scene).map_err(|e| miette!("{e}"))?;
+            quick.push(t.elapsed().as_secs_f64() * 1e3);
+            let t = std::time::Instant::now();
+            let stats = renderer.render(&quick_with).map_err(|e| miette!("{e}"))?.stats;
+            quick_with_ms.push(t.elapsed().as_secs_f64() * 1e3);
+            quick_ao.push(stats.occlusion_ms);
+        }
+        let (quick, quick_with_ms, quick_ao) = (median(&mut quick), median(&mut quick_with_ms), median(&mut quick_ao));
         // Feature lines: frames with and without them, one after the other.
         let lined = Scene { lines: Some(FeatureLines::default()), ..scene.clone() };
         let (mut without, mut with_lines) = (Vec::new(), Vec::new());
@@ -165,10 +177,11 @@ pub fn run(args: &AoArgs) -> Result<()> {
         let reference_s = t.elapsed().as_secs_f64();
         let rmse = |image| kage::compare::compare(image, &truth, 0.05).map(|e| e.rmse).map_err(|e| miette!("{e}"));
         println!(
-            "| {name} | {}x{} | {radius:.3} | {plain:.1} | {with:.1} | {pass_ms:.1} | {quick:.1} | {quick_ao:.1} ({:.0}%) | {:.4} | {:.4} | {:.4} | {reference_s:.1} | {xray_ms:.1} ({:.2}x) | {without:.1}, {with_lines:.1} ({:.2}x) | {section_ms:.1} |",
+            "| {name} | {}x{} | {radius:.3} | {plain:.1} | {with:.1} | {pass_ms:.1} | {quick:.1} | {quick_ao:.1} ({:.0}%) | {quick_with_ms:.1} ({:.2}x) | {:.4} | {:.4} | {:.4} | {reference_s:.1} | {xray_ms:.1} ({:.2}x) | {without:.1}, {with_lines:.1} ({:.2}x) | {section_ms:.1} |",
             c.width,
             c.height,
             100.0 * quick_ao / quick,
+            quick_with_ms / quick,
             rmse(&first)?,
             rmse(&refined.image)?,
             rmse(&screen)?,
@@ -177,7 +190,7 @@ pub fn run(args: &AoArgs) -> Result<()> {
         );
     }
     println!(
-        "\nOpen share alone (white ambient reflectors, one white ambient light): the full frame (edge pass, {} rays a pixel), {} jittered passes of {} rays (the viewer's refinement), the quick frame's screen-space estimate (no antialiasing, the viewer's while the camera moves), and the reference ({} x {} rays a pixel, {} AO rays at each hit); frame times of the scene as it is, median of {} frames (with and without feature lines: one frame of each in turn, the median of each); {} threads.",
+        "\nOpen share alone (white ambient reflectors, one white ambient light): the full frame (edge pass, {} rays a pixel), {} jittered passes of {} rays (the viewer's refinement), the quick frame's screen-space estimate (no antialiasing, the viewer's while the camera moves), and the reference ({} x {} rays a pixel, {} AO rays at each hit); frame times of the scene as it is, median of {} frames (with and without feature lines, and quick frames with and without the screen-space estimate: one frame of each in turn, the median of each); {} threads.",
         AmbientOcclusion::default().rays,
         args.passes,
         args.pass_rays,

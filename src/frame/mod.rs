@@ -29,7 +29,9 @@ use crate::raytrace::{occlusion, traced, TraceCache};
 use crate::resolve::edges::{EdgeOptions, EdgePass};
 use crate::resolve::jitter;
 use crate::scene::{Antialias, Scene};
-use crate::shading::{self, fog, translucency, Component, ComponentSet, PassStats, SubpixelShading, Target};
+use crate::shading::{
+    self, fog, translucency, Component, ComponentSet, OpenShares, PassStats, SubpixelShading, Target,
+};
 use crate::shadows::methods::technique;
 use crate::shadows::MapPool;
 use crate::visibility::{self, RasterStats, VisibilityBuffer};
@@ -626,7 +628,16 @@ fn render_pass(
     let vb = &*visibility;
     let held = visibility.rect();
     image.resize(held.width(), held.height());
-    let darkened = scene.ambient_occlusion.is_some().then_some(ambient);
+    // The quick form of ambient occlusion is found before the shading, which
+    // scales the ambient term by it; the traced form darkens the pass's
+    // ambient after it.
+    let screen_space = scene.ambient_occlusion.is_some_and(|a| a.screen_space);
+    if screen_space {
+        stats.timed(Stage::Occlusion, || shading::screen_occlusion::open_shares(scene, vb, occlusion));
+    }
+    let open = screen_space
+        .then(|| OpenShares::new(occlusion.pixels(), held.width() as usize, (held.x0 as usize, held.y0 as usize)));
+    let darkened = (scene.ambient_occlusion.is_some() && !screen_space).then_some(ambient);
     let mut images = PassImages::new(image, aovs, component_images, darkened);
     let targets = &mut images.targets;
     let beside = |s: &mut SubpixelShading| {
@@ -634,7 +645,7 @@ fn render_pass(
         edge_pass.plan(scene, vb, edges, s);
         start.elapsed()
     };
-    let (lit, planned) = stats.timed(Stage::Shading, || shade(scene, vb, targets, maps, subpixel, beside));
+    let (lit, planned) = stats.timed(Stage::Shading, || shade(scene, vb, targets, maps, subpixel, open, beside));
     stats.add_lit(&lit);
     stats.add(Stage::Edges, planned);
     if options.shadow_images {
@@ -642,7 +653,9 @@ fn render_pass(
     }
     stop.check()?;
     let builds = trace.builds();
-    if scene.ambient_occlusion.is_some() {
+    if screen_space {
+        stats.timed(Stage::Occlusion, || shading::screen_occlusion::darken_samples(vb, occlusion, subpixel));
+    } else if scene.ambient_occlusion.is_some() {
         let open = occlusion;
         stats.timed(Stage::Occlusion, || occlusion_term(scene, vb, &mut images, subpixel, trace, open));
     }
@@ -697,10 +710,11 @@ fn shade<T: Send>(
     targets: &mut [Target],
     maps: &mut MapPool,
     subpixel: &mut SubpixelShading,
+    open: Option<OpenShares>,
     beside: impl FnOnce(&mut SubpixelShading) -> T + Send,
 ) -> (PassStats, T) {
     let mut out = None;
-    let lit = shading::shade_lit_beside(scene, vb, targets, maps, subpixel, |s| out = Some(beside(s)));
+    let lit = shading::shade_lit_beside(scene, vb, targets, maps, subpixel, open, |s| out = Some(beside(s)));
     (lit, out.expect("the passes run what goes beside them"))
 }
 
@@ -762,11 +776,7 @@ fn occlusion_term(
     let Some(k) = images.targets.iter().position(|t| t.parts == ambient) else { return };
     let (image, rest) = images.targets.split_at_mut(1);
     let (image, ambient) = (&mut *image[0].image, &mut *rest[k - 1].image);
-    if scene.ambient_occlusion.is_some_and(|a| a.screen_space) {
-        shading::screen_occlusion::darken_ambient(scene, vb, image, ambient, subpixel, open);
-    } else {
-        occlusion::darken_ambient(scene, vb, trace.get(scene), image, ambient, subpixel, open);
-    }
+    occlusion::darken_ambient(scene, vb, trace.get(scene), image, ambient, subpixel, open);
     if images.own_ambient {
         images.targets.remove(k);
         images.own_ambient = false;

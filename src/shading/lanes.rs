@@ -245,7 +245,7 @@ impl Block {
                 }
             }
         }
-        let rgb = lighting.shade(&inputs, &s);
+        let rgb = lighting.shade(&inputs, &s, lighting.open_lanes(x0, rays.y));
         for (i, px) in out.iter_mut().enumerate() {
             if self.live[i] {
                 blend.apply(px, rgb.lane(i));
@@ -333,7 +333,7 @@ pub fn shade_run(
                 *m = Mirror { km: k.km(), r: r.lane(i) };
             }
         }
-        let rgb = lighting.shade(&inputs, &s);
+        let rgb = lighting.shade(&inputs, &s, lighting.open_lanes(x0 + b * LANES, rays.y));
         let (r, g, b) = (rgb.x.to_array(), rgb.y.to_array(), rgb.z.to_array());
         for (i, px) in out.iter_mut().enumerate() {
             blend.apply(px, Vec3::new(r[i], g[i], b[i]));
@@ -547,6 +547,49 @@ pub struct Lighting<'a> {
     emission: bool,
     diffuse: f32,
     specular: f32,
+    /// Each pixel's open share, which scales the ambient term (ambient
+    /// occlusion found before the shading); `None`: open everywhere.
+    open: Option<OpenShares<'a>>,
+}
+
+/// Each pixel's open share of ambient occlusion, in an image of the pixels
+/// a visibility buffer holds (its first lane read), which scales the ambient
+/// term where the pixels are shaded.
+#[derive(Debug, Clone, Copy)]
+pub struct OpenShares<'a> {
+    shares: &'a [Vec3],
+    width: usize,
+    corner: (usize, usize),
+}
+
+impl<'a> OpenShares<'a> {
+    /// The shares in `shares`, row by row, of the rectangle whose top-left
+    /// pixel is `corner` and whose rows are `width` long.
+    ///
+    /// # Panics
+    ///
+    /// If `shares` is not a whole number of rows.
+    #[must_use]
+    pub fn new(shares: &'a [Vec3], width: usize, corner: (usize, usize)) -> Self {
+        assert!(width > 0 && shares.len().is_multiple_of(width), "whole rows of shares");
+        OpenShares { shares, width, corner }
+    }
+
+    /// The shares of the eight pixels from column `x` of row `y` (1 past
+    /// the row's end).
+    #[inline(always)]
+    fn lanes(&self, x: usize, y: usize) -> F {
+        let (x, y) = (x - self.corner.0, y - self.corner.1);
+        let row = &self.shares[y * self.width..][..self.width];
+        if let Some(run) = row.get(x..x + LANES) {
+            return F::new(std::array::from_fn(|i| run[i].x));
+        }
+        let mut out = [1.0; LANES];
+        for (o, s) in out.iter_mut().zip(&row[x.min(self.width)..]) {
+            *o = s.x;
+        }
+        F::new(out)
+    }
 }
 
 impl<'a> Lighting<'a> {
@@ -555,7 +598,20 @@ impl<'a> Lighting<'a> {
     #[must_use]
     pub fn pass(ambient: impl IntoIterator<Item = &'a Light>, direct: Vec<Direct<'a>>, emission: bool) -> Self {
         let ambient = ambient.into_iter().map(|l| l.color * l.ambient).sum();
-        Lighting { direct, ambient, emission, diffuse: 1.0, specular: 1.0 }
+        Lighting { direct, ambient, emission, diffuse: 1.0, specular: 1.0, open: None }
+    }
+
+    /// The same pass with its ambient term scaled by each pixel's share in
+    /// `open` (the sub-pixel points of [`Lighting::shade_points`] are not).
+    #[must_use]
+    pub fn with_open(self, open: Option<OpenShares<'a>>) -> Self {
+        Lighting { open, ..self }
+    }
+
+    /// The open shares of the eight pixels from column `x` of row `y`.
+    #[inline(always)]
+    fn open_lanes(&self, x: usize, y: usize) -> F {
+        self.open.as_ref().map_or(F::ONE, |o| o.lanes(x, y))
     }
 
     /// The same pass keeping only the components in `parts` (an AOV).
@@ -568,6 +624,7 @@ impl<'a> Lighting<'a> {
             emission: self.emission && parts.contains(Component::Emission),
             diffuse: self.diffuse * keep(Component::Diffuse),
             specular: self.specular * keep(Component::Specular),
+            open: self.open,
         }
     }
 
@@ -598,7 +655,7 @@ impl<'a> Lighting<'a> {
         let inputs = k.inputs();
         let zero = F::ZERO;
         let surface = LaneSurface { p: p.load(), n: n.load(), v: v.load(), weights: [zero; 3] };
-        let [ambient, diffuse, specular, emission] = self.components(&inputs, &surface);
+        let [ambient, diffuse, specular, emission] = self.components(&inputs, &surface, F::ONE);
         std::array::from_fn(|i| {
             if points[i].is_none() {
                 return Components::default();
@@ -609,17 +666,18 @@ impl<'a> Lighting<'a> {
         })
     }
 
-    /// Seed 002 eq. 1 summed over the pass's lights, per lane.
+    /// Seed 002 eq. 1 summed over the pass's lights, per lane, the ambient
+    /// term scaled by `open`.
     #[inline(always)]
-    fn shade(&self, inp: &LaneInputs, s: &LaneSurface) -> V3 {
-        let [ambient, diffuse, specular, emission] = self.components(inp, s);
+    fn shade(&self, inp: &LaneInputs, s: &LaneSurface, open: F) -> V3 {
+        let [ambient, diffuse, specular, emission] = self.components(inp, s, open);
         ambient.add(diffuse).add(specular).add(emission)
     }
 
     /// Seed 002 eq. 1's components summed over the pass's lights, per lane:
-    /// ambient, diffuse, specular, emission.
+    /// ambient (scaled by `open`), diffuse, specular, emission.
     #[inline(always)]
-    fn components(&self, inp: &LaneInputs, s: &LaneSurface) -> [V3; 4] {
+    fn components(&self, inp: &LaneInputs, s: &LaneSurface, open: F) -> [V3; 4] {
         let mut diffuse = V3::splat(Vec3::ZERO);
         let mut specular = V3::splat(Vec3::ZERO);
         let direct = if self.diffuse > 0.0 || self.specular > 0.0 { self.direct.as_slice() } else { &[] };
@@ -637,7 +695,7 @@ impl<'a> Lighting<'a> {
         }
         let (kd, ks) = (inp.kd.scale(F::splat(self.diffuse)), inp.ks.scale(F::splat(self.specular)));
         let emission = if self.emission { inp.ke } else { V3::splat(Vec3::ZERO) };
-        [inp.ka.mul(V3::splat(self.ambient)), kd.mul(diffuse), ks.mul(specular), emission]
+        [inp.ka.mul(V3::splat(self.ambient)).scale(open), kd.mul(diffuse), ks.mul(specular), emission]
     }
 }
 
@@ -741,6 +799,8 @@ pub struct RowRays {
     forward: Vec3,
     ndc_scale: f32,
     ortho: bool,
+    /// The row.
+    y: usize,
     /// From this row's rays to the next row's: added to the origin
     /// (orthographic) or the direction base (perspective).
     down: Vec3,
@@ -771,6 +831,7 @@ impl RowRays {
             forward: rays.forward.normalize(),
             ndc_scale: 2.0 / rays.size.x,
             ortho: rays.ortho,
+            y,
             down: rays.up * (-2.0 / rays.size.y),
         }
     }
@@ -779,6 +840,7 @@ impl RowRays {
     #[must_use]
     pub fn below(&self) -> RowRays {
         let mut r = *self;
+        r.y += 1;
         if self.ortho {
             r.origin += self.down;
         } else {

@@ -35,7 +35,7 @@ use crate::scene::{Material, Scene};
 use crate::shadows::{Receiver, ShadowTerm};
 use crate::visibility::{ItemId, VisibilityBuffer};
 
-pub use lanes::{Blend, Lighting};
+pub use lanes::{Blend, Lighting, OpenShares};
 pub(crate) use passes::frame_lights_within;
 pub use passes::{frame_lights, shade_lit, shade_lit_beside, FrameLight, PassStats, Target};
 pub use phong::{Component, ComponentSet, Components};

@@ -31,6 +31,7 @@ use crate::idle::{IdleClock, IdleTime};
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
+use super::lanes::OpenShares;
 use super::reflection_map::{add_reflection_map, flat_background};
 use super::visible::screen_surfaces;
 use super::{
@@ -168,7 +169,7 @@ pub fn shade_lit(
     pool: &mut MapPool,
     subpixel: &mut SubpixelShading,
 ) -> PassStats {
-    shade_lit_beside(scene, vb, targets, pool, subpixel, |_| {})
+    shade_lit_beside(scene, vb, targets, pool, subpixel, None, |_| {})
 }
 
 /// [`shade_lit`] with the sub-pixel samples set up by `beside` while the
@@ -176,12 +177,15 @@ pub fn shade_lit(
 /// (the edge pass's plan) fills the gaps the pixels' shading leaves on the
 /// workers, instead of running before it. The samples get every pass, the
 /// first included (shaded beside the pixels too, once `beside` is done).
+/// With `open`, every pass's ambient term is scaled by each pixel's open
+/// share at the pixels (not at the sub-pixel samples).
 pub fn shade_lit_beside(
     scene: &Scene,
     vb: &VisibilityBuffer,
     targets: &mut [Target],
     pool: &mut MapPool,
     subpixel: &mut SubpixelShading,
+    open: Option<OpenShares>,
     beside: impl FnOnce(&mut SubpixelShading) + Send,
 ) -> PassStats {
     let mut stats = PassStats::default();
@@ -205,7 +209,7 @@ pub fn shade_lit_beside(
     stats.shadow_bytes = FUSED_SHADOW_BUDGET - budget;
     let direct = fused.iter().map(|(l, t)| (&l.light, t.as_slice())).collect();
     let ambient = lights.iter().map(|l| &l.light).filter(|l| l.only.is_none());
-    let first = Lighting::pass(ambient, direct, true);
+    let first = Lighting::pass(ambient, direct, true).with_open(open);
     let first = LitPass { lighting: &first, blend: Blend::Replace, receivers: None };
     let mut mirrors = mirror_buffer(scene, vb, targets);
     run(scene, vb, targets, subpixel, first, beside, mirrors.as_deref_mut());
@@ -221,7 +225,7 @@ pub fn shade_lit_beside(
         let receivers = light.only.as_ref().map(|only| (0..scene.objects.len()).map(|i| only.contains(&i)).collect());
         // A light that lights every object had its ambient added in the first pass.
         let ambient = light.only.is_some().then_some(light);
-        let lighting = Lighting::pass(ambient, vec![(light, &terms)], false);
+        let lighting = Lighting::pass(ambient, vec![(light, &terms)], false).with_open(open);
         let pass = LitPass { lighting: &lighting, blend: Blend::Add, receivers };
         run(scene, vb, targets, subpixel, pass, |_| {}, None);
         stats.passes += 1;
