@@ -273,3 +273,43 @@ fn a_reused_renderer_keeps_no_item_of_the_frame_before() {
     assert!(empty > reused.len() / 10, "the turned view leaves pixels empty ({empty})");
     assert!(reused == fresh.visibility.items(), "items differ from a fresh renderer's");
 }
+
+/// Open shares handed to the passes scale each pixel's ambient term and
+/// nothing else: the demo (textured, shadowed lights, a reflecting floor)
+/// shaded with a share varying over the image equals the shading without
+/// shares less `(1 − share)` times its ambient component, pixel by pixel.
+#[test]
+fn open_shares_scale_the_ambient_term_alone() {
+    use kage::shading::{shade_lit_beside, Component, ComponentSet, OpenShares, SubpixelShading, Target};
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenes/demo.toml");
+    let mut scene = kage::scene::file::load_scene(&path).unwrap();
+    (scene.width, scene.height) = (240, 135);
+    let frame = render(&scene, &RenderOptions::default()).unwrap();
+    let vb = &frame.visibility;
+    let (w, h) = (scene.width, scene.height);
+    let shares: Vec<Vec3> =
+        (0..w * h).map(|i| Vec3::splat(((i % w) as f32 / w as f32 + (i / w) as f32 / h as f32) * 0.5)).collect();
+    let shade = |open: Option<OpenShares>| {
+        let mut all = kage::image::LinearImage::new(w, h);
+        let mut ambient = kage::image::LinearImage::new(w, h);
+        let mut targets = [
+            Target { parts: ComponentSet::ALL, image: &mut all },
+            Target { parts: ComponentSet::only(Component::Ambient), image: &mut ambient },
+        ];
+        let mut pool = kage::shadows::MapPool::default();
+        shade_lit_beside(&scene, vb, &mut targets, &mut pool, &mut SubpixelShading::default(), open, |_| {});
+        (all, ambient)
+    };
+    let (plain, ambient) = shade(None);
+    let (darkened, darkened_ambient) = shade(Some(OpenShares::new(&shares, w as usize, (0, 0))));
+    let mut checked = 0;
+    for (i, share) in shares.iter().enumerate() {
+        let expected = plain.pixels()[i] - (1.0 - share.x) * ambient.pixels()[i];
+        let d = (darkened.pixels()[i] - expected).abs().max_element();
+        assert!(d < 1e-4, "pixel {i}: {} against {expected}", darkened.pixels()[i]);
+        let d = (darkened_ambient.pixels()[i] - share.x * ambient.pixels()[i]).abs().max_element();
+        assert!(d < 1e-4, "pixel {i}'s ambient");
+        checked += usize::from(ambient.pixels()[i].max_element() > 1e-3 && share.x < 0.9);
+    }
+    assert!(checked > 1000, "{checked} pixels with an ambient term darkened");
+}
