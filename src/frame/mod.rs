@@ -351,6 +351,8 @@ struct Scratch {
     edges: EdgePass,
     /// The edge pass's sub-pixel samples and what the passes added there.
     subpixel: SubpixelShading,
+    /// Translucent fragments ready to blend, their memory kept.
+    layers: translucency::Layers,
 }
 
 impl Renderer {
@@ -620,7 +622,16 @@ fn render_pass(
     let ray_depth = options.ray_depth;
     let Frame { image, visibility, aovs, stats, .. } = frame;
     let Scratch {
-        aovs: component_images, maps, trace, edges: edge_pass, subpixel, shadows, ambient, occlusion, ..
+        aovs: component_images,
+        maps,
+        trace,
+        edges: edge_pass,
+        subpixel,
+        shadows,
+        ambient,
+        occlusion,
+        layers: kept,
+        ..
     } = scratch;
     visibility.resize_to(scene.width, scene.height, Some(drawn(scene, options.region)));
     stats.raster = stats.timed(Stage::Visibility, || visibility::rasterize(scene, visibility));
@@ -676,7 +687,7 @@ fn render_pass(
     stats.timed(Stage::Edges, || edge_pass.record(targets, subpixel, nothing_over));
     let fog = stats.timed(Stage::Shading, || fog::fog_targets(scene, vb, targets));
     let (blended, transmittance) =
-        stats.timed(Stage::Shading, || translucency::composite(scene, vb, layers, targets, maps));
+        stats.timed(Stage::Shading, || translucency::composite(scene, vb, layers, targets, maps, kept));
     stats.translucent_fragments += blended;
     let seen = seen_through(fog.as_deref(), transmittance.as_deref());
     stats.timed(Stage::Edges, || edge_pass.apply(scene, vb, targets, seen.as_deref(), trace));
