@@ -30,9 +30,9 @@
 //!   pixel's share as it shades it ([`crate::shading::OpenShares`]): no
 //!   pass of its own over the image, no ambient image to shade.
 //!
-//! Measured (`kage-bench ao`, 960×540, 2-core EPYC VM): 1.0–1.2 ms, 5–14% of
-//! a quick frame (the whole frame with it 1.10–1.17× the one without), at
-//! 0.033–0.042 RMSE from the reference's traced share (the traced form's 64
+//! Measured (`kage-bench ao`, 960×540, 2-core EPYC VM): 1.0–1.1 ms, 5–13% of
+//! a quick frame (the whole frame with it 1.10–1.22× the one without), at
+//! 0.033–0.045 RMSE from the reference's traced share (the traced form's 64
 //! passes: 0.005–0.009). Before these three choices the same estimate cost
 //! 6.9–9.5 ms.
 
