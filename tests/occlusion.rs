@@ -117,6 +117,21 @@ fn screen(rays: u32) -> Option<AmbientOcclusion> {
 
 #[test]
 fn the_screen_space_form_leaves_a_floor_open_darkens_a_boxs_foot_and_nears_the_reference() {
+    screen_space_against_the_traced(&|s| s);
+}
+
+/// The same through an orthographic camera (whose stored depth is linear in
+/// the distance, not its reciprocal).
+#[test]
+fn the_screen_space_form_does_the_same_through_an_orthographic_camera() {
+    screen_space_against_the_traced(&|mut s| {
+        s.camera.projection = kage::camera::Projection::Orthographic { height: 4.0 };
+        s
+    });
+}
+
+fn screen_space_against_the_traced(view: &dyn Fn(Scene) -> Scene) {
+    let floor_scene = |with_box, ao| view(floor_scene(with_box, ao));
     let alone = frame(&floor_scene(false, screen(16)));
     assert!(alone.occlusion.pixels().iter().all(|&p| p == Vec3::ONE), "a floor alone closes nothing");
     let scene = floor_scene(true, screen(16));

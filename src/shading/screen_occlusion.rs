@@ -468,3 +468,41 @@ impl<'a> Probe<'a> {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::camera::Projection;
+
+    /// Each pixel's surface point projects back onto the pixel's centre at
+    /// the view distance its stored depth gives, through a perspective and
+    /// an orthographic camera.
+    #[test]
+    fn surface_points_project_back_to_their_pixels() {
+        for ortho in [false, true] {
+            let mut scene = crate::scene::demo::demo_scene().expect("the demo");
+            (scene.width, scene.height) = (96, 54);
+            if ortho {
+                scene.camera.projection = Projection::Orthographic { height: 6.0 };
+            }
+            let mut vb = VisibilityBuffer::new(scene.width, scene.height);
+            crate::visibility::rasterize(&scene, &mut vb);
+            let probe = Probe::new(&scene, &vb, 1.0);
+            let t = &probe.to_pixel;
+            let mut seen = 0;
+            for (x, y) in (0..54).flat_map(|y| (0..96).map(move |x| (x, y))) {
+                let Some((p, _)) = probe.point_at(x, y) else { continue };
+                seen += 1;
+                let v = p - t.origin;
+                let d = v.dot(t.forward);
+                let s = if t.ortho { 1.0 } else { 1.0 / d };
+                let at = Vec2::new(t.centre.x + v.dot(t.to_x) * s, t.centre.y - v.dot(t.to_y) * s);
+                let centre = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
+                assert!((at - centre).length() < 0.05, "ortho {ortho}: pixel ({x}, {y}) projects to {at}");
+                let expected = scene.camera.view_distance_at_depth(vb.depth(x, y));
+                assert!((d - expected).abs() < 1e-3 * expected, "ortho {ortho}: distance {d} against {expected}");
+            }
+            assert!(seen > 1000, "{seen} pixels seen");
+        }
+    }
+}
