@@ -124,9 +124,7 @@ pub fn open_shares(scene: &Scene, vb: &VisibilityBuffer, open: &mut LinearImage)
 /// Scales the ambient term of the edge pass's samples by the open share of
 /// their pixels in `open` (as [`open_shares`] wrote it for `vb`).
 pub fn darken_samples(vb: &VisibilityBuffer, open: &LinearImage, subpixel: &mut SubpixelShading) {
-    let held = vb.rect();
-    let w = held.width() as usize;
-    let share = |(x, y): (u32, u32)| open.pixels()[(y - held.y0) as usize * w + (x - held.x0) as usize].x;
+    let share = |(x, y): (u32, u32)| open.pixels()[vb.index(x, y)].x;
     let samples = subpixel.lit.par_iter_mut().zip(&subpixel.samples);
     samples.for_each(|(lit, sample)| lit.ambient *= share(sample.pixel));
 }
@@ -419,9 +417,9 @@ impl<'a> Probe<'a> {
             let inside = ax.simd_ge(splat(held.x0 as f32))
                 & ay.simd_ge(splat(held.y0 as f32))
                 & ax.simd_lt(splat(held.x1 as f32))
-                & ay.simd_lt(splat(held.y1 as f32))
-                & (if t.ortho { splat(1.0).simd_gt(splat(0.0)) } else { distance.simd_gt(splat(0.0)) });
-            let inside = inside.to_bitmask();
+                & ay.simd_lt(splat(held.y1 as f32));
+            // Perspective: only points ahead of the eye.
+            let inside = if t.ortho { inside } else { inside & distance.simd_gt(splat(0.0)) }.to_bitmask();
             let (ax, ay) = (ax.to_array(), ay.to_array());
             // Where the point falls outside the frame, 0: nothing seen.
             let surface = f32x8::new(std::array::from_fn(|i| {
