@@ -86,6 +86,34 @@ fn a_plane_beyond_everything_removes_it_and_one_behind_keeps_it() {
 }
 
 #[test]
+fn a_plane_on_a_solids_face_with_the_solid_beyond_leaves_nothing_from_any_side() {
+    // A box standing on z = 0 (turned about z, so its faces are not the
+    // plane's to the bit), cut keeping z ≤ 0: the regularized answer is
+    // empty, not a sheet of spans of no length seen from some sides.
+    let turned = Affine3A::from_rotation_z(0.7) * Affine3A::from_scale(Vec3::new(1.3, 0.9, 1.1));
+    let cube = Primitive {
+        shape: Shape::Polyhedron(kage::csg::ConvexPolyhedron::unit_cube()),
+        transform: turned * Affine3A::from_translation(Vec3::new(-0.5, -0.5, 0.0)),
+        color: None,
+        source: 0..0,
+    };
+    let mut rng = StdRng::seed_from_u64(11);
+    let mut seen = Vec::new();
+    for view in 0..24 {
+        let mut scene = ball(true);
+        let solid = CsgSolid { primitives: vec![cube.clone()], tree: Some(CsgTree::Leaf(0)) };
+        scene.objects[0].body = Body::Solid { solid: Arc::new(solid), materials: Arc::from([0]) };
+        scene.camera = common::random_camera(&mut rng, view % 2 == 0);
+        let report = scene.section(SectionPlane::through(Vec3::ZERO, Vec3::Z).expect("a plane"));
+        assert_eq!(report.capped, 1, "the plane crosses the solid's box");
+        let mut vb = kage::visibility::VisibilityBuffer::new(SIZE, SIZE);
+        kage::visibility::rasterize(&scene, &mut vb);
+        seen.push(vb.items().iter().filter(|i| !i.is_none()).count());
+    }
+    assert!(seen.iter().all(|&n| n == 0), "pixels drawn per view: {seen:?}");
+}
+
+#[test]
 fn an_open_mesh_cut_shows_its_inside_and_says_so() {
     let mut scene = ball(false);
     scene.objects[0].body = Body::Mesh(Arc::new(shapes::plane()));

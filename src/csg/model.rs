@@ -61,10 +61,19 @@ impl ConvexPolyhedron {
     /// The box `[0, 1]³`.
     #[must_use]
     pub fn unit_cube() -> Self {
-        let planes = [Vec3::X, Vec3::Y, Vec3::Z].into_iter().flat_map(|n| [n.extend(1.0), (-n).extend(0.0)]).collect();
+        Self::boxed(Vec3::ZERO, Vec3::ONE)
+    }
+
+    /// The axis-aligned box `lo..hi`.
+    #[must_use]
+    pub fn boxed(lo: Vec3, hi: Vec3) -> Self {
+        let planes = [Vec3::X, Vec3::Y, Vec3::Z]
+            .into_iter()
+            .flat_map(|n| [n.extend(n.dot(hi)), (-n).extend(-n.dot(lo))])
+            .collect();
         let vertices =
-            (0..8).map(|i| Vec3::new((i & 1) as f32, ((i >> 1) & 1) as f32, ((i >> 2) & 1) as f32)).collect();
-        ConvexPolyhedron { planes, vertices }
+            (0..8).map(|i| Vec3::new([lo.x, hi.x][i & 1], [lo.y, hi.y][(i >> 1) & 1], [lo.z, hi.z][(i >> 2) & 1]));
+        ConvexPolyhedron { planes, vertices: vertices.collect() }
     }
 
     /// Whether `p` lies inside or on the surface (within `eps` of a plane).

@@ -19,7 +19,7 @@
 use std::collections::HashMap;
 use std::sync::Arc;
 
-use glam::{DVec3, Vec2, Vec3, Vec4};
+use glam::{DVec3, Vec2, Vec3};
 use manifold_rust::linalg::Vec2 as MVec2;
 use manifold_rust::polygon::triangulate;
 
@@ -88,7 +88,7 @@ impl Scene {
                     Sectioned::Kept => out.push(object),
                     Sectioned::Removed => report.removed += 1,
                     Sectioned::Cut(solid) => {
-                        let materials = materials.iter().copied().chain([cap]).collect();
+                        let materials = materials.iter().copied().chain([cap, cap]).collect();
                         out.push(Object { body: Body::Solid { solid: Arc::new(solid), materials }, ..object });
                         report.capped += 1;
                     }
@@ -352,7 +352,16 @@ fn cap_mesh(kept: &Mesh, loops: &[Vec<u32>], n: DVec3) -> Option<Mesh> {
     })
 }
 
-/// `solid` intersected with its bounding box cut by `(n, d)`.
+/// `solid` less the part of its (grown) bounding box beyond `(n, d)`.
+///
+/// The plane is a cutter rather than one more operand of an intersection, so
+/// a face of the solid lying on the plane is decided as a difference decides
+/// coplanar faces ([`crate::csg::TIE`]): the cut removes it (a plane on a
+/// part's bottom face, the part kept below: nothing), instead of leaving
+/// spans of no length that speckle the image and its shadows. The result is
+/// also met with a box a little larger than the kept part's, whose faces
+/// stay clear of the solid, so the cut solid's bounds (its shadow maps',
+/// its camera's framing) are the kept part's.
 fn cut_solid(solid: &CsgSolid, (n, d): (DVec3, f64)) -> Sectioned<CsgSolid> {
     let (Some((lo, hi)), Some(tree)) = (solid.bounds(), &solid.tree) else { return Sectioned::Kept };
     let grow = (hi - lo).max_element().max(1e-3) * 0.01;
@@ -366,35 +375,41 @@ fn cut_solid(solid: &CsgSolid, (n, d): (DVec3, f64)) -> Sectioned<CsgSolid> {
     if side.iter().all(|&s| s > 0.0) {
         return Sectioned::Removed;
     }
-    let mut vertices: Vec<Vec3> =
-        corners.iter().zip(&side).filter(|(_, &s)| s <= 0.0).map(|(c, _)| c.as_vec3()).collect();
+    let mut crossings = Vec::new();
     for a in 0..8usize {
         for bit in [1, 2, 4] {
             let b = a | bit;
             if b != a && (side[a] <= 0.0) != (side[b] <= 0.0) {
                 let t = side[a] / (side[a] - side[b]);
-                vertices.push(corners[a].lerp(corners[b], t).as_vec3());
+                crossings.push(corners[a].lerp(corners[b], t).as_vec3());
             }
         }
     }
+    let on = |keep: bool| {
+        let corners = corners.iter().zip(&side).filter(move |(_, &s)| (s <= 0.0) == keep || s == 0.0);
+        corners.map(|(c, _)| c.as_vec3()).chain(crossings.iter().copied())
+    };
+    let (kept_lo, kept_hi) = on(true).fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(l, h), p| (l.min(p), h.max(p)));
+    // Pushed out across the plane only: its other faces are the grown box's.
+    let (lo, hi) = (lo.as_vec3(), hi.as_vec3());
+    let kept = ConvexPolyhedron::boxed(
+        Vec3::select(kept_lo.cmpgt(lo), kept_lo - grow, kept_lo),
+        Vec3::select(kept_hi.cmplt(hi), kept_hi + grow, kept_hi),
+    );
+    let mut beyond = ConvexPolyhedron::boxed(lo, hi);
     let length = n.length();
-    let mut planes: Vec<Vec4> = [Vec3::X, Vec3::Y, Vec3::Z]
-        .into_iter()
-        .flat_map(|axis| {
-            let (l, h) = (axis.dot(lo.as_vec3()), axis.dot(hi.as_vec3()));
-            [axis.extend(h), (-axis).extend(-l)]
-        })
-        .collect();
-    planes.push((n / length).as_vec3().extend((d / length) as f32));
+    beyond.planes.push((-n / length).as_vec3().extend((-d / length) as f32));
+    beyond.vertices = on(false).collect();
     let mut cut = solid.clone();
-    cut.primitives.push(Primitive {
-        shape: Shape::Polyhedron(ConvexPolyhedron { planes, vertices }),
+    let first = cut.primitives.len();
+    cut.primitives.extend([kept, beyond].map(|poly| Primitive {
+        shape: Shape::Polyhedron(poly),
         transform: glam::Affine3A::IDENTITY,
         color: None,
         source: 0..0,
-    });
-    let leaf = CsgTree::Leaf(cut.primitives.len() - 1);
-    cut.tree = Some(CsgTree::Intersection(vec![tree.clone(), leaf]));
+    }));
+    let less = CsgTree::Difference(Box::new(tree.clone()), vec![CsgTree::Leaf(first + 1)]);
+    cut.tree = Some(CsgTree::Intersection(vec![less, CsgTree::Leaf(first)]));
     Sectioned::Cut(cut)
 }
 
