@@ -207,3 +207,29 @@ fn a_roughness_map_sets_the_exponent_texel_by_texel() {
     assert!(apart > 0.05, "the two exponents' highlights differ by only {apart}");
     assert!(left < 2e-3 && right < 2e-3, "the smooth half is off by {left}, the rough half by {right}");
 }
+
+#[test]
+fn a_translucent_surface_reads_its_texture_at_the_pixels_footprint_as_an_opaque_one_does() {
+    // The checkered ground seen through itself at half opacity: each pixel
+    // is half the background and half what the opaque ground shows there,
+    // far texels filtered alike (read at the finest level, the far
+    // checkers alias into noise and the two disagree).
+    let alpha = 0.5;
+    let mut opaque = checkered_ground(Filter::Trilinear);
+    opaque.antialias = Antialias::None;
+    let mut translucent = opaque.clone();
+    translucent.materials[0].opacity = alpha;
+    let (a, b) =
+        (render(&opaque, &RenderOptions::default()).unwrap(), render(&translucent, &RenderOptions::default()).unwrap());
+    let (mut worst, mut far) = (0.0f32, 0);
+    for (i, (&o, &t)) in a.image.pixels().iter().zip(b.image.pixels()).enumerate() {
+        if a.visibility.items()[i].is_none() {
+            continue;
+        }
+        let expected = opaque.background * (1.0 - alpha) + o * alpha;
+        worst = worst.max((t - expected).abs().max_element());
+        far += usize::from(i < 55 * 160);
+    }
+    assert!(far > 500, "the ground runs to the horizon: {far} pixels above row 55");
+    assert!(worst < 1e-3, "largest difference from the blend of the opaque image: {worst}");
+}

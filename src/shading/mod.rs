@@ -232,10 +232,16 @@ impl TriangleCache {
         TriangleCache { slots: vec![None; slots.max(1)] }
     }
 
+    /// Where among `slots` slots `item` is held (by this cache, or by a
+    /// cache of something else per triangle kept beside it).
+    pub(crate) fn slot(item: ItemId, slots: usize) -> usize {
+        (item.triangle as usize ^ (item.object as usize).wrapping_mul(0x9E37)) % slots
+    }
+
     /// `item`'s triangle (a mesh's), prepared now unless it is held.
     pub(crate) fn get(&mut self, scene: &Scene, frames: &ObjectFrames, item: ItemId) -> &PreparedTriangle {
-        let key = (item.triangle as usize ^ (item.object as usize).wrapping_mul(0x9E37)) % self.slots.len();
-        let slot = &mut self.slots[key];
+        let at = Self::slot(item, self.slots.len());
+        let slot = &mut self.slots[at];
         match slot {
             Some(t) if t.item == item => {}
             _ => *slot = Some(frames.prepare(scene, item)),

@@ -273,7 +273,8 @@ impl PreparedTriangle {
     }
 
     /// The texture coordinates at barycentric weights `w` (zero without them).
-    fn uv_at(&self, w: [f32; 3]) -> Vec2 {
+    #[must_use]
+    pub fn uv_at(&self, w: [f32; 3]) -> Vec2 {
         self.uvs.map_or(Vec2::ZERO, |u| u[0] * w[0] + u[1] * w[1] + u[2] * w[2])
     }
 
@@ -281,6 +282,13 @@ impl PreparedTriangle {
     #[must_use]
     pub fn surface(&self, ray: &Ray) -> SurfacePoint {
         let (t, w) = self.hit(ray);
+        self.surface_at(ray, t, w)
+    }
+
+    /// The surface point at distance `t` along `ray` (of unit direction),
+    /// where the barycentric weights are `w` (found by the caller).
+    #[must_use]
+    pub fn surface_at(&self, ray: &Ray, t: f32, w: [f32; 3]) -> SurfacePoint {
         let to_eye = -ray.dir;
         let normal = self.normal_at(w, to_eye);
         let uv = self.uv_at(w);

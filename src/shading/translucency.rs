@@ -23,32 +23,48 @@ use rayon::prelude::*;
 
 use super::phong::{self, Coefficients, Components};
 use super::reflection_map::reflection_map;
+use super::surface::{PreparedTriangle, TriangleGeometry};
 use super::{frame_lights_within, Component, FrameLight, ObjectFrames, SurfacePoint, Target, TriangleCache};
+use crate::camera::PixelRays;
 use crate::scene::{Scene, TranslucencyOrder};
 use crate::shadows::{MapPool, Receiver, ShadowTerm};
-use crate::visibility::{Fragment, VisibilityBuffer};
+use crate::visibility::{Fragment, ItemId, VisibilityBuffer};
 
 /// The translucent fragments of a frame ready to be added, kept from frame to
-/// frame so that their memory is reused: some hundred bytes a fragment,
-/// which allocated afresh for each frame cost more in page faults than
-/// preparing the fragments did.
+/// frame so that their memory is reused (allocated afresh for each frame, it
+/// cost more in page faults than preparing the fragments did).
 #[derive(Debug, Default)]
-pub struct Layers(Vec<Layer>);
+pub struct Layers {
+    layers: Vec<Layer>,
+    /// Each layer's surface and coefficients, kept only while lights with
+    /// shadow maps are still to be added.
+    details: Vec<Detail>,
+}
 
-/// One translucent fragment, ready to be added.
+/// One translucent fragment, ready to be added: a few dozen bytes, so that
+/// the passes over all of them (weights, blending) read little memory.
 #[derive(Debug)]
 struct Layer {
-    pixel: usize,
+    /// Its pixel ([`VisibilityBuffer::index`] of the opaque buffer).
+    pixel: u32,
+    /// Its object.
+    object: u32,
     /// Its opacity.
     alpha: f32,
     /// Its share of the pixel: its opacity times what the nearer layers let
     /// through.
     weight: f32,
-    surface: SurfacePoint,
-    k: Coefficients,
-    object: usize,
     fog: f32,
     lit: Components,
+    /// The environment's reflection in it (zero unless a target adds it).
+    reflection: Vec3,
+}
+
+/// What lighting a [`Layer`] by one more light reads.
+#[derive(Debug)]
+struct Detail {
+    surface: SurfacePoint,
+    k: Coefficients,
 }
 
 /// Blends `fragments` (in front of the opaque surfaces) into every target, in
@@ -62,7 +78,7 @@ struct Layer {
 pub fn composite(
     scene: &Scene,
     opaque: &VisibilityBuffer,
-    mut fragments: Vec<Fragment>,
+    fragments: Vec<Fragment>,
     targets: &mut [Target],
     pool: &mut MapPool,
     kept: &mut Layers,
@@ -71,17 +87,18 @@ pub fn composite(
         return (0, None);
     }
     // Nearest first within each pixel: by depth, or the last drawn first.
-    match scene.translucency {
-        TranslucencyOrder::Sorted => fragments.par_sort_unstable_by_key(nearest_first),
-        TranslucencyOrder::Unsorted => {
-            let mut indexed: Vec<(usize, Fragment)> = fragments.into_iter().enumerate().collect();
-            indexed.par_sort_by(|(i, a), (j, b)| a.pixel.cmp(&b.pixel).then(j.cmp(i)));
-            fragments = indexed.into_iter().map(|(_, f)| f).collect();
-        }
-    }
+    let fragments = by_pixel(&fragments, opaque.depths().len(), scene.translucency);
     let mut transmittance = vec![1.0f32; opaque.depths().len()];
-    prepare(scene, &fragments, opaque, &mut kept.0);
-    let layers = &mut kept.0;
+    let bounds = scene.caster_bounds().unwrap_or_default();
+    // Lights nothing shadows are added as the fragments are prepared (one
+    // pass over them); each of the others needs its shadow maps, rendered
+    // and dropped one light at a time.
+    let (unshadowed, shadowed): (Vec<FrameLight>, Vec<FrameLight>) =
+        frame_lights_within(scene, bounds).into_iter().partition(|l| !l.light.casts_shadows());
+    let reflect = targets.iter().any(|t| t.parts.contains(Component::Reflection));
+    let keep = !shadowed.is_empty();
+    prepare(scene, &fragments, opaque, (&unshadowed, reflect, keep), kept);
+    let layers = &mut kept.layers;
     let width = opaque.rect().width().max(1) as usize;
     let rows = Rows::of(layers, width, transmittance.len() / width);
     front_to_back_weights(layers, &rows, &mut transmittance);
@@ -90,19 +107,20 @@ pub fn composite(
     }
     // Where a texture's alpha is 0 the fragment adds nothing.
     let adds = |l: &Layer| l.weight > 0.0;
-    let bounds = scene.caster_bounds().unwrap_or_default();
-    for FrameLight { light, samples } in &frame_lights_within(scene, bounds) {
+    for FrameLight { light, samples } in &shadowed {
         let terms = pool.terms(scene, samples, bounds);
-        let lit = |l: &&mut Layer| adds(l) && light.only.as_ref().is_none_or(|o| o.contains(&l.object));
-        layers.par_iter_mut().with_min_len(256).filter(lit).for_each(|l| {
-            let s = &l.surface;
+        let lit = |(l, _): &(&mut Layer, &Detail)| {
+            adds(l) && light.only.as_ref().is_none_or(|o| o.contains(&(l.object as usize)))
+        };
+        let each = layers.par_iter_mut().zip(kept.details.par_iter()).with_min_len(256);
+        each.filter(lit).for_each(|(l, Detail { surface: s, k })| {
             let cos = s.normal.dot(light.incident(s.position).to_light);
             let shadow = if cos > 0.0 {
-                ShadowTerm::mean_lit(&terms, s.position, cos, &Receiver::of_object(l.object as u32))
+                ShadowTerm::mean_lit(&terms, s.position, cos, &Receiver::of_object(l.object))
             } else {
                 1.0
             };
-            phong::add_light(&mut l.lit, light, &l.k, s, shadow);
+            phong::add_light(&mut l.lit, light, k, s, shadow);
         });
         terms.into_iter().for_each(|t| pool.recycle(t));
     }
@@ -112,16 +130,48 @@ pub fn composite(
     (layers.iter().filter(|l| adds(l)).count(), Some(transmittance))
 }
 
-/// A fragment's place in the sorted order: by pixel, then nearest (largest
-/// reversed depth) first, then by item, so that the order is the same
-/// whatever order the fragments came in. One number, compared at once.
+/// `fragments` (in drawing order) sorted by pixel, each pixel's in `order`:
+/// nearest first ([`nearest_first`]), or the last drawn first. A counting
+/// sort by pixel (stable, so each pixel's stay in drawing order), then each
+/// pixel's few sorted on their own: a comparison sort of the whole list by
+/// one key took four times as long.
+fn by_pixel(fragments: &[Fragment], pixels: usize, order: TranslucencyOrder) -> Vec<Fragment> {
+    let mut starts = vec![0u32; pixels + 1];
+    for f in fragments {
+        starts[f.pixel as usize + 1] += 1;
+    }
+    for i in 0..pixels {
+        starts[i + 1] += starts[i];
+    }
+    let mut next = starts.clone();
+    let mut sorted = fragments.to_vec();
+    for f in fragments {
+        let at = &mut next[f.pixel as usize];
+        sorted[*at as usize] = *f;
+        *at += 1;
+    }
+    // Each pixel's run of two or more, cut off the list in turn.
+    let (mut runs, mut rest, mut cut) = (Vec::new(), sorted.as_mut_slice(), 0);
+    for w in starts.windows(2).filter(|w| w[1] - w[0] > 1) {
+        let (start, end) = (w[0] as usize, w[1] as usize);
+        let (run, tail) = std::mem::take(&mut rest)[start - cut..].split_at_mut(end - start);
+        runs.push(run);
+        (rest, cut) = (tail, end);
+    }
+    runs.into_par_iter().with_min_len(1024).for_each(|run| match order {
+        TranslucencyOrder::Sorted => run.sort_unstable_by_key(nearest_first),
+        TranslucencyOrder::Unsorted => run.reverse(),
+    });
+    sorted
+}
+
+/// A fragment's place in a pixel's sorted order: nearest (largest reversed
+/// depth) first, then by item, so that the order is the same whatever order
+/// the fragments came in. One number, compared at once.
 fn nearest_first(f: &Fragment) -> u128 {
     // Reversed depth is positive: its bits order as the numbers do.
     let farther = u32::MAX - f.depth.to_bits();
-    (u128::from(f.pixel) << 96)
-        | (u128::from(farther) << 64)
-        | (u128::from(f.item.object) << 32)
-        | u128::from(f.item.triangle)
+    (u128::from(farther) << 64) | (u128::from(f.item.object) << 32) | u128::from(f.item.triangle)
 }
 
 /// Where each row of pixels' layers start in a list sorted by pixel: row
@@ -134,7 +184,7 @@ struct Rows {
 impl Rows {
     /// The rows of `rows` rows of `width` pixels.
     fn of(layers: &[Layer], width: usize, rows: usize) -> Self {
-        let starts = (0..=rows).map(|r| layers.partition_point(|l| l.pixel < r * width)).collect();
+        let starts = (0..=rows).map(|r| layers.partition_point(|l| (l.pixel as usize) < r * width)).collect();
         Rows { starts, width }
     }
 
@@ -158,38 +208,180 @@ fn front_to_back_weights(layers: &mut [Layer], rows: &Rows, transmittance: &mut 
     let per_row = rows.split(layers).into_par_iter().zip(transmittance.par_chunks_mut(width)).enumerate();
     per_row.for_each(|(r, (layers, transmittance))| {
         for l in layers {
-            let t = &mut transmittance[l.pixel - r * width];
+            let t = &mut transmittance[l.pixel as usize - r * width];
             l.weight = l.alpha * *t;
             *t *= 1.0 - l.alpha;
         }
     });
 }
 
-/// The surface, opacity (the material's, times its alpha map's),
-/// coefficients, emission and fog of every fragment (found in front of
-/// `opaque`), into `layers`.
-fn prepare(scene: &Scene, fragments: &[Fragment], opaque: &VisibilityBuffer, layers: &mut Vec<Layer>) {
+/// Triangles a worker keeps prepared (and their [`ScreenTriangle`]s).
+const FORMS: usize = 512;
+
+/// The opacity (the material's, times its alpha map's), emission, fog,
+/// reflection (if `reflect`) and light from the `unshadowed` lights of every
+/// fragment (found in front of `opaque`), into `kept`'s layers; their surfaces
+/// and coefficients into its details too if `keep` (for the lights still to
+/// add).
+fn prepare(
+    scene: &Scene,
+    fragments: &[Fragment],
+    opaque: &VisibilityBuffer,
+    (unshadowed, reflect, keep): (&[FrameLight], bool, bool),
+    kept: &mut Layers,
+) {
     let frames = ObjectFrames::new(scene);
     let rays = scene.camera.pixel_rays(Vec2::new(opaque.width() as f32, opaque.height() as f32));
     let held = opaque.rect();
     let stride = held.width().max(1);
-    layers.clear();
-    let prepared = fragments.par_iter().with_min_len(256).map_init(
-        || TriangleCache::new(512),
-        |cache, f| {
-            let (x, y) = (held.x0 + f.pixel % stride, held.y0 + f.pixel / stride);
-            let ray = rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
-            let mut surface = cache.get(scene, &frames, f.item).surface(&ray);
-            let material = &scene.materials[surface.material];
-            let (uv, duv) = surface.coords(material.alpha_set());
-            let alpha = material.alpha_at(uv, duv);
-            let k = phong::sample_maps(material, &mut surface);
-            let fog = scene.fog.map_or(0.0, |fog| fog.amount_at(&scene.camera, surface.position));
-            let lit = Components { emission: k.parts().3, ..Default::default() };
-            Layer { pixel: f.pixel as usize, alpha, weight: 0.0, surface, k, object: f.item.object as usize, fog, lit }
-        },
-    );
-    prepared.collect_into_vec(layers);
+    let one = |(cache, forms): &mut (TriangleCache, Vec<Option<(ItemId, ScreenTriangle)>>), f: &Fragment| {
+        let (x, y) = (held.x0 + f.pixel % stride, held.y0 + f.pixel / stride);
+        let centre = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
+        let triangle = cache.get(scene, &frames, f.item);
+        let slot = &mut forms[TriangleCache::slot(f.item, FORMS)];
+        let form = match slot {
+            Some((item, form)) if *item == f.item => *form,
+            _ => slot.insert((f.item, ScreenTriangle::new(&rays, &triangle.geometry()))).1,
+        };
+        let mut surface = form.surface(triangle, &rays, centre);
+        // Ray differentials, as the opaque surfaces get them: the same
+        // triangle's plane met one pixel right and one below (so a
+        // texture is read at the level that matches the pixel).
+        let uv = |d: Vec2| form.weights(centre + d).map_or(surface.uv, |w| triangle.uv_at(w));
+        surface.duv = [uv(Vec2::X) - surface.uv, uv(Vec2::Y) - surface.uv];
+        let material = &scene.materials[surface.material];
+        let (uv, duv) = surface.coords(material.alpha_set());
+        let alpha = material.alpha_at(uv, duv);
+        let k = phong::sample_maps(material, &mut surface);
+        let fog = scene.fog.map_or(0.0, |fog| fog.amount_at(&scene.camera, surface.position));
+        let mut lit = Components { emission: k.parts().3, ..Default::default() };
+        for FrameLight { light, .. } in unshadowed {
+            if light.only.as_ref().is_none_or(|o| o.contains(&(f.item.object as usize))) {
+                phong::add_light(&mut lit, light, &k, &surface, 1.0);
+            }
+        }
+        let reflection = if reflect { reflection_map(scene, &surface) } else { Vec3::ZERO };
+        let layer = Layer { pixel: f.pixel, object: f.item.object, alpha, weight: 0.0, fog, lit, reflection };
+        (layer, Detail { surface, k })
+    };
+    let each = fragments.par_iter().with_min_len(256);
+    let caches = || (TriangleCache::new(FORMS), vec![None; FORMS]);
+    if keep {
+        each.map_init(caches, one).unzip_into_vecs(&mut kept.layers, &mut kept.details);
+    } else {
+        // Without the details: no surface or coefficients written.
+        each.map_init(caches, |c, f| one(c, f).0).collect_into_vec(&mut kept.layers);
+        kept.details.clear();
+    }
+}
+
+/// A value affine in a pixel's position `p`: `c + p.x · dx + p.y · dy`.
+#[derive(Debug, Clone, Copy)]
+struct Affine {
+    c: f32,
+    dx: f32,
+    dy: f32,
+}
+
+impl Affine {
+    fn at(self, p: Vec2) -> f32 {
+        self.c + p.x * self.dx + p.y * self.dy
+    }
+}
+
+/// A vector affine in a pixel's position: `v + p.x · dx + p.y · dy`.
+#[derive(Debug, Clone, Copy)]
+struct AffineVec {
+    v: Vec3,
+    dx: Vec3,
+    dy: Vec3,
+}
+
+impl AffineVec {
+    /// The image plane's offset from its centre at pixel `p` ([`PixelRays::ray`]'s).
+    fn offset(rays: &PixelRays) -> Self {
+        let (dx, dy) = (2.0 * rays.right / rays.size.x, -2.0 * rays.up / rays.size.y);
+        AffineVec { v: rays.up - rays.right, dx, dy }
+    }
+
+    fn at(&self, p: Vec2) -> Vec3 {
+        self.v + p.x * self.dx + p.y * self.dy
+    }
+
+    fn dot(&self, c: Vec3) -> Affine {
+        Affine { c: self.v.dot(c), dx: self.dx.dot(c), dy: self.dy.dot(c) }
+    }
+}
+
+/// A triangle's ray intersection (Möller–Trumbore) as a function of the
+/// pixel: the determinant and the two barycentric numerators are affine in
+/// the pixel's position, through a perspective camera (rays from one point,
+/// directions affine) and an orthographic one (origins affine), and so is
+/// the distance's numerator. Set up once a triangle, a pixel then costs three
+/// affine forms and a division instead of two cross products, four dot
+/// products and a division — and the differentials one pixel over, a
+/// division each.
+#[derive(Debug, Clone, Copy)]
+struct ScreenTriangle {
+    det: Affine,
+    b1: Affine,
+    b2: Affine,
+    /// The distance's numerator (along the unnormalised direction).
+    t: Affine,
+}
+
+impl ScreenTriangle {
+    fn new(rays: &PixelRays, g: &TriangleGeometry) -> Self {
+        let offset = AffineVec::offset(rays);
+        let (e1, e2) = (g.e1, g.e2);
+        if rays.ortho {
+            let dir = rays.forward.normalize();
+            let from_a = AffineVec { v: rays.origin - g.a + offset.v, ..offset };
+            let det = e1.dot(dir.cross(e2));
+            ScreenTriangle {
+                det: Affine { c: det, dx: 0.0, dy: 0.0 },
+                b1: from_a.dot(dir.cross(e2)),
+                b2: from_a.dot(e1.cross(dir)),
+                t: from_a.dot(e1.cross(e2)),
+            }
+        } else {
+            let from_a = rays.origin - g.a;
+            let q = from_a.cross(e1);
+            let dir = AffineVec { v: rays.forward + offset.v, ..offset };
+            let t = e2.dot(q);
+            ScreenTriangle {
+                det: dir.dot(e2.cross(e1)),
+                b1: dir.dot(e2.cross(from_a)),
+                b2: dir.dot(q),
+                t: Affine { c: t, dx: 0.0, dy: 0.0 },
+            }
+        }
+    }
+
+    /// The barycentric weights at pixel position `p` (`None` edge-on).
+    fn weights(&self, p: Vec2) -> Option<[f32; 3]> {
+        let det = self.det.at(p);
+        if det.abs() < f32::MIN_POSITIVE {
+            return None;
+        }
+        let inv = 1.0 / det;
+        let (b1, b2) = (self.b1.at(p) * inv, self.b2.at(p) * inv);
+        Some([1.0 - b1 - b2, b1, b2])
+    }
+
+    /// `triangle`'s surface point at pixel position `p`.
+    fn surface(&self, triangle: &PreparedTriangle, rays: &PixelRays, p: Vec2) -> SurfacePoint {
+        let ray = rays.ray(p);
+        let det = self.det.at(p);
+        if det.abs() < f32::MIN_POSITIVE {
+            return triangle.surface(&ray);
+        }
+        let inv = 1.0 / det;
+        let (b1, b2) = (self.b1.at(p) * inv, self.b2.at(p) * inv);
+        // Perspective: `t` is along the unnormalised direction.
+        let stretch = if rays.ortho { 1.0 } else { (rays.forward + AffineVec::offset(rays).at(p)).length() };
+        triangle.surface_at(&ray, self.t.at(p) * inv * stretch, [1.0 - b1 - b2, b1, b2])
+    }
 }
 
 /// Adds each layer's share of `t`'s components to `t`, rows in parallel.
@@ -205,9 +397,58 @@ fn add_layers(scene: &Scene, layers: &[Layer], rows: &Rows, t: &mut Target) {
             let c = l.lit;
             let mut colour = c.ambient * ambient + c.diffuse * diffuse + c.specular * specular + c.emission * emission;
             if parts.contains(Component::Reflection) {
-                colour += reflection_map(scene, &l.surface);
+                colour += l.reflection;
             }
-            row[l.pixel - r * width] += l.weight * (colour * (1.0 - l.fog) + fog_colour * l.fog);
+            row[l.pixel as usize - r * width] += l.weight * (colour * (1.0 - l.fog) + fog_colour * l.fog);
         }
     });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::camera::Projection;
+
+    /// A triangle's point and texture coordinates found through its
+    /// [`ScreenTriangle`] are those the ray through the pixel finds
+    /// (Möller–Trumbore, [`PreparedTriangle::surface`]), through a
+    /// perspective and an orthographic camera.
+    #[test]
+    fn screen_forms_meet_the_triangle_where_the_pixels_ray_does() {
+        let mut scene = crate::scene::demo::demo_scene().expect("the demo");
+        let frames = ObjectFrames::new(&scene);
+        let size = Vec2::new(320.0, 180.0);
+        let mut checked = 0;
+        for projection in [Projection::Perspective { fov_y_deg: 50.0 }, Projection::Orthographic { height: 6.0 }] {
+            scene.camera.projection = projection;
+            let rays = scene.camera.pixel_rays(size);
+            for (object, o) in scene.objects.iter().enumerate() {
+                let Some(mesh) = o.triangles() else { continue };
+                for triangle in (0..mesh.triangles.len()).step_by(97) {
+                    let item = ItemId { object: object as u32, triangle: triangle as u32 };
+                    let prepared = frames.prepare(&scene, item);
+                    let form = ScreenTriangle::new(&rays, &prepared.geometry());
+                    for k in 0..8u32 {
+                        let p = Vec2::new((37 * k + triangle as u32) as f32 % size.x, (23 * k) as f32 % size.y);
+                        let ray = rays.ray(p);
+                        // Not at a grazing angle, where both lose precision.
+                        if prepared.geometry().geometric.dot(ray.dir).abs() < 0.2 {
+                            continue;
+                        }
+                        let (want, got) = (prepared.surface(&ray), form.surface(&prepared, &rays, p));
+                        let reach = (want.position - ray.origin).length().max(1.0);
+                        assert!(
+                            (got.position - want.position).length() < 1e-4 * reach,
+                            "{projection:?} {item:?} at {p}: {} vs {}",
+                            got.position,
+                            want.position
+                        );
+                        assert!((got.uv - want.uv).length() < 1e-3, "{item:?} at {p}: uv {} vs {}", got.uv, want.uv);
+                        checked += 1;
+                    }
+                }
+            }
+        }
+        assert!(checked > 100, "{checked} points checked");
+    }
 }
