@@ -12,9 +12,15 @@
 //!   triangulated (Manifold's ear clipper, holes included) into a cap of the
 //!   [`CAP_MATERIAL`] facing the removed side, from the very points of the
 //!   cut; an open mesh keeps no cap and is drawn two-sided, so its inside shows.
-//! - A CSG solid (seed 003) is intersected with one more convex primitive: its
-//!   bounding box cut by the plane. The cut face is that primitive's face, in
-//!   the cap material, found by the same scanline walk as every other face.
+//! - A CSG solid (seed 003) gets one more cutter: the part of its bounding box
+//!   beyond the plane, a convex primitive. The cut face is that primitive's
+//!   face, in the cap material, found by the same scanline walk as every other
+//!   face. As a cutter, its face decides a solid's face lying on the plane as
+//!   every difference decides coplanar faces (removed): a plane on a part's
+//!   bottom face, the part kept below, leaves nothing rather than a sheet of
+//!   zero-length spans. The result is also met with a box just holding the
+//!   kept part, so the solid's bounds (its shadow maps' framing) shrink with
+//!   the cut.
 
 use std::collections::HashMap;
 use std::sync::Arc;
