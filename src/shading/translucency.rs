@@ -38,7 +38,7 @@ use super::phong::{self, Coefficients, Components};
 use super::reflection_map::reflection_map;
 use super::surface::{PreparedTriangle, TriangleGeometry};
 use super::{frame_lights_within, Component, FrameLight, ObjectFrames, SurfacePoint, Target, TriangleCache};
-use crate::camera::PixelRays;
+use crate::camera::{PixelRays, Ray};
 use crate::scene::{Scene, TranslucencyOrder};
 use crate::shadows::{MapPool, Receiver, ShadowTerm};
 use crate::visibility::{Fragment, ItemId, VisibilityBuffer};
@@ -244,7 +244,7 @@ fn prepare(
     kept: &mut Layers,
 ) {
     let frames = ObjectFrames::new(scene);
-    let rays = scene.camera.pixel_rays(Vec2::new(opaque.width() as f32, opaque.height() as f32));
+    let rays = ScreenRays::new(&scene.camera.pixel_rays(Vec2::new(opaque.width() as f32, opaque.height() as f32)));
     let held = opaque.rect();
     let stride = held.width().max(1);
     let one = |(cache, forms): &mut (TriangleCache, Vec<Option<(ItemId, ScreenTriangle)>>), f: &Fragment| {
@@ -311,10 +311,9 @@ struct AffineVec {
 }
 
 impl AffineVec {
-    /// The image plane's offset from its centre at pixel `p` ([`PixelRays::ray`]'s).
-    fn offset(rays: &PixelRays) -> Self {
-        let (dx, dy) = (2.0 * rays.right / rays.size.x, -2.0 * rays.up / rays.size.y);
-        AffineVec { v: rays.up - rays.right, dx, dy }
+    /// The same vector at every pixel.
+    fn constant(v: Vec3) -> Self {
+        AffineVec { v, dx: Vec3::ZERO, dy: Vec3::ZERO }
     }
 
     fn at(&self, p: Vec2) -> Vec3 {
@@ -326,14 +325,46 @@ impl AffineVec {
     }
 }
 
+/// A camera's pixel rays ([`PixelRays::ray`]) as affine functions of the
+/// pixel's position: through a perspective camera the origin is fixed and
+/// the (unnormalised) direction affine, through an orthographic one the
+/// origin is affine and the direction fixed.
+#[derive(Debug, Clone, Copy)]
+struct ScreenRays {
+    origin: AffineVec,
+    dir: AffineVec,
+    ortho: bool,
+}
+
+impl ScreenRays {
+    fn new(rays: &PixelRays) -> Self {
+        // The image plane's offset from its centre.
+        let (dx, dy) = (2.0 * rays.right / rays.size.x, -2.0 * rays.up / rays.size.y);
+        let offset = |at: Vec3| AffineVec { v: at + rays.up - rays.right, dx, dy };
+        if rays.ortho {
+            let dir = AffineVec::constant(rays.forward.normalize());
+            ScreenRays { origin: offset(rays.origin), dir, ortho: true }
+        } else {
+            ScreenRays { origin: AffineVec::constant(rays.origin), dir: offset(rays.forward), ortho: false }
+        }
+    }
+
+    /// The ray through pixel position `p` (a unit direction) and the length
+    /// of its unnormalised direction.
+    fn ray(&self, p: Vec2) -> (Ray, f32) {
+        let d = self.dir.at(p);
+        let length = d.length();
+        (Ray { origin: self.origin.at(p), dir: d / length }, length)
+    }
+}
+
 /// A triangle's ray intersection (Möller–Trumbore) as a function of the
 /// pixel: the determinant and the two barycentric numerators are affine in
-/// the pixel's position, through a perspective camera (rays from one point,
-/// directions affine) and an orthographic one (origins affine), and so is
-/// the distance's numerator. Set up once a triangle, a pixel then costs three
-/// affine forms and a division instead of two cross products, four dot
-/// products and a division — and the differentials one pixel over, a
-/// division each.
+/// the pixel's position ([`ScreenRays`]: one of the ray's origin and
+/// direction is fixed, the other affine), and so is the distance's
+/// numerator. Set up once a triangle, a pixel then costs three affine forms
+/// and a division instead of two cross products, four dot products and a
+/// division — and the differentials one pixel over, a division each.
 #[derive(Debug, Clone, Copy)]
 struct ScreenTriangle {
     det: Affine,
@@ -344,56 +375,46 @@ struct ScreenTriangle {
 }
 
 impl ScreenTriangle {
-    fn new(rays: &PixelRays, g: &TriangleGeometry) -> Self {
-        let offset = AffineVec::offset(rays);
+    fn new(rays: &ScreenRays, g: &TriangleGeometry) -> Self {
         let (e1, e2) = (g.e1, g.e2);
+        let det = rays.dir.dot(e2.cross(e1));
         if rays.ortho {
-            let dir = rays.forward.normalize();
-            let from_a = AffineVec { v: rays.origin - g.a + offset.v, ..offset };
-            let det = e1.dot(dir.cross(e2));
-            ScreenTriangle {
-                det: Affine { c: det, dx: 0.0, dy: 0.0 },
-                b1: from_a.dot(dir.cross(e2)),
-                b2: from_a.dot(e1.cross(dir)),
-                t: from_a.dot(e1.cross(e2)),
-            }
+            let (dir, from_a) = (rays.dir.v, AffineVec { v: rays.origin.v - g.a, ..rays.origin });
+            let (b1, b2, t) = (from_a.dot(dir.cross(e2)), from_a.dot(e1.cross(dir)), from_a.dot(e1.cross(e2)));
+            ScreenTriangle { det, b1, b2, t }
         } else {
-            let from_a = rays.origin - g.a;
+            let from_a = rays.origin.v - g.a;
             let q = from_a.cross(e1);
-            let dir = AffineVec { v: rays.forward + offset.v, ..offset };
-            let t = e2.dot(q);
-            ScreenTriangle {
-                det: dir.dot(e2.cross(e1)),
-                b1: dir.dot(e2.cross(from_a)),
-                b2: dir.dot(q),
-                t: Affine { c: t, dx: 0.0, dy: 0.0 },
-            }
+            let t = AffineVec::constant(e2).dot(q);
+            ScreenTriangle { det, b1: rays.dir.dot(e2.cross(from_a)), b2: rays.dir.dot(q), t }
         }
     }
 
-    /// The barycentric weights at pixel position `p` (`None` edge-on).
-    fn weights(&self, p: Vec2) -> Option<[f32; 3]> {
+    /// The reciprocal of the determinant and the barycentric weights at
+    /// pixel position `p` (`None` edge-on).
+    fn hit(&self, p: Vec2) -> Option<(f32, [f32; 3])> {
         let det = self.det.at(p);
         if det.abs() < f32::MIN_POSITIVE {
             return None;
         }
         let inv = 1.0 / det;
         let (b1, b2) = (self.b1.at(p) * inv, self.b2.at(p) * inv);
-        Some([1.0 - b1 - b2, b1, b2])
+        Some((inv, [1.0 - b1 - b2, b1, b2]))
+    }
+
+    /// The barycentric weights at pixel position `p` (`None` edge-on).
+    fn weights(&self, p: Vec2) -> Option<[f32; 3]> {
+        self.hit(p).map(|(_, w)| w)
     }
 
     /// `triangle`'s surface point at pixel position `p`.
-    fn surface(&self, triangle: &PreparedTriangle, rays: &PixelRays, p: Vec2) -> SurfacePoint {
-        let ray = rays.ray(p);
-        let det = self.det.at(p);
-        if det.abs() < f32::MIN_POSITIVE {
-            return triangle.surface(&ray);
+    fn surface(&self, triangle: &PreparedTriangle, rays: &ScreenRays, p: Vec2) -> SurfacePoint {
+        let (ray, length) = rays.ray(p);
+        match self.hit(p) {
+            // `t` is along the unnormalised direction.
+            Some((inv, w)) => triangle.surface_at(&ray, self.t.at(p) * inv * length, w),
+            None => triangle.surface(&ray),
         }
-        let inv = 1.0 / det;
-        let (b1, b2) = (self.b1.at(p) * inv, self.b2.at(p) * inv);
-        // Perspective: `t` is along the unnormalised direction.
-        let stretch = if rays.ortho { 1.0 } else { (rays.forward + AffineVec::offset(rays).at(p)).length() };
-        triangle.surface_at(&ray, self.t.at(p) * inv * stretch, [1.0 - b1 - b2, b1, b2])
     }
 }
 
@@ -435,12 +456,13 @@ mod tests {
         for projection in [Projection::Perspective { fov_y_deg: 50.0 }, Projection::Orthographic { height: 6.0 }] {
             scene.camera.projection = projection;
             let rays = scene.camera.pixel_rays(size);
+            let screen = ScreenRays::new(&rays);
             for (object, o) in scene.objects.iter().enumerate() {
                 let Some(mesh) = o.triangles() else { continue };
                 for triangle in (0..mesh.triangles.len()).step_by(97) {
                     let item = ItemId { object: object as u32, triangle: triangle as u32 };
                     let prepared = frames.prepare(&scene, item);
-                    let form = ScreenTriangle::new(&rays, &prepared.geometry());
+                    let form = ScreenTriangle::new(&screen, &prepared.geometry());
                     for k in 0..8u32 {
                         let p = Vec2::new((37 * k + triangle as u32) as f32 % size.x, (23 * k) as f32 % size.y);
                         let ray = rays.ray(p);
@@ -448,7 +470,7 @@ mod tests {
                         if prepared.geometry().geometric.dot(ray.dir).abs() < 0.2 {
                             continue;
                         }
-                        let (want, got) = (prepared.surface(&ray), form.surface(&prepared, &rays, p));
+                        let (want, got) = (prepared.surface(&ray), form.surface(&prepared, &screen, p));
                         let reach = (want.position - ray.origin).length().max(1.0);
                         assert!(
                             (got.position - want.position).length() < 1e-4 * reach,
